@@ -1,0 +1,247 @@
+/*
+ * radiosity.h -- the public contract of the radiosity engine.
+ *
+ * The engine solves the radiosity equation for diffuse (Lambertian) scenes,
+ *
+ *     B_i = E_i + rho_i * sum_j F_ij B_j            (constant elements)
+ *
+ * and turns the answer into images, per-surface figures and view factors.
+ * Everything a program may use is declared here; nothing else is API.
+ *
+ * Pipeline, as the API exposes it:
+ *
+ *     rad_context_create          threads, progress, cancellation, error text
+ *       rad_scene_load_file       OBJ+MTL, glTF 2.0 (assimp) or the built-in
+ *       rad_scene_create_cornell_box     Cornell box
+ *         rad_solution_create     mesh -> visibility -> form factors
+ *           rad_solution_solve    B per element, residual
+ *             rad_solution_render image of radiance L = B / pi
+ *             rad_solution_write_stats / rad_solution_write_view_factors
+ *
+ * Conventions (docs/units.md): lengths in metres, radiosity B and emission E
+ * in W/m^2 (exitance), radiance L = B / pi in W/(m^2 sr).  OBJ/MTL `Ke` and
+ * glTF emissive colour are read as emitted RADIANCE, so E = pi * Ke.
+ *
+ * Error handling: every fallible call returns a rad_result; on failure the
+ * out pointer is set to NULL, nothing leaks, and rad_context_error() returns
+ * one human-readable line (e.g. "box.obj:12: face has 2 vertices").
+ * Destroying NULL is a no-op.  Option structs are zero-initialisable: a zero
+ * field means "the documented default".
+ */
+#ifndef RADIOSITY_H
+#define RADIOSITY_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RAD_VERSION_MAJOR 0
+#define RAD_VERSION_MINOR 1
+#define RAD_VERSION_PATCH 0
+#define RAD_VERSION_STRING "0.1.0"
+
+typedef enum rad_result {
+    RAD_OK = 0,
+    RAD_ERROR_IO,               /* a file could not be read or written */
+    RAD_ERROR_PARSE,            /* a file is malformed */
+    RAD_ERROR_INVALID_SCENE,    /* NaN coordinates, reflectance >= 1, no emitter, ... */
+    RAD_ERROR_INVALID_ARGUMENT, /* an option out of range, an unknown method name */
+    RAD_ERROR_OUT_OF_MEMORY,    /* an allocation failed or would exceed the memory limit */
+    RAD_ERROR_INTERRUPTED,      /* the cancel flag was raised; results are partial */
+    RAD_ERROR_INTERNAL          /* a library (Embree, LAPACK) failed unexpectedly */
+} rad_result;
+
+/* A short name for a result code ("RAD_ERROR_IO"); never NULL. */
+const char *rad_result_string(rad_result result);
+
+/* ------------------------------------------------------------------------
+ * Context: threads, progress, cancellation and the last error message.
+ * ---------------------------------------------------------------------- */
+
+typedef struct rad_context rad_context;
+
+/* Progress of a long phase: `phase` is a short name ("form factors"),
+ * `done` of `total` units finished.  Called from the calling thread only. */
+typedef void (*rad_progress_fn)(void *user, const char *phase, uint64_t done, uint64_t total);
+
+typedef struct rad_context_options {
+    int threads;                 /* worker threads; 0 = all cores */
+    rad_progress_fn progress;    /* optional progress callback */
+    void *progress_user;         /* passed to `progress` */
+    /* Optional cancellation flag (set it from a signal handler); long phases
+     * poll it and return RAD_ERROR_INTERRUPTED with partial results. */
+    volatile int *cancel;
+} rad_context_options;
+
+rad_result rad_context_create(const rad_context_options *options, rad_context **out);
+void rad_context_destroy(rad_context *ctx);
+/* The message of the most recent failure in this context ("" if none). */
+const char *rad_context_error(const rad_context *ctx);
+int rad_context_threads(const rad_context *ctx);
+
+/* ------------------------------------------------------------------------
+ * Scene: named surfaces made of planar polygons with Lambertian materials.
+ * ---------------------------------------------------------------------- */
+
+typedef struct rad_scene rad_scene;
+
+/* Load OBJ(+MTL) or glTF 2.0 (.gltf/.glb) through assimp.  The scene is
+ * validated: finite coordinates, polygons of non-zero area, reflectance in
+ * [0, 1).  A scene without an emitter loads; solving it is an error. */
+rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out);
+
+/* Load from memory.  `name` is used in messages and to guess the format
+ * from its extension (".obj", ".gltf", ".glb").  `mtl`, if not NULL, is the
+ * text of the material library an OBJ names in `mtllib`. */
+rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void *data,
+                                 size_t size, const void *mtl, size_t mtl_size,
+                                 rad_scene **out);
+
+/* The measured Cornell box (Cornell University Program of Computer
+ * Graphics), in metres, with its published camera. */
+rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **out);
+
+void rad_scene_destroy(rad_scene *scene);
+
+size_t rad_scene_surface_count(const rad_scene *scene);
+const char *rad_scene_surface_name(const rad_scene *scene, size_t surface);
+double rad_scene_surface_area(const rad_scene *scene, size_t surface); /* m^2 */
+size_t rad_scene_polygon_count(const rad_scene *scene);
+
+/* A pinhole camera.  vfov_degrees is the full vertical field of view. */
+typedef struct rad_camera {
+    double position[3];
+    double look_at[3];
+    double up[3];
+    double vfov_degrees;
+} rad_camera;
+
+/* Parse "px,py,pz,lx,ly,lz[,ux,uy,uz[,vfov]]": position, look-at point,
+ * up vector (default 0,1,0) and vertical field of view (default 40). */
+rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera);
+
+/* The scene's own camera (from the file, or the Cornell box's published
+ * one).  Returns 0 and leaves *camera untouched when there is none. */
+int rad_scene_camera(const rad_scene *scene, rad_camera *camera);
+
+/* ------------------------------------------------------------------------
+ * Solution: mesh, form factors and radiosity for one scene.
+ * ---------------------------------------------------------------------- */
+
+typedef struct rad_solution rad_solution;
+
+typedef struct rad_options {
+    /* Meshing: elements no longer than mesh_size metres on a side; or, when
+     * mesh_size is 0, about target_elements elements in all (default 2000). */
+    double mesh_size;
+    size_t target_elements;
+    double crease_angle_degrees;  /* vertices of one surface are shared across
+                                     polygons meeting at less than this; 0 = 30 */
+
+    const char *form_factors;     /* method name; NULL = "analytic" */
+    int shadow_rays;              /* visibility rays per element pair; 0 = 4 (16 where partial) */
+    const char *visibility;       /* "embree" (default) or "brute" */
+
+    const char *solver;           /* NULL = "gauss-seidel" */
+    double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
+    int max_iterations;           /* sweeps (gathering) or shots per element (shooting); 0 = automatic */
+
+    uint64_t seed;                /* all sampling is seeded per element pair: results do
+                                     not depend on the thread count */
+    double max_memory_bytes;      /* refuse to allocate more; 0 = 80% of physical memory */
+} rad_options;
+
+/* Mesh the scene, build visibility and compute form factors.  The returned
+ * solution holds B = E (not yet solved). */
+rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene,
+                               const rad_options *options, rad_solution **out);
+
+/* Solve for B with the solver named in the options.  The scene must have
+ * an emitter.  Returns RAD_ERROR_INTERRUPTED with the current iterate kept
+ * (marked partial in the stats) if the cancel flag was raised. */
+rad_result rad_solution_solve(rad_context *ctx, rad_solution *solution);
+
+void rad_solution_destroy(rad_solution *solution);
+
+size_t rad_solution_element_count(const rad_solution *solution);
+/* Residual measure after solving: sum_i A_i |r_i| / sum_i A_i E_i summed over
+ * the channels, with r = B - E - rho F B (the notes' residual). */
+double rad_solution_residual(const rad_solution *solution);
+int rad_solution_iterations(const rad_solution *solution);
+
+/* Area-weighted mean radiosity of a surface, RGB, W/m^2. */
+void rad_solution_surface_radiosity(const rad_solution *solution, size_t surface,
+                                    double rgb[3]);
+
+/* Surface-to-surface view factors: F[i * S + j] for S surfaces, the
+ * area-weighted sum over their elements.  `F` holds S*S doubles. */
+void rad_solution_surface_view_factors(const rad_solution *solution, double *F);
+
+/* Power in watts (summed over RGB / 3): emitted, absorbed by surfaces. */
+void rad_solution_power(const rad_solution *solution, double *emitted, double *absorbed);
+
+/* ------------------------------------------------------------------------
+ * Output
+ * ---------------------------------------------------------------------- */
+
+typedef enum rad_shading { RAD_SHADING_SMOOTH = 0, RAD_SHADING_FLAT = 1 } rad_shading;
+
+typedef struct rad_render_options {
+    int width, height;            /* pixels; 0 = 512 x 512 */
+    int samples;                  /* anti-aliasing samples per pixel (square); 0 = 4 */
+    const rad_camera *camera;     /* NULL = the scene's, else framed automatically */
+    rad_shading shading;
+    double exposure;              /* multiplier on radiance; 0 = automatic */
+} rad_render_options;
+
+/* A linear-radiance RGB image, W/(m^2 sr). */
+typedef struct rad_image rad_image;
+
+rad_result rad_solution_render(rad_context *ctx, rad_solution *solution,
+                               const rad_render_options *options, rad_image **out);
+void rad_image_destroy(rad_image *image);
+int rad_image_width(const rad_image *image);
+int rad_image_height(const rad_image *image);
+const float *rad_image_pixels(const rad_image *image); /* RGB, row 0 at the top */
+
+/* Write by extension: .png (exposed, sRGB, 8 bit), .hdr (Radiance RGBE) or
+ * .pfm (32-bit float).  The file is written to a temporary name and renamed,
+ * so a failure never leaves a partial file. */
+rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
+/* As rad_image_write, with the PNG exposure given (0 = automatic; ignored
+ * by the linear formats). */
+rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, const char *path,
+                                   double exposure);
+
+/* Stats as JSON (schema in docs/stats.md).  `partial` marks an interrupted run. */
+rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *solution,
+                                    const char *path, int partial);
+
+/* Surface-level view factors: .json (surfaces with name, area, row_sum; F)
+ * or .csv.  Atomic like the image writer. */
+rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *solution,
+                                           const char *path);
+
+/* ------------------------------------------------------------------------
+ * Method registries
+ * ---------------------------------------------------------------------- */
+
+typedef enum rad_method_kind {
+    RAD_METHOD_FORM_FACTOR = 0,
+    RAD_METHOD_SOLVER = 1,
+    RAD_METHOD_VISIBILITY = 2
+} rad_method_kind;
+
+/* Enumerate methods: returns 0 past the end.  *name and *description are
+ * static strings. */
+int rad_method_info(rad_method_kind kind, size_t index, const char **name,
+                    const char **description);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RADIOSITY_H */

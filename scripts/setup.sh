@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Install what is missing (Debian 12 packages), then configure and build
+# into build/.  Safe to run again: it installs nothing that is there and
+# rebuilds only what changed.
+#
+#   RADIOSITY_BUILD_DIR   build folder (default: build)
+#   RADIOSITY_CMAKE_ARGS  extra arguments for cmake's configure step
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(build-essential cmake pkg-config libembree-dev libassimp-dev libstb-dev
+          libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -qq
+  $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+build="${RADIOSITY_BUILD_DIR:-build}"
+# shellcheck disable=SC2086
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release ${RADIOSITY_CMAKE_ARGS:-} >/dev/null
+cmake --build "$build" -j "$(nproc)" 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make|Consolidate compiler' || true
+test -x "$build/radiosity" || { echo "setup: build failed" >&2; exit 1; }
+echo "setup: built $build/radiosity"

@@ -1,0 +1,324 @@
+/*
+ * api.c -- the public solution object: runs the pipeline stages in order
+ * and answers the per-surface questions.
+ *
+ *     scene --mesh--> elements --vis--> rays --formfactor--> F --solve--> B
+ */
+#include "api/solution.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Registry names are short; the copy keeps the options independent of the
+ * caller's strings. */
+static void copy_name(char *dst, size_t size, const char *name)
+{
+    snprintf(dst, size, "%s", name);
+}
+
+/* "a, b, c" listing of a registry, for error messages. */
+static void list_methods(rad_method_kind kind, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    const char *name, *desc;
+    for (size_t i = 0; rad_method_info(kind, i, &name, &desc); i++) {
+        if (i)
+            strncat(buf, ", ", size - strlen(buf) - 1);
+        strncat(buf, name, size - strlen(buf) - 1);
+    }
+}
+
+static rad_result resolve_options(rad_context *ctx, const rad_options *in, rad_solution *s)
+{
+    rad_options o = in ? *in : (rad_options){0};
+    char known[256];
+    if (!o.form_factors)
+        o.form_factors = "analytic";
+    if (!o.solver)
+        o.solver = "gauss-seidel";
+    if (!o.visibility)
+        o.visibility = "embree";
+    if (!rad_ff_find(o.form_factors)) {
+        list_methods(RAD_METHOD_FORM_FACTOR, known, sizeof known);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "unknown form-factor method '%s' (known: %s)",
+                        o.form_factors, known);
+    }
+    if (!rad_solver_find(o.solver)) {
+        list_methods(RAD_METHOD_SOLVER, known, sizeof known);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "unknown solver '%s' (known: %s)", o.solver,
+                        known);
+    }
+    if (!rad_vis_find(o.visibility)) {
+        list_methods(RAD_METHOD_VISIBILITY, known, sizeof known);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "unknown visibility backend '%s' (known: %s)", o.visibility, known);
+    }
+    if (o.tolerance == 0.0)
+        o.tolerance = 1e-6;
+    if (!(o.tolerance > 0.0 && o.tolerance < 1.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "tolerance must be in (0, 1), got %g",
+                        o.tolerance);
+    if (o.max_iterations < 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "max iterations must be >= 0");
+    if (o.shadow_rays < 0 || o.shadow_rays > 48)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "shadow rays must be in [1, 48], got %d",
+                        o.shadow_rays);
+    if (o.shadow_rays == 0)
+        o.shadow_rays = 4;
+    if (o.max_memory_bytes == 0.0)
+        o.max_memory_bytes = 0.8 * (double)rad_physical_memory_bytes();
+    if (!(o.max_memory_bytes > 0.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "max memory must be positive");
+    copy_name(s->form_factor_name, sizeof s->form_factor_name, o.form_factors);
+    copy_name(s->solver_name, sizeof s->solver_name, o.solver);
+    copy_name(s->visibility_name, sizeof s->visibility_name, o.visibility);
+    o.form_factors = s->form_factor_name;
+    o.solver = s->solver_name;
+    o.visibility = s->visibility_name;
+    s->options = o;
+    return RAD_OK;
+}
+
+rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const rad_options *options,
+                               rad_solution **out)
+{
+    *out = NULL;
+    if (!ctx || !scene)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_solution_create: NULL argument");
+    rad_solution *s = calloc(1, sizeof *s);
+    if (!s)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
+    s->scene = scene;
+    s->seconds.load = scene->load_seconds;
+    rad_result r = resolve_options(ctx, options, s);
+    if (r != RAD_OK) {
+        free(s);
+        return r;
+    }
+
+    /* 1. mesh: surfaces -> elements */
+    double t = rad_seconds();
+    rad_mesh_options mo = {s->options.mesh_size, s->options.target_elements,
+                           s->options.crease_angle_degrees};
+    r = rad_mesh_build(ctx, scene, &mo, &s->mesh);
+    s->seconds.mesh = rad_seconds() - t;
+    if (r != RAD_OK)
+        goto fail;
+    size_t n = s->mesh->element_count;
+
+    /* 2. visibility: acceleration structure over the patches */
+    r = rad_vis_create(ctx, s->options.visibility, s->mesh, &s->vis);
+    if (r != RAD_OK)
+        goto fail;
+    s->seconds.visibility = s->vis->build_seconds;
+
+    /* 3. per-element materials */
+    s->area = rad_alloc_array(ctx, n, sizeof *s->area, "solution: areas");
+    s->reflectance = rad_alloc_array(ctx, 3 * n, sizeof *s->reflectance, "solution: reflectance");
+    s->emission = rad_alloc_array(ctx, 3 * n, sizeof *s->emission, "solution: emission");
+    s->radiosity = rad_alloc_array(ctx, 3 * n, sizeof *s->radiosity, "solution: radiosity");
+    if (!s->area || !s->reflectance || !s->emission || !s->radiosity) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto fail;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const rad_element *e = &s->mesh->elements[i];
+        const rad_material *m = &scene->materials[e->material];
+        s->area[i] = e->area;
+        for (int c = 0; c < 3; c++) {
+            s->reflectance[3 * i + c] = m->reflectance[c];
+            s->emission[3 * i + c] = m->emission[c];
+            s->radiosity[3 * i + c] = m->emission[c];
+        }
+    }
+
+    /* 4. form factors */
+    rad_ff_request req = {s->mesh, s->vis, s->options.seed, s->options.shadow_rays};
+    r = rad_form_factors(ctx, rad_ff_find(s->options.form_factors), &req, s->options.max_memory_bytes,
+                         &s->F, &s->ff_stats);
+    s->seconds.form_factors = s->ff_stats.seconds;
+    if (r != RAD_OK)
+        goto fail;
+    *out = s;
+    return RAD_OK;
+fail:
+    rad_solution_destroy(s);
+    return r;
+}
+
+rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
+{
+    if (!rad_scene_has_emitter(s->scene))
+        return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
+                        "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
+                        s->scene->source);
+    rad_system sys = {s->mesh->element_count, s->F, s->area, s->reflectance, s->emission};
+    rad_solve_params p = {s->options.tolerance, s->options.max_iterations};
+    const rad_solver *solver = rad_solver_find(s->options.solver);
+    memcpy(s->radiosity, s->emission, 3 * sys.n * sizeof *s->radiosity);
+    memset(&s->solve_stats, 0, sizeof s->solve_stats);
+    s->solve_stats.method = solver->name;
+    double t = rad_seconds();
+    rad_result r = solver->solve(ctx, &sys, &p, s->radiosity, &s->solve_stats);
+    s->solve_stats.seconds = rad_seconds() - t;
+    s->seconds.solve = s->solve_stats.seconds;
+    s->solved = r == RAD_OK;
+    free(s->vertex_radiosity);
+    s->vertex_radiosity = NULL;
+    return r;
+}
+
+void rad_solution_destroy(rad_solution *s)
+{
+    if (!s)
+        return;
+    rad_vis_destroy(s->vis);
+    rad_mesh_destroy(s->mesh);
+    free(s->F);
+    free(s->area);
+    free(s->reflectance);
+    free(s->emission);
+    free(s->radiosity);
+    free(s->vertex_radiosity);
+    free(s);
+}
+
+size_t rad_solution_element_count(const rad_solution *s) { return s->mesh->element_count; }
+double rad_solution_residual(const rad_solution *s) { return s->solve_stats.residual; }
+int rad_solution_iterations(const rad_solution *s) { return s->solve_stats.iterations; }
+
+void rad_solution_surface_radiosity(const rad_solution *s, size_t surface, double rgb[3])
+{
+    double sum[3] = {0, 0, 0}, area = 0.0;
+    for (size_t i = 0; i < s->mesh->element_count; i++) {
+        if (s->mesh->elements[i].surface != surface)
+            continue;
+        area += s->area[i];
+        for (int c = 0; c < 3; c++)
+            sum[c] += s->area[i] * s->radiosity[3 * i + c];
+    }
+    for (int c = 0; c < 3; c++)
+        rgb[c] = area > 0.0 ? sum[c] / area : 0.0;
+}
+
+void rad_solution_surface_view_factors(const rad_solution *s, double *F)
+{
+    size_t S = s->scene->surface_count, n = s->mesh->element_count;
+    double *area = calloc(S ? S : 1, sizeof *area);
+    memset(F, 0, S * S * sizeof *F);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t si = s->mesh->elements[i].surface;
+        if (area)
+            area[si] += s->area[i];
+        const float *Fi = s->F + i * n;
+        double *row = F + (size_t)si * S;
+        for (size_t j = 0; j < n; j++)
+            row[s->mesh->elements[j].surface] += s->area[i] * Fi[j];
+    }
+    for (size_t a = 0; a < S; a++)
+        for (size_t b = 0; b < S; b++)
+            F[a * S + b] = area && area[a] > 0.0 ? F[a * S + b] / area[a] : 0.0;
+    free(area);
+}
+
+void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed)
+{
+    size_t n = s->mesh->element_count;
+    double em = 0.0, ab = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : em, ab)
+    for (size_t i = 0; i < n; i++) {
+        const float *Fi = s->F + i * n;
+        double h[3] = {0, 0, 0};
+        for (size_t j = 0; j < n; j++)
+            for (int c = 0; c < 3; c++)
+                h[c] += Fi[j] * s->radiosity[3 * j + c];
+        for (int c = 0; c < 3; c++) {
+            em += s->area[i] * s->emission[3 * i + c];
+            ab += s->area[i] * (1.0 - s->reflectance[3 * i + c]) * h[c];
+        }
+    }
+    *emitted = em / 3.0;
+    *absorbed = ab / 3.0;
+}
+
+rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_render_options *options,
+                               rad_image **out)
+{
+    *out = NULL;
+    rad_render_options o = options ? *options : (rad_render_options){0};
+    size_t n = s->mesh->element_count;
+    /* Display values: a partial shooting solution gets the ambient term. */
+    double *display = rad_alloc_array(ctx, 3 * n, sizeof *display, "render: element values");
+    if (!display)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++)
+            display[3 * i + c] = s->radiosity[3 * i + c] +
+                                 s->reflectance[3 * i + c] * s->solve_stats.ambient[c];
+    free(s->vertex_radiosity);
+    s->vertex_radiosity = rad_alloc_array(ctx, 3 * s->mesh->vertex_count, sizeof *s->vertex_radiosity,
+                                          "render: vertex values");
+    if (!s->vertex_radiosity) {
+        free(display);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    double t = rad_seconds();
+    rad_result r = rad_vertex_values(ctx, s->mesh, display, s->vertex_radiosity);
+    if (r != RAD_OK) {
+        free(display);
+        return r;
+    }
+    rad_render_input in;
+    in.mesh = s->mesh;
+    in.vis = s->vis;
+    in.element_radiosity = display;
+    in.vertex_radiosity = s->vertex_radiosity;
+    int w = o.width > 0 ? o.width : 512, h = o.height > 0 ? o.height : 512;
+    if (o.camera)
+        in.camera = *o.camera;
+    else if (!rad_scene_camera(s->scene, &in.camera))
+        in.camera = rad_camera_frame(s->scene->bounds_min, s->scene->bounds_max, (double)w / h);
+    r = rad_render_image(ctx, &in, &o, out);
+    s->seconds.render = rad_seconds() - t;
+    int spp = o.samples > 0 ? o.samples : 4;
+    s->render_rays = (uint64_t)w * (uint64_t)h * (uint64_t)spp * (uint64_t)spp;
+    free(display);
+    return r;
+}
+
+rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera)
+{
+    return rad_camera_parse(ctx, text, camera);
+}
+
+int rad_method_info(rad_method_kind kind, size_t index, const char **name, const char **description)
+{
+    size_t count = 0;
+    switch (kind) {
+    case RAD_METHOD_FORM_FACTOR:
+        while (rad_ff_methods[count])
+            count++;
+        if (index >= count)
+            return 0;
+        *name = rad_ff_methods[index]->name;
+        *description = rad_ff_methods[index]->description;
+        return 1;
+    case RAD_METHOD_SOLVER:
+        while (rad_solvers[count])
+            count++;
+        if (index >= count)
+            return 0;
+        *name = rad_solvers[index]->name;
+        *description = rad_solvers[index]->description;
+        return 1;
+    case RAD_METHOD_VISIBILITY:
+        while (rad_vis_backends[count])
+            count++;
+        if (index >= count)
+            return 0;
+        *name = rad_vis_backends[index]->name;
+        *description = rad_vis_backends[index]->description;
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,36 @@
+/*
+ * solution.h -- the solution object behind the public rad_solution handle:
+ * everything one run owns, and the seconds and bytes each phase took.
+ */
+#ifndef RAD_SOLUTION_H
+#define RAD_SOLUTION_H
+
+#include "formfactor/formfactor.h"
+#include "output/output.h"
+#include "solve/solve.h"
+
+struct rad_solution {
+    const rad_scene *scene;    /* borrowed: must outlive the solution */
+    rad_options options;       /* resolved defaults */
+    char form_factor_name[32];
+    char solver_name[32];
+    char visibility_name[32];
+    rad_mesh *mesh;
+    rad_vis *vis;
+    float *F;                  /* n x n */
+    double *area;              /* n */
+    double *reflectance;       /* 3n */
+    double *emission;          /* 3n */
+    double *radiosity;         /* 3n, W/m^2 */
+    double *vertex_radiosity;  /* 3 per mesh vertex, computed on demand */
+    rad_ff_stats ff_stats;
+    rad_solve_stats solve_stats;
+    bool solved;
+    struct {
+        double load, mesh, visibility, form_factors, solve, render;
+    } seconds;
+    double render_seconds_total;
+    uint64_t render_rays;
+};
+
+#endif /* RAD_SOLUTION_H */

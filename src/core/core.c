@@ -1,0 +1,208 @@
+/*
+ * core.c -- context, errors, progress, clocks, memory figures, checked
+ * allocation and atomic file output.
+ */
+#include "core/core.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <time.h>
+#include <unistd.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+const char *rad_result_string(rad_result result)
+{
+    switch (result) {
+    case RAD_OK: return "RAD_OK";
+    case RAD_ERROR_IO: return "RAD_ERROR_IO";
+    case RAD_ERROR_PARSE: return "RAD_ERROR_PARSE";
+    case RAD_ERROR_INVALID_SCENE: return "RAD_ERROR_INVALID_SCENE";
+    case RAD_ERROR_INVALID_ARGUMENT: return "RAD_ERROR_INVALID_ARGUMENT";
+    case RAD_ERROR_OUT_OF_MEMORY: return "RAD_ERROR_OUT_OF_MEMORY";
+    case RAD_ERROR_INTERRUPTED: return "RAD_ERROR_INTERRUPTED";
+    case RAD_ERROR_INTERNAL: return "RAD_ERROR_INTERNAL";
+    }
+    return "RAD_ERROR_UNKNOWN";
+}
+
+rad_result rad_context_create(const rad_context_options *options, rad_context **out)
+{
+    *out = NULL;
+    rad_context *ctx = calloc(1, sizeof *ctx);
+    if (!ctx)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_context_options defaults = {0};
+    if (!options)
+        options = &defaults;
+    if (options->threads < 0) {
+        free(ctx);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    ctx->threads = options->threads;
+    if (ctx->threads == 0) {
+#ifdef _OPENMP
+        ctx->threads = omp_get_num_procs();
+#else
+        ctx->threads = 1;
+#endif
+    }
+    ctx->progress = options->progress;
+    ctx->progress_user = options->progress_user;
+    ctx->cancel = options->cancel;
+    *out = ctx;
+    return RAD_OK;
+}
+
+void rad_context_destroy(rad_context *ctx) { free(ctx); }
+
+const char *rad_context_error(const rad_context *ctx) { return ctx ? ctx->error : ""; }
+
+int rad_context_threads(const rad_context *ctx) { return ctx ? ctx->threads : 1; }
+
+rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
+{
+    if (!ctx)
+        return result;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(ctx->error, sizeof ctx->error, fmt, ap);
+    va_end(ap);
+    /* One line: a message never carries a newline into the terminal. */
+    for (char *c = ctx->error; *c; c++)
+        if (*c == '\n' || *c == '\r')
+            *c = ' ';
+    ctx->last_result = result;
+    return result;
+}
+
+void rad_progress(rad_context *ctx, const char *phase, uint64_t done, uint64_t total)
+{
+    if (ctx && ctx->progress)
+        ctx->progress(ctx->progress_user, phase, done, total);
+}
+
+double rad_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+size_t rad_peak_memory_bytes(void)
+{
+    struct rusage ru;
+    if (getrusage(RUSAGE_SELF, &ru) != 0)
+        return 0;
+    return (size_t)ru.ru_maxrss * 1024u; /* Linux reports kilobytes */
+}
+
+size_t rad_physical_memory_bytes(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages <= 0 || page <= 0)
+        return (size_t)1 << 32;
+    return (size_t)pages * (size_t)page;
+}
+
+void *rad_alloc_array(rad_context *ctx, size_t count, size_t size, const char *what)
+{
+    if (size != 0 && count > SIZE_MAX / size) {
+        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: %zu x %zu bytes overflows the address space",
+                 what, count, size);
+        return NULL;
+    }
+    size_t bytes = count * size;
+    void *p = calloc(1, bytes ? bytes : 1);
+    if (!p)
+        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory allocating %.1f MiB", what,
+                 (double)bytes / 1048576.0);
+    return p;
+}
+
+char *rad_strdup(const char *s)
+{
+    if (!s)
+        return NULL;
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d)
+        memcpy(d, s, n);
+    return d;
+}
+
+void rad_path_extension(const char *path, char *ext, size_t ext_size)
+{
+    if (ext_size == 0)
+        return;
+    ext[0] = '\0';
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        return;
+    size_t i = 0;
+    for (dot++; *dot && i + 1 < ext_size; dot++)
+        ext[i++] = (char)tolower((unsigned char)*dot);
+    ext[i] = '\0';
+}
+
+rad_result rad_atomic_open(rad_context *ctx, const char *path, rad_atomic_file *out)
+{
+    memset(out, 0, sizeof *out);
+    size_t n = strlen(path) + 32;
+    out->final_path = rad_strdup(path);
+    out->temp_path = malloc(n);
+    if (!out->final_path || !out->temp_path) {
+        rad_atomic_abort(out);
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    snprintf(out->temp_path, n, "%s.tmp.%ld", path, (long)getpid());
+    out->file = fopen(out->temp_path, "wb");
+    if (!out->file) {
+        int err = errno;
+        rad_atomic_abort(out);
+        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot write: %s", path, strerror(err));
+    }
+    return RAD_OK;
+}
+
+rad_result rad_atomic_commit(rad_context *ctx, rad_atomic_file *f)
+{
+    int failed = ferror(f->file);
+    int err = errno;
+    if (fclose(f->file) != 0 && !failed) {
+        failed = 1;
+        err = errno;
+    }
+    f->file = NULL;
+    if (!failed && rename(f->temp_path, f->final_path) != 0) {
+        failed = 1;
+        err = errno;
+    }
+    if (failed) {
+        rad_result r = rad_fail(ctx, RAD_ERROR_IO, "%s: write failed: %s", f->final_path,
+                                strerror(err));
+        rad_atomic_abort(f);
+        return r;
+    }
+    free(f->final_path);
+    free(f->temp_path);
+    f->final_path = f->temp_path = NULL;
+    return RAD_OK;
+}
+
+void rad_atomic_abort(rad_atomic_file *f)
+{
+    if (f->file)
+        fclose(f->file);
+    if (f->temp_path)
+        remove(f->temp_path);
+    free(f->final_path);
+    free(f->temp_path);
+    memset(f, 0, sizeof *f);
+}

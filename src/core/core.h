@@ -1,0 +1,141 @@
+/*
+ * core.h -- what every module shares: 3-vectors, the context (threads,
+ * progress, cancellation, first error), timers, seeded random numbers and
+ * atomic file output.  Upstream of everything; includes nothing of ours but
+ * the public header.
+ */
+#ifndef RAD_CORE_H
+#define RAD_CORE_H
+
+#include "radiosity.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* ---- 3-vectors (double: geometry is done in double, rays in float) ---- */
+
+typedef struct vec3 {
+    double x, y, z;
+} vec3;
+
+static inline vec3 v3(double x, double y, double z) { vec3 r = {x, y, z}; return r; }
+static inline vec3 v3_add(vec3 a, vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline vec3 v3_sub(vec3 a, vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline vec3 v3_scale(vec3 a, double s) { return v3(a.x * s, a.y * s, a.z * s); }
+static inline vec3 v3_mad(vec3 a, vec3 b, double s) { return v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s); }
+static inline double v3_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline vec3 v3_cross(vec3 a, vec3 b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline double v3_length(vec3 a) { return sqrt(v3_dot(a, a)); }
+static inline vec3 v3_normalize(vec3 a)
+{
+    double l = v3_length(a);
+    return l > 0.0 ? v3_scale(a, 1.0 / l) : a;
+}
+static inline vec3 v3_lerp(vec3 a, vec3 b, double t) { return v3_mad(a, v3_sub(b, a), t); }
+static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)); }
+static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
+static inline bool v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+/* ---- context ---- */
+
+struct rad_context {
+    int threads;                /* OpenMP and Embree threads */
+    rad_progress_fn progress;
+    void *progress_user;
+    volatile int *cancel;
+    rad_result last_result;
+    char error[1024];           /* first line of the most recent failure */
+};
+
+/* Record a failure and return `result`, so callers can write
+ * `return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open", path);`.
+ * ctx may be NULL (then the message is dropped). */
+rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* True once the user asked to stop (cancel flag raised). */
+static inline bool rad_cancelled(const rad_context *ctx)
+{
+    return ctx && ctx->cancel && *ctx->cancel;
+}
+
+/* Report progress (calling thread only); cheap when no callback is set. */
+void rad_progress(rad_context *ctx, const char *phase, uint64_t done, uint64_t total);
+
+/* ---- time and memory ---- */
+
+double rad_seconds(void);              /* monotonic wall clock, seconds */
+size_t rad_peak_memory_bytes(void);    /* peak resident set of the process */
+size_t rad_physical_memory_bytes(void);
+
+/* Checked allocation of count * size bytes: fails (returns NULL and sets the
+ * context error naming `what`) on overflow or exhaustion. */
+void *rad_alloc_array(rad_context *ctx, size_t count, size_t size, const char *what);
+
+/* ---- random numbers: counter-based, so a sample depends only on its key ---- */
+
+/* SplitMix64 finaliser: a good 64-bit mix (Steele, Lea, Flood 2014). */
+static inline uint64_t rad_mix64(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+typedef struct rad_rng {
+    uint64_t state;
+} rad_rng;
+
+/* A stream keyed by (seed, a, b): the same key gives the same numbers
+ * whatever thread draws them. */
+static inline rad_rng rad_rng_keyed(uint64_t seed, uint64_t a, uint64_t b)
+{
+    rad_rng r = {rad_mix64(seed ^ rad_mix64(a ^ rad_mix64(b + 0x632be59bd9b4e019ULL)))};
+    return r;
+}
+
+/* Uniform in [0, 1). */
+static inline double rad_rng_uniform(rad_rng *r)
+{
+    r->state += 0x9e3779b97f4a7c15ULL;
+    uint64_t z = r->state;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* ---- atomic output: write to "path.tmp.<pid>", then rename ---- */
+
+typedef struct rad_atomic_file {
+    FILE *file;
+    char *final_path;
+    char *temp_path;
+} rad_atomic_file;
+
+rad_result rad_atomic_open(rad_context *ctx, const char *path, rad_atomic_file *out);
+/* Flush, close and rename; on any error removes the temporary file. */
+rad_result rad_atomic_commit(rad_context *ctx, rad_atomic_file *file);
+/* Remove the temporary file (after a failed write). */
+void rad_atomic_abort(rad_atomic_file *file);
+
+/* Lower-case extension of a path without the dot ("" if none), in `ext`. */
+void rad_path_extension(const char *path, char *ext, size_t ext_size);
+
+char *rad_strdup(const char *s);
+
+#endif /* RAD_CORE_H */

@@ -1,0 +1,89 @@
+/*
+ * formfactor.c -- the registry of form-factor methods, and what every
+ * method gets for free: the memory check before the dense matrix is
+ * allocated, timing, and the diagnostics (row sums, reciprocity, F_ii).
+ */
+#include "formfactor/formfactor.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+extern const rad_ff_method rad_ff_analytic;
+
+const rad_ff_method *const rad_ff_methods[] = {
+    &rad_ff_analytic,
+    NULL,
+};
+
+const rad_ff_method *rad_ff_find(const char *name)
+{
+    for (size_t i = 0; rad_ff_methods[i]; i++)
+        if (strcmp(rad_ff_methods[i]->name, name) == 0)
+            return rad_ff_methods[i];
+    return NULL;
+}
+
+/* Row sums, the worst reciprocity error and the largest F_ii.  Pairs whose
+ * larger power coupling is below 1e-9 of the larger area are ignored: there
+ * single-precision rounding of F dominates the relative error. */
+static void diagnostics(const rad_mesh *mesh, const float *F, rad_ff_stats *s)
+{
+    size_t n = mesh->element_count;
+    double rmin = INFINITY, rmax = -INFINITY, rsum = 0.0, recip = 0.0, diag = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double row = 0.0;
+        const float *Fi = F + i * n;
+        for (size_t j = 0; j < n; j++)
+            row += Fi[j];
+        rmin = fmin(rmin, row);
+        rmax = fmax(rmax, row);
+        rsum += row;
+        diag = fmax(diag, Fi[i]);
+    }
+    /* Reciprocity over the upper triangle, in tiles to keep F[j][i] cached. */
+    const size_t tile = 64;
+    for (size_t i0 = 0; i0 < n; i0 += tile)
+        for (size_t j0 = i0; j0 < n; j0 += tile)
+            for (size_t i = i0; i < i0 + tile && i < n; i++)
+                for (size_t j = j0 > i + 1 ? j0 : i + 1; j < j0 + tile && j < n; j++) {
+                    double ai = mesh->elements[i].area, aj = mesh->elements[j].area;
+                    double gij = ai * F[i * n + j], gji = aj * F[j * n + i];
+                    double big = fmax(gij, gji);
+                    if (big > 1e-9 * fmax(ai, aj))
+                        recip = fmax(recip, fabs(gij - gji) / big);
+                }
+    s->row_sum_min = n ? rmin : 0.0;
+    s->row_sum_max = n ? rmax : 0.0;
+    s->row_sum_mean = n ? rsum / (double)n : 0.0;
+    s->reciprocity_max = recip;
+    s->diagonal_max = diag;
+}
+
+rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
+                            double max_memory, float **F_out, rad_ff_stats *stats)
+{
+    *F_out = NULL;
+    memset(stats, 0, sizeof *stats);
+    stats->method = method->name;
+    size_t n = req->mesh->element_count;
+    double bytes = (double)n * (double)n * sizeof(float);
+    if (bytes > max_memory)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "form factors: the dense matrix for %zu elements needs %.2f GiB, above "
+                        "the memory limit of %.2f GiB (--max-memory); use fewer elements "
+                        "(--elements or a larger --mesh-size)",
+                        n, bytes / 1073741824.0, max_memory / 1073741824.0);
+    float *F = rad_alloc_array(ctx, n * n, sizeof *F, "form factors: dense matrix");
+    if (!F)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    double t0 = rad_seconds();
+    rad_result r = method->compute(ctx, req, F, stats);
+    stats->seconds = rad_seconds() - t0;
+    if (r != RAD_OK && r != RAD_ERROR_INTERRUPTED) {
+        free(F);
+        return r;
+    }
+    diagnostics(req->mesh, F, stats);
+    *F_out = F;
+    return r;
+}

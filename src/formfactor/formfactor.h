@@ -1,0 +1,59 @@
+/*
+ * formfactor.h -- element-to-element form factors behind one small table.
+ *
+ *     F_ij = 1/A_i  int_{A_i} int_{A_j} cos(theta_i) cos(theta_j) V / (pi r^2) dA_j dA_i
+ *
+ * the fraction of the power leaving element i that arrives directly at
+ * element j.  A method fills the dense n x n matrix (row i = factors FROM i)
+ * and counts its rays; the registry wrapper (formfactor.c) checks memory
+ * first and computes the diagnostics every method reports: row sums,
+ * reciprocity error and F_ii.
+ */
+#ifndef RAD_FORMFACTOR_H
+#define RAD_FORMFACTOR_H
+
+#include "vis/vis.h"
+
+typedef struct rad_ff_request {
+    const rad_mesh *mesh;
+    const rad_vis *vis;
+    uint64_t seed;
+    int shadow_rays;          /* rays per pair for the visibility fraction */
+} rad_ff_request;
+
+typedef struct rad_ff_stats {
+    const char *method;
+    double seconds;
+    uint64_t rays;            /* shadow / visibility rays cast */
+    uint64_t pairs;           /* element pairs evaluated (not culled) */
+    double row_sum_min, row_sum_max, row_sum_mean;
+    double reciprocity_max;   /* max |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) */
+    double diagonal_max;      /* max F_ii */
+} rad_ff_stats;
+
+typedef struct rad_ff_method {
+    const char *name;
+    const char *description; /* one line: idea, cost, accuracy */
+    /* Fill F (n*n floats, zeroed by the caller). */
+    rad_result (*compute)(rad_context *ctx, const rad_ff_request *req, float *F,
+                          rad_ff_stats *stats);
+} rad_ff_method;
+
+extern const rad_ff_method *const rad_ff_methods[]; /* NULL-terminated */
+const rad_ff_method *rad_ff_find(const char *name);
+
+/* Allocate F (checking `max_memory`), run the method, fill the diagnostics. */
+rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
+                            const rad_ff_request *req, double max_memory,
+                            float **F_out, rad_ff_stats *stats);
+
+/* ---- shared kernels (polygon.c) ---- */
+
+/* Unoccluded point-to-polygon form factor F_{dA -> polygon} (Lambert's
+ * contour formula, Baum, Rushmeier & Winget 1989): the polygon is first
+ * clipped to the half-space in front of the point's tangent plane.  The
+ * polygon's own orientation is honoured: a polygon seen from its back gives
+ * 0.  n <= 8 vertices. */
+double rad_point_polygon_ff(vec3 point, vec3 normal, const vec3 *poly, size_t n);
+
+#endif /* RAD_FORMFACTOR_H */

@@ -1,0 +1,28 @@
+/*
+ * interp.h -- element radiosities to vertex radiosities, for smooth
+ * (Gouraud / bilinear) shading.
+ *
+ * Interior vertex: area-weighted mean of the elements around it.
+ * Boundary vertex (on an edge used by one element only): linear
+ * extrapolation through the element centre, B_v = 2 * mean(elements) -
+ * mean(interior neighbour vertices), the construction of the lecture notes
+ * ("Computing Vertex Colors", after Cohen & Wallace 1993, sec. 9.2), clamped
+ * to >= 0.  T-vertices (mesh.h) are then set to the interpolation of their
+ * edge, so shading is continuous across patches with different grids.
+ */
+#ifndef RAD_INTERP_H
+#define RAD_INTERP_H
+
+#include "mesh/mesh.h"
+
+/* element_value: 3 doubles per element; vertex_value: 3 doubles per mesh
+ * vertex (written).  Returns RAD_ERROR_OUT_OF_MEMORY on allocation failure. */
+rad_result rad_vertex_values(rad_context *ctx, const rad_mesh *mesh,
+                             const double *element_value, double *vertex_value);
+
+/* The smooth value at local element coordinates (s, t) (as returned by
+ * rad_patch_locate): bilinear on quads, barycentric on triangles. */
+void rad_element_interpolate(const rad_mesh *mesh, const rad_element *e,
+                             const double *vertex_value, double s, double t, double rgb[3]);
+
+#endif /* RAD_INTERP_H */

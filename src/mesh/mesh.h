@@ -1,0 +1,100 @@
+/*
+ * mesh.h -- surfaces split into elements.
+ *
+ * Each scene polygon becomes one or more PATCHES (a planar convex quad or a
+ * triangle; other polygons are triangulated).  Each patch is meshed as a
+ * structured grid, so an element is found from a point's patch parameters
+ * in O(1) (this is how the renderer maps a ray hit to an element):
+ *
+ *    quad patch, nu x nv cells           triangle patch, k^2 cells (k = 3)
+ *    c3 +----+----+----+ c2              c2
+ *       |  3 |  4 |  5 |  t                |\
+ *       +----+----+----+  ^                |8\
+ *       |  0 |  1 |  2 |  |                |--\
+ *    c0 +----+----+----+ c1 -> s           |\5|\  (row-major from c0; in row
+ *                                          |3\|7\  y the upward cells come
+ *                                       c0 +--+--+ c1    first, then downward)
+ *
+ * Vertices are shared ("welded") between elements of one surface whose
+ * normals differ by less than the crease angle, across patch boundaries too.
+ * A welded vertex lying inside another element's edge (a T-vertex, where
+ * neighbouring patches have different grids) is recorded so that vertex
+ * values can be made continuous there (interp/).
+ */
+#ifndef RAD_MESH_H
+#define RAD_MESH_H
+
+#include "scene/scene.h"
+
+typedef struct rad_patch {
+    uint32_t polygon;        /* scene polygon it came from */
+    uint32_t surface;
+    uint32_t material;
+    uint32_t corner_count;   /* 3 or 4 */
+    vec3 corner[4];          /* m, counter-clockwise about normal */
+    vec3 normal;             /* unit */
+    uint32_t nu, nv;         /* quad: grid cells along c0->c1 and c0->c3; triangle: nu = nv = k */
+    uint32_t first_element;  /* elements of this patch are contiguous */
+    uint32_t element_count;
+} rad_patch;
+
+typedef struct rad_element {
+    uint32_t patch;
+    uint32_t surface;
+    uint32_t material;
+    uint32_t vertex_count;   /* 3 or 4 */
+    uint32_t vertex[4];      /* welded vertex indices, counter-clockwise */
+    vec3 centroid;           /* m */
+    vec3 normal;             /* unit */
+    double area;             /* m^2 */
+} rad_element;
+
+/* A vertex that lies on the open edge (a, b) of a neighbouring element:
+ * its value must be lerp(value[a], value[b], t) for the shading to be
+ * continuous. */
+typedef struct rad_tvertex {
+    uint32_t vertex, a, b;
+    double t;
+} rad_tvertex;
+
+typedef struct rad_mesh {
+    rad_patch *patches;
+    size_t patch_count;
+    rad_element *elements;
+    size_t element_count;
+    vec3 *vertices;          /* welded positions, m */
+    size_t vertex_count;
+    rad_tvertex *tvertices;
+    size_t tvertex_count;
+    double mesh_size;        /* the edge length actually used, m */
+} rad_mesh;
+
+typedef struct rad_mesh_options {
+    double mesh_size;        /* m; 0 = derive from target_elements */
+    size_t target_elements;  /* used when mesh_size is 0; 0 = 2000 */
+    double crease_angle_degrees; /* 0 = 30 */
+} rad_mesh_options;
+
+rad_result rad_mesh_build(rad_context *ctx, const rad_scene *scene,
+                          const rad_mesh_options *options, rad_mesh **out);
+void rad_mesh_destroy(rad_mesh *mesh);
+
+/* The element of `patch` containing the point with patch parameters (s, t)
+ * (quad: bilinear coordinates in [0,1]^2; triangle: barycentrics of c1 and
+ * c2), and the point's coordinates inside that element (same convention,
+ * relative to the element's own vertex order).  Cannot fail: parameters are
+ * clamped. */
+uint32_t rad_patch_locate(const rad_patch *patch, double s, double t,
+                          double *local_s, double *local_t);
+
+/* Patch parameters (s, t) of a point on (or near) the patch plane. */
+void rad_patch_parameters(const rad_patch *patch, vec3 p, double *s, double *t);
+
+/* The point of the patch at parameters (s, t). */
+vec3 rad_patch_point(const rad_patch *patch, double s, double t);
+
+/* A point of element e at unit-square parameters (u, v) in [0,1)^2, uniform
+ * in area (triangles fold the square).  For sampling. */
+vec3 rad_element_sample(const rad_mesh *mesh, const rad_element *e, double u, double v);
+
+#endif /* RAD_MESH_H */

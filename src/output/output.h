@@ -1,0 +1,51 @@
+/*
+ * output.h -- turning a solution into files: images (render.c, image.c),
+ * automatic camera framing (camera.c), stats and view-factor files (stats.c).
+ */
+#ifndef RAD_OUTPUT_H
+#define RAD_OUTPUT_H
+
+#include "interp/interp.h"
+#include "vis/vis.h"
+
+struct rad_image {
+    int width, height;
+    float *pixels;          /* RGB radiance, W/(m^2 sr), row 0 at the top */
+};
+
+rad_image *rad_image_create(rad_context *ctx, int width, int height);
+
+/* What the renderer needs from a solution. */
+typedef struct rad_render_input {
+    const rad_mesh *mesh;
+    const rad_vis *vis;              /* closest-hit queries against the patches */
+    const double *element_radiosity; /* 3 per element, W/m^2 */
+    const double *vertex_radiosity;  /* 3 per mesh vertex, W/m^2 */
+    rad_camera camera;               /* resolved: never "none" */
+} rad_render_input;
+
+/* Ray-cast the mesh from the camera; each sample takes the radiance B/pi of
+ * the element it hits (flat) or the interpolated vertex values (smooth).
+ * Stratified anti-aliasing with samples x samples per pixel.  Parallel;
+ * deterministic. */
+rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
+                            const rad_render_options *options, rad_image **out);
+
+/* A camera that frames the bounding box, looking along -z from +z
+ * (a three-quarter view would hide the interior of open boxes). */
+rad_camera rad_camera_frame(vec3 bounds_min, vec3 bounds_max, double aspect);
+
+/* Parse "px,py,pz,lx,ly,lz[,ux,uy,uz[,vfov]]" (the CLI's --camera). */
+rad_result rad_camera_parse(rad_context *ctx, const char *text, rad_camera *camera);
+
+/* rad_image_write with an explicit exposure for .png (a multiplier on
+ * radiance; 0 = rad_image_auto_exposure).  .hdr and .pfm are always
+ * written as linear radiance, unexposed. */
+rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, const char *path,
+                                   double exposure);
+
+/* Automatic exposure: the multiplier that maps the 95th percentile of
+ * luminance among non-saturated pixels to 0.8. */
+double rad_image_auto_exposure(const rad_image *image);
+
+#endif /* RAD_OUTPUT_H */

@@ -1,0 +1,217 @@
+/*
+ * render.c -- ray-cast images of a solution: each camera ray takes the
+ * radiance L = B / pi of the surface point it hits (surfaces are
+ * Lambertian, so radiance is the same in every direction).
+ *
+ *   pinhole camera: forward f = normalize(look_at - position),
+ *                   right r = normalize(f x up), true up u = r x f;
+ *                   pixel (x, y), row 0 at the top, maps to
+ *                   f + ((2 x / W) - 1) tan(vfov/2) aspect r
+ *                     + (1 - (2 y / H)) tan(vfov/2) u
+ *   hit -> patch parameters -> element + local coordinates (mesh.h, O(1))
+ *       -> flat: B of the element; smooth: interpolated vertex values
+ *   back side of a patch (one-sided surfaces) and misses are black.
+ *
+ * Anti-aliasing: samples x samples strata per pixel, each jittered by a
+ * random offset keyed by (pixel, sample), so the image does not depend on
+ * the thread count.  Rows are shared out to OpenMP threads; each thread
+ * sends its row's rays to the visibility backend in batches.
+ */
+#include "output/output.h"
+
+#include <stdlib.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#define RAD_RENDER_MAX_SIZE 16384   /* pixels per side, samples per side */
+#define RAD_RENDER_BATCH 4096       /* rays per backend call: amortises the
+                                       call, fits a thread's cache */
+
+typedef struct render_view {
+    vec3 position, forward, right, up; /* right and up scaled to the image half-extent */
+    int width, height, samples;
+} render_view;
+
+static int option_or_default(int value, int fallback) { return value == 0 ? fallback : value; }
+
+static rad_result check_size(rad_context *ctx, const char *what, int value)
+{
+    if (value < 1 || value > RAD_RENDER_MAX_SIZE)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "render: %s must be in 1..%d (0 = default), got %d", what,
+                        RAD_RENDER_MAX_SIZE, value);
+    return RAD_OK;
+}
+
+static rad_result make_view(rad_context *ctx, const rad_camera *camera, int width, int height,
+                            int samples, render_view *view)
+{
+    vec3 position = v3(camera->position[0], camera->position[1], camera->position[2]);
+    vec3 look_at = v3(camera->look_at[0], camera->look_at[1], camera->look_at[2]);
+    vec3 up = v3(camera->up[0], camera->up[1], camera->up[2]);
+    vec3 forward = v3_sub(look_at, position);
+    vec3 right = v3_cross(forward, up);
+    if (!v3_finite(position) || !v3_finite(look_at) || !v3_finite(up))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "render: camera is not finite");
+    if (v3_length(forward) == 0.0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "render: camera position and look-at point coincide");
+    /* Same round-off allowance as rad_camera_parse. */
+    if (v3_length(right) <= 1e-9 * v3_length(forward) * v3_length(up))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "render: camera up vector is zero or parallel to the view direction");
+    if (!(camera->vfov_degrees > 0.0 && camera->vfov_degrees < 180.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "render: vertical field of view must be in (0, 180) degrees, got %g",
+                        camera->vfov_degrees);
+    double half_height = tan(0.5 * camera->vfov_degrees * M_PI / 180.0);
+    double half_width = half_height * (double)width / (double)height;
+    view->position = position;
+    view->forward = v3_normalize(forward);
+    view->right = v3_normalize(right);
+    view->up = v3_scale(v3_cross(view->right, view->forward), half_height);
+    view->right = v3_scale(view->right, half_width);
+    view->width = width;
+    view->height = height;
+    view->samples = samples;
+    return RAD_OK;
+}
+
+/* Radiosity (W/m^2) seen along `ray` given its hit; 0 for a miss or the
+ * back of a patch. */
+static void shade(const rad_render_input *input, rad_shading shading, const rad_ray *ray,
+                  const rad_hit *hit, double rgb[3])
+{
+    rgb[0] = rgb[1] = rgb[2] = 0.0;
+    if (!isfinite(hit->t))
+        return;
+    const rad_mesh *mesh = input->mesh;
+    const rad_patch *patch = &mesh->patches[hit->patch];
+    if (v3_dot(ray->direction, patch->normal) > 0.0)
+        return;
+    vec3 p = v3_mad(ray->origin, ray->direction, hit->t);
+    double s, t, local_s, local_t;
+    rad_patch_parameters(patch, p, &s, &t);
+    uint32_t e = rad_patch_locate(patch, s, t, &local_s, &local_t);
+    if (shading == RAD_SHADING_SMOOTH && input->vertex_radiosity) {
+        rad_element_interpolate(mesh, &mesh->elements[e], input->vertex_radiosity, local_s,
+                                local_t, rgb);
+    } else {
+        for (int c = 0; c < 3; c++)
+            rgb[c] = input->element_radiosity[3 * (size_t)e + (size_t)c];
+    }
+}
+
+/* One row: width x samples^2 rays in batches; writes the row's pixels. */
+static void render_row(const rad_render_input *input, rad_shading shading,
+                       const render_view *view, int y, rad_ray *rays, rad_hit *hits,
+                       double *sum, float *pixels)
+{
+    const uint64_t per_pixel = (uint64_t)view->samples * (uint64_t)view->samples;
+    const uint64_t total = (uint64_t)view->width * per_pixel;
+    for (int x = 0; x < 3 * view->width; x++)
+        sum[x] = 0.0;
+    for (uint64_t first = 0; first < total; first += RAD_RENDER_BATCH) {
+        size_t count = (size_t)(total - first < RAD_RENDER_BATCH ? total - first : RAD_RENDER_BATCH);
+        for (size_t k = 0; k < count; k++) {
+            uint64_t r = first + k, x = r / per_pixel, sample = r % per_pixel;
+            uint64_t pixel = (uint64_t)y * (uint64_t)view->width + x;
+            rad_rng rng = rad_rng_keyed(0, pixel, sample);
+            double jx = rad_rng_uniform(&rng), jy = rad_rng_uniform(&rng);
+            double fx = ((double)x + ((double)(sample % (uint64_t)view->samples) + jx) /
+                                         view->samples) / view->width;
+            double fy = ((double)y + ((double)(sample / (uint64_t)view->samples) + jy) /
+                                         view->samples) / view->height;
+            vec3 direction = v3_mad(v3_mad(view->forward, view->right, 2.0 * fx - 1.0), view->up,
+                                    1.0 - 2.0 * fy);
+            rays[k].origin = view->position;
+            rays[k].direction = direction;
+            rays[k].tnear = 0.0;
+            rays[k].tfar = INFINITY;
+        }
+        input->vis->backend->intersect(input->vis->state, rays, count, hits);
+        for (size_t k = 0; k < count; k++) {
+            double rgb[3];
+            shade(input, shading, &rays[k], &hits[k], rgb);
+            uint64_t x = (first + k) / per_pixel;
+            for (int c = 0; c < 3; c++)
+                sum[3 * x + (uint64_t)c] += rgb[c];
+        }
+    }
+    double scale = 1.0 / (M_PI * (double)per_pixel); /* mean, and L = B / pi */
+    for (int x = 0; x < 3 * view->width; x++)
+        pixels[x] = (float)(sum[x] * scale);
+}
+
+rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
+                            const rad_render_options *options, rad_image **out)
+{
+    *out = NULL;
+    rad_render_options o = options ? *options : (rad_render_options){0};
+    int width = option_or_default(o.width, 512);
+    int height = option_or_default(o.height, 512);
+    int samples = option_or_default(o.samples, 4);
+    rad_result r;
+    if ((r = check_size(ctx, "width", width)) != RAD_OK ||
+        (r = check_size(ctx, "height", height)) != RAD_OK ||
+        (r = check_size(ctx, "samples", samples)) != RAD_OK)
+        return r;
+    render_view view;
+    if ((r = make_view(ctx, &input->camera, width, height, samples, &view)) != RAD_OK)
+        return r;
+
+    int threads = ctx && ctx->threads > 0 ? ctx->threads : 1;
+    rad_image *image = rad_image_create(ctx, width, height);
+    rad_ray *rays = rad_alloc_array(ctx, (size_t)threads * RAD_RENDER_BATCH, sizeof *rays,
+                                    "render rays");
+    rad_hit *hits = rad_alloc_array(ctx, (size_t)threads * RAD_RENDER_BATCH, sizeof *hits,
+                                    "render hits");
+    double *sums = rad_alloc_array(ctx, (size_t)threads * (size_t)width, 3 * sizeof(double),
+                                   "render rows");
+    if (!image || !rays || !hits || !sums) {
+        rad_image_destroy(image);
+        free(rays);
+        free(hits);
+        free(sums);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+
+    int rows_done = 0, rows_skipped = 0;
+    rad_progress(ctx, "render", 0, (uint64_t)height);
+#pragma omp parallel num_threads(threads)
+    {
+        int thread = 0;
+#ifdef _OPENMP
+        thread = omp_get_thread_num();
+#endif
+        rad_ray *my_rays = rays + (size_t)thread * RAD_RENDER_BATCH;
+        rad_hit *my_hits = hits + (size_t)thread * RAD_RENDER_BATCH;
+        double *my_sum = sums + (size_t)thread * (size_t)width * 3;
+#pragma omp for schedule(dynamic)
+        for (int y = 0; y < height; y++) {
+            if (rad_cancelled(ctx)) {
+#pragma omp atomic update
+                rows_skipped++;
+                continue;
+            }
+            render_row(input, o.shading, &view, y, my_rays, my_hits, my_sum,
+                       &image->pixels[(size_t)y * (size_t)width * 3]);
+            int done;
+#pragma omp atomic capture
+            done = ++rows_done;
+            if (thread == 0) /* progress callbacks run on the calling thread only */
+                rad_progress(ctx, "render", (uint64_t)done, (uint64_t)height);
+        }
+    }
+    free(rays);
+    free(hits);
+    free(sums);
+    rad_progress(ctx, "render", (uint64_t)rows_done, (uint64_t)height);
+    *out = image;
+    if (rows_skipped > 0)
+        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "render: interrupted after %d of %d rows",
+                        rows_done, height);
+    return RAD_OK;
+}

@@ -1,0 +1,534 @@
+/*
+ * scene.c -- the scene builder, its validation, and the public scene
+ * accessors and loaders.
+ *
+ * Importers hand the builder materials, named surfaces and polygons one at
+ * a time, and each is checked as it arrives, so that an error can name the
+ * file, the line where the importer knows it, and the surface:
+ *
+ *   rad_scene_builder_polygon:
+ *     finite coordinates -> drop repeated vertices -> at least 3 left
+ *       -> non-zero area -> simple (no self-intersection)
+ *       -> planar?  yes: kept as one polygon   no: split into triangles
+ *   rad_scene_builder_finish:
+ *     not empty -> drop surfaces without polygons and unused materials
+ *       -> surface areas, bounds -> the immutable rad_scene
+ *
+ * Every vertex of every polygon gets its own slot in `positions`; welding
+ * shared vertices is the mesher's job, which knows the crease angle.
+ */
+#include "scene/scene.h"
+
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct rad_scene_builder {
+    rad_context *ctx;
+    char *source; /* file name, the prefix of every message */
+    vec3 *positions;
+    size_t position_count, position_capacity;
+    uint32_t *indices;
+    size_t index_count, index_capacity;
+    rad_polygon *polygons;
+    size_t polygon_count, polygon_capacity;
+    rad_surface *surfaces;
+    size_t surface_count, surface_capacity;
+    rad_material *materials;
+    size_t material_count, material_capacity;
+    vec3 *polygon_scratch; /* the polygon being added, repeats dropped */
+    size_t polygon_scratch_capacity;
+    uint32_t *triangle_scratch; /* its ear-clipped triangles */
+    size_t triangle_scratch_capacity;
+    bool has_camera;
+    rad_camera camera;
+};
+
+/* Return `array` grown (by doubling) to hold at least `needed` elements of
+ * `size` bytes; NULL with the error set on failure, `array` then intact. */
+static void *reserve(rad_scene_builder *b, void *array, size_t *capacity, size_t needed,
+                     size_t size, const char *what)
+{
+    if (needed <= *capacity)
+        return array;
+    size_t grown = *capacity ? *capacity : 16;
+    while (grown < needed)
+        grown = grown > SIZE_MAX / 2 ? needed : grown * 2;
+    if (grown > SIZE_MAX / size) {
+        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: too many %s", b->source, what);
+        return NULL;
+    }
+    void *grown_array = realloc(array, grown * size);
+    if (!grown_array) {
+        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory for %zu %s", b->source,
+                 needed, what);
+        return NULL;
+    }
+    *capacity = grown;
+    return grown_array;
+}
+
+rad_scene_builder *rad_scene_builder_create(rad_context *ctx, const char *source)
+{
+    rad_scene_builder *b = calloc(1, sizeof *b);
+    if (b)
+        b->source = rad_strdup(source ? source : "scene");
+    if (!b || !b->source) {
+        free(b);
+        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", source ? source : "scene");
+        return NULL;
+    }
+    b->ctx = ctx;
+    return b;
+}
+
+void rad_scene_builder_destroy(rad_scene_builder *b)
+{
+    if (!b)
+        return;
+    for (size_t i = 0; i < b->surface_count; i++)
+        free(b->surfaces[i].name);
+    for (size_t i = 0; i < b->material_count; i++)
+        free(b->materials[i].name);
+    free(b->source);
+    free(b->positions);
+    free(b->indices);
+    free(b->polygons);
+    free(b->surfaces);
+    free(b->materials);
+    free(b->polygon_scratch);
+    free(b->triangle_scratch);
+    free(b);
+}
+
+int rad_scene_builder_material(rad_scene_builder *b, const char *name,
+                               const double reflectance[3], const double emission[3])
+{
+    if (!b)
+        return -1;
+    char fallback[32];
+    if (!name || !*name) {
+        snprintf(fallback, sizeof fallback, "material_%zu", b->material_count);
+        name = fallback;
+    }
+    for (int c = 0; c < 3; c++) {
+        /* rho = 1 would make the radiosity system singular in a closed room. */
+        if (!(reflectance[c] >= 0.0 && reflectance[c] < 1.0)) {
+            rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                     "%s: material '%s': reflectance %g is outside [0, 1)", b->source, name,
+                     reflectance[c]);
+            return -1;
+        }
+        if (!(emission[c] >= 0.0 && isfinite(emission[c]))) {
+            rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                     "%s: material '%s': emission %g is not a finite non-negative exitance",
+                     b->source, name, emission[c]);
+            return -1;
+        }
+    }
+    if (b->material_count >= INT_MAX) {
+        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: too many materials", b->source);
+        return -1;
+    }
+    rad_material *materials = reserve(b, b->materials, &b->material_capacity,
+                                      b->material_count + 1, sizeof *materials, "materials");
+    if (!materials)
+        return -1;
+    b->materials = materials;
+    rad_material *m = &materials[b->material_count];
+    m->name = rad_strdup(name);
+    if (!m->name) {
+        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+        return -1;
+    }
+    memcpy(m->reflectance, reflectance, sizeof m->reflectance);
+    memcpy(m->emission, emission, sizeof m->emission);
+    return (int)b->material_count++;
+}
+
+int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
+{
+    if (!b)
+        return -1;
+    char fallback[32];
+    if (!name || !*name) {
+        snprintf(fallback, sizeof fallback, "surface_%zu", b->surface_count);
+        name = fallback;
+    }
+    /* A linear search: importers ask once per mesh, and scenes that a
+     * radiosity solve can handle have hundreds of surfaces, not millions. */
+    for (size_t i = 0; i < b->surface_count; i++)
+        if (strcmp(b->surfaces[i].name, name) == 0)
+            return (int)i;
+    if (b->surface_count >= INT_MAX) {
+        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: too many surfaces", b->source);
+        return -1;
+    }
+    rad_surface *surfaces = reserve(b, b->surfaces, &b->surface_capacity, b->surface_count + 1,
+                                    sizeof *surfaces, "surfaces");
+    if (!surfaces)
+        return -1;
+    b->surfaces = surfaces;
+    rad_surface *s = &surfaces[b->surface_count];
+    s->name = rad_strdup(name);
+    s->area = 0.0;
+    if (!s->name) {
+        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+        return -1;
+    }
+    return (int)b->surface_count++;
+}
+
+/* "FILE:LINE: polygon in surface 'NAME' <problem>", without ":LINE" when
+ * the line is unknown (0). */
+static rad_result polygon_error(const rad_scene_builder *b, int surface, int line,
+                                rad_result code, const char *problem)
+{
+    char at[24] = "";
+    if (line > 0)
+        snprintf(at, sizeof at, ":%d", line);
+    return rad_fail(b->ctx, code, "%s%s: polygon in surface '%s' %s", b->source, at,
+                    b->surfaces[surface].name, problem);
+}
+
+/* Append one checked planar polygon; its vertices get fresh positions. */
+static rad_result append_polygon(rad_scene_builder *b, int surface, int material,
+                                 const vec3 *vertices, size_t n, vec3 normal, double area)
+{
+    if (b->position_count + n > UINT32_MAX || b->polygon_count >= UINT32_MAX)
+        return rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: more than 2^32 vertices",
+                        b->source);
+    vec3 *positions = reserve(b, b->positions, &b->position_capacity, b->position_count + n,
+                              sizeof *positions, "vertices");
+    if (!positions)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    b->positions = positions;
+    uint32_t *indices = reserve(b, b->indices, &b->index_capacity, b->index_count + n,
+                                sizeof *indices, "vertex indices");
+    if (!indices)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    b->indices = indices;
+    rad_polygon *polygons = reserve(b, b->polygons, &b->polygon_capacity,
+                                    b->polygon_count + 1, sizeof *polygons, "polygons");
+    if (!polygons)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    b->polygons = polygons;
+
+    rad_polygon *p = &polygons[b->polygon_count++];
+    p->first_index = (uint32_t)b->index_count;
+    p->vertex_count = (uint32_t)n;
+    p->surface = (uint32_t)surface;
+    p->material = (uint32_t)material;
+    p->normal = normal;
+    p->area = area;
+    for (size_t i = 0; i < n; i++) {
+        indices[b->index_count++] = (uint32_t)b->position_count;
+        positions[b->position_count++] = vertices[i];
+    }
+    return RAD_OK;
+}
+
+static bool v3_equal(vec3 a, vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int material,
+                                     const vec3 *vertices, size_t vertex_count, int line)
+{
+    if (!b)
+        return RAD_ERROR_INVALID_ARGUMENT;
+    if (surface < 0 || (size_t)surface >= b->surface_count || material < 0 ||
+        (size_t)material >= b->material_count || (vertex_count > 0 && !vertices))
+        return rad_fail(b->ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: polygon refers to surface %d and material %d, of %zu and %zu",
+                        b->source, surface, material, b->surface_count, b->material_count);
+    for (size_t i = 0; i < vertex_count; i++)
+        if (!v3_finite(vertices[i]))
+            return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE,
+                                 "has a non-finite coordinate");
+
+    vec3 *polygon = reserve(b, b->polygon_scratch, &b->polygon_scratch_capacity, vertex_count,
+                            sizeof *polygon, "polygon vertices");
+    if (!polygon)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    b->polygon_scratch = polygon;
+    size_t n = 0;
+    for (size_t i = 0; i < vertex_count; i++)
+        if (n == 0 || !v3_equal(vertices[i], polygon[n - 1]))
+            polygon[n++] = vertices[i];
+    while (n > 1 && v3_equal(polygon[n - 1], polygon[0]))
+        n--;
+    if (n < 3) {
+        char problem[64];
+        snprintf(problem, sizeof problem, "has %zu distinct vertices (3 or more needed)", n);
+        return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE, problem);
+    }
+
+    vec3 lo = polygon[0], hi = polygon[0], centroid = v3(0.0, 0.0, 0.0);
+    for (size_t i = 0; i < n; i++) {
+        lo = v3_min(lo, polygon[i]);
+        hi = v3_max(hi, polygon[i]);
+        centroid = v3_add(centroid, polygon[i]);
+    }
+    centroid = v3_scale(centroid, 1.0 / (double)n);
+    /* The bounding-box diagonal stands in for the polygon's diameter: it is
+     * at most sqrt(3) times larger and costs O(n), not O(n^2). */
+    double diameter = v3_length(v3_sub(hi, lo));
+    vec3 newell = rad_polygon_newell(polygon, n);
+    double area = 0.5 * v3_length(newell);
+    /* 1e-12 x diameter^2: a polygon a million-millionth as wide as it is
+     * long is a line, and its normal is rounding noise.  1e-20 m^2 (a
+     * 0.1 nm square) catches polygons too small to have a normal at all. */
+    if (!(area >= 1e-12 * diameter * diameter) || area < 1e-20)
+        return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE, "has zero area");
+    vec3 normal = v3_scale(newell, 0.5 / area);
+
+    size_t triangle_count = 0;
+    if (n > 3) {
+        uint32_t *triangles = reserve(b, b->triangle_scratch, &b->triangle_scratch_capacity,
+                                      3 * (n - 2), sizeof *triangles, "triangles");
+        if (!triangles)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        b->triangle_scratch = triangles;
+        triangle_count = rad_triangulate_polygon(polygon, n, normal, triangles);
+        if (triangle_count == 0)
+            return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE,
+                                 "intersects itself");
+    }
+
+    /* Newell's normal through the centroid is the best-fit plane.  1e-4 x
+     * diameter (0.1 mm on a 1 m wall) is far above float round-off in the
+     * files and far below anything a viewer would call curved. */
+    double max_distance = 0.0;
+    for (size_t i = 0; i < n; i++)
+        max_distance = fmax(max_distance, fabs(v3_dot(v3_sub(polygon[i], centroid), normal)));
+    if (max_distance <= 1e-4 * diameter || n == 3)
+        return append_polygon(b, surface, material, polygon, n, normal, area);
+
+    for (size_t t = 0; t < triangle_count; t++) {
+        vec3 triangle[3] = {polygon[b->triangle_scratch[3 * t]],
+                            polygon[b->triangle_scratch[3 * t + 1]],
+                            polygon[b->triangle_scratch[3 * t + 2]]};
+        vec3 triangle_newell = rad_polygon_newell(triangle, 3);
+        double triangle_area = 0.5 * v3_length(triangle_newell);
+        if (triangle_area < 1e-20)
+            continue; /* nothing to radiate or receive; ear clipping avoids these anyway */
+        rad_result r = append_polygon(b, surface, material, triangle, 3,
+                                      v3_scale(triangle_newell, 0.5 / triangle_area),
+                                      triangle_area);
+        if (r != RAD_OK)
+            return r;
+    }
+    return RAD_OK;
+}
+
+void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera)
+{
+    if (!b)
+        return;
+    b->has_camera = camera != NULL;
+    if (camera)
+        b->camera = *camera;
+}
+
+static bool camera_is_valid(const rad_camera *c)
+{
+    vec3 position = v3(c->position[0], c->position[1], c->position[2]);
+    vec3 look_at = v3(c->look_at[0], c->look_at[1], c->look_at[2]);
+    vec3 up = v3(c->up[0], c->up[1], c->up[2]);
+    return v3_finite(position) && v3_finite(look_at) && v3_finite(up) &&
+           !v3_equal(position, look_at) && v3_length(up) > 0.0 && c->vfov_degrees > 0.0 &&
+           c->vfov_degrees < 180.0;
+}
+
+rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
+{
+    if (!out) {
+        rad_scene_builder_destroy(b);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    *out = NULL;
+    if (!b)
+        return RAD_ERROR_INVALID_ARGUMENT;
+    rad_result r = RAD_OK;
+    uint32_t *surface_map = NULL, *material_map = NULL;
+    rad_scene *scene = NULL;
+    if (b->polygon_count == 0) {
+        r = rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE, "%s: scene is empty (no polygons)",
+                     b->source);
+        goto done;
+    }
+    if (b->has_camera && !camera_is_valid(&b->camera)) {
+        r = rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                     "%s: camera has a non-finite or degenerate position, direction or "
+                     "field of view",
+                     b->source);
+        goto done;
+    }
+    surface_map = rad_alloc_array(b->ctx, b->surface_count, sizeof *surface_map, "surface map");
+    material_map =
+        rad_alloc_array(b->ctx, b->material_count, sizeof *material_map, "material map");
+    scene = calloc(1, sizeof *scene);
+    if (!surface_map || !material_map || !scene) {
+        r = rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+        goto done;
+    }
+
+    /* From here on nothing can fail.  Keep used surfaces and materials in
+     * their order; a map entry of UINT32_MAX marks one that no polygon uses. */
+    for (size_t i = 0; i < b->surface_count; i++)
+        surface_map[i] = UINT32_MAX;
+    for (size_t i = 0; i < b->material_count; i++)
+        material_map[i] = UINT32_MAX;
+    for (size_t p = 0; p < b->polygon_count; p++) {
+        surface_map[b->polygons[p].surface] = 0;
+        material_map[b->polygons[p].material] = 0;
+    }
+    size_t kept = 0;
+    for (size_t i = 0; i < b->surface_count; i++) {
+        if (surface_map[i] == UINT32_MAX) {
+            free(b->surfaces[i].name);
+            continue;
+        }
+        b->surfaces[kept] = b->surfaces[i];
+        b->surfaces[kept].area = 0.0;
+        surface_map[i] = (uint32_t)kept++;
+    }
+    b->surface_count = kept;
+    kept = 0;
+    for (size_t i = 0; i < b->material_count; i++) {
+        if (material_map[i] == UINT32_MAX) {
+            free(b->materials[i].name);
+            continue;
+        }
+        b->materials[kept] = b->materials[i];
+        material_map[i] = (uint32_t)kept++;
+    }
+    b->material_count = kept;
+    for (size_t p = 0; p < b->polygon_count; p++) {
+        rad_polygon *polygon = &b->polygons[p];
+        polygon->surface = surface_map[polygon->surface];
+        polygon->material = material_map[polygon->material];
+        b->surfaces[polygon->surface].area += polygon->area;
+    }
+    scene->bounds_min = scene->bounds_max = b->positions[0];
+    for (size_t i = 1; i < b->position_count; i++) {
+        scene->bounds_min = v3_min(scene->bounds_min, b->positions[i]);
+        scene->bounds_max = v3_max(scene->bounds_max, b->positions[i]);
+    }
+
+    scene->source = b->source;
+    scene->positions = b->positions;
+    scene->position_count = b->position_count;
+    scene->indices = b->indices;
+    scene->index_count = b->index_count;
+    scene->polygons = b->polygons;
+    scene->polygon_count = b->polygon_count;
+    scene->surfaces = b->surfaces;
+    scene->surface_count = b->surface_count;
+    scene->materials = b->materials;
+    scene->material_count = b->material_count;
+    scene->has_camera = b->has_camera;
+    scene->camera = b->camera;
+    free(b->polygon_scratch);
+    free(b->triangle_scratch);
+    memset(b, 0, sizeof *b); /* all moved or freed: the destroy below frees the shell */
+    *out = scene;
+    scene = NULL;
+
+done:
+    free(surface_map);
+    free(material_map);
+    free(scene);
+    rad_scene_builder_destroy(b);
+    return r;
+}
+
+/* ---- the public scene ---- */
+
+rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out)
+{
+    if (!out)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_file: out is NULL");
+    *out = NULL;
+    if (!path)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_file: path is NULL");
+    double start = rad_seconds();
+    rad_result r = rad_import_assimp_file(ctx, path, out);
+    if (r == RAD_OK)
+        (*out)->load_seconds = rad_seconds() - start;
+    return r;
+}
+
+rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void *data,
+                                 size_t size, const void *mtl, size_t mtl_size,
+                                 rad_scene **out)
+{
+    if (!out)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_memory: out is NULL");
+    *out = NULL;
+    if (!name || (!data && size > 0) || (!mtl && mtl_size > 0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "rad_scene_load_memory: name is NULL, or data is NULL with a size");
+    double start = rad_seconds();
+    rad_result r = rad_import_assimp_memory(ctx, name, data, size, mtl, mtl_size, out);
+    if (r == RAD_OK)
+        (*out)->load_seconds = rad_seconds() - start;
+    return r;
+}
+
+void rad_scene_destroy(rad_scene *scene)
+{
+    if (!scene)
+        return;
+    for (size_t i = 0; i < scene->surface_count; i++)
+        free(scene->surfaces[i].name);
+    for (size_t i = 0; i < scene->material_count; i++)
+        free(scene->materials[i].name);
+    free(scene->source);
+    free(scene->positions);
+    free(scene->indices);
+    free(scene->polygons);
+    free(scene->surfaces);
+    free(scene->materials);
+    free(scene);
+}
+
+size_t rad_scene_surface_count(const rad_scene *scene) { return scene ? scene->surface_count : 0; }
+
+const char *rad_scene_surface_name(const rad_scene *scene, size_t surface)
+{
+    return scene && surface < scene->surface_count ? scene->surfaces[surface].name : NULL;
+}
+
+double rad_scene_surface_area(const rad_scene *scene, size_t surface)
+{
+    return scene && surface < scene->surface_count ? scene->surfaces[surface].area : 0.0;
+}
+
+size_t rad_scene_polygon_count(const rad_scene *scene) { return scene ? scene->polygon_count : 0; }
+
+int rad_scene_camera(const rad_scene *scene, rad_camera *camera)
+{
+    if (!scene || !scene->has_camera || !camera)
+        return 0;
+    *camera = scene->camera;
+    return 1;
+}
+
+bool rad_scene_has_emitter(const rad_scene *scene)
+{
+    if (!scene)
+        return false;
+    for (size_t p = 0; p < scene->polygon_count; p++) {
+        const double *emission = scene->materials[scene->polygons[p].material].emission;
+        if (emission[0] > 0.0 || emission[1] > 0.0 || emission[2] > 0.0)
+            return true;
+    }
+    return false;
+}
+
+double rad_scene_diagonal(const rad_scene *scene)
+{
+    if (!scene || scene->polygon_count == 0)
+        return 0.0;
+    return v3_length(v3_sub(scene->bounds_max, scene->bounds_min));
+}

@@ -1,0 +1,100 @@
+/*
+ * scene.h -- the scene as the rest of the pipeline sees it: named surfaces
+ * made of planar polygons (any vertex count, validated) with Lambertian
+ * materials.  Importers (assimp for OBJ/MTL and glTF; the built-in Cornell
+ * box) fill a rad_scene_builder; rad_scene_builder_finish validates and
+ * produces the immutable scene.
+ *
+ *     importer --polygons, materials, names--> builder --validate--> rad_scene
+ */
+#ifndef RAD_SCENE_H
+#define RAD_SCENE_H
+
+#include "core/core.h"
+
+typedef struct rad_material {
+    char *name;
+    double reflectance[3]; /* rho, RGB, in [0, 1) */
+    double emission[3];    /* E, self-emitted exitance, W/m^2 (= pi * radiance) */
+} rad_material;
+
+typedef struct rad_surface {
+    char *name;            /* OBJ o/g name, glTF node name; unique in the scene */
+    double area;           /* m^2, sum of its polygons */
+} rad_surface;
+
+typedef struct rad_polygon {
+    uint32_t first_index;  /* into rad_scene.indices */
+    uint32_t vertex_count; /* >= 3 */
+    uint32_t surface;
+    uint32_t material;
+    vec3 normal;           /* unit, right-hand rule over the vertex order */
+    double area;           /* m^2 */
+} rad_polygon;
+
+struct rad_scene {
+    char *source;             /* file name, or "cornell-box" */
+    vec3 *positions;          /* m */
+    size_t position_count;
+    uint32_t *indices;        /* polygon vertex lists */
+    size_t index_count;
+    rad_polygon *polygons;
+    size_t polygon_count;
+    rad_surface *surfaces;
+    size_t surface_count;
+    rad_material *materials;
+    size_t material_count;
+    vec3 bounds_min, bounds_max; /* m */
+    double load_seconds;      /* time the importer took */
+    bool has_camera;
+    rad_camera camera;
+};
+
+/* ---- building a scene ---- */
+
+typedef struct rad_scene_builder rad_scene_builder;
+
+rad_scene_builder *rad_scene_builder_create(rad_context *ctx, const char *source);
+void rad_scene_builder_destroy(rad_scene_builder *b);
+
+/* Returns the index of the material, or -1 on failure (error set).
+ * `emission` is exitance in W/m^2. */
+int rad_scene_builder_material(rad_scene_builder *b, const char *name,
+                               const double reflectance[3], const double emission[3]);
+/* Returns the index of the surface with that name, creating it if new;
+ * -1 on failure. */
+int rad_scene_builder_surface(rad_scene_builder *b, const char *name);
+/* Add a polygon; `line` (0 if unknown) is used in error messages.  Returns
+ * RAD_OK or an error (with message) for bad input. */
+rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int material,
+                                     const vec3 *vertices, size_t vertex_count, int line);
+void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera);
+
+/* Validate and produce the scene; the builder is consumed (destroyed) either
+ * way.  Fails on an empty scene. */
+rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out);
+
+/* ---- importers ---- */
+
+/* assimp: OBJ(+MTL) and glTF 2.0, from a file or memory (scene/import_assimp.c). */
+rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene **out);
+rad_result rad_import_assimp_memory(rad_context *ctx, const char *name, const void *data,
+                                    size_t size, const void *mtl, size_t mtl_size,
+                                    rad_scene **out);
+
+/* ---- queries used downstream ---- */
+
+/* True if some material emits. */
+bool rad_scene_has_emitter(const rad_scene *scene);
+double rad_scene_diagonal(const rad_scene *scene); /* m */
+
+/* Triangulate a simple planar polygon (convex or not) by ear clipping in
+ * the plane of `normal`.  Writes (n - 2) * 3 local vertex indices into
+ * `triangles`.  Returns the number of triangles, or 0 if the polygon is not
+ * simple (self-intersecting) or degenerate. */
+size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, uint32_t *triangles);
+
+/* Newell's normal (unnormalised; its length is twice the area). */
+vec3 rad_polygon_newell(const vec3 *vertices, size_t n);
+
+#endif /* RAD_SCENE_H */

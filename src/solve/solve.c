@@ -1,0 +1,47 @@
+/*
+ * solve.c -- the solver registry and the residual every solver reports.
+ */
+#include "solve/solve.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+extern const rad_solver rad_solver_gauss_seidel;
+extern const rad_solver rad_solver_southwell;
+
+const rad_solver *const rad_solvers[] = {
+    &rad_solver_gauss_seidel,
+    &rad_solver_southwell,
+    NULL,
+};
+
+const rad_solver *rad_solver_find(const char *name)
+{
+    for (size_t i = 0; rad_solvers[i]; i++)
+        if (strcmp(rad_solvers[i]->name, name) == 0)
+            return rad_solvers[i];
+    return NULL;
+}
+
+double rad_residual(const rad_system *sys, const double *B)
+{
+    size_t n = sys->n;
+    double num = 0.0, den = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : num, den)
+    for (size_t i = 0; i < n; i++) {
+        const float *Fi = sys->F + i * n;
+        double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+        for (size_t j = 0; j < n; j++) {
+            double f = Fi[j];
+            g0 += f * B[3 * j];
+            g1 += f * B[3 * j + 1];
+            g2 += f * B[3 * j + 2];
+        }
+        const double *rho = sys->reflectance + 3 * i, *E = sys->emission + 3 * i;
+        double a = sys->area[i];
+        num += a * (fabs(B[3 * i] - E[0] - rho[0] * g0) + fabs(B[3 * i + 1] - E[1] - rho[1] * g1) +
+                    fabs(B[3 * i + 2] - E[2] - rho[2] * g2));
+        den += a * (E[0] + E[1] + E[2]);
+    }
+    return den > 0.0 ? num / den : num;
+}

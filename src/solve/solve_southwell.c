@@ -1,0 +1,113 @@
+/*
+ * solve_southwell.c -- progressive refinement by shooting (Cohen, Chen,
+ * Wallace & Greenberg, SIGGRAPH 1988; the notes' "Progressive Refinement"):
+ * the element with the most unshot power dB_i A_i shoots it to all others,
+ *
+ *     dB_j += rho_j F_ji dB_i,  B_j += the same,  dB_i = 0,
+ *
+ * which is Southwell iteration on the radiosity system.  F_ji is read from
+ * row i through reciprocity, F_ji = F_ij A_i / A_j, so the pass is one
+ * contiguous row.  Shooting stops when the unshot power falls below the
+ * tolerance times the emitted power; the residual is then measured.
+ *
+ * The ambient term (the notes' "Ambient Term"; Cohen et al. 1988) estimates
+ * the light not yet shot, for display of a partial solution:
+ *
+ *     I_a = mu * sum_j dB_j A_j / sum_k A_k,  mu = 1 / (1 - rho_avg)
+ *
+ * and rad_southwell_ambient() returns it; display adds rho_i I_a.
+ */
+#include "solve/solve.h"
+
+#include <stdlib.h>
+
+
+void rad_southwell_ambient(const rad_system *sys, const double *dB, double ambient[3])
+{
+    double area = 0.0, rho_area[3] = {0, 0, 0}, unshot[3] = {0, 0, 0};
+    for (size_t i = 0; i < sys->n; i++) {
+        area += sys->area[i];
+        for (int c = 0; c < 3; c++) {
+            rho_area[c] += sys->reflectance[3 * i + c] * sys->area[i];
+            unshot[c] += dB[3 * i + c] * sys->area[i];
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        double rho_avg = area > 0.0 ? rho_area[c] / area : 0.0;
+        double mu = 1.0 / (1.0 - rho_avg);
+        ambient[c] = area > 0.0 ? mu * unshot[c] / area : 0.0;
+    }
+}
+
+static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
+                            double *B, rad_solve_stats *stats)
+{
+    size_t n = sys->n;
+    double *dB = rad_alloc_array(ctx, 3 * n, sizeof *dB, "solve: unshot radiosity");
+    if (!dB)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    double emitted = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++)
+            dB[3 * i + c] = B[3 * i + c];
+        emitted += sys->area[i] * (sys->emission[3 * i] + sys->emission[3 * i + 1] +
+                                   sys->emission[3 * i + 2]);
+    }
+    long long max_shots = p->max_iterations > 0 ? (long long)p->max_iterations
+                                                : 1000LL * (long long)(n > 0 ? n : 1);
+    long long shot = 0;
+    rad_result result = RAD_OK;
+    for (; shot < max_shots; shot++) {
+        size_t best = 0;
+        double best_power = -1.0, unshot = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            double power = sys->area[i] * (dB[3 * i] + dB[3 * i + 1] + dB[3 * i + 2]);
+            unshot += power;
+            if (power > best_power) {
+                best_power = power;
+                best = i;
+            }
+        }
+        if (!(unshot > p->tolerance * emitted) || best_power <= 0.0)
+            break;
+        const float *Fi = sys->F + best * n;
+        double s0 = dB[3 * best], s1 = dB[3 * best + 1], s2 = dB[3 * best + 2];
+        double ai = sys->area[best];
+        dB[3 * best] = dB[3 * best + 1] = dB[3 * best + 2] = 0.0;
+        for (size_t j = 0; j < n; j++) {
+            double fji = Fi[j] * ai / sys->area[j];
+            if (fji == 0.0)
+                continue;
+            const double *rho = sys->reflectance + 3 * j;
+            double d0 = rho[0] * fji * s0, d1 = rho[1] * fji * s1, d2 = rho[2] * fji * s2;
+            dB[3 * j] += d0;
+            dB[3 * j + 1] += d1;
+            dB[3 * j + 2] += d2;
+            B[3 * j] += d0;
+            B[3 * j + 1] += d1;
+            B[3 * j + 2] += d2;
+        }
+        if ((shot & 255) == 0) {
+            rad_progress(ctx, "solve", (uint64_t)shot, (uint64_t)max_shots);
+            if (rad_cancelled(ctx)) {
+                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %lld shots",
+                                  shot + 1);
+                shot++;
+                break;
+            }
+        }
+    }
+    stats->iterations = shot > 2147483647LL ? 2147483647 : (int)shot;
+    rad_southwell_ambient(sys, dB, stats->ambient);
+    free(dB);
+    stats->residual = rad_residual(sys, B);
+    stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    return result;
+}
+
+const rad_solver rad_solver_southwell = {
+    "southwell",
+    "progressive refinement: shoot the largest unshot power (Cohen et al. 1988), "
+    "ambient term for display; O(n) per shot",
+    southwell,
+};

@@ -1,0 +1,121 @@
+/*
+ * vis.c -- the visibility registry and the handle around a backend.
+ *
+ * Each backend (vis_embree.c, vis_brute.c) is one rad_vis_backend table of
+ * function pointers; this file lists them, finds one by name, times its
+ * build and owns the handle.  Callers query through vis->backend.
+ */
+#include "vis/vis.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+extern const rad_vis_backend rad_vis_embree;
+extern const rad_vis_backend rad_vis_brute;
+
+const rad_vis_backend *const rad_vis_backends[] = {&rad_vis_embree, &rad_vis_brute, NULL};
+
+const rad_vis_backend *rad_vis_find(const char *name)
+{
+    if (!name)
+        return NULL;
+    for (size_t i = 0; rad_vis_backends[i]; i++)
+        if (strcmp(rad_vis_backends[i]->name, name) == 0)
+            return rad_vis_backends[i];
+    return NULL;
+}
+
+rad_result rad_vis_create(rad_context *ctx, const char *name, const rad_mesh *mesh, rad_vis **out)
+{
+    *out = NULL;
+    const rad_vis_backend *backend = rad_vis_find(name);
+    if (!backend)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "unknown visibility backend '%s' (known: embree, brute)",
+                        name ? name : "(null)");
+    rad_vis *vis = rad_alloc_array(ctx, 1, sizeof *vis, "visibility");
+    if (!vis)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    double start = rad_seconds();
+    rad_result r = backend->create(ctx, mesh, &vis->state);
+    if (r != RAD_OK) {
+        free(vis);
+        return r;
+    }
+    vis->backend = backend;
+    vis->build_seconds = rad_seconds() - start;
+    *out = vis;
+    return RAD_OK;
+}
+
+void rad_vis_destroy(rad_vis *vis)
+{
+    if (!vis)
+        return;
+    vis->backend->destroy(vis->state);
+    free(vis);
+}
+
+double rad_vis_epsilon(const rad_mesh *mesh)
+{
+    vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (size_t i = 0; i < mesh->vertex_count; i++) {
+        lo = v3_min(lo, mesh->vertices[i]);
+        hi = v3_max(hi, mesh->vertices[i]);
+    }
+    /* The patch corners span the same box; they cover a mesh whose
+     * vertices have not been welded (or filled in, as in some tests). */
+    for (size_t i = 0; i < mesh->patch_count; i++)
+        for (uint32_t c = 0; c < mesh->patches[i].corner_count; c++) {
+            lo = v3_min(lo, mesh->patches[i].corner[c]);
+            hi = v3_max(hi, mesh->patches[i].corner[c]);
+        }
+    double diagonal = v3_length(v3_sub(hi, lo));
+    /* An empty or single-point mesh has no scale: take 1 m. */
+    if (!(diagonal > 0.0) || !isfinite(diagonal))
+        diagonal = 1.0;
+    return 1e-5 * diagonal;
+}
+
+/* Largest distance of a quad's corners from the plane of its first three. */
+static double patch_bend(const rad_patch *p)
+{
+    if (p->corner_count != 4)
+        return 0.0;
+    return fabs(v3_dot(p->normal, v3_sub(p->corner[3], p->corner[0]))) +
+           fabs(v3_dot(p->normal, v3_sub(p->corner[1], p->corner[0]))) +
+           fabs(v3_dot(p->normal, v3_sub(p->corner[2], p->corner[0])));
+}
+
+rad_result rad_vis_primitives(rad_context *ctx, const rad_mesh *mesh, rad_vis_prim **out,
+                              size_t *count)
+{
+    /* Bent beyond a tenth of the ray offset: use the elements. */
+    double limit = 0.1 * rad_vis_epsilon(mesh);
+    size_t n = 0;
+    for (size_t i = 0; i < mesh->patch_count; i++)
+        n += patch_bend(&mesh->patches[i]) > limit ? mesh->patches[i].element_count : 1;
+    rad_vis_prim *prims = rad_alloc_array(ctx, n ? n : 1, sizeof *prims, "visibility primitives");
+    if (!prims)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    size_t k = 0;
+    for (size_t i = 0; i < mesh->patch_count; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        if (patch_bend(p) > limit) {
+            for (uint32_t e = 0; e < p->element_count; e++) {
+                const rad_element *el = &mesh->elements[p->first_element + e];
+                prims[k].corner_count = el->vertex_count;
+                for (uint32_t c = 0; c < el->vertex_count; c++)
+                    prims[k].corner[c] = mesh->vertices[el->vertex[c]];
+                prims[k++].patch = (uint32_t)i;
+            }
+        } else {
+            prims[k].corner_count = p->corner_count;
+            memcpy(prims[k].corner, p->corner, sizeof p->corner);
+            prims[k++].patch = (uint32_t)i;
+        }
+    }
+    *out = prims;
+    *count = k;
+    return RAD_OK;
+}

@@ -1,0 +1,653 @@
+/*
+ * test_scene.c -- the scene module: the built-in Cornell box against its
+ * published geometry, OBJ+MTL and glTF import (names, areas, reflectance,
+ * emission E = pi * Ke, transforms, camera), the builder's validation, ear
+ * clipping, and one test per kind of bad input (error code AND a message
+ * naming the file, with the line where it is known).
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "scene/scene.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#ifndef RAD_TEST_DATA
+#define RAD_TEST_DATA "tests/data"
+#endif
+
+static char temp_dir[] = "/tmp/rad_test_scene_XXXXXX";
+static rad_context *ctx;
+
+/* ---- helpers ---- */
+
+static void check_close(double actual, double expected, double tolerance, const char *what,
+                        const char *file, int line)
+{
+    if (!(fabs(actual - expected) <= tolerance)) {
+        print_error("%s = %.17g, expected %.17g (tolerance %g)\n", what, actual, expected,
+                    tolerance);
+        _fail(file, line);
+    }
+}
+#define assert_close(actual, expected, tolerance) \
+    check_close((actual), (expected), (tolerance), #actual, __FILE__, __LINE__)
+#define assert_close_relative(actual, expected, relative) \
+    check_close((actual), (expected), (relative) * fabs(expected), #actual, __FILE__, __LINE__)
+
+static void check_contains(const char *text, const char *part, const char *file, int line)
+{
+    if (!strstr(text, part)) {
+        print_error("message \"%s\" does not contain \"%s\"\n", text, part);
+        _fail(file, line);
+    }
+}
+#define assert_contains(text, part) check_contains((text), (part), __FILE__, __LINE__)
+
+/* Write `text` to temp_dir/name; returns the path (static, overwritten by
+ * the next call). */
+static const char *write_temp(const char *name, const char *text)
+{
+    static char path[512];
+    snprintf(path, sizeof path, "%s/%s", temp_dir, name);
+    FILE *file = fopen(path, "wb");
+    assert_non_null(file);
+    assert_int_equal(fwrite(text, 1, strlen(text), file), strlen(text));
+    assert_int_equal(fclose(file), 0);
+    return path;
+}
+
+static size_t surface_index(const rad_scene *scene, const char *name)
+{
+    for (size_t i = 0; i < rad_scene_surface_count(scene); i++)
+        if (strcmp(rad_scene_surface_name(scene, i), name) == 0)
+            return i;
+    print_error("no surface '%s'\n", name);
+    fail();
+    return 0;
+}
+
+/* The material of the first polygon of a surface. */
+static const rad_material *surface_material(const rad_scene *scene, size_t surface)
+{
+    for (size_t p = 0; p < scene->polygon_count; p++)
+        if (scene->polygons[p].surface == surface)
+            return &scene->materials[scene->polygons[p].material];
+    fail();
+    return NULL;
+}
+
+/* Twice the signed area of a 2D polygon (shoelace), for independent checks. */
+static double shoelace(const double (*xy)[2], size_t n)
+{
+    double twice = 0.0;
+    for (size_t i = 0; i < n; i++)
+        twice += xy[i][0] * xy[(i + 1) % n][1] - xy[(i + 1) % n][0] * xy[i][1];
+    return 0.5 * twice;
+}
+
+/* ---- the Cornell box ---- */
+
+static void check_cornell_geometry(const rad_scene *scene)
+{
+    static const char *const names[] = {"floor",      "ceiling",   "light",       "back_wall",
+                                        "right_wall", "left_wall", "short_block", "tall_block"};
+    assert_int_equal(rad_scene_surface_count(scene), 8);
+    for (size_t i = 0; i < 8; i++)
+        assert_string_equal(rad_scene_surface_name(scene, i), names[i]);
+    assert_null(rad_scene_surface_name(scene, 8));
+    /* floor 1, ceiling 4 quads around the light, light 1, back 1, right 1,
+     * left 2 triangles, blocks 5 faces each */
+    assert_int_equal(rad_scene_polygon_count(scene), 20);
+
+    /* The floor quad, (x, z) as published (in metres). */
+    static const double floor_xz[4][2] = {
+        {0.5528, 0.0}, {0.0, 0.0}, {0.0, 0.5592}, {0.5496, 0.5592}};
+    assert_close(rad_scene_surface_area(scene, 0), fabs(shoelace(floor_xz, 4)), 1e-12);
+    assert_close(rad_scene_surface_area(scene, 1), 0.556 * 0.5592 - 0.13 * 0.105, 1e-9);
+    assert_close(rad_scene_surface_area(scene, 2), 0.13 * 0.105, 1e-12);
+
+    const rad_material *light = surface_material(scene, 2);
+    assert_close_relative(light->emission[0], M_PI * 17.1972, 1e-9);
+    assert_close_relative(light->emission[1], M_PI * 11.4744, 1e-9);
+    assert_close_relative(light->emission[2], M_PI * 3.0619, 1e-9);
+    const rad_material *white = surface_material(scene, 0);
+    assert_string_equal(white->name, "white");
+    assert_close(white->reflectance[0], 0.7378, 1e-12);
+    assert_close(white->reflectance[1], 0.7361, 1e-12);
+    assert_close(white->reflectance[2], 0.7374, 1e-12);
+    assert_close(white->emission[0], 0.0, 0.0);
+    assert_true(rad_scene_has_emitter(scene));
+
+    /* Winding: the floor faces up into the room, the light down into it. */
+    for (size_t p = 0; p < scene->polygon_count; p++) {
+        const rad_polygon *polygon = &scene->polygons[p];
+        if (polygon->surface == 0)
+            assert_close(polygon->normal.y, 1.0, 1e-12);
+        if (polygon->surface == 2)
+            assert_close(polygon->normal.y, -1.0, 1e-12);
+    }
+    assert_close(rad_scene_diagonal(scene), sqrt(0.556 * 0.556 + 0.5488 * 0.5488 +
+                                                 0.5592 * 0.5592), 1e-12);
+}
+
+static void test_cornell_box(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    check_cornell_geometry(scene);
+    assert_string_equal(scene->source, "cornell-box");
+
+    rad_camera camera;
+    assert_int_equal(rad_scene_camera(scene, &camera), 1);
+    assert_close(camera.vfov_degrees, 39.3076, 1e-3);
+    assert_close(camera.position[0], 0.278, 0.0);
+    assert_close(camera.position[1], 0.273, 0.0);
+    assert_close(camera.position[2], -0.8, 0.0);
+    assert_close(camera.look_at[2] - camera.position[2], 0.8, 1e-15); /* looks along +z */
+    assert_close(camera.up[1], 1.0, 0.0);
+    rad_scene_destroy(scene);
+}
+
+/* The same box from the files on disk: the MTL is found next to the OBJ. */
+static void test_cornell_box_file(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_file(ctx, RAD_TEST_DATA "/cornell_box.obj", &scene), RAD_OK);
+    check_cornell_geometry(scene);
+    rad_camera none;
+    assert_false(rad_scene_camera(scene, &none));
+    assert_true(scene->load_seconds >= 0.0);
+    rad_scene_destroy(scene);
+}
+
+/* ---- OBJ + MTL from memory ---- */
+
+static const char lamp_obj[] = "mtllib lamp.mtl\n"
+                               "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
+                               "v 0 0 1\nv 1 0 1\nv 0 1 1\n"
+                               "o panel\nusemtl grey\nf 1 2 3 4\n"
+                               "o lamp\nusemtl glow\nf -3 -2 -1\n";
+static const char lamp_mtl[] = "newmtl grey\nKd 0.5 0.25 0.125\n"
+                               "newmtl glow\nKd 0.1 0.1 0.1\nKe 2 1 0.5\n";
+
+static void test_obj_from_memory(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "lamp.obj", lamp_obj, strlen(lamp_obj),
+                                           lamp_mtl, strlen(lamp_mtl), &scene),
+                     RAD_OK);
+    assert_int_equal(rad_scene_surface_count(scene), 2);
+    size_t panel = surface_index(scene, "panel"), lamp = surface_index(scene, "lamp");
+    assert_close(rad_scene_surface_area(scene, panel), 2.0, 1e-15);
+    assert_close(rad_scene_surface_area(scene, lamp), 0.5, 1e-15);
+    const rad_material *grey = surface_material(scene, panel);
+    assert_close(grey->reflectance[0], 0.5, 0.0);
+    assert_close(grey->reflectance[1], 0.25, 0.0);
+    assert_close(grey->reflectance[2], 0.125, 0.0);
+    assert_close(grey->emission[0], 0.0, 0.0);
+    const rad_material *glow = surface_material(scene, lamp);
+    assert_close(glow->emission[0], M_PI * 2.0, 1e-14);
+    assert_close(glow->emission[1], M_PI * 1.0, 1e-14);
+    assert_close(glow->emission[2], M_PI * 0.5, 1e-14);
+    /* The lamp's relative indices -3 -2 -1 are vertices 5 6 7 at z = 1. */
+    const rad_polygon *triangle = &scene->polygons[scene->polygons[0].surface == lamp ? 0 : 1];
+    assert_int_equal(triangle->vertex_count, 3);
+    assert_close(scene->positions[scene->indices[triangle->first_index]].z, 1.0, 0.0);
+    rad_camera none;
+    assert_false(rad_scene_camera(scene, &none));
+    assert_true(rad_scene_has_emitter(scene));
+    rad_scene_destroy(scene);
+}
+
+/* `g` names a surface like `o`; with no name at all assimp says "defaultobject". */
+static void test_obj_groups(void **state)
+{
+    (void)state;
+    static const char obj[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                              "f 1 2 3\n"
+                              "g wall\nf 1 3 4\nf 1 2\n";
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "groups.obj", obj, strlen(obj), NULL, 0, &scene),
+                     RAD_OK);
+    assert_int_equal(rad_scene_surface_count(scene), 2);
+    assert_string_equal(rad_scene_surface_name(scene, 0), "defaultobject");
+    assert_string_equal(rad_scene_surface_name(scene, 1), "wall");
+    assert_int_equal(rad_scene_polygon_count(scene), 2); /* the 2-vertex face is skipped */
+    assert_false(rad_scene_has_emitter(scene));
+    rad_scene_destroy(scene);
+}
+
+/* ---- glTF 2.0 ---- */
+
+/* A unit quad (4 float positions, 6 ushort indices, base64) used by two
+ * nodes: "lamp" moved up by 2, and "big" scaled by 2 inside "group" moved
+ * by 10 in x.  Emissive (1, 0.5, 0.25) at strength 4; a camera node at
+ * z = 5 with yfov 0.5 rad. */
+static const char quad_gltf[] =
+    "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0,\n"
+    " \"scenes\": [{\"nodes\": [0, 1, 2]}],\n"
+    " \"nodes\": [{\"name\": \"lamp\", \"mesh\": 0, \"translation\": [0, 2, 0]},\n"
+    "            {\"name\": \"cam\", \"camera\": 0, \"translation\": [0, 0, 5]},\n"
+    "            {\"name\": \"group\", \"translation\": [10, 0, 0], \"children\": [3]},\n"
+    "            {\"name\": \"big\", \"mesh\": 0, \"scale\": [2, 2, 2]}],\n"
+    " \"cameras\": [{\"type\": \"perspective\",\n"
+    "               \"perspective\": {\"yfov\": 0.5, \"aspectRatio\": 1.5, \"znear\": 0.1}}],\n"
+    " \"meshes\": [{\"name\": \"quadmesh\",\n"
+    "             \"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1,\n"
+    "                             \"material\": 0}]}],\n"
+    " \"materials\": [{\"name\": \"glow\",\n"
+    "                \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.4, 0.3, 1]},\n"
+    "                \"emissiveFactor\": [1, 0.5, 0.25],\n"
+    "                \"extensions\": {\"KHR_materials_emissive_strength\":\n"
+    "                               {\"emissiveStrength\": 4}}}],\n"
+    " \"extensionsUsed\": [\"KHR_materials_emissive_strength\"],\n"
+    " \"buffers\": [{\"byteLength\": 60, \"uri\": \"data:application/octet-stream;base64,"
+    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA\"}],\n"
+    " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48},\n"
+    "                  {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 12}],\n"
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4,\n"
+    "                \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]},\n"
+    "               {\"bufferView\": 1, \"componentType\": 5123, \"count\": 6,\n"
+    "                \"type\": \"SCALAR\"}]}\n";
+
+static void check_quad_gltf(const rad_scene *scene)
+{
+    assert_int_equal(rad_scene_surface_count(scene), 2);
+    assert_string_equal(rad_scene_surface_name(scene, 0), "lamp"); /* node, not mesh, name */
+    assert_string_equal(rad_scene_surface_name(scene, 1), "big");
+    assert_int_equal(rad_scene_polygon_count(scene), 4);
+    assert_close(rad_scene_surface_area(scene, 0), 1.0, 1e-12);
+    assert_close(rad_scene_surface_area(scene, 1), 4.0, 1e-12); /* scaled by 2 */
+    /* lamp at y in [2, 3]; big at x in [10, 12] (parent * child) */
+    assert_close(scene->bounds_min.x, 0.0, 0.0);
+    assert_close(scene->bounds_max.x, 12.0, 1e-12);
+    assert_close(scene->bounds_max.y, 3.0, 1e-12);
+    for (size_t p = 0; p < scene->polygon_count; p++)
+        if (scene->polygons[p].surface == 0)
+            for (uint32_t k = 0; k < scene->polygons[p].vertex_count; k++)
+                assert_true(scene->positions[scene->indices[scene->polygons[p].first_index + k]]
+                                .y >= 2.0);
+
+    const rad_material *glow = surface_material(scene, 0);
+    assert_close(glow->emission[0], M_PI * 4.0 * 1.0, 1e-12);
+    assert_close(glow->emission[1], M_PI * 4.0 * 0.5, 1e-12);
+    assert_close(glow->emission[2], M_PI * 4.0 * 0.25, 1e-12);
+    assert_close(glow->reflectance[0], 0.5, 1e-12);
+    assert_close(glow->reflectance[1], 0.4, 1e-12);
+    assert_close(glow->reflectance[2], 0.3, 1e-12);
+
+    rad_camera camera;
+    assert_int_equal(rad_scene_camera(scene, &camera), 1);
+    assert_close(camera.position[2], 5.0, 1e-12); /* the node's translation, counted once */
+    assert_close(camera.look_at[2], 4.0, 1e-12);  /* glTF cameras look down -z */
+    assert_close(camera.up[1], 1.0, 1e-12);
+    assert_close(camera.vfov_degrees, 0.5 * 180.0 / M_PI, 1e-9);
+}
+
+static void test_gltf(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_file(ctx, write_temp("quad.gltf", quad_gltf), &scene),
+                     RAD_OK);
+    check_quad_gltf(scene);
+    rad_scene_destroy(scene);
+    scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "quad.gltf", quad_gltf, strlen(quad_gltf), NULL,
+                                           0, &scene),
+                     RAD_OK);
+    check_quad_gltf(scene);
+    rad_scene_destroy(scene);
+}
+
+/* ---- the builder ---- */
+
+static void test_builder_surfaces_and_materials(void **state)
+{
+    (void)state;
+    const double grey[3] = {0.5, 0.5, 0.5}, black[3] = {0.0, 0.0, 0.0};
+    const vec3 square[] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 0}};
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "built");
+    int unused_material = rad_scene_builder_material(b, "unused", grey, black);
+    int material = rad_scene_builder_material(b, "grey", grey, black);
+    assert_int_equal(unused_material, 0);
+    assert_int_equal(material, 1);
+    int a = rad_scene_builder_surface(b, "a");
+    int empty = rad_scene_builder_surface(b, "empty");
+    int c = rad_scene_builder_surface(b, "c");
+    assert_int_equal(rad_scene_builder_surface(b, "a"), a); /* same name, same surface */
+    assert_int_equal(empty, 1);
+    /* The repeated vertex and the closing copy of the first are dropped. */
+    assert_int_equal(rad_scene_builder_polygon(b, a, material, square, 6, 0), RAD_OK);
+    assert_int_equal(rad_scene_builder_polygon(b, c, material, square, 3, 0), RAD_OK);
+    assert_int_equal(rad_scene_builder_polygon(b, a, material, square, 3, 0), RAD_OK);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_OK);
+    assert_int_equal(rad_scene_surface_count(scene), 2); /* "empty" is dropped */
+    assert_string_equal(rad_scene_surface_name(scene, 0), "a");
+    assert_string_equal(rad_scene_surface_name(scene, 1), "c");
+    assert_close(rad_scene_surface_area(scene, 0), 1.5, 1e-15);
+    assert_close(rad_scene_surface_area(scene, 1), 0.5, 1e-15);
+    assert_int_equal(scene->material_count, 1); /* "unused" is dropped */
+    assert_string_equal(scene->materials[0].name, "grey");
+    assert_int_equal(scene->polygons[0].vertex_count, 4);
+    assert_int_equal(scene->polygons[1].surface, 1);
+    assert_int_equal(scene->polygons[2].surface, 0);
+    assert_false(rad_scene_has_emitter(scene));
+    rad_scene_destroy(scene);
+}
+
+/* A quad with one corner lifted is split into two triangles; a planar
+ * non-convex pentagon stays one polygon. */
+static void test_builder_non_planar(void **state)
+{
+    (void)state;
+    const double grey[3] = {0.5, 0.5, 0.5}, black[3] = {0.0, 0.0, 0.0};
+    const vec3 bent[] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0.1}, {0, 1, 0}};
+    const vec3 arrow[] = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {1, 1, 0}, {0, 2, 0}};
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "bent.obj");
+    int material = rad_scene_builder_material(b, "grey", grey, black);
+    int surface = rad_scene_builder_surface(b, "bent");
+    int flat = rad_scene_builder_surface(b, "arrow");
+    assert_int_equal(rad_scene_builder_polygon(b, surface, material, bent, 4, 3), RAD_OK);
+    assert_int_equal(rad_scene_builder_polygon(b, flat, material, arrow, 5, 4), RAD_OK);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_OK);
+    assert_int_equal(rad_scene_polygon_count(scene), 3);
+    double expected = 0.0;
+    for (size_t p = 0; p < 2; p++) {
+        const rad_polygon *triangle = &scene->polygons[p];
+        assert_int_equal(triangle->vertex_count, 3);
+        assert_int_equal(triangle->surface, 0);
+        const vec3 *v = &scene->positions[scene->indices[triangle->first_index]];
+        vec3 cross = v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0]));
+        expected += 0.5 * v3_length(cross);
+        assert_true(v3_dot(cross, triangle->normal) > 0.0); /* winding kept */
+        assert_true(triangle->normal.z > 0.9);
+    }
+    assert_close(rad_scene_surface_area(scene, 0), expected, 1e-15);
+    assert_true(expected > 1.0 && expected < 1.01); /* lifting a corner by 0.1 adds < 1 % */
+    assert_int_equal(scene->polygons[2].vertex_count, 5);
+    assert_close(rad_scene_surface_area(scene, 1), 3.0, 1e-15);
+    rad_scene_destroy(scene);
+}
+
+static void test_builder_errors(void **state)
+{
+    (void)state;
+    const double grey[3] = {0.5, 0.5, 0.5}, black[3] = {0.0, 0.0, 0.0};
+    const double bright[3] = {0.5, 1.2, 0.5}, negative[3] = {0.0, -1.0, 0.0};
+    vec3 triangle[] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const vec3 bowtie[] = {{0, 0, 0}, {2, 1, 0}, {2, 0, 0}, {0, 2, 0}};
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "box.obj");
+    assert_int_equal(rad_scene_builder_material(b, "white", bright, black), -1);
+    assert_int_equal(ctx->last_result, RAD_ERROR_INVALID_SCENE);
+    assert_string_equal(rad_context_error(ctx),
+                        "box.obj: material 'white': reflectance 1.2 is outside [0, 1)");
+    assert_int_equal(rad_scene_builder_material(b, "lamp", grey, negative), -1);
+    assert_contains(rad_context_error(ctx), "material 'lamp': emission -1");
+    int material = rad_scene_builder_material(b, "grey", grey, black);
+    int surface = rad_scene_builder_surface(b, "wall");
+
+    triangle[1].y = NAN;
+    assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 3, 7),
+                     RAD_ERROR_INVALID_SCENE);
+    assert_string_equal(rad_context_error(ctx),
+                        "box.obj:7: polygon in surface 'wall' has a non-finite coordinate");
+    assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 3, 0),
+                     RAD_ERROR_INVALID_SCENE);
+    assert_string_equal(rad_context_error(ctx),
+                        "box.obj: polygon in surface 'wall' has a non-finite coordinate");
+    triangle[1] = v3(1e-7, 1e-7, 0.0); /* on the line through the others, nearly */
+    triangle[2] = v3(1.0, 1.0 + 1e-13, 0.0);
+    assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 3, 0),
+                     RAD_ERROR_INVALID_SCENE);
+    assert_contains(rad_context_error(ctx), "has zero area");
+    assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 2, 0),
+                     RAD_ERROR_INVALID_SCENE);
+    assert_contains(rad_context_error(ctx), "has 2 distinct vertices");
+    assert_int_equal(rad_scene_builder_polygon(b, surface, material, bowtie, 4, 9),
+                     RAD_ERROR_INVALID_SCENE);
+    assert_string_equal(rad_context_error(ctx),
+                        "box.obj:9: polygon in surface 'wall' intersects itself");
+    assert_int_equal(rad_scene_builder_polygon(b, surface + 5, material, bowtie, 4, 9),
+                     RAD_ERROR_INVALID_ARGUMENT);
+
+    rad_scene sentinel, *scene = &sentinel; /* must come back NULL */
+    assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_ERROR_INVALID_SCENE);
+    assert_null(scene);
+    assert_string_equal(rad_context_error(ctx), "box.obj: scene is empty (no polygons)");
+}
+
+/* ---- ear clipping ---- */
+
+static double triangles_area(const vec3 *v, const uint32_t *t, size_t count, vec3 normal)
+{
+    double area = 0.0;
+    for (size_t i = 0; i < count; i++) {
+        vec3 cross = v3_cross(v3_sub(v[t[3 * i + 1]], v[t[3 * i]]),
+                              v3_sub(v[t[3 * i + 2]], v[t[3 * i]]));
+        double signed_area = 0.5 * v3_dot(cross, normal);
+        assert_true(fabs(signed_area) > 1e-9); /* no slivers from collinear vertices */
+        area += signed_area;
+    }
+    return area;
+}
+
+static void test_triangulate_l_shape(void **state)
+{
+    (void)state;
+    /* An L: the 2 x 2 square without its top-right unit square; area 3. */
+    const vec3 l_shape[] = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
+    uint32_t t[12];
+    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, 1), t), 4);
+    assert_close(triangles_area(l_shape, t, 4, v3(0, 0, 1)), 3.0, 1e-15);
+    assert_close(0.5 * v3_length(rad_polygon_newell(l_shape, 6)), 3.0, 1e-15);
+
+    /* Seen from the other side (clockwise about the normal) the triangles
+     * keep the polygon's own winding. */
+    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, -1), t), 4);
+    assert_close(triangles_area(l_shape, t, 4, v3(0, 0, 1)), 3.0, 1e-15);
+
+    /* The same L standing in the x = 5 plane, tilted normal. */
+    vec3 standing[6];
+    for (int i = 0; i < 6; i++)
+        standing[i] = v3(5.0, l_shape[i].x, l_shape[i].y);
+    assert_int_equal(rad_triangulate_polygon(standing, 6, v3(1, 0.01, 0), t), 4);
+    assert_close(triangles_area(standing, t, 4, v3(1, 0, 0)), 3.0, 1e-15);
+}
+
+static void test_triangulate_collinear(void **state)
+{
+    (void)state;
+    /* The unit square with a vertex in the middle of each side. */
+    const vec3 square[] = {{0, 0, 0},   {0.5, 0, 0}, {1, 0, 0},   {1, 0.5, 0},
+                           {1, 1, 0},   {0.5, 1, 0}, {0, 1, 0},   {0, 0.5, 0}};
+    uint32_t t[18];
+    assert_int_equal(rad_triangulate_polygon(square, 8, v3(0, 0, 1), t), 6);
+    assert_close(triangles_area(square, t, 6, v3(0, 0, 1)), 1.0, 1e-15);
+}
+
+static void test_triangulate_rejects(void **state)
+{
+    (void)state;
+    uint32_t t[12];
+    /* A symmetric bowtie (area 0) and a lopsided one (area != 0). */
+    const vec3 bowtie[] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 1, 0}};
+    const vec3 lopsided[] = {{0, 0, 0}, {2, 1, 0}, {2, 0, 0}, {0, 2, 0}};
+    const vec3 line[] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+    const vec3 spike[] = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {2, 3, 0}, {2, 1, 0}, {0, 1, 0}};
+    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 1), t), 0);
+    assert_int_equal(rad_triangulate_polygon(lopsided, 4, v3(0, 0, 1), t), 0);
+    assert_int_equal(rad_triangulate_polygon(line, 3, v3(0, 0, 1), t), 0);
+    assert_int_equal(rad_triangulate_polygon(spike, 6, v3(0, 0, 1), t), 0);
+    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 0), t), 0);
+}
+
+/* ---- bad input: the code, and a message naming the file (and line) ---- */
+
+typedef struct bad_input {
+    const char *name;    /* written to temp_dir and loaded */
+    const char *text;
+    const char *mtl_name; /* written too, when not NULL */
+    const char *mtl_text;
+    rad_result expected;
+    const char *message[3]; /* parts the message must contain */
+} bad_input;
+
+static const bad_input bad_inputs[] = {
+    {"garbage.obj", "this is not an obj file\n@@@ ### !!!\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"garbage.obj:1: ", "unknown statement 'this'", NULL}},
+    {"range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nf 1 2 40\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"range.obj:5: face references vertex 40 of 3", NULL, NULL}},
+    {"relative.obj", "v 0 0 0\nf -1 -2 -3\nv 1 0 0\nv 0 1 0\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"relative.obj:2: face references vertex -2 of 1", NULL, NULL}},
+    {"nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"nan.obj:2: vertex coordinate 'nan' is not a finite number", NULL, NULL}},
+    {"word.obj", "v 0 zero 0\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"word.obj:1: vertex coordinate 'zero' is not a finite number", NULL, NULL}},
+    {"bright.obj", "mtllib bright.mtl\nusemtl white\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+     "bright.mtl", "# white\nnewmtl white\nKd 1.2 0.5 0.5\n", RAD_ERROR_INVALID_SCENE,
+     {"bright.mtl:3: ", "material 'white': reflectance (Kd) 1.2 is outside [0, 1)", NULL}},
+    {"dark.obj", "mtllib dark.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "dark.mtl",
+     "newmtl black\nKd -0.1 0.5 0.5\n", RAD_ERROR_INVALID_SCENE,
+     {"dark.mtl:2: ", "reflectance (Kd) -0.1", NULL}},
+    {"ke.obj", "mtllib ke.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "ke.mtl",
+     "newmtl lamp\nKe 1 inf 1\n", RAD_ERROR_PARSE, {"ke.mtl:2: ", "'inf' is not a finite", NULL}},
+    {"nomtl.obj", "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", NULL, NULL,
+     RAD_ERROR_IO, {"nomtl.obj:1: material library 'nowhere.mtl': cannot open", NULL, NULL}},
+    {"collinear.obj", "o stick\nv 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", NULL, NULL,
+     RAD_ERROR_INVALID_SCENE, {"collinear.obj: polygon in surface 'stick' has zero area", NULL,
+                               NULL}},
+    {"empty.obj", "# nothing\n# but comments\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"empty.obj: scene is empty (no polygons)", NULL, NULL}},
+    {"lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"lines.obj: scene is empty (no polygons)", NULL, NULL}},
+    {"bad.gltf", "{ garbage", NULL, NULL, RAD_ERROR_PARSE, {"bad.gltf: ", NULL, NULL}},
+    {"white.gltf",
+     "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": "
+     "[{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, "
+     "\"mode\": 4, \"material\": 0}]}], \"materials\": [{\"name\": \"plain\"}], \"buffers\": "
+     "[{\"byteLength\": 36, \"uri\": \"data:application/octet-stream;base64,"
+     "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}], \"bufferViews\": [{\"buffer\": 0, "
+     "\"byteLength\": 36}], \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, "
+     "\"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}]}",
+     NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"white.gltf: material 'plain': reflectance 1 is outside [0, 1)", NULL, NULL}},
+};
+
+static void check_bad_input(const bad_input *bad, rad_result result, const rad_scene *scene)
+{
+    if (result != bad->expected)
+        print_error("%s: got %s (\"%s\"), expected %s\n", bad->name, rad_result_string(result),
+                    rad_context_error(ctx), rad_result_string(bad->expected));
+    assert_int_equal(result, bad->expected);
+    assert_null(scene);
+    assert_null(strchr(rad_context_error(ctx), '\n'));
+    for (int i = 0; i < 3 && bad->message[i]; i++)
+        assert_contains(rad_context_error(ctx), bad->message[i]);
+}
+
+static void test_bad_files(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof bad_inputs / sizeof bad_inputs[0]; i++) {
+        const bad_input *bad = &bad_inputs[i];
+        if (bad->mtl_name)
+            write_temp(bad->mtl_name, bad->mtl_text);
+        rad_scene sentinel, *scene = &sentinel;
+        rad_result result = rad_scene_load_file(ctx, write_temp(bad->name, bad->text), &scene);
+        check_bad_input(bad, result, scene);
+    }
+}
+
+/* The same inputs from memory, where the MTL travels beside the OBJ. */
+static void test_bad_memory(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof bad_inputs / sizeof bad_inputs[0]; i++) {
+        const bad_input *bad = &bad_inputs[i];
+        if (strcmp(bad->name, "nomtl.obj") == 0)
+            continue; /* from memory a missing MTL just means default materials */
+        rad_scene sentinel, *scene = &sentinel;
+        rad_result result =
+            rad_scene_load_memory(ctx, bad->name, bad->text, strlen(bad->text), bad->mtl_text,
+                                  bad->mtl_text ? strlen(bad->mtl_text) : 0, &scene);
+        check_bad_input(bad, result, scene);
+    }
+}
+
+static void test_missing_file(void **state)
+{
+    (void)state;
+    char path[512];
+    snprintf(path, sizeof path, "%s/missing.obj", temp_dir);
+    rad_scene sentinel, *scene = &sentinel;
+    assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_ERROR_IO);
+    assert_null(scene);
+    char expected[600];
+    snprintf(expected, sizeof expected, "%s: cannot open: No such file or directory", path);
+    assert_string_equal(rad_context_error(ctx), expected);
+    scene = &sentinel;
+    assert_int_equal(rad_scene_load_file(ctx, RAD_TEST_DATA "/missing.gltf", &scene),
+                     RAD_ERROR_IO);
+    assert_null(scene);
+    assert_contains(rad_context_error(ctx), "missing.gltf: cannot open");
+}
+
+/* ---- fixtures ---- */
+
+static int setup(void **state)
+{
+    (void)state;
+    if (!mkdtemp(temp_dir))
+        return -1;
+    return rad_context_create(NULL, &ctx) == RAD_OK ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    static const char *const written[] = {
+        "quad.gltf", "garbage.obj", "range.obj", "relative.obj", "nan.obj",   "word.obj",
+        "bright.obj", "bright.mtl", "dark.obj",  "dark.mtl",     "ke.obj",    "ke.mtl",
+        "nomtl.obj", "collinear.obj", "empty.obj", "lines.obj",  "bad.gltf",  "white.gltf"};
+    for (size_t i = 0; i < sizeof written / sizeof written[0]; i++) {
+        char path[512];
+        snprintf(path, sizeof path, "%s/%s", temp_dir, written[i]);
+        remove(path);
+    }
+    rmdir(temp_dir);
+    rad_context_destroy(ctx);
+    return 0;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cornell_box),
+        cmocka_unit_test(test_cornell_box_file),
+        cmocka_unit_test(test_obj_from_memory),
+        cmocka_unit_test(test_obj_groups),
+        cmocka_unit_test(test_gltf),
+        cmocka_unit_test(test_builder_surfaces_and_materials),
+        cmocka_unit_test(test_builder_non_planar),
+        cmocka_unit_test(test_builder_errors),
+        cmocka_unit_test(test_triangulate_l_shape),
+        cmocka_unit_test(test_triangulate_collinear),
+        cmocka_unit_test(test_triangulate_rejects),
+        cmocka_unit_test(test_bad_files),
+        cmocka_unit_test(test_bad_memory),
+        cmocka_unit_test(test_missing_file),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
