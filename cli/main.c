@@ -15,6 +15,7 @@
 #include "radiosity.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -379,6 +380,13 @@ static int fail(rad_context *ctx, rad_result r)
 
 static int interrupted_status(void) { return cancel_signal == SIGTERM ? 143 : 130; }
 
+/* The absolute path of a file just written, for telling the user where it
+ * is; falls back to the name as given. */
+static const char *where(const char *path, char *buf)
+{
+    return realpath(path, buf) ? buf : path;
+}
+
 int main(int argc, char **argv)
 {
     settings s;
@@ -458,8 +466,9 @@ int main(int argc, char **argv)
             status = fail(ctx, r);
             goto done;
         }
+        char full[PATH_MAX];
         if (!s.quiet)
-            printf("wrote %s (%zu surfaces, %zu elements, %.2f s)\n", output,
+            printf("wrote %s (%zu surfaces, %zu elements, %.2f s)\n", where(output, full),
                    rad_scene_surface_count(scene), rad_solution_element_count(sol),
                    now_seconds() - t0);
         status = 0;
@@ -493,8 +502,9 @@ int main(int argc, char **argv)
         status = fail(ctx, r);
         goto done;
     }
+    char full[PATH_MAX];
     if (!s.quiet)
-        printf("wrote %s (%dx%d, %zu elements, residual %.2g, %.1f s)%s\n", output,
+        printf("wrote %s (%dx%d, %zu elements, residual %.2g, %.1f s)%s\n", where(output, full),
                rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
                rad_solution_residual(sol), now_seconds() - t0, partial ? " [partial]" : "");
     status = partial ? interrupted_status() : 0;

@@ -415,6 +415,9 @@ static void test_builder_errors(void **state)
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 2, 0),
                      RAD_ERROR_INVALID_SCENE);
     assert_contains(rad_context_error(ctx), "has 2 distinct vertices");
+    assert_int_equal(rad_scene_builder_polygon(b, surface, material, NULL, 0, 0),
+                     RAD_ERROR_INVALID_SCENE);
+    assert_contains(rad_context_error(ctx), "has 0 distinct vertices");
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, bowtie, 4, 9),
                      RAD_ERROR_INVALID_SCENE);
     assert_string_equal(rad_context_error(ctx),
@@ -515,6 +518,21 @@ static const bad_input bad_inputs[] = {
      {"nan.obj:2: vertex coordinate 'nan' is not a finite number", NULL, NULL}},
     {"word.obj", "v 0 zero 0\n", NULL, NULL, RAD_ERROR_PARSE,
      {"word.obj:1: vertex coordinate 'zero' is not a finite number", NULL, NULL}},
+    {"indented.obj", "v 0 0 0\nv 1 0 0\n\tv 0 1 0\nv 0 0 1\nf 1 2 3\n", NULL, NULL,
+     RAD_ERROR_PARSE, {"indented.obj:3: statement 'v' is indented", NULL, NULL}},
+    {"five.obj", "v 0 0 0\nv 1 0 0 1 0\nv 0 1 0\nf 1 2 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"five.obj:2: vertex has 5 numbers", NULL, NULL}},
+    {"point.obj", "v 0 0 0\nv .5 0 0\nv 0 1 0\nf 1 2 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"point.obj:2: vertex coordinate '.5'", NULL, NULL}},
+    {"weight.obj", "v 0 0 0 1\nv 1 0 0 0\nv 0 1 0 1\nf 1 2 3\n", NULL, NULL,
+     RAD_ERROR_INVALID_SCENE, {"weight.obj:2: vertex has weight w = 0", NULL, NULL}},
+    {"normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n", NULL, NULL,
+     RAD_ERROR_PARSE, {"normal.obj:5: face references normal 2 of 1", NULL, NULL}},
+    {"line.obj", "v 0 0 0\nv 1 0 0\nl 1 red\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"line.obj:3: face has a malformed vertex 'red'", NULL, NULL}},
+    {"grey.obj", "mtllib grey.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "grey.mtl",
+     "newmtl grey\n\tKd 0.5\n", RAD_ERROR_PARSE, {"grey.mtl:2: material 'grey': Kd needs 3",
+                                                 NULL, NULL}},
     {"bright.obj", "mtllib bright.mtl\nusemtl white\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
      "bright.mtl", "# white\nnewmtl white\nKd 1.2 0.5 0.5\n", RAD_ERROR_INVALID_SCENE,
      {"bright.mtl:3: ", "material 'white': reflectance (Kd) 1.2 is outside [0, 1)", NULL}},
@@ -614,21 +632,24 @@ static int setup(void **state)
     return rad_context_create(NULL, &ctx) == RAD_OK ? 0 : -1;
 }
 
+static void remove_temp(const char *name)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", temp_dir, name);
+    remove(path);
+}
+
 static int teardown(void **state)
 {
     (void)state;
-    static const char *const written[] = {
-        "quad.gltf", "garbage.obj", "range.obj", "relative.obj", "nan.obj",   "word.obj",
-        "bright.obj", "bright.mtl", "dark.obj",  "dark.mtl",     "ke.obj",    "ke.mtl",
-        "nomtl.obj", "collinear.obj", "empty.obj", "lines.obj",  "bad.gltf",  "white.gltf"};
-    for (size_t i = 0; i < sizeof written / sizeof written[0]; i++) {
-        char path[512];
-        snprintf(path, sizeof path, "%s/%s", temp_dir, written[i]);
-        remove(path);
+    remove_temp("quad.gltf");
+    for (size_t i = 0; i < sizeof bad_inputs / sizeof bad_inputs[0]; i++) {
+        remove_temp(bad_inputs[i].name);
+        if (bad_inputs[i].mtl_name)
+            remove_temp(bad_inputs[i].mtl_name);
     }
-    rmdir(temp_dir);
     rad_context_destroy(ctx);
-    return 0;
+    return rmdir(temp_dir) == 0 ? 0 : -1; /* fails if a file was left behind */
 }
 
 int main(void)

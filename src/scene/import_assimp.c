@@ -35,7 +35,6 @@
 
 #include <ctype.h>
 #include <errno.h>
-#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -108,10 +107,10 @@ static void rest_of_line(const char *p, const char *end, char *out, size_t size)
 
 typedef enum number_kind { NUMBER_FINITE, NUMBER_NOT_FINITE, NUMBER_GARBAGE } number_kind;
 
-/* A number as OBJ and MTL files write it and as assimp's reader counts it:
- * a digit or sign first, then digits, '.' and an exponent ("1", "-0.5",
- * "2e-3").  assimp skips or misreads ".5" and "0x1p3", so those are
- * garbage here; "nan", "inf" and "1e999" are numbers that are not finite. */
+/* A number as OBJ and MTL files write it: digits, sign, '.' and an
+ * exponent ("1", "-0.5", ".5", "2e-3"); assimp misreads "0x1p3", so that
+ * is garbage here.  "nan", "inf" and "1e999" are numbers that are not
+ * finite. */
 static number_kind parse_number(const char *token, size_t length, double *value)
 {
     if (length == 0 || length >= TOKEN_SIZE)
@@ -122,9 +121,7 @@ static number_kind parse_number(const char *token, size_t length, double *value)
         return NUMBER_GARBAGE;
     if (!isfinite(*value))
         return NUMBER_NOT_FINITE;
-    if (!strchr("0123456789+-", token[0]) || strspn(token, "0123456789+-.eE") != length)
-        return NUMBER_GARBAGE;
-    return NUMBER_FINITE;
+    return strspn(token, "0123456789+-.eE") == length ? NUMBER_FINITE : NUMBER_GARBAGE;
 }
 
 /* ---- pre-scan of OBJ and MTL text: line-numbered errors assimp omits ---- */
@@ -151,7 +148,11 @@ static bool is_obj_statement(const char *token)
  * the file would be silently lost. */
 static bool has_nul(const char *line, const char *end)
 {
-    return memchr(line, '\0', (size_t)(end - line)) != NULL;
+    /* A loop, not memchr: GCC 12 at -O3 misjudges memchr's bound here. */
+    for (const char *c = line; c < end; c++)
+        if (*c == '\0')
+            return true;
+    return false;
 }
 
 /* What the slots of a face vertex "v/vt/vn" index, and their statements. */
@@ -166,13 +167,45 @@ static int face_slot_of(const char *statement)
     return -1;
 }
 
+/* Check one face vertex, "v", "v/vt", "v//vn" or "v/vt/vn": each index
+ * in 1..total, or relative (-1 = the latest seen so far). */
+static rad_result check_face_vertex(rad_context *ctx, const char *path, int line,
+                                    const char *token, const size_t total[3],
+                                    const size_t seen[3])
+{
+    const char *part = token;
+    for (int slot = 0; slot < 3; slot++) {
+        const char *slash = strchr(part, '/');
+        size_t length = slash ? (size_t)(slash - part) : strlen(part);
+        if (length > 0 || slot == 0) {
+            char *after;
+            errno = 0;
+            long index = strtol(part, &after, 10);
+            if (length == 0 || !strchr("0123456789+-", part[0]) || after != part + length)
+                return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: face has a malformed vertex '%s'",
+                                path, line, token);
+            size_t available = index < 0 ? seen[slot] : total[slot];
+            bool in_range = errno == 0 && index != 0 &&
+                            (index > 0 ? (unsigned long)index <= available
+                                       : (unsigned long)(-(index + 1)) < available);
+            if (!in_range)
+                return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: face references %s %ld of %zu",
+                                path, line, face_slot_names[slot], index, available);
+        }
+        if (!slash)
+            return RAD_OK;
+        part = slash + 1;
+    }
+    return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: face has a malformed vertex '%s'", path, line,
+                    token);
+}
+
 /* Check an OBJ where assimp would silently misread it or fail without a
  * line number: text without NUL bytes, known statements, none indented,
  * vertices of 3, 4 or 6 finite numbers (assimp drops other vertices and
- * divides by the 4th), face, line and point indices in range (1..count,
- * or -1 for the latest).  Writes the
- * first `mtllib` name (or "") and its line.  Not a parser: assimp reads
- * the file afterwards. */
+ * divides by the 4th), face, line and point indices in range.  Writes
+ * the first `mtllib` name (or "") and its line.  Not a parser: assimp
+ * reads the file afterwards. */
 static rad_result prescan_obj(rad_context *ctx, const char *path, const char *text, size_t size,
                               char *mtllib, size_t mtllib_size, int *mtllib_line)
 {
@@ -201,6 +234,8 @@ static rad_result prescan_obj(rad_context *ctx, const char *path, const char *te
             double value = 1.0;
             while ((length = next_token(&p, end, token)) > 0) {
                 number_kind kind = parse_number(token, length, &value);
+                if (token[0] == '.') /* assimp does not count ".5" as a coordinate */
+                    kind = NUMBER_GARBAGE;
                 if (kind != NUMBER_FINITE)
                     return rad_fail(ctx,
                                     kind == NUMBER_GARBAGE ? RAD_ERROR_PARSE
@@ -241,34 +276,16 @@ static rad_result prescan_obj(rad_context *ctx, const char *path, const char *te
             strcmp(token, "p") != 0)
             continue;
         while (next_token(&p, end, token) > 0) {
-            const char *part = token;
-            for (int k = 0; k < 3 && *part; k++) {
-                char *after;
-                errno = 0;
-                long index = strtol(part, &after, 10);
-                bool empty = after == part && *part == '/' && k > 0; /* "1//3" */
-                if ((!empty && !strchr("0123456789+-", *part)) || (after == part && !empty) ||
-                    (*after != '\0' && *after != '/') || (k == 2 && *after == '/'))
-                    return rad_fail(ctx, RAD_ERROR_PARSE,
-                                    "%s:%d: face has a malformed vertex '%s'", path,
-                                    lines.number, token);
-                size_t available = index < 0 ? seen[k] : total[k];
-                bool in_range = errno == 0 && index != 0 &&
-                                (index > 0 ? (unsigned long)index <= available
-                                           : (unsigned long)(-(index + 1)) < available);
-                if (!empty && !in_range)
-                    return rad_fail(ctx, RAD_ERROR_PARSE,
-                                    "%s:%d: face references %s %ld of %zu", path,
-                                    lines.number, face_slot_names[k], index, available);
-                part = *after == '/' ? after + 1 : after;
-            }
+            rad_result r = check_face_vertex(ctx, path, lines.number, token, total, seen);
+            if (r != RAD_OK)
+                return r;
         }
     }
     return RAD_OK;
 }
 
-/* Check an MTL: Kd (reflectance) and Ke (emitted radiance) are 1 or 3
- * finite numbers, Kd in [0, 1) and Ke >= 0. */
+/* Check an MTL: Kd (reflectance) and Ke (emitted radiance) are 3 finite
+ * numbers, Kd in [0, 1) and Ke >= 0. */
 static rad_result prescan_mtl(rad_context *ctx, const char *path, const char *text, size_t size)
 {
     char token[TOKEN_SIZE], material[64] = "";
@@ -298,7 +315,7 @@ static rad_result prescan_mtl(rad_context *ctx, const char *path, const char *te
                                 path, lines.number, material, key, token);
             count++;
         }
-        if (count != 1 && count != 3)
+        if (count != 3) /* assimp reads "Kd 0.5" as (0.5, 0, 0) */
             return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: material '%s': %s needs 3 numbers",
                             path, lines.number, material, key);
         for (int c = 0; c < count; c++) {
@@ -371,9 +388,11 @@ static double gltf_first_camera_yfov(const cJSON *root)
 /* ---- from assimp's float to double ---- */
 
 /* assimp keeps coordinates and colours as float.  Map a float back to the
- * shortest decimal of 6 to 9 significant digits that rounds to it, so that
- * 0.5528 in a file is 0.5528 here, not 0.552800000 1; for data that were
- * floats to begin with (glTF buffers) the change is below half an ulp. */
+ * decimal of 6, 7 or 8 significant digits that rounds to it, if there is
+ * one, so that 0.5528 in a file is 0.5528 here and not the float's
+ * 0.55279999971; areas and emissions then match the file to double
+ * precision.  Data that were floats to begin with (glTF buffers) move by
+ * less than half a float ulp. */
 static double decimal_of(ai_real value)
 {
     if (sizeof(ai_real) != sizeof(float) || value == 0 || !isfinite(value))

@@ -245,8 +245,8 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
             return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE,
                                  "has a non-finite coordinate");
 
-    vec3 *polygon = reserve(b, b->polygon_scratch, &b->polygon_scratch_capacity, vertex_count,
-                            sizeof *polygon, "polygon vertices");
+    vec3 *polygon = reserve(b, b->polygon_scratch, &b->polygon_scratch_capacity,
+                            vertex_count + 1, sizeof *polygon, "polygon vertices");
     if (!polygon)
         return RAD_ERROR_OUT_OF_MEMORY;
     b->polygon_scratch = polygon;

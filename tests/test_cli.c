@@ -1,0 +1,337 @@
+/*
+ * test_cli.c -- the `radiosity` command as a user meets it: every bad input
+ * gives exactly one line on stderr that names the file (and the line where
+ * it is known), a non-zero exit status (1 failure, 2 usage), and leaves no
+ * output file behind; good runs print where the result went.  The path of
+ * the binary is argv[1].
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static const char *radiosity_bin;
+static char workdir[256];
+static char err_text[8192], out_text[8192];
+
+static void write_file(const char *name, const char *text)
+{
+    char path[600];
+    snprintf(path, sizeof path, "%s/%s", workdir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void slurp(const char *path, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return;
+    size_t n = fread(buf, 1, size - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+}
+
+/* Run `radiosity ARGS` in the work dir; capture stdout and stderr. */
+static int run(const char *fmt, ...)
+{
+    char args[2048], cmd[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >stdout.txt 2>stderr.txt </dev/null", workdir,
+             radiosity_bin, args);
+    int status = system(cmd);
+    char p[600];
+    snprintf(p, sizeof p, "%s/stderr.txt", workdir);
+    slurp(p, err_text, sizeof err_text);
+    snprintf(p, sizeof p, "%s/stdout.txt", workdir);
+    slurp(p, out_text, sizeof out_text);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static bool exists(const char *name)
+{
+    char path[600];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/%s", workdir, name);
+    return stat(path, &st) == 0;
+}
+
+/* No file whose name starts with `prefix` (the output or its temporary). */
+static void assert_no_output(const char *prefix)
+{
+    DIR *d = opendir(workdir);
+    assert_non_null(d);
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if (strncmp(e->d_name, prefix, strlen(prefix)) == 0)
+            fail_msg("unexpected output file %s", e->d_name);
+    closedir(d);
+}
+
+/* One line on stderr containing every needle. */
+static void assert_one_line_error(const char *needle1, const char *needle2)
+{
+    size_t len = strlen(err_text);
+    if (len == 0 || err_text[len - 1] != '\n' || strchr(err_text, '\n') != err_text + len - 1)
+        fail_msg("expected exactly one line on stderr, got: <%s>", err_text);
+    if (needle1 && !strstr(err_text, needle1))
+        fail_msg("stderr lacks '%s': %s", needle1, err_text);
+    if (needle2 && !strstr(err_text, needle2))
+        fail_msg("stderr lacks '%s': %s", needle2, err_text);
+}
+
+static const char *good_mtl = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
+
+/* A small closed-enough scene: floor and a lamp above it. */
+static const char *good_obj = "mtllib good.mtl\n"
+                              "o floor\nusemtl white\n"
+                              "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
+                              "o lamp\nusemtl lamp\n"
+                              "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n";
+
+/* ---- bad input: the scene ---- */
+
+static void bad_scene(const char *obj_name, const char *obj, const char *mtl_name, const char *mtl,
+                      const char *needle1, const char *needle2)
+{
+    write_file(obj_name, obj);
+    if (mtl_name)
+        write_file(mtl_name, mtl);
+    assert_int_equal(run("render %s -o bad_out.png --stats bad_stats.json", obj_name), 1);
+    assert_one_line_error(needle1, needle2);
+    assert_no_output("bad_out");
+    assert_no_output("bad_stats");
+}
+
+static void test_missing_file(void **state)
+{
+    (void)state;
+    assert_int_equal(run("render no_such_scene.obj -o bad_out.png"), 1);
+    assert_one_line_error("no_such_scene.obj", "No such file");
+    assert_no_output("bad_out");
+}
+
+static void test_malformed_obj(void **state)
+{
+    (void)state;
+    bad_scene("garbage.obj", "this is not\n\x01\x02 an obj file at all {{{\nf 1 2\n", NULL, NULL,
+              "garbage.obj", NULL);
+}
+
+static void test_face_index_out_of_range(void **state)
+{
+    (void)state;
+    bad_scene("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 40\n", NULL, NULL, "range.obj:4", NULL);
+}
+
+static void test_nan_coordinates(void **state)
+{
+    (void)state;
+    bad_scene("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", NULL, NULL, "nan.obj:2", NULL);
+}
+
+static void test_infinite_coordinates(void **state)
+{
+    (void)state;
+    bad_scene("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n", NULL, NULL, "inf.obj:3", NULL);
+}
+
+static void test_zero_area_polygon(void **state)
+{
+    (void)state;
+    bad_scene("flat.obj", "mtllib good.mtl\no sliver\nusemtl lamp\nv 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+              "good.mtl", good_mtl, "flat.obj", "sliver");
+}
+
+static void test_reflectance_too_high(void **state)
+{
+    (void)state;
+    bad_scene("bright.obj", "mtllib bright.mtl\no a\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+              "bright.mtl", "newmtl m\nKd 1.2 0.5 0.5\n", "bright.mtl:2", "1.2");
+}
+
+static void test_reflectance_negative(void **state)
+{
+    (void)state;
+    bad_scene("neg.obj", "mtllib neg.mtl\no a\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+              "neg.mtl", "newmtl m\nKd 0.5 -0.1 0.5\n", "neg.mtl:2", NULL);
+}
+
+static void test_no_emitter(void **state)
+{
+    (void)state;
+    bad_scene("dark.obj", "mtllib good.mtl\no a\nusemtl white\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+              "good.mtl", good_mtl, "dark.obj", "emitter");
+}
+
+static void test_empty_scene(void **state)
+{
+    (void)state;
+    bad_scene("empty.obj", "# nothing here\n", NULL, NULL, "empty.obj", "empty");
+}
+
+static void test_malformed_gltf(void **state)
+{
+    (void)state;
+    bad_scene("broken.gltf", "{ \"asset\": {\"version\": \"2.0\"}, \"meshes\": [ {", NULL, NULL,
+              "broken.gltf", NULL);
+}
+
+/* ---- bad input: the command line ---- */
+
+static void test_unknown_method_names(void **state)
+{
+    (void)state;
+    assert_int_equal(run("render -o bad_out.png --solver nosuch"), 1);
+    assert_one_line_error("nosuch", "gauss-seidel");
+    assert_int_equal(run("render -o bad_out.png --form-factors nosuch"), 1);
+    assert_one_line_error("nosuch", "analytic");
+    assert_int_equal(run("viewfactors -o bad_out.json --visibility nosuch"), 1);
+    assert_one_line_error("nosuch", "embree");
+    assert_no_output("bad_out");
+}
+
+static void test_usage_errors(void **state)
+{
+    (void)state;
+    assert_int_equal(run("render --width abc"), 2);
+    assert_one_line_error("--width", "abc");
+    assert_int_equal(run("render --mesh-size -1"), 2);
+    assert_one_line_error("--mesh-size", NULL);
+    assert_int_equal(run("render --tolerance nan"), 2);
+    assert_one_line_error("--tolerance", NULL);
+    assert_int_equal(run("render --bogus"), 2);
+    assert_one_line_error("--bogus", NULL);
+    assert_int_equal(run("frobnicate"), 2);
+    assert_one_line_error("frobnicate", NULL);
+    assert_int_equal(run("render --camera 1,2,3"), 2);
+    assert_one_line_error("--camera", NULL);
+    assert_int_equal(run("render a.obj b.obj"), 2);
+    assert_one_line_error("more than one scene", NULL);
+    assert_int_equal(run("render --solver"), 2);
+    assert_one_line_error("--solver", NULL);
+    assert_int_equal(run(""), 2);
+    assert_no_output("radiosity.png");
+}
+
+static void test_unwritable_output(void **state)
+{
+    (void)state;
+    write_file("good.obj", good_obj);
+    write_file("good.mtl", good_mtl);
+    assert_int_equal(run("render good.obj --elements 50 -o no_such_dir/out.png"), 1);
+    assert_one_line_error("no_such_dir/out.png", NULL);
+    assert_int_equal(run("render good.obj --elements 50 -o out.xyz"), 1);
+    assert_one_line_error("out.xyz", ".png");
+    assert_no_output("out.xyz");
+}
+
+/* ---- good runs ---- */
+
+static void test_render_reports_output(void **state)
+{
+    (void)state;
+    write_file("good.obj", good_obj);
+    write_file("good.mtl", good_mtl);
+    assert_int_equal(run("render good.obj --elements 50 --width 16 --height 16 -o good.png --stats good.json"), 0);
+    assert_true(exists("good.png"));
+    assert_true(exists("good.json"));
+    assert_non_null(strstr(out_text, "good.png"));
+    assert_string_equal(err_text, ""); /* no progress bar without a terminal */
+    assert_int_equal(run("render good.obj --elements 50 --width 16 --height 16 -o good.pfm -q"), 0);
+    assert_true(exists("good.pfm"));
+    assert_string_equal(out_text, "");
+}
+
+static void test_help_version_methods(void **state)
+{
+    (void)state;
+    assert_int_equal(run("--help"), 0);
+    assert_non_null(strstr(out_text, "--mesh-size"));
+    assert_non_null(strstr(out_text, "viewfactors"));
+    assert_int_equal(run("--version"), 0);
+    assert_non_null(strstr(out_text, "radiosity 0."));
+    assert_int_equal(run("--list-methods"), 0);
+    assert_non_null(strstr(out_text, "analytic"));
+    assert_non_null(strstr(out_text, "southwell"));
+    assert_non_null(strstr(out_text, "brute"));
+}
+
+static void test_viewfactors_csv(void **state)
+{
+    (void)state;
+    write_file("good.obj", good_obj);
+    write_file("good.mtl", good_mtl);
+    assert_int_equal(run("viewfactors good.obj --elements 64 -o vf.csv"), 0);
+    char path[600], text[4096];
+    snprintf(path, sizeof path, "%s/vf.csv", workdir);
+    slurp(path, text, sizeof text);
+    assert_true(strncmp(text, "from,area_m2,floor,lamp\n", 24) == 0);
+    /* Two unit squares 1 m apart, facing: F = 0.1998 both ways. */
+    double area, f_ff, f_fl;
+    assert_int_equal(sscanf(strchr(text, '\n') + 1, "floor,%lf,%lf,%lf", &area, &f_ff, &f_fl), 3);
+    assert_true(fabs(area - 1.0) < 1e-12);
+    assert_true(f_ff == 0.0);
+    assert_true(fabs(f_fl - 0.199824895698) < 2e-4);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(workdir, sizeof workdir, "/tmp/radiosity-cli-XXXXXX");
+    return mkdtemp(workdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    char cmd[400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", workdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_cli PATH_TO_RADIOSITY\n");
+        return 2;
+    }
+    radiosity_bin = argv[1];
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_missing_file),
+        cmocka_unit_test(test_malformed_obj),
+        cmocka_unit_test(test_face_index_out_of_range),
+        cmocka_unit_test(test_nan_coordinates),
+        cmocka_unit_test(test_infinite_coordinates),
+        cmocka_unit_test(test_zero_area_polygon),
+        cmocka_unit_test(test_reflectance_too_high),
+        cmocka_unit_test(test_reflectance_negative),
+        cmocka_unit_test(test_no_emitter),
+        cmocka_unit_test(test_empty_scene),
+        cmocka_unit_test(test_malformed_gltf),
+        cmocka_unit_test(test_unknown_method_names),
+        cmocka_unit_test(test_usage_errors),
+        cmocka_unit_test(test_unwritable_output),
+        cmocka_unit_test(test_render_reports_output),
+        cmocka_unit_test(test_help_version_methods),
+        cmocka_unit_test(test_viewfactors_csv),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
