@@ -292,7 +292,7 @@ static void test_solvers_two_patch(void **state)
     const double area[2] = {1.0, 1.0};
     const double rho[6] = {0.8, 0.5, 0.2, 0.8, 0.5, 0.2};
     const double E[6] = {1.0, 2.0, 3.0, 0.0, 0.0, 0.0};
-    rad_system sys = {2, F, area, rho, E};
+    rad_system sys = {2, F, area, rho, E, 2};
     for (size_t k = 0; rad_solvers[k]; k++) {
         double B[6];
         memcpy(B, E, sizeof B);
@@ -321,7 +321,7 @@ static void test_residual_definition(void **state)
     const double area[2] = {2.0, 2.0};
     const double rho[6] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
     const double E[6] = {1, 1, 1, 0, 0, 0};
-    rad_system sys = {2, F, area, rho, E};
+    rad_system sys = {2, F, area, rho, E, 2};
     /* r_2 = -rho F B_1 = -0.25 per channel; sum A|r| = 2*0.25*3; emitted = 2*3. */
     assert_true(fabs(rad_residual(&sys, E) - 0.25) < 1e-15);
 }

@@ -89,6 +89,7 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     if (!s)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
     s->scene = scene;
+    s->threads = rad_context_threads(ctx);
     s->seconds.load = scene->load_seconds;
     rad_result r = resolve_options(ctx, options, s);
     if (r != RAD_OK) {
@@ -152,7 +153,7 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
                         s->scene->source);
-    rad_system sys = {s->mesh->element_count, s->F, s->area, s->reflectance, s->emission};
+    rad_system sys = {s->mesh->element_count, s->F, s->area, s->reflectance, s->emission, s->threads};
     rad_solve_params p = {s->options.tolerance, s->options.max_iterations};
     const rad_solver *solver = rad_solver_find(s->options.solver);
     memcpy(s->radiosity, s->emission, 3 * sys.n * sizeof *s->radiosity);
@@ -223,20 +224,32 @@ void rad_solution_surface_view_factors(const rad_solution *s, double *F)
 
 void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed)
 {
+    /* Per-element absorption in parallel, summed in order (thread-independent). */
     size_t n = s->mesh->element_count;
+    double *absorbed_by = malloc((n ? n : 1) * sizeof *absorbed_by);
     double em = 0.0, ab = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : em, ab)
+    if (!absorbed_by) {
+        *emitted = *absorbed = NAN;
+        return;
+    }
+#pragma omp parallel for schedule(static) num_threads(s->threads)
     for (size_t i = 0; i < n; i++) {
         const float *Fi = s->F + i * n;
         double h[3] = {0, 0, 0};
         for (size_t j = 0; j < n; j++)
             for (int c = 0; c < 3; c++)
                 h[c] += Fi[j] * s->radiosity[3 * j + c];
-        for (int c = 0; c < 3; c++) {
-            em += s->area[i] * s->emission[3 * i + c];
-            ab += s->area[i] * (1.0 - s->reflectance[3 * i + c]) * h[c];
-        }
+        double a = 0.0;
+        for (int c = 0; c < 3; c++)
+            a += s->area[i] * (1.0 - s->reflectance[3 * i + c]) * h[c];
+        absorbed_by[i] = a;
     }
+    for (size_t i = 0; i < n; i++) {
+        ab += absorbed_by[i];
+        for (int c = 0; c < 3; c++)
+            em += s->area[i] * s->emission[3 * i + c];
+    }
+    free(absorbed_by);
     *emitted = em / 3.0;
     *absorbed = ab / 3.0;
 }

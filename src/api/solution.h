@@ -12,6 +12,7 @@
 struct rad_solution {
     const rad_scene *scene;    /* borrowed: must outlive the solution */
     rad_options options;       /* resolved defaults */
+    int threads;               /* the context's, for parallel passes */
     char form_factor_name[32];
     char solver_name[32];
     char visibility_name[32];

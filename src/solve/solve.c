@@ -23,11 +23,16 @@ const rad_solver *rad_solver_find(const char *name)
     return NULL;
 }
 
+/* Rows in parallel, each into its own slot, then a sequential sum: the
+ * result is bit-identical whatever the thread count (a reduction clause
+ * would add in a thread-dependent order). */
 double rad_residual(const rad_system *sys, const double *B)
 {
     size_t n = sys->n;
-    double num = 0.0, den = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : num, den)
+    double *row = malloc((n ? n : 1) * sizeof *row);
+    if (!row)
+        return INFINITY; /* cannot measure: never reported as converged */
+#pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
     for (size_t i = 0; i < n; i++) {
         const float *Fi = sys->F + i * n;
         double g0 = 0.0, g1 = 0.0, g2 = 0.0;
@@ -38,10 +43,15 @@ double rad_residual(const rad_system *sys, const double *B)
             g2 += f * B[3 * j + 2];
         }
         const double *rho = sys->reflectance + 3 * i, *E = sys->emission + 3 * i;
-        double a = sys->area[i];
-        num += a * (fabs(B[3 * i] - E[0] - rho[0] * g0) + fabs(B[3 * i + 1] - E[1] - rho[1] * g1) +
-                    fabs(B[3 * i + 2] - E[2] - rho[2] * g2));
-        den += a * (E[0] + E[1] + E[2]);
+        row[i] = sys->area[i] * (fabs(B[3 * i] - E[0] - rho[0] * g0) +
+                                 fabs(B[3 * i + 1] - E[1] - rho[1] * g1) +
+                                 fabs(B[3 * i + 2] - E[2] - rho[2] * g2));
     }
+    double num = 0.0, den = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        num += row[i];
+        den += sys->area[i] * (sys->emission[3 * i] + sys->emission[3 * i + 1] + sys->emission[3 * i + 2]);
+    }
+    free(row);
     return den > 0.0 ? num / den : num;
 }

@@ -19,6 +19,7 @@ typedef struct rad_system {
     const double *area;       /* n, m^2 */
     const double *reflectance;/* 3n, interleaved RGB */
     const double *emission;   /* 3n, W/m^2 */
+    int threads;              /* for the O(n^2) passes that run in parallel */
 } rad_system;
 
 typedef struct rad_solve_params {
