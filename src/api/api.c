@@ -234,11 +234,8 @@ void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed
     }
 #pragma omp parallel for schedule(static) num_threads(s->threads)
     for (size_t i = 0; i < n; i++) {
-        const float *Fi = s->F + i * n;
-        double h[3] = {0, 0, 0};
-        for (size_t j = 0; j < n; j++)
-            for (int c = 0; c < 3; c++)
-                h[c] += Fi[j] * s->radiosity[3 * j + c];
+        double h[3];
+        rad_gather(s->F + i * n, s->radiosity, n, h);
         double a = 0.0;
         for (int c = 0; c < 3; c++)
             a += s->area[i] * (1.0 - s->reflectance[3 * i + c]) * h[c];

@@ -34,18 +34,12 @@ double rad_residual(const rad_system *sys, const double *B)
         return INFINITY; /* cannot measure: never reported as converged */
 #pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
     for (size_t i = 0; i < n; i++) {
-        const float *Fi = sys->F + i * n;
-        double g0 = 0.0, g1 = 0.0, g2 = 0.0;
-        for (size_t j = 0; j < n; j++) {
-            double f = Fi[j];
-            g0 += f * B[3 * j];
-            g1 += f * B[3 * j + 1];
-            g2 += f * B[3 * j + 2];
-        }
+        double g[3];
+        rad_gather(sys->F + i * n, B, n, g);
         const double *rho = sys->reflectance + 3 * i, *E = sys->emission + 3 * i;
-        row[i] = sys->area[i] * (fabs(B[3 * i] - E[0] - rho[0] * g0) +
-                                 fabs(B[3 * i + 1] - E[1] - rho[1] * g1) +
-                                 fabs(B[3 * i + 2] - E[2] - rho[2] * g2));
+        row[i] = sys->area[i] * (fabs(B[3 * i] - E[0] - rho[0] * g[0]) +
+                                 fabs(B[3 * i + 1] - E[1] - rho[1] * g[1]) +
+                                 fabs(B[3 * i + 2] - E[2] - rho[2] * g[2]));
     }
     double num = 0.0, den = 0.0;
     for (size_t i = 0; i < n; i++) {

@@ -47,6 +47,21 @@ typedef struct rad_solver {
 extern const rad_solver *const rad_solvers[]; /* NULL-terminated */
 const rad_solver *rad_solver_find(const char *name);
 
+/* Irradiance gathered by one row: g[c] = sum_j F_ij B_jc (B interleaved RGB). */
+static inline void rad_gather(const float *F_row, const double *B, size_t n, double g[3])
+{
+    double g0 = 0.0, g1 = 0.0, g2 = 0.0;
+    for (size_t j = 0; j < n; j++) {
+        double f = F_row[j];
+        g0 += f * B[3 * j];
+        g1 += f * B[3 * j + 1];
+        g2 += f * B[3 * j + 2];
+    }
+    g[0] = g0;
+    g[1] = g1;
+    g[2] = g2;
+}
+
 /* The residual measure above (O(n^2)). */
 double rad_residual(const rad_system *sys, const double *B);
 

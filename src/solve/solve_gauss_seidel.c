@@ -26,17 +26,11 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
     for (int sweep = 0; sweep < max_sweeps && stats->residual > p->tolerance; sweep++) {
         double change = 0.0;
         for (size_t i = 0; i < n; i++) {
-            const float *Fi = sys->F + i * n;
-            double g0 = 0.0, g1 = 0.0, g2 = 0.0;
-            for (size_t j = 0; j < n; j++) {
-                double f = Fi[j];
-                g0 += f * B[3 * j];
-                g1 += f * B[3 * j + 1];
-                g2 += f * B[3 * j + 2];
-            }
             /* F_ii B_i is included: the element's own (concave) share. */
+            double g[3];
+            rad_gather(sys->F + i * n, B, n, g);
             const double *rho = sys->reflectance + 3 * i, *E = sys->emission + 3 * i;
-            double b0 = E[0] + rho[0] * g0, b1 = E[1] + rho[1] * g1, b2 = E[2] + rho[2] * g2;
+            double b0 = E[0] + rho[0] * g[0], b1 = E[1] + rho[1] * g[1], b2 = E[2] + rho[2] * g[2];
             change += sys->area[i] * (fabs(b0 - B[3 * i]) + fabs(b1 - B[3 * i + 1]) + fabs(b2 - B[3 * i + 2]));
             B[3 * i] = b0;
             B[3 * i + 1] = b1;
