@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -33,7 +34,9 @@ enum option_id {
     OPT_OUTPUT, OPT_MESH_SIZE, OPT_ELEMENTS, OPT_FORM_FACTORS, OPT_SOLVER, OPT_VISIBILITY,
     OPT_SHADOW_RAYS, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_WIDTH, OPT_HEIGHT, OPT_SAMPLES,
     OPT_CAMERA, OPT_EXPOSURE, OPT_FLAT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_MAX_MEMORY,
-    OPT_QUIET, OPT_HELP, OPT_VERSION, OPT_LIST_METHODS
+    OPT_QUIET, OPT_HELP, OPT_VERSION, OPT_LIST_METHODS, OPT_HEMICUBE_RES, OPT_SAMPLES_FF,
+    OPT_NEAR_FIELD, OPT_CLOSURE, OPT_RELAXATION, OPT_UNSHOT_TOLERANCE, OPT_HISTORY,
+    OPT_PROGRESS_IMAGES, OPT_EVERY, OPT_LEVEL
 };
 
 enum { CMD_RENDER = 1, CMD_VIEWFACTORS = 2, CMD_ALL = 3 };
@@ -58,10 +61,29 @@ static const option_def OPTIONS[] = {
     {OPT_VISIBILITY, 0, "visibility", "NAME", CMD_ALL, "ray backend: embree (default) or brute"},
     {OPT_SHADOW_RAYS, 0, "shadow-rays", "N", CMD_ALL,
      "visibility rays per element pair, 4x more where partial (default 4)"},
+    {OPT_HEMICUBE_RES, 0, "hemicube-res", "N", CMD_ALL, "hemicube: pixels along a full face (default 256)"},
+    {OPT_SAMPLES_FF, 0, "ff-samples", "N", CMD_ALL,
+     "hemisphere: rays per element; montecarlo: point pairs per element pair; matrix-free "
+     "shooting: rays per shot (default: the method's)"},
+    {OPT_NEAR_FIELD, 0, "near-field", "X", CMD_ALL,
+     "hybrid: pairs closer than X element sizes use the exact method (default 3)"},
+    {OPT_CLOSURE, 0, "closure-correction", NULL, CMD_ALL,
+     "rescale F so rows sum to 1 keeping reciprocity (closed scenes only; docs/methods.md)"},
+    {OPT_LEVEL, 0, "level", "WHICH", CMD_VIEWFACTORS,
+     "view factors between 'surface's (default) or 'element's"},
     {OPT_TOLERANCE, 0, "tolerance", "X", CMD_RENDER,
      "stop when the residual (unaccounted power / emitted power) < X (default 1e-6)"},
     {OPT_MAX_ITERATIONS, 0, "max-iterations", "N", CMD_RENDER,
      "cap on sweeps (gathering) or shots (shooting); 0 = automatic"},
+    {OPT_UNSHOT_TOLERANCE, 0, "unshot-tolerance", "X", CMD_RENDER,
+     "shooting: stop when unshot power / emitted power < X (default: --tolerance)"},
+    {OPT_RELAXATION, 0, "relaxation", "W", CMD_RENDER,
+     "over-relaxation in (0, 2): SOR for jacobi / gauss-seidel, overshooting for southwell (default 1)"},
+    {OPT_HISTORY, 0, "history", "FILE.csv", CMD_RENDER,
+     "write the convergence history: iteration, seconds, residual, unshot power"},
+    {OPT_PROGRESS_IMAGES, 0, "progress-images", "DIR", CMD_RENDER,
+     "write the image every --every iterations while solving (progressive display)"},
+    {OPT_EVERY, 0, "every", "K", CMD_RENDER, "with --progress-images: every K iterations (default 1)"},
     {OPT_WIDTH, 0, "width", "W", CMD_RENDER, "image width in pixels (default 512)"},
     {OPT_HEIGHT, 0, "height", "H", CMD_RENDER, "image height in pixels (default 512)"},
     {OPT_SAMPLES, 0, "samples", "N", CMD_RENDER, "N x N anti-aliasing samples per pixel (default 2)"},
@@ -114,6 +136,10 @@ typedef struct settings {
     const char *output;
     const char *stats;
     const char *camera;
+    const char *history;
+    const char *progress_dir;
+    long every;
+    int element_level;
     rad_options solve;
     rad_render_options render;
     int threads;
@@ -304,12 +330,46 @@ static int parse_args(int argc, char **argv, settings *s)
         case OPT_MAX_MEMORY:
             bad = parse_size(o->name, value, &s->solve.max_memory_bytes);
             break;
+        case OPT_HEMICUBE_RES:
+            bad = parse_int(o->name, value, 2, 8192, &l);
+            s->solve.hemicube_resolution = (int)l;
+            break;
+        case OPT_SAMPLES_FF:
+            bad = parse_int(o->name, value, 1, 100000000, &l);
+            s->solve.samples = (int)l;
+            break;
+        case OPT_NEAR_FIELD:
+            bad = parse_double(o->name, value, 1e-6, 1e6, &s->solve.near_field);
+            break;
+        case OPT_CLOSURE: s->solve.closure_correction = 1; break;
+        case OPT_RELAXATION:
+            bad = parse_double(o->name, value, 1e-3, 1.999, &s->solve.relaxation);
+            break;
+        case OPT_UNSHOT_TOLERANCE:
+            bad = parse_double(o->name, value, 1e-15, 0.5, &s->solve.unshot_tolerance);
+            break;
+        case OPT_HISTORY:
+            s->history = value;
+            s->solve.record_history = 1;
+            break;
+        case OPT_PROGRESS_IMAGES: s->progress_dir = value; break;
+        case OPT_EVERY: bad = parse_int(o->name, value, 1, 2000000000, &s->every); break;
+        case OPT_LEVEL:
+            if (strcmp(value, "surface") == 0)
+                s->element_level = 0;
+            else if (strcmp(value, "element") == 0)
+                s->element_level = 1;
+            else
+                bad = usage_error("--level: expected 'surface' or 'element', got '%s'", value);
+            break;
         }
         if (bad)
             return bad;
     }
     if (!s->command)
         return usage_error("no command given: use render or viewfactors");
+    if (s->every && !s->progress_dir)
+        return usage_error("--every needs --progress-images DIR");
     return -1;
 }
 
@@ -367,6 +427,38 @@ static void on_signal(int sig)
 {
     cancel_flag = 1;
     cancel_signal = sig;
+}
+
+/* ---- progressive display: an image every K solver steps ---- */
+
+typedef struct progressive {
+    rad_context *ctx;
+    const char *dir;
+    long every;
+    const rad_render_options *render;
+    double exposure;
+    int failed;
+} progressive;
+
+static int on_step(void *user, rad_solution *solution, const rad_solve_step *step)
+{
+    progressive *p = user;
+    if (!p->dir || step->iteration % p->every != 0)
+        return 0;
+    rad_image *image = NULL;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/step_%08d.png", p->dir, step->iteration);
+    rad_result r = rad_solution_render(p->ctx, solution, p->render, &image);
+    if (r == RAD_OK && p->exposure == 0.0)
+        p->exposure = rad_image_auto_exposure(image); /* fixed from the first frame on */
+    if (r == RAD_OK)
+        r = rad_image_write_exposed(p->ctx, image, path, p->exposure);
+    rad_image_destroy(image);
+    if (r != RAD_OK) {
+        p->failed = 1;
+        return 1; /* stop: the message is in the context */
+    }
+    return 0;
 }
 
 /* ---- the commands ---- */
@@ -444,6 +536,20 @@ int main(int argc, char **argv)
     if (s.command == CMD_RENDER && !s.quiet && !s.scene_path)
         printf("radiosity: no scene given, rendering the built-in Cornell box\n");
 
+    /* Progressive display keeps one exposure for all frames (the user's, or
+     * the first frame's automatic one), so the picture visibly brightens as
+     * light is shot; with the ambient term the first frame is already close
+     * to the final brightness. */
+    progressive prog = {ctx, s.progress_dir, s.every ? s.every : 1, &s.render, s.render.exposure, 0};
+    if (s.progress_dir) {
+        if (mkdir(s.progress_dir, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "radiosity: %s: cannot create directory: %s\n", s.progress_dir, strerror(errno));
+            goto done;
+        }
+        s.solve.on_step = on_step;
+        s.solve.on_step_user = &prog;
+    }
+
     /* 2-3. mesh, visibility, form factors */
     r = rad_solution_create(ctx, scene, &s.solve, &sol);
     progress_end(&progress);
@@ -459,7 +565,7 @@ int main(int argc, char **argv)
 
     if (s.command == CMD_VIEWFACTORS) {
         /* 5. view factors */
-        r = rad_solution_write_view_factors(ctx, sol, output);
+        r = rad_solution_write_view_factors(ctx, sol, output, s.element_level);
         if (r == RAD_OK && s.stats)
             r = rad_solution_write_stats(ctx, sol, s.stats, 0);
         if (r != RAD_OK) {
@@ -478,6 +584,10 @@ int main(int argc, char **argv)
     /* 4. solve */
     r = rad_solution_solve(ctx, sol);
     progress_end(&progress);
+    if (prog.failed) {
+        status = fail(ctx, RAD_ERROR_IO);
+        goto done;
+    }
     int partial = r == RAD_ERROR_INTERRUPTED;
     if (r != RAD_OK && !partial) {
         status = fail(ctx, r);
@@ -498,6 +608,8 @@ int main(int argc, char **argv)
         r = rad_image_write_exposed(ctx, image, output, s.render.exposure);
     if (r == RAD_OK && s.stats)
         r = rad_solution_write_stats(ctx, sol, s.stats, partial);
+    if (r == RAD_OK && s.history)
+        r = rad_solution_write_history(ctx, sol, s.history);
     if (r != RAD_OK) {
         status = fail(ctx, r);
         goto done;

@@ -133,6 +133,16 @@ int rad_scene_camera(const rad_scene *scene, rad_camera *camera);
 
 typedef struct rad_solution rad_solution;
 
+/* One solver iteration, as reported to rad_options.on_step and kept in the
+ * convergence history. */
+typedef struct rad_solve_step {
+    int iteration;                /* 1, 2, ...: sweeps or shots */
+    double seconds;               /* since the solve began */
+    double residual;              /* the residual (see rad_solution_residual); NAN where a
+                                     solver does not measure it at this step */
+    double unshot;                /* unshot power / emitted power (shooting); NAN otherwise */
+} rad_solve_step;
+
 typedef struct rad_options {
     /* Meshing: elements no longer than mesh_size metres on a side; or, when
      * mesh_size is 0, about target_elements elements in all (default 2000). */
@@ -144,10 +154,28 @@ typedef struct rad_options {
     const char *form_factors;     /* method name; NULL = "analytic" */
     int shadow_rays;              /* visibility rays per element pair; 0 = 4 (16 where partial) */
     const char *visibility;       /* "embree" (default) or "brute" */
+    int hemicube_resolution;      /* hemicube: pixels along a full face; 0 = 256 */
+    int samples;                  /* hemisphere: rays per element; montecarlo: point pairs
+                                     per element pair; 0 = the method's default */
+    double near_field;            /* hybrid: pairs closer than this many element sizes use
+                                     the exact method; 0 = 3 */
+    int closure_correction;       /* nonzero: rescale F symmetrically so rows of a closed
+                                     scene sum to 1 while A_i F_ij = A_j F_ji (thermal use) */
 
     const char *solver;           /* NULL = "gauss-seidel" */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
-    int max_iterations;           /* sweeps (gathering) or shots per element (shooting); 0 = automatic */
+    double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
+                                     below (shooting); 0 = not used */
+    int max_iterations;           /* sweeps (gathering) or shots (shooting); 0 = automatic */
+    double relaxation;            /* over-relaxation factor omega in (0, 2): SOR for jacobi
+                                     and gauss-seidel, overshooting for southwell; 0 = 1 */
+    /* Called after every solver iteration (sweep or shot) with the solution in its
+     * current state (rad_solution_render works on it: progressive display).  Return
+     * nonzero to stop the solve early (it then returns RAD_ERROR_INTERRUPTED). */
+    int (*on_step)(void *user, rad_solution *solution, const struct rad_solve_step *step);
+    void *on_step_user;
+    int record_history;           /* nonzero: keep every step's residual in the history
+                                     (gathering then measures the residual every sweep) */
 
     uint64_t seed;                /* all sampling is seeded per element pair: results do
                                      not depend on the thread count */
@@ -171,6 +199,13 @@ size_t rad_solution_element_count(const rad_solution *solution);
  * the channels, with r = B - E - rho F B (the notes' residual). */
 double rad_solution_residual(const rad_solution *solution);
 int rad_solution_iterations(const rad_solution *solution);
+
+/* The convergence history of the last solve: *count steps, owned by the
+ * solution. */
+const rad_solve_step *rad_solution_history(const rad_solution *solution, size_t *count);
+/* Write it as CSV (iteration,seconds,residual,unshot), atomically. */
+rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *solution,
+                                      const char *path);
 
 /* Area-weighted mean radiosity of a surface, RGB, W/m^2. */
 void rad_solution_surface_radiosity(const rad_solution *solution, size_t surface,
@@ -211,6 +246,10 @@ const float *rad_image_pixels(const rad_image *image); /* RGB, row 0 at the top 
  * .pfm (32-bit float).  The file is written to a temporary name and renamed,
  * so a failure never leaves a partial file. */
 rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
+/* The automatic exposure of an image: the multiplier that maps the 95th
+ * percentile of its luminance to 0.8 (1 if it is black). */
+double rad_image_auto_exposure(const rad_image *image);
+
 /* As rad_image_write, with the PNG exposure given (0 = automatic; ignored
  * by the linear formats). */
 rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, const char *path,
@@ -220,10 +259,12 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
 rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *solution,
                                     const char *path, int partial);
 
-/* Surface-level view factors: .json (surfaces with name, area, row_sum; F)
- * or .csv.  Atomic like the image writer. */
+/* View factors, by extension: .json (surfaces with name, area, row_sum; F),
+ * .csv (dense) or .mtx (Matrix Market coordinate, sparse).  `elements`
+ * nonzero writes element-to-element factors instead of surface-level ones.
+ * Atomic like the image writer.  Formats: docs/formats.md. */
 rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *solution,
-                                           const char *path);
+                                           const char *path, int elements);
 
 /* ------------------------------------------------------------------------
  * Method registries

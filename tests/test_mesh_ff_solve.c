@@ -257,10 +257,10 @@ static void test_analytic_cube(void **state)
     rad_mesh_options o = {0.34, 0, 0}; /* 3x3 per face */
     rad_mesh *mesh = NULL;
     assert_int_equal(rad_mesh_build(ctx, scene, &o, &mesh), RAD_OK);
-    rad_ff_request req = {mesh, NULL, 7, 4}; /* no occluders in a cube */
+    rad_ff_request req = {.mesh = mesh, .seed = 7, .shadow_rays = 4}; /* no occluders in a cube */
     float *F = NULL;
     rad_ff_stats st;
-    assert_int_equal(rad_form_factors(ctx, rad_ff_find("analytic"), &req, 1e9, &F, &st), RAD_OK);
+    assert_int_equal(rad_form_factors(ctx, rad_ff_find("analytic"), &req, 1e9, false, &F, NULL, &st), RAD_OK);
     size_t n = mesh->element_count;
     assert_int_equal(n, 54);
     assert_true(st.row_sum_min > 1.0 - 1e-4 && st.row_sum_max < 1.0 + 1e-4);
@@ -274,7 +274,7 @@ static void test_analytic_cube(void **state)
     free(F);
 
     /* The memory limit is checked before allocating. */
-    assert_int_equal(rad_form_factors(ctx, rad_ff_find("analytic"), &req, 100.0, &F, &st),
+    assert_int_equal(rad_form_factors(ctx, rad_ff_find("analytic"), &req, 100.0, false, &F, NULL, &st),
                      RAD_ERROR_OUT_OF_MEMORY);
     assert_null(F);
     assert_non_null(strstr(rad_context_error(ctx), "--max-memory"));
@@ -292,11 +292,11 @@ static void test_solvers_two_patch(void **state)
     const double area[2] = {1.0, 1.0};
     const double rho[6] = {0.8, 0.5, 0.2, 0.8, 0.5, 0.2};
     const double E[6] = {1.0, 2.0, 3.0, 0.0, 0.0, 0.0};
-    rad_system sys = {2, F, area, rho, E, 2};
+    rad_system sys = {.n = 2, .F = F, .area = area, .reflectance = rho, .emission = E, .threads = 2};
     for (size_t k = 0; rad_solvers[k]; k++) {
         double B[6];
         memcpy(B, E, sizeof B);
-        rad_solve_params p = {1e-12, 0};
+        rad_solve_params p = {.tolerance = 1e-12};
         rad_solve_stats st;
         memset(&st, 0, sizeof st);
         assert_int_equal(rad_solvers[k]->solve(ctx, &sys, &p, B, &st), RAD_OK);
@@ -321,7 +321,7 @@ static void test_residual_definition(void **state)
     const double area[2] = {2.0, 2.0};
     const double rho[6] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
     const double E[6] = {1, 1, 1, 0, 0, 0};
-    rad_system sys = {2, F, area, rho, E, 2};
+    rad_system sys = {.n = 2, .F = F, .area = area, .reflectance = rho, .emission = E, .threads = 2};
     /* r_2 = -rho F B_1 = -0.25 per channel; sum A|r| = 2*0.25*3; emitted = 2*3. */
     assert_true(fabs(rad_residual(&sys, E) - 0.25) < 1e-15);
 }

@@ -65,6 +65,20 @@ static rad_result resolve_options(rad_context *ctx, const rad_options *in, rad_s
                         o.shadow_rays);
     if (o.shadow_rays == 0)
         o.shadow_rays = 4;
+    if (o.hemicube_resolution < 0 || o.hemicube_resolution > 8192)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "hemicube resolution must be in [2, 8192], got %d",
+                        o.hemicube_resolution);
+    if (o.samples < 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "samples must be positive, got %d", o.samples);
+    if (!(o.near_field >= 0.0) || !isfinite(o.near_field))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "near field must be a positive number of element sizes");
+    if (o.relaxation == 0.0)
+        o.relaxation = 1.0;
+    if (!(o.relaxation > 0.0 && o.relaxation < 2.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "relaxation must be in (0, 2), got %g", o.relaxation);
+    if (!(o.unshot_tolerance >= 0.0 && o.unshot_tolerance < 1.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "unshot tolerance must be in [0, 1), got %g",
+                        o.unshot_tolerance);
     if (o.max_memory_bytes == 0.0)
         o.max_memory_bytes = 0.8 * (double)rad_physical_memory_bytes();
     if (!(o.max_memory_bytes > 0.0))
@@ -133,18 +147,64 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
         }
     }
 
-    /* 4. form factors */
-    rad_ff_request req = {s->mesh, s->vis, s->options.seed, s->options.shadow_rays};
-    r = rad_form_factors(ctx, rad_ff_find(s->options.form_factors), &req, s->options.max_memory_bytes,
-                         &s->F, &s->ff_stats);
-    s->seconds.form_factors = s->ff_stats.seconds;
-    if (r != RAD_OK)
-        goto fail;
+    /* 4. form factors (unless the solver computes its own on the fly) */
+    if (!(rad_solver_find(s->options.solver)->flags & RAD_SOLVER_MATRIX_FREE)) {
+        rad_ff_request req = {s->mesh, s->vis, s->options.seed, s->options.shadow_rays,
+                              s->options.hemicube_resolution, s->options.samples, s->options.near_field};
+        r = rad_form_factors(ctx, rad_ff_find(s->options.form_factors), &req, s->options.max_memory_bytes,
+                             s->options.closure_correction != 0, &s->F, &s->F_variance, &s->ff_stats);
+        s->seconds.form_factors = s->ff_stats.seconds;
+        if (r != RAD_OK)
+            goto fail;
+    } else {
+        s->ff_stats.method = "none (matrix-free solver)";
+    }
     *out = s;
     return RAD_OK;
 fail:
     rad_solution_destroy(s);
     return r;
+}
+
+/* The solver's monitor: keeps the history, exposes the shooting ambient
+ * term for display, and hands the step to the caller's on_step. */
+typedef struct monitor_state {
+    rad_solution *solution;
+    bool keep_all;
+} monitor_state;
+
+static bool history_push(rad_solution *s, const rad_solve_step *step)
+{
+    if (s->history_count == s->history_capacity) {
+        size_t cap = s->history_capacity ? 2 * s->history_capacity : 256;
+        rad_solve_step *h = realloc(s->history, cap * sizeof *h);
+        if (!h)
+            return false;
+        s->history = h;
+        s->history_capacity = cap;
+    }
+    s->history[s->history_count++] = *step;
+    return true;
+}
+
+static int solve_monitor(void *user, const rad_solve_step *step, const double *B, const double *ambient)
+{
+    monitor_state *m = user;
+    rad_solution *s = m->solution;
+    (void)B; /* B is s->radiosity, updated in place */
+    if (ambient)
+        memcpy(s->solve_stats.ambient, ambient, sizeof s->solve_stats.ambient);
+    if (m->keep_all && !history_push(s, step))
+        return 1;
+    if (s->options.on_step)
+        return s->options.on_step(s->options.on_step_user, s, step);
+    return 0;
+}
+
+const rad_solve_step *rad_solution_history(const rad_solution *s, size_t *count)
+{
+    *count = s->history_count;
+    return s->history;
 }
 
 rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
@@ -153,15 +213,29 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
                         s->scene->source);
-    rad_system sys = {s->mesh->element_count, s->F, s->area, s->reflectance, s->emission, s->threads};
-    rad_solve_params p = {s->options.tolerance, s->options.max_iterations};
+    rad_system sys = {s->mesh->element_count, s->F, s->area, s->reflectance, s->emission, s->threads,
+                      s->mesh, s->vis, s->options.seed, s->options.samples};
+    monitor_state m = {s, s->options.record_history != 0};
+    rad_solve_params p = {s->options.tolerance, s->options.unshot_tolerance, s->options.max_iterations,
+                          s->options.relaxation, NULL, &m};
+    if (m.keep_all || s->options.on_step)
+        p.monitor = solve_monitor;
     const rad_solver *solver = rad_solver_find(s->options.solver);
     memcpy(s->radiosity, s->emission, 3 * sys.n * sizeof *s->radiosity);
     memset(&s->solve_stats, 0, sizeof s->solve_stats);
+    s->history_count = 0;
     s->solve_stats.method = solver->name;
+    s->solve_stats.unshot = NAN; /* shooting solvers measure it */
+    s->solve_stats.absorbed = NAN; /* matrix-free solvers report it */
     double t = rad_seconds();
     rad_result r = solver->solve(ctx, &sys, &p, s->radiosity, &s->solve_stats);
     s->solve_stats.seconds = rad_seconds() - t;
+    /* The final state always ends the history. */
+    rad_solve_step last = {s->solve_stats.iterations, s->solve_stats.seconds, s->solve_stats.residual,
+                           s->solve_stats.unshot};
+    if (s->history_count == 0 || s->history[s->history_count - 1].iteration != last.iteration ||
+        isnan(s->history[s->history_count - 1].residual))
+        history_push(s, &last);
     s->seconds.solve = s->solve_stats.seconds;
     s->solved = r == RAD_OK;
     free(s->vertex_radiosity);
@@ -176,6 +250,8 @@ void rad_solution_destroy(rad_solution *s)
     rad_vis_destroy(s->vis);
     rad_mesh_destroy(s->mesh);
     free(s->F);
+    free(s->F_variance);
+    free(s->history);
     free(s->area);
     free(s->reflectance);
     free(s->emission);
@@ -205,6 +281,10 @@ void rad_solution_surface_radiosity(const rad_solution *s, size_t surface, doubl
 void rad_solution_surface_view_factors(const rad_solution *s, double *F)
 {
     size_t S = s->scene->surface_count, n = s->mesh->element_count;
+    if (!s->F) { /* matrix-free: no factors were computed */
+        memset(F, 0, S * S * sizeof *F);
+        return;
+    }
     double *area = calloc(S ? S : 1, sizeof *area);
     memset(F, 0, S * S * sizeof *F);
     for (size_t i = 0; i < n; i++) {
@@ -226,6 +306,15 @@ void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed
 {
     /* Per-element absorption in parallel, summed in order (thread-independent). */
     size_t n = s->mesh->element_count;
+    if (!s->F) { /* matrix-free: the solver measured what it deposited */
+        double em = 0.0;
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++)
+                em += s->area[i] * s->emission[3 * i + c];
+        *emitted = em / 3.0;
+        *absorbed = s->solve_stats.absorbed;
+        return;
+    }
     double *absorbed_by = malloc((n ? n : 1) * sizeof *absorbed_by);
     double em = 0.0, ab = 0.0;
     if (!absorbed_by) {

@@ -18,7 +18,8 @@ struct rad_solution {
     char visibility_name[32];
     rad_mesh *mesh;
     rad_vis *vis;
-    float *F;                  /* n x n */
+    float *F;                  /* n x n; NULL for matrix-free solvers */
+    float *F_variance;         /* n x n for methods that estimate it, else NULL */
     double *area;              /* n */
     double *reflectance;       /* 3n */
     double *emission;          /* 3n */
@@ -27,6 +28,8 @@ struct rad_solution {
     rad_ff_stats ff_stats;
     rad_solve_stats solve_stats;
     bool solved;
+    rad_solve_step *history;   /* the last solve's steps */
+    size_t history_count, history_capacity;
     struct {
         double load, mesh, visibility, form_factors, solve, render;
     } seconds;

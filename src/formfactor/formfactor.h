@@ -16,9 +16,13 @@
 
 typedef struct rad_ff_request {
     const rad_mesh *mesh;
-    const rad_vis *vis;
+    const rad_vis *vis;       /* NULL: treat everything as mutually visible */
     uint64_t seed;
-    int shadow_rays;          /* rays per pair for the visibility fraction */
+    int shadow_rays;          /* rays per pair for the visibility fraction; 0 = 4 */
+    int hemicube_resolution;  /* pixels along a full hemicube face; 0 = 256 */
+    int samples;              /* hemisphere: rays per element; montecarlo: point pairs
+                                 per element pair; 0 = the method's default */
+    double near_field;        /* hybrid: exact method below this many element sizes; 0 = 3 */
 } rad_ff_request;
 
 typedef struct rad_ff_stats {
@@ -29,23 +33,44 @@ typedef struct rad_ff_stats {
     double row_sum_min, row_sum_max, row_sum_mean;
     double reciprocity_max;   /* max |A_i F_ij - A_j F_ji| / max(A_i F_ij, A_j F_ji) */
     double diagonal_max;      /* max F_ii */
+    double std_error_max;     /* methods with RAD_FF_VARIANCE: largest standard error of an F_ij */
+    uint64_t near_pairs;      /* hybrid: pairs given to the exact method */
+    bool closure_corrected;   /* the symmetric closure correction was applied */
 } rad_ff_stats;
+
+/* Method flags. */
+enum {
+    RAD_FF_VARIANCE = 1u << 0 /* compute() also estimates the variance of each F_ij */
+};
 
 typedef struct rad_ff_method {
     const char *name;
     const char *description; /* one line: idea, cost, accuracy */
-    /* Fill F (n*n floats, zeroed by the caller). */
-    rad_result (*compute)(rad_context *ctx, const rad_ff_request *req, float *F,
+    unsigned flags;
+    /* Fill F (n*n floats, zeroed by the caller), and, for methods with
+     * RAD_FF_VARIANCE, `variance` (n*n floats, zeroed; else NULL) with the
+     * estimated variance of each F_ij.  Parallel (ctx->threads), polling
+     * rad_cancelled(ctx) (then RAD_ERROR_INTERRUPTED), reporting progress
+     * with rad_progress(ctx, "form factors", ...) from one thread. */
+    rad_result (*compute)(rad_context *ctx, const rad_ff_request *req, float *F, float *variance,
                           rad_ff_stats *stats);
 } rad_ff_method;
 
 extern const rad_ff_method *const rad_ff_methods[]; /* NULL-terminated */
 const rad_ff_method *rad_ff_find(const char *name);
 
-/* Allocate F (checking `max_memory`), run the method, fill the diagnostics. */
+/* Allocate F (and the variance for RAD_FF_VARIANCE methods; *variance_out
+ * may be NULL to decline it), checking `max_memory` first; run the method;
+ * optionally apply the closure correction; fill the diagnostics. */
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
-                            const rad_ff_request *req, double max_memory,
-                            float **F_out, rad_ff_stats *stats);
+                            const rad_ff_request *req, double max_memory, bool close,
+                            float **F_out, float **variance_out, rad_ff_stats *stats);
+
+/* Reciprocity-preserving closure correction for closed scenes: find x > 0
+ * with sum_j x_i x_j A_i F_ij = A_i (symmetric Sinkhorn scaling of the
+ * power-coupling matrix G = A F), then F_ij <- x_i x_j F_ij.  Keeps zeros,
+ * positivity and A_i F_ij = A_j F_ji; rows that see nothing stay 0. */
+void rad_ff_close(const rad_mesh *mesh, float *F);
 
 /* ---- shared kernels (polygon.c) ---- */
 

@@ -84,6 +84,11 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     cJSON_AddNumberToObject(ff, "row_sum_mean", s->ff_stats.row_sum_mean);
     cJSON_AddNumberToObject(ff, "reciprocity_max", s->ff_stats.reciprocity_max);
     cJSON_AddNumberToObject(ff, "diagonal_max", s->ff_stats.diagonal_max);
+    cJSON_AddBoolToObject(ff, "closure_corrected", s->ff_stats.closure_corrected);
+    if (s->F_variance)
+        cJSON_AddNumberToObject(ff, "std_error_max", s->ff_stats.std_error_max);
+    if (s->ff_stats.near_pairs)
+        cJSON_AddNumberToObject(ff, "near_pairs", (double)s->ff_stats.near_pairs);
     cJSON_AddNumberToObject(ff, "seconds", s->ff_stats.seconds);
 
     cJSON *so = cJSON_AddObjectToObject(root, "solver");
@@ -93,6 +98,10 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     cJSON_AddNumberToObject(so, "iterations", s->solve_stats.iterations);
     cJSON_AddNumberToObject(so, "residual", s->solve_stats.residual);
     cJSON_AddNumberToObject(so, "tolerance", s->options.tolerance);
+    cJSON_AddNumberToObject(so, "relaxation", s->options.relaxation);
+    if (!isnan(s->solve_stats.unshot))
+        cJSON_AddNumberToObject(so, "unshot", s->solve_stats.unshot);
+    cJSON_AddNumberToObject(so, "components", (double)s->solve_stats.components);
     cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve_stats.ambient));
     cJSON_AddNumberToObject(so, "seconds", s->solve_stats.seconds);
 
@@ -131,7 +140,7 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
 
     cJSON *mem = cJSON_AddObjectToObject(root, "memory_bytes");
     cJSON_AddNumberToObject(mem, "peak_resident", (double)rad_peak_memory_bytes());
-    cJSON_AddNumberToObject(mem, "form_factor_matrix", (double)n * (double)n * sizeof(float));
+    cJSON_AddNumberToObject(mem, "form_factor_matrix", s->F ? (double)n * (double)n * sizeof(float) : 0.0);
     cJSON_AddNumberToObject(mem, "limit", s->options.max_memory_bytes);
 
     rad_result r = write_json(ctx, root, path);
@@ -139,57 +148,215 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     return r;
 }
 
-rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *s, const char *path)
+/* Surface-level standard errors from element variances (independent
+ * estimates): var F_IJ = sum_{i in I} (A_i / A_I)^2 sum_{j in J} var F_ij. */
+static void surface_std_errors(const rad_solution *s, double *err)
 {
-    size_t S = s->scene->surface_count;
+    size_t S = s->scene->surface_count, n = s->mesh->element_count;
+    double *area = calloc(S ? S : 1, sizeof *area);
+    memset(err, 0, S * S * sizeof *err);
+    if (!area)
+        return;
+    for (size_t i = 0; i < n; i++)
+        area[s->mesh->elements[i].surface] += s->area[i];
+    for (size_t i = 0; i < n; i++) {
+        uint32_t si = s->mesh->elements[i].surface;
+        double w = s->area[i] / area[si];
+        for (size_t j = 0; j < n; j++)
+            err[(size_t)si * S + s->mesh->elements[j].surface] += w * w * s->F_variance[i * n + j];
+    }
+    for (size_t k = 0; k < S * S; k++)
+        err[k] = sqrt(err[k]);
+    free(area);
+}
+
+/* A CSV field: quoted (with doubled quotes) when it holds a comma, quote or
+ * line break (RFC 4180). */
+static void csv_field(FILE *f, const char *text)
+{
+    if (!strpbrk(text, ",\"\r\n")) {
+        fputs(text, f);
+        return;
+    }
+    fputc('"', f);
+    for (const char *c = text; *c; c++) {
+        if (*c == '"')
+            fputc('"', f);
+        fputc(*c, f);
+    }
+    fputc('"', f);
+}
+
+/* Names and areas of the rows of the matrix being written: surfaces, or
+ * elements ("surface#k", k counting the surface's elements). */
+typedef struct vf_rows {
+    size_t count;
+    char **names;
+    double *area;
+    double *F;      /* count x count */
+    double *err;    /* count x count standard errors, or NULL */
+} vf_rows;
+
+static void vf_rows_free(vf_rows *r)
+{
+    for (size_t k = 0; r->names && k < r->count; k++)
+        free(r->names[k]);
+    free(r->names);
+    free(r->area);
+    free(r->F);
+    free(r->err);
+}
+
+static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, int elements, vf_rows *r)
+{
+    memset(r, 0, sizeof *r);
+    size_t n = s->mesh->element_count, S = s->scene->surface_count;
+    r->count = elements ? n : S;
+    r->names = rad_alloc_array(ctx, r->count, sizeof *r->names, "view factors");
+    r->area = rad_alloc_array(ctx, r->count, sizeof *r->area, "view factors");
+    r->F = rad_alloc_array(ctx, r->count * r->count, sizeof *r->F, "view factors");
+    bool with_err = s->F_variance != NULL;
+    if (with_err)
+        r->err = rad_alloc_array(ctx, r->count * r->count, sizeof *r->err, "view factors");
+    if (!r->names || !r->area || !r->F || (with_err && !r->err)) {
+        vf_rows_free(r);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (!elements) {
+        rad_solution_surface_view_factors(s, r->F);
+        if (with_err)
+            surface_std_errors(s, r->err);
+        for (size_t k = 0; k < S; k++) {
+            r->names[k] = rad_strdup(s->scene->surfaces[k].name);
+            r->area[k] = s->scene->surfaces[k].area;
+        }
+    } else {
+        size_t *seen = calloc(S ? S : 1, sizeof *seen);
+        for (size_t i = 0; i < n; i++) {
+            uint32_t si = s->mesh->elements[i].surface;
+            char name[512];
+            snprintf(name, sizeof name, "%s#%zu", s->scene->surfaces[si].name, seen ? seen[si]++ : i);
+            r->names[i] = rad_strdup(name);
+            r->area[i] = s->area[i];
+            for (size_t j = 0; j < n; j++) {
+                r->F[i * n + j] = s->F[i * n + j];
+                if (with_err)
+                    r->err[i * n + j] = sqrt(s->F_variance[i * n + j]);
+            }
+        }
+        free(seen);
+    }
+    for (size_t k = 0; k < r->count; k++)
+        if (!r->names[k]) {
+            vf_rows_free(r);
+            return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "view factors: out of memory");
+        }
+    return RAD_OK;
+}
+
+rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *s, const char *path,
+                                           int elements)
+{
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);
-    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0)
+    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: unknown view-factor format (use .json or .csv)", path);
-    double *F = rad_alloc_array(ctx, S * S, sizeof *F, "view factors");
-    if (!F)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    rad_solution_surface_view_factors(s, F);
-    rad_result r;
+                        "%s: unknown view-factor format (use .json, .csv or .mtx)", path);
+    if (!s->F)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: no view factors: solver '%s' computes no form-factor matrix", path,
+                        s->options.solver);
+    vf_rows rows;
+    rad_result r = vf_rows_build(ctx, s, elements, &rows);
+    if (r != RAD_OK)
+        return r;
+    size_t N = rows.count;
     if (strcmp(ext, "json") == 0) {
         cJSON *root = cJSON_CreateObject();
         cJSON_AddStringToObject(root, "scene", s->scene->source);
         cJSON_AddStringToObject(root, "method", s->options.form_factors);
+        cJSON_AddStringToObject(root, "level", elements ? "element" : "surface");
         cJSON_AddNumberToObject(root, "elements", (double)s->mesh->element_count);
-        cJSON *surfaces = cJSON_AddArrayToObject(root, "surfaces");
-        cJSON *rows = cJSON_AddArrayToObject(root, "F");
-        for (size_t a = 0; a < S; a++) {
+        cJSON_AddBoolToObject(root, "closure_corrected", s->ff_stats.closure_corrected);
+        cJSON *list = cJSON_AddArrayToObject(root, elements ? "elements_list" : "surfaces");
+        cJSON *F = cJSON_AddArrayToObject(root, "F");
+        cJSON *E = rows.err ? cJSON_AddArrayToObject(root, "F_std_error") : NULL;
+        for (size_t a = 0; a < N; a++) {
             double sum = 0.0;
-            for (size_t b = 0; b < S; b++)
-                sum += F[a * S + b];
+            for (size_t b = 0; b < N; b++)
+                sum += rows.F[a * N + b];
             cJSON *o = cJSON_CreateObject();
-            cJSON_AddStringToObject(o, "name", s->scene->surfaces[a].name);
-            cJSON_AddNumberToObject(o, "area", s->scene->surfaces[a].area);
+            cJSON_AddStringToObject(o, "name", rows.names[a]);
+            if (elements)
+                cJSON_AddStringToObject(o, "surface",
+                                        s->scene->surfaces[s->mesh->elements[a].surface].name);
+            cJSON_AddNumberToObject(o, "area", rows.area[a]);
             cJSON_AddNumberToObject(o, "row_sum", sum);
-            cJSON_AddItemToArray(surfaces, o);
-            cJSON_AddItemToArray(rows, cJSON_CreateDoubleArray(F + a * S, (int)S));
+            cJSON_AddItemToArray(list, o);
+            cJSON_AddItemToArray(F, cJSON_CreateDoubleArray(rows.F + a * N, (int)N));
+            if (E)
+                cJSON_AddItemToArray(E, cJSON_CreateDoubleArray(rows.err + a * N, (int)N));
         }
         r = write_json(ctx, root, path);
         cJSON_Delete(root);
     } else {
         rad_atomic_file f;
         r = rad_atomic_open(ctx, path, &f);
-        if (r == RAD_OK) {
-            /* Header: from,area,<to names...>; one row per emitting surface. */
+        if (r == RAD_OK && strcmp(ext, "csv") == 0) {
+            /* Header: from,area_m2,<to names...>; one row per emitting surface/element. */
             fputs("from,area_m2", f.file);
-            for (size_t b = 0; b < S; b++)
-                fprintf(f.file, ",%s", s->scene->surfaces[b].name);
+            for (size_t b = 0; b < N; b++) {
+                fputc(',', f.file);
+                csv_field(f.file, rows.names[b]);
+            }
             fputc('\n', f.file);
-            for (size_t a = 0; a < S; a++) {
-                fprintf(f.file, "%s,%.17g", s->scene->surfaces[a].name, s->scene->surfaces[a].area);
-                for (size_t b = 0; b < S; b++)
-                    fprintf(f.file, ",%.17g", F[a * S + b]);
+            for (size_t a = 0; a < N; a++) {
+                csv_field(f.file, rows.names[a]);
+                fprintf(f.file, ",%.17g", rows.area[a]);
+                for (size_t b = 0; b < N; b++)
+                    fprintf(f.file, ",%.17g", rows.F[a * N + b]);
                 fputc('\n', f.file);
             }
-            r = rad_atomic_commit(ctx, &f);
+        } else if (r == RAD_OK) {
+            /* Matrix Market coordinate format, 1-based, nonzeros only; the
+             * comments carry the row names and areas (docs/formats.md). */
+            size_t nnz = 0;
+            for (size_t k = 0; k < N * N; k++)
+                nnz += rows.F[k] != 0.0;
+            fprintf(f.file, "%%%%MatrixMarket matrix coordinate real general\n");
+            fprintf(f.file, "%% view factors F[i][j] from row i to column j (radiosity %s, %s level)\n",
+                    RAD_VERSION_STRING, elements ? "element" : "surface");
+            for (size_t a = 0; a < N; a++)
+                fprintf(f.file, "%% %zu %s area_m2 %.17g\n", a + 1, rows.names[a], rows.area[a]);
+            fprintf(f.file, "%zu %zu %zu\n", N, N, nnz);
+            for (size_t a = 0; a < N; a++)
+                for (size_t b = 0; b < N; b++)
+                    if (rows.F[a * N + b] != 0.0)
+                        fprintf(f.file, "%zu %zu %.9g\n", a + 1, b + 1, rows.F[a * N + b]);
         }
+        if (r == RAD_OK)
+            r = rad_atomic_commit(ctx, &f);
     }
-    free(F);
+    vf_rows_free(&rows);
     return r;
+}
+
+rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, const char *path)
+{
+    rad_atomic_file f;
+    rad_result r = rad_atomic_open(ctx, path, &f);
+    if (r != RAD_OK)
+        return r;
+    fputs("iteration,seconds,residual,unshot\n", f.file);
+    for (size_t k = 0; k < s->history_count; k++) {
+        const rad_solve_step *h = &s->history[k];
+        fprintf(f.file, "%d,%.9g,", h->iteration, h->seconds);
+        if (!isnan(h->residual))
+            fprintf(f.file, "%.9g", h->residual);
+        fputc(',', f.file);
+        if (!isnan(h->unshot))
+            fprintf(f.file, "%.9g", h->unshot);
+        fputc('\n', f.file);
+    }
+    return rad_atomic_commit(ctx, &f);
 }

@@ -13,6 +13,9 @@
 
 #include "core/core.h"
 
+struct rad_mesh;
+struct rad_vis;
+
 typedef struct rad_system {
     size_t n;
     const float *F;           /* n x n, row i = factors from i */
@@ -20,11 +23,26 @@ typedef struct rad_system {
     const double *reflectance;/* 3n, interleaved RGB */
     const double *emission;   /* 3n, W/m^2 */
     int threads;              /* for the O(n^2) passes that run in parallel */
+    /* Matrix-free solvers (F == NULL) compute what they need on the fly: */
+    const struct rad_mesh *mesh;
+    const struct rad_vis *vis;
+    uint64_t seed;
+    int samples;              /* rays per shot; 0 = the solver's default */
 } rad_system;
 
+/* Called after each iteration; a nonzero return stops the solve
+ * (RAD_ERROR_INTERRUPTED).  `B` is the current iterate (3n); `ambient` is the
+ * shooting ambient term (RGB, W/m^2) or NULL. */
+typedef int (*rad_solve_monitor_fn)(void *user, const rad_solve_step *step, const double *B,
+                                    const double *ambient);
+
 typedef struct rad_solve_params {
-    double tolerance;
-    int max_iterations;
+    double tolerance;         /* on the residual */
+    double unshot_tolerance;  /* on unshot / emitted power (shooting); 0 = unused */
+    int max_iterations;       /* 0 = the solver's default */
+    double relaxation;        /* omega; 1 = none */
+    rad_solve_monitor_fn monitor; /* may be NULL */
+    void *monitor_user;
 } rad_solve_params;
 
 typedef struct rad_solve_stats {
@@ -34,11 +52,20 @@ typedef struct rad_solve_stats {
     double seconds;
     bool converged;
     double ambient[3];        /* shooting: estimate of unshot light for display, W/m^2 */
+    double unshot;            /* shooting: unshot power / emitted power at the end; else NAN */
+    double absorbed;          /* matrix-free: power absorbed, W (mean over RGB); else NAN */
+    size_t components;        /* independent groups of elements solved separately (0 = not split) */
 } rad_solve_stats;
+
+/* Solver flags. */
+enum {
+    RAD_SOLVER_MATRIX_FREE = 1u << 0 /* needs no F: rad_solution_create skips the matrix */
+};
 
 typedef struct rad_solver {
     const char *name;
     const char *description;
+    unsigned flags;
     /* B (3n) holds the starting guess (E) and receives the answer. */
     rad_result (*solve)(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
                         double *B, rad_solve_stats *stats);

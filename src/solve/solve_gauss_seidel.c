@@ -1,16 +1,17 @@
 /*
  * solve_gauss_seidel.c -- gathering: each element in turn gathers from all
  * others, using the newest values at once (Cohen & Wallace 1993, sec. 5.3;
- * the notes' "Gathering"):
+ * the notes' "Gathering"), optionally over-relaxed (SOR, omega in (0, 2)):
  *
- *     B_i <- E_i + rho_i sum_{j != i} F_ij B_j
+ *     B_i <- (1 - w) B_i + w (E_i + rho_i sum_{j != i} F_ij B_j) / (1 - rho_i F_ii)
  *
  * The radiosity matrix is diagonally dominant (rho_i sum_j F_ij <= rho_i <
  * 1), so the iteration converges, each sweep shrinking the error by about
  * the mean reflectance.  A sweep's change sum_i A_i |B_i' - B_i| bounds the
- * residual left behind it (r_i = rho_i sum_{j>i} F_ij (B_j' - B_j)), so the
- * true residual (solve.h, an O(n^2) pass) is measured only once the change
- * falls below the tolerance, and the sweeps stop when it does too.
+ * residual left behind it (r_i = rho_i sum_{j>i} F_ij (B_j' - B_j) for w = 1),
+ * so unless every step is to be measured (a history or a monitor wants it)
+ * the true residual (solve.h, an O(n^2) pass) is measured only once the
+ * change falls below the tolerance; the sweeps stop when it does too.
  */
 #include "solve/solve.h"
 
@@ -19,26 +20,37 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
 {
     size_t n = sys->n;
     int max_sweeps = p->max_iterations > 0 ? p->max_iterations : 1000;
+    double w = p->relaxation > 0.0 ? p->relaxation : 1.0;
     double emitted = 0.0;
     for (size_t i = 0; i < n; i++)
         emitted += sys->area[i] * (sys->emission[3 * i] + sys->emission[3 * i + 1] + sys->emission[3 * i + 2]);
+    double t0 = rad_seconds();
     stats->residual = rad_residual(sys, B);
     for (int sweep = 0; sweep < max_sweeps && stats->residual > p->tolerance; sweep++) {
         double change = 0.0;
         for (size_t i = 0; i < n; i++) {
-            /* F_ii B_i is included: the element's own (concave) share. */
             double g[3];
-            rad_gather(sys->F + i * n, B, n, g);
+            const float *Fi = sys->F + i * n;
+            rad_gather(Fi, B, n, g);
             const double *rho = sys->reflectance + 3 * i, *E = sys->emission + 3 * i;
-            double b0 = E[0] + rho[0] * g[0], b1 = E[1] + rho[1] * g[1], b2 = E[2] + rho[2] * g[2];
-            change += sys->area[i] * (fabs(b0 - B[3 * i]) + fabs(b1 - B[3 * i + 1]) + fabs(b2 - B[3 * i + 2]));
-            B[3 * i] = b0;
-            B[3 * i + 1] = b1;
-            B[3 * i + 2] = b2;
+            double fii = Fi[i]; /* nonzero only for concave elements */
+            for (int c = 0; c < 3; c++) {
+                double old = B[3 * i + c];
+                double gathered = (E[c] + rho[c] * (g[c] - fii * old)) / (1.0 - rho[c] * fii);
+                double updated = (1.0 - w) * old + w * gathered;
+                change += sys->area[i] * fabs(updated - old);
+                B[3 * i + c] = updated;
+            }
         }
         stats->iterations = sweep + 1;
         double estimate = emitted > 0.0 ? change / emitted : change;
-        stats->residual = estimate > p->tolerance ? estimate : rad_residual(sys, B);
+        bool measure = p->monitor != NULL || estimate <= p->tolerance || w != 1.0;
+        stats->residual = measure ? rad_residual(sys, B) : estimate;
+        if (p->monitor) {
+            rad_solve_step step = {sweep + 1, rad_seconds() - t0, stats->residual, NAN};
+            if (p->monitor(p->monitor_user, &step, B, NULL))
+                return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: stopped after %d sweeps", sweep + 1);
+        }
         rad_progress(ctx, "solve", (uint64_t)(sweep + 1), (uint64_t)max_sweeps);
         if (rad_cancelled(ctx))
             return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %d sweeps",
@@ -50,7 +62,8 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
 
 const rad_solver rad_solver_gauss_seidel = {
     "gauss-seidel",
-    "gathering, newest values first (Cohen & Wallace 1993); O(n^2) per sweep, "
+    "gathering, newest values first, optional SOR (--relaxation); O(n^2) per sweep, "
     "error shrinks ~rho per sweep",
+    0,
     gauss_seidel,
 };

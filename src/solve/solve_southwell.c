@@ -5,7 +5,11 @@
  *
  *     dB_j += rho_j F_ji dB_i,  B_j += the same,  dB_i = 0,
  *
- * which is Southwell iteration on the radiosity system.  F_ji is read from
+ * which is Southwell iteration on the radiosity system: with B' = B - dB
+ * the light already shot, K B' = E - dB, so dB is the residual of B' and a
+ * shot relaxes one equation.  Over-relaxation (omega > 1, "overshooting",
+ * Feda & Purgathofer 1992) shoots omega dB_i and leaves (1 - omega) dB_i
+ * unshot, negative; selection is then by |dB_i| A_i.  F_ji is read from
  * row i through reciprocity, F_ji = F_ij A_i / A_j, so the pass is one
  * contiguous row.  Shooting stops when the unshot power falls below the
  * tolerance times the emitted power; the residual is then measured.
@@ -43,6 +47,7 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
                             double *B, rad_solve_stats *stats)
 {
     size_t n = sys->n;
+    double w = p->relaxation > 0.0 ? p->relaxation : 1.0;
     double *dB = rad_alloc_array(ctx, 3 * n, sizeof *dB, "solve: unshot radiosity");
     if (!dB)
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -53,27 +58,35 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
         emitted += sys->area[i] * (sys->emission[3 * i] + sys->emission[3 * i + 1] +
                                    sys->emission[3 * i + 2]);
     }
+    /* Unshot power alone does not bound the residual tightly (the residual is
+     * rho F dB); shooting stops on unshot power below the residual tolerance,
+     * or below unshot_tolerance when given, and the residual is then measured. */
+    double unshot_goal = p->unshot_tolerance > 0.0 ? p->unshot_tolerance : p->tolerance;
     long long max_shots = p->max_iterations > 0 ? (long long)p->max_iterations
                                                 : 1000LL * (long long)(n > 0 ? n : 1);
     long long shot = 0;
+    double t0 = rad_seconds(), unshot = 0.0;
     rad_result result = RAD_OK;
     for (; shot < max_shots; shot++) {
         size_t best = 0;
-        double best_power = -1.0, unshot = 0.0;
+        double best_power = -1.0;
+        unshot = 0.0;
         for (size_t i = 0; i < n; i++) {
-            double power = sys->area[i] * (dB[3 * i] + dB[3 * i + 1] + dB[3 * i + 2]);
+            double power = sys->area[i] * (fabs(dB[3 * i]) + fabs(dB[3 * i + 1]) + fabs(dB[3 * i + 2]));
             unshot += power;
             if (power > best_power) {
                 best_power = power;
                 best = i;
             }
         }
-        if (!(unshot > p->tolerance * emitted) || best_power <= 0.0)
+        unshot = emitted > 0.0 ? unshot / emitted : unshot;
+        if (!(unshot > unshot_goal) || best_power <= 0.0)
             break;
+        /* Shoot w dB_i (overshooting for w > 1: Southwell over-relaxation);
+         * B_i keeps its value, the rest of dB_i stays unshot (negative). */
         const float *Fi = sys->F + best * n;
-        double s0 = dB[3 * best], s1 = dB[3 * best + 1], s2 = dB[3 * best + 2];
+        double s0 = w * dB[3 * best], s1 = w * dB[3 * best + 1], s2 = w * dB[3 * best + 2];
         double ai = sys->area[best];
-        dB[3 * best] = dB[3 * best + 1] = dB[3 * best + 2] = 0.0;
         for (size_t j = 0; j < n; j++) {
             double fji = Fi[j] * ai / sys->area[j];
             if (fji == 0.0)
@@ -87,17 +100,30 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
             B[3 * j + 1] += d1;
             B[3 * j + 2] += d2;
         }
+        dB[3 * best] -= s0;
+        dB[3 * best + 1] -= s1;
+        dB[3 * best + 2] -= s2;
+        if (p->monitor) {
+            rad_southwell_ambient(sys, dB, stats->ambient);
+            rad_solve_step step = {(int)(shot + 1 < 2147483647LL ? shot + 1 : 2147483647LL),
+                                   rad_seconds() - t0, NAN, unshot};
+            if (p->monitor(p->monitor_user, &step, B, stats->ambient)) {
+                shot++;
+                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: stopped after %lld shots", shot);
+                break;
+            }
+        }
         if ((shot & 255) == 0) {
             rad_progress(ctx, "solve", (uint64_t)shot, (uint64_t)max_shots);
             if (rad_cancelled(ctx)) {
-                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %lld shots",
-                                  shot + 1);
                 shot++;
+                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %lld shots", shot);
                 break;
             }
         }
     }
     stats->iterations = shot > 2147483647LL ? 2147483647 : (int)shot;
+    stats->unshot = unshot;
     rad_southwell_ambient(sys, dB, stats->ambient);
     free(dB);
     stats->residual = rad_residual(sys, B);
@@ -108,6 +134,7 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
 const rad_solver rad_solver_southwell = {
     "southwell",
     "progressive refinement: shoot the largest unshot power (Cohen et al. 1988), "
-    "ambient term for display; O(n) per shot",
+    "overshooting with --relaxation > 1, ambient term for display; O(n) per shot",
+    0,
     southwell,
 };
