@@ -615,10 +615,20 @@ int main(int argc, char **argv)
         goto done;
     }
     char full[PATH_MAX];
-    if (!s.quiet)
-        printf("wrote %s (%dx%d, %zu elements, residual %.2g, %.1f s)%s\n", where(output, full),
+    if (!s.quiet) {
+        /* Matrix-free solvers measure unshot power, not the residual. */
+        size_t steps = 0;
+        const rad_solve_step *h = rad_solution_history(sol, &steps);
+        double residual = rad_solution_residual(sol);
+        char measure[64];
+        if (isnan(residual) && steps > 0)
+            snprintf(measure, sizeof measure, "unshot %.2g", h[steps - 1].unshot);
+        else
+            snprintf(measure, sizeof measure, "residual %.2g", residual);
+        printf("wrote %s (%dx%d, %zu elements, %s, %.1f s)%s\n", where(output, full),
                rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
-               rad_solution_residual(sol), now_seconds() - t0, partial ? " [partial]" : "");
+               measure, now_seconds() - t0, partial ? " [partial]" : "");
+    }
     status = partial ? interrupted_status() : 0;
 
 done:

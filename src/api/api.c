@@ -213,8 +213,17 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
                         s->scene->source);
-    rad_system sys = {s->mesh->element_count, s->F, s->area, s->reflectance, s->emission, s->threads,
-                      s->mesh, s->vis, s->options.seed, s->options.samples};
+    rad_system sys = {.n = s->mesh->element_count,
+                      .F = s->F,
+                      .area = s->area,
+                      .reflectance = s->reflectance,
+                      .emission = s->emission,
+                      .threads = s->threads,
+                      .mesh = s->mesh,
+                      .vis = s->vis,
+                      .seed = s->options.seed,
+                      .samples = s->options.samples,
+                      .max_memory = s->options.max_memory_bytes};
     monitor_state m = {s, s->options.record_history != 0};
     rad_solve_params p = {s->options.tolerance, s->options.unshot_tolerance, s->options.max_iterations,
                           s->options.relaxation, NULL, &m};
@@ -228,14 +237,25 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     s->solve_stats.unshot = NAN; /* shooting solvers measure it */
     s->solve_stats.absorbed = NAN; /* matrix-free solvers report it */
     double t = rad_seconds();
-    rad_result r = solver->solve(ctx, &sys, &p, s->radiosity, &s->solve_stats);
+    /* Independent groups of elements (rooms that cannot see each other) are
+     * solved separately; one group is solved as is. */
+    rad_result r = rad_solve_by_components(ctx, solver, &sys, &p, s->radiosity, &s->solve_stats);
     s->solve_stats.seconds = rad_seconds() - t;
-    /* The final state always ends the history. */
+    /* The final state always ends the history: as a new row, or completing
+     * the last one where it was the same step with the residual unmeasured.
+     * (Steps count across independent groups, so the last row's iteration
+     * can exceed the largest group's count.) */
     rad_solve_step last = {s->solve_stats.iterations, s->solve_stats.seconds, s->solve_stats.residual,
                            s->solve_stats.unshot};
-    if (s->history_count == 0 || s->history[s->history_count - 1].iteration != last.iteration ||
-        isnan(s->history[s->history_count - 1].residual))
+    rad_solve_step *tail = s->history_count ? &s->history[s->history_count - 1] : NULL;
+    if (!tail || tail->iteration < last.iteration) {
         history_push(s, &last);
+    } else {
+        if (isnan(tail->residual))
+            tail->residual = last.residual;
+        if (isnan(tail->unshot))
+            tail->unshot = last.unshot;
+    }
     s->seconds.solve = s->solve_stats.seconds;
     s->solved = r == RAD_OK;
     free(s->vertex_radiosity);

@@ -9,9 +9,19 @@
 #include <string.h>
 
 extern const rad_ff_method rad_ff_analytic;
+extern const rad_ff_method rad_ff_hemicube;
+extern const rad_ff_method rad_ff_hemisphere;
+extern const rad_ff_method rad_ff_montecarlo;
+extern const rad_ff_method rad_ff_contour;
+extern const rad_ff_method rad_ff_hybrid;
 
 const rad_ff_method *const rad_ff_methods[] = {
     &rad_ff_analytic,
+    &rad_ff_hemicube,
+    &rad_ff_hemisphere,
+    &rad_ff_montecarlo,
+    &rad_ff_contour,
+    &rad_ff_hybrid,
     NULL,
 };
 

@@ -81,4 +81,83 @@ void rad_ff_close(const rad_mesh *mesh, float *F);
  * 0.  n <= 8 vertices. */
 double rad_point_polygon_ff(vec3 point, vec3 normal, const vec3 *poly, size_t n);
 
+/* How far a point sampled on element e (bilinear, rad_element_sample) can
+ * lie from the flat pieces a ray backend builds over it, m: 0 for triangles
+ * and flat quads; for a bent quad, its corners' spread about its plane.
+ * Ray end points on e are lifted by rad_vis_epsilon plus this, so that a
+ * ray never starts behind the surface it leaves.  Cannot fail. */
+double rad_element_bend(const rad_mesh *mesh, const rad_element *e);
+
+/* The density correction of rad_element_sample at (u, v): the Jacobian of
+ * the bilinear map over the element's area, so that the mean of
+ * f(x(u,v)) * weight over uniform (u, v) is the mean of f over the element
+ * (exactly 1 for triangles and parallelograms; its mean is 1 for any flat
+ * quad).  Cannot fail. */
+double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
+
+/* ---- the hemicube's delta form factors (ff_hemicube.c) ---- */
+
+/* Fill delta[] with the form factor of each pixel of a unit hemicube with
+ * `resolution` pixels along a full face (even, >= 2), seen from its centre:
+ * the top face (resolution^2 pixels, row-major) and then the four side
+ * faces (resolution/2 rows from the base up, resolution columns each), so
+ * 3 * resolution^2 values.  Each is dF = dA / (pi (x^2+y^2+1)^2) (top) or
+ * z dA / (pi (y^2+z^2+1)^2) (sides) integrated exactly over the pixel.
+ * Returns their sum, 1 up to rounding.  Cannot fail. */
+double rad_hemicube_deltas(int resolution, double *delta);
+
+/* ---- shadow-ray visibility (visibility.c): analytic, contour, hybrid ---- */
+
+enum {
+    RAD_FF_MAX_RAYS = 256,     /* rays in one rad_ff_rays batch */
+    RAD_FF_MAX_BASE_RAYS = 48  /* first-round rays per pair: 4x more follow, within one batch */
+};
+
+/* One end of a bundle of shadow rays: an element, or a piece of one. */
+typedef struct rad_ff_end {
+    vec3 corner[4];           /* m, counter-clockwise; corner[3] unused for triangles */
+    uint32_t corners;         /* 3 or 4 */
+    vec3 normal;              /* unit */
+    double lift;              /* m: end points move this far along the normal and inward */
+} rad_ff_end;
+
+/* Element e as a ray end, lifted by eps (rad_vis_epsilon) plus its bend.
+ * Cannot fail. */
+void rad_ff_end_element(const rad_mesh *mesh, uint32_t e, double eps, rad_ff_end *end);
+
+/* Draw `count` (<= RAD_FF_MAX_RAYS) stratified pairs of random points of a
+ * and b (bilinear on quads, as rad_element_sample) from `rng`, and cast the
+ * rays of the pairs that face each other (each end in front of the other's
+ * plane); *facing = how many were cast (also added to *rays_cast).
+ * Returns how many pass.  Cannot fail. */
+int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, int count,
+                rad_rng *rng, uint64_t *rays_cast, int *facing);
+
+/* Visibility fraction of elements i and j: base_rays (<= RAD_FF_MAX_BASE_RAYS)
+ * rays keyed on (req->seed, i, j); if they disagree (or none faces), 4 x
+ * base_rays more and the fraction of all cast.  1 when req->vis is NULL or
+ * no ray faces.  Cannot fail. */
+double rad_ff_visibility(const rad_ff_request *req, uint32_t i, uint32_t j, double eps,
+                         int base_rays, uint64_t *rays_cast);
+
+/* ---- the contour kernel (ff_contour.c): contour, hybrid ---- */
+
+/* The unoccluded power coupling A_i F_ij = A_j F_ji (m^2) of two planar
+ * convex polygons (3 or 4 vertices, counter-clockwise about their unit
+ * normals), each first clipped to the front of the other's plane, by the
+ * double contour integral.  Plane distances within plane_tol count as 0.
+ * Cannot fail; 0 for polygons that do not face each other. */
+double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const vec3 *poly_j,
+                            size_t n_j, vec3 normal_j, double plane_tol);
+
+/* rad_polygon_coupling of elements i and j of the mesh.  Cannot fail. */
+double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
+
+/* False when either element lies wholly on or behind the other's plane
+ * (their factors vanish).  Cannot fail. */
+bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
+
+/* 1e-9 x the mesh's extent: coplanar elements are culled despite rounding. */
+double rad_ff_plane_tolerance(const rad_mesh *mesh);
+
 #endif /* RAD_FORMFACTOR_H */

@@ -1,5 +1,7 @@
 /*
- * polygon.c -- the unoccluded point-to-polygon form factor.
+ * polygon.c -- the unoccluded point-to-polygon form factor; and two small
+ * element helpers the sampling methods share: the bend of a quad (how far
+ * ray end points must be lifted) and the density of rad_element_sample.
  *
  * Lambert's contour formula (Lambert 1760; in radiosity: Baum, Rushmeier &
  * Winget, SIGGRAPH 1989; Cohen & Wallace 1993, sec. 4.6):
@@ -66,4 +68,29 @@ double rad_point_polygon_ff(vec3 x, vec3 normal, const vec3 *poly, size_t n)
      * front: the contour runs clockwise seen from x, so the sum is negative. */
     double f = -sum / (2.0 * M_PI);
     return f > 0.0 ? f : 0.0;
+}
+
+/* Summed distances of corners 1..3 from the plane through corner 0: an
+ * upper bound on any sampled point's distance from the backend's pieces. */
+double rad_element_bend(const rad_mesh *mesh, const rad_element *e)
+{
+    if (e->vertex_count != 4)
+        return 0.0;
+    vec3 o = mesh->vertices[e->vertex[0]];
+    double bend = 0.0;
+    for (int k = 1; k < 4; k++)
+        bend += fabs(v3_dot(e->normal, v3_sub(mesh->vertices[e->vertex[k]], o)));
+    return bend;
+}
+
+double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v)
+{
+    if (e->vertex_count != 4 || !(e->area > 0.0))
+        return 1.0;
+    const vec3 *P = mesh->vertices;
+    vec3 p0 = P[e->vertex[0]], p1 = P[e->vertex[1]], p2 = P[e->vertex[2]], p3 = P[e->vertex[3]];
+    /* x(u, v) = lerp(lerp(p0, p1, u), lerp(p3, p2, u), v), as rad_element_sample. */
+    vec3 du = v3_add(v3_scale(v3_sub(p1, p0), 1.0 - v), v3_scale(v3_sub(p2, p3), v));
+    vec3 dv = v3_sub(v3_lerp(p3, p2, u), v3_lerp(p0, p1, u));
+    return v3_length(v3_cross(du, dv)) / e->area;
 }

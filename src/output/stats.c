@@ -136,6 +136,7 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
 
     cJSON *rays = cJSON_AddObjectToObject(root, "rays");
     cJSON_AddNumberToObject(rays, "form_factors", (double)s->ff_stats.rays);
+    cJSON_AddNumberToObject(rays, "solve", (double)s->solve_stats.rays);
     cJSON_AddNumberToObject(rays, "render", (double)s->render_rays);
 
     cJSON *mem = cJSON_AddObjectToObject(root, "memory_bytes");

@@ -8,10 +8,18 @@
 
 extern const rad_solver rad_solver_gauss_seidel;
 extern const rad_solver rad_solver_southwell;
+extern const rad_solver rad_solver_jacobi;
+extern const rad_solver rad_solver_direct;
+extern const rad_solver rad_solver_conjugate_gradient;
+extern const rad_solver rad_solver_shooting;
 
 const rad_solver *const rad_solvers[] = {
     &rad_solver_gauss_seidel,
     &rad_solver_southwell,
+    &rad_solver_jacobi,
+    &rad_solver_direct,
+    &rad_solver_conjugate_gradient,
+    &rad_solver_shooting,
     NULL,
 };
 

@@ -28,6 +28,7 @@ typedef struct rad_system {
     const struct rad_vis *vis;
     uint64_t seed;
     int samples;              /* rays per shot; 0 = the solver's default */
+    double max_memory;        /* bytes a solver may allocate; 0 = 80% of physical memory */
 } rad_system;
 
 /* Called after each iteration; a nonzero return stops the solve
@@ -54,6 +55,7 @@ typedef struct rad_solve_stats {
     double ambient[3];        /* shooting: estimate of unshot light for display, W/m^2 */
     double unshot;            /* shooting: unshot power / emitted power at the end; else NAN */
     double absorbed;          /* matrix-free: power absorbed, W (mean over RGB); else NAN */
+    uint64_t rays;            /* matrix-free: rays cast while solving */
     size_t components;        /* independent groups of elements solved separately (0 = not split) */
 } rad_solve_stats;
 
@@ -88,6 +90,21 @@ static inline void rad_gather(const float *F_row, const double *B, size_t n, dou
     g[1] = g1;
     g[2] = g2;
 }
+
+/* Solve the independent groups of elements separately (components.c): the
+ * graph with an edge i-j where F_ij > 0 or F_ji > 0 is split into connected
+ * components (union-find, one O(n^2) scan of F); when two or more have more
+ * than one element, each one's sub-system (a copy of its block of F, at
+ * most the largest block's 4 n_k^2 bytes at a time) is solved with `solver`
+ * and scattered back into B.  Monitor steps are renumbered 1, 2, ... over
+ * the whole run, their residual and unshot rescaled to the whole system.
+ * stats: iterations = the most any component took, residual measured on
+ * the whole system at the end, components = the number of groups.  With
+ * one group, a matrix-free solver (F == NULL), or no room for the copy
+ * beside F under max_memory, it calls `solver` as is (components = 0).  Fails only as the solver does, or with
+ * RAD_ERROR_OUT_OF_MEMORY for the copies; B then holds the current iterate. */
+rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, const rad_system *sys,
+                                   const rad_solve_params *p, double *B, rad_solve_stats *stats);
 
 /* The residual measure above (O(n^2)). */
 double rad_residual(const rad_system *sys, const double *B);

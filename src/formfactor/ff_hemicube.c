@@ -1,0 +1,404 @@
+/*
+ * ff_hemicube.c -- form factors by the hemicube (Cohen & Greenberg, "The
+ * hemi-cube: a radiosity solution for complex environments", SIGGRAPH 1985;
+ * the lecture notes' "Form Factor - Hemicube").
+ *
+ * Nusselt's analogue: the factor from a point to a polygon is the area of
+ * the polygon projected onto the unit hemisphere and then onto its base,
+ * over pi.  Any surface enclosing the point gives the same answer, and half
+ * a cube is five ordinary pinhole images.  Every other element is
+ * rasterised onto them with a z-buffer; an item buffer keeps the nearest
+ * element of each pixel; each pixel then adds its precomputed delta form
+ * factor to the element it shows:
+ *
+ *              +-----------+  z = 1         top:   dF = dA / (pi (x^2+y^2+1)^2)
+ *             /|   top    /|                sides: dF = z dA / (pi (y^2+z^2+1)^2)
+ *            +-----------+ |
+ *            | |  side   | |  z in [0, 1]   R x R pixels on top, R x R/2 on
+ *            | +---------|-+                each side (pixels 2/R wide)
+ *            |/    * i   |/   <- base: the tangent plane of element i,
+ *            +-----------+       lifted by rad_vis_epsilon
+ *
+ *     F_ij ~= sum of dF over the pixels that show j
+ *
+ * The hemicube sits at the receiver's centroid, so F_ij is the point factor
+ * there: the outer integral over A_i is a one-point rule, and reciprocity
+ * holds only as well as that rule does (worst for pairs sharing an edge).
+ * An element half under an occluder (a floor element under a Cornell-box
+ * block) sees all or nothing.  The other error is aliasing: pixels sample
+ * the image at their centres.  Measured at R = 512 and 400 elements: 5e-4
+ * (parallel squares) to 7e-3 (occluded squares) relative; the Cornell box's
+ * surface radiosities at 1000 elements, R = 256, within 2.1% of the
+ * analytic method's.
+ * The delta factors are the formulas above integrated exactly over each
+ * pixel (the closed forms below), so they sum to 1 to rounding; the
+ * midpoint values would sum to 1 + 8.3e-6 at R = 256, 1 + 2.1e-6 at 512.
+ *
+ * Each polygon is clipped in 3-D against a near plane and the face's
+ * frustum (a side face's lower plane is the hemicube's base, so elements
+ * crossing under the receiver's tangent plane are cut to the hemisphere),
+ * projected, and filled by scanline, with 1/w as depth: for a planar
+ * polygon it is affine in screen coordinates.  Shared edges are clipped and
+ * crossed the same way from both sides, so a closed box covers every pixel
+ * (its rows sum to 1 to rounding).  Surfaces are one-sided: an
+ * element seen from behind still occludes but counts for nothing (it is
+ * written as a "blocker").  The z-buffer is the visibility: req->vis is not
+ * used.  Cost: O(n^2) projections plus O(n R^2) pixel visits; the result
+ * is deterministic and does not depend on the thread count.
+ */
+#include "formfactor/formfactor.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* ---- delta form factors ---- */
+
+/* int_0^x int_0^y dA / (pi (u^2+v^2+1)^2): the factor from a point to the
+ * rectangle [0,x] x [0,y] one unit above it, the normal through a corner
+ * (Siegel & Howell; odd in x and in y, so corners may be negative). */
+static double top_corner(double x, double y)
+{
+    double a = sqrt(1.0 + x * x), b = sqrt(1.0 + y * y);
+    return (x / a * atan(y / a) + y / b * atan(x / b)) / (2.0 * M_PI);
+}
+
+/* int_0^y int_0^z z' dA / (pi (u^2+z'^2+1)^2): a side face's rectangle
+ * [0,y] x [0,z] on the plane one unit away, perpendicular to the base
+ * (inner integral in z' gives 1/2 (1/(1+u^2) - 1/(1+u^2+z^2))). */
+static double side_corner(double y, double z)
+{
+    double c = sqrt(1.0 + z * z);
+    return (atan(y) - atan(y / c) / c) / (2.0 * M_PI);
+}
+
+double rad_hemicube_deltas(int resolution, double *delta)
+{
+    int R = resolution, H = resolution / 2;
+    double h = 2.0 / R, sum = 0.0;
+    size_t k = 0;
+    for (int r = 0; r < R; r++)
+        for (int c = 0; c < R; c++) {
+            double x0 = -1.0 + c * h, x1 = -1.0 + (c + 1) * h;
+            double y0 = -1.0 + r * h, y1 = -1.0 + (r + 1) * h;
+            double d = top_corner(x1, y1) - top_corner(x0, y1) - top_corner(x1, y0) + top_corner(x0, y0);
+            delta[k++] = d;
+            sum += d;
+        }
+    for (int face = 0; face < 4; face++)
+        for (int r = 0; r < H; r++)
+            for (int c = 0; c < R; c++) {
+                double y0 = -1.0 + c * h, y1 = -1.0 + (c + 1) * h;
+                double z0 = r * h, z1 = (r + 1) * h;
+                double d = side_corner(y1, z1) - side_corner(y0, z1) - side_corner(y1, z0) +
+                           side_corner(y0, z0);
+                delta[k++] = d;
+                sum += d;
+            }
+    return sum;
+}
+
+/* ---- rasterisation ---- */
+
+/* fmin/fmax without the NaN handling that keeps them out of line (inputs
+ * here are finite). */
+static inline double min2(double a, double b) { return a < b ? a : b; }
+static inline double max2(double a, double b) { return a > b ? a : b; }
+
+/* A point in a face's coordinates: x, y across the image, w forward. */
+typedef struct hpoint {
+    double x, y, w;
+} hpoint;
+
+/* The five faces, as permutations (with sign) of the receiver's frame
+ * (u, v, n):  0 top (x=u, y=v, w=n); 1, 2: w = +u, -u; 3, 4: w = +v, -v,
+ * with y = n on the sides.  The delta factors are symmetric in x, so the
+ * sides' handedness does not matter. */
+static hpoint face_point(int face, vec3 l)
+{
+    switch (face) {
+    case 0: return (hpoint){l.x, l.y, l.z};
+    case 1: return (hpoint){l.y, l.z, l.x};
+    case 2: return (hpoint){l.y, l.z, -l.x};
+    case 3: return (hpoint){l.x, l.z, l.y};
+    default: return (hpoint){l.x, l.z, -l.y};
+    }
+}
+
+/* Signed distance to clip plane k (inside >= 0): 0 near, 1-4 the frustum;
+ * on a side face plane 4 is the base, y >= 0. */
+static double plane_distance(hpoint p, int k, bool top, double near)
+{
+    switch (k) {
+    case 0: return p.w - near;
+    case 1: return p.w - p.x;
+    case 2: return p.w + p.x;
+    case 3: return p.w - p.y;
+    default: return top ? p.w + p.y : p.y;
+    }
+}
+
+/* Sutherland-Hodgman against one plane; `out` holds m + 1 points.  An
+ * edge is cut only where it crosses strictly (a vertex on the plane is not
+ * emitted twice), and always from its inside end, so that two polygons
+ * sharing the edge get the same point. */
+static int clip_plane(const hpoint *in, int m, hpoint *out, int k, bool top, double near)
+{
+    int count = 0;
+    for (int a = 0; a < m; a++) {
+        hpoint p = in[a], q = in[(a + 1) % m];
+        double dp = plane_distance(p, k, top, near), dq = plane_distance(q, k, top, near);
+        if (dp >= 0.0)
+            out[count++] = p;
+        if ((dp > 0.0 && dq < 0.0) || (dp < 0.0 && dq > 0.0)) {
+            hpoint in_end = dp > 0.0 ? p : q, out_end = dp > 0.0 ? q : p;
+            double d_in = fmax(dp, dq), d_out = fmin(dp, dq), t = d_in / (d_in - d_out);
+            out[count++] = (hpoint){in_end.x + t * (out_end.x - in_end.x), in_end.y + t * (out_end.y - in_end.y),
+                                    in_end.w + t * (out_end.w - in_end.w)};
+        }
+    }
+    return count;
+}
+
+/* Per-thread buffers, allocated once per thread. */
+typedef struct hc_scratch {
+    vec3 *local;     /* per mesh vertex: coordinates in the receiver's frame (u, v, n), m */
+    float *depth;    /* per pixel: 1/w of the nearest surface, 1/m; 0 = none */
+    uint32_t *item;  /* per pixel: 0 none, j + 1 element j, n + 1 a back face */
+    double *sum;     /* n + 2 accumulators, indexed like item */
+} hc_scratch;
+
+typedef struct hc_setup {
+    int R, H;            /* pixels along a full face; rows of a side face */
+    size_t pixels;       /* 3 R^2 */
+    const double *delta; /* per pixel, in rad_hemicube_deltas' layout */
+    double near;         /* near plane, m */
+    double edge_on;      /* |apex distance from a polygon's plane| below this: edge-on, m */
+} hc_setup;
+
+/* Rasterise one polygon (corners in the receiver's frame) onto one face.
+ * m_local is the polygon's unit normal in that frame and c = normal . (point
+ * of the polygon - apex): its plane is m . l = c. */
+static void raster_face(const hc_setup *hs, hc_scratch *s, int face, const vec3 *corner, int count,
+                        vec3 m_local, double c, uint32_t id)
+{
+    bool top = face == 0;
+    hpoint buf[2][12];
+    int m = count;
+    bool inside_all = true;
+    for (int k = 0; k < m; k++)
+        buf[0][k] = face_point(face, corner[k]);
+    /* Trivial reject (all corners outside one plane) and accept. */
+    for (int p = 0; p < 5; p++) {
+        int out = 0;
+        for (int k = 0; k < m; k++)
+            out += plane_distance(buf[0][k], p, top, hs->near) < 0.0;
+        if (out == m)
+            return;
+        if (out)
+            inside_all = false;
+    }
+    int cur = 0;
+    if (!inside_all)
+        for (int p = 0; p < 5 && m >= 3; p++) {
+            m = clip_plane(buf[cur], m, buf[1 - cur], p, top, hs->near);
+            cur = 1 - cur;
+        }
+    if (m < 3)
+        return;
+
+    /* Pixel coordinates: X in [0, R], Y in [0, R] (top) or [0, R/2] (side). */
+    int R = hs->R, rows = top ? R : hs->H;
+    double half = 0.5 * R, X[12], Y[12], ylo = INFINITY, yhi = -INFINITY;
+    for (int k = 0; k < m; k++) {
+        const hpoint *p = &buf[cur][k];
+        X[k] = (p->x / p->w + 1.0) * half;
+        Y[k] = (p->y / p->w + (top ? 1.0 : 0.0)) * half;
+        ylo = min2(ylo, Y[k]);
+        yhi = max2(yhi, Y[k]);
+    }
+    /* Depth 1/w = (m.x sx + m.y sy + m.w) / c with screen coordinates
+     * sx = X / half - 1, sy = Y / half - (top ? 1 : 0). */
+    hpoint mf = face_point(face, m_local);
+    double dx = mf.x / (half * c), dy = mf.y / (half * c);
+    double d0 = (mf.w - mf.x - (top ? mf.y : 0.0)) / c;
+
+    /* Scanlines through pixel centres.  A convex polygon's span on a row
+     * runs between its edges' crossings of it; each crossing is computed
+     * from the edge's lower end, so two polygons sharing an edge get the
+     * same value and, both spans being closed, leave no pixel between
+     * them uncovered. */
+    int r0 = (int)ceil(max2(ylo, 0.5) - 0.5), r1 = (int)floor(min2(yhi, rows - 0.5) - 0.5);
+    size_t offset = top ? 0 : (size_t)R * R + (size_t)(face - 1) * hs->H * R;
+    for (int r = r0; r <= r1; r++) {
+        double py = r + 0.5, lo = INFINITY, hi = -INFINITY;
+        for (int k = 0; k < m; k++) {
+            int k1 = k + 1 < m ? k + 1 : 0;
+            int a = Y[k] < Y[k1] || (Y[k] == Y[k1] && X[k] < X[k1]) ? k : k1, b = a == k ? k1 : k;
+            if (py < Y[a] || py > Y[b])
+                continue;
+            double x = Y[b] > Y[a] ? X[a] + (py - Y[a]) / (Y[b] - Y[a]) * (X[b] - X[a]) : X[a];
+            double x2 = Y[b] > Y[a] ? x : X[b]; /* a horizontal edge spans both ends */
+            lo = min2(lo, x);
+            hi = max2(hi, x2);
+        }
+        lo = max2(lo, 0.5);
+        hi = min2(hi, R - 0.5);
+        if (!(lo <= hi))
+            continue;
+        int c0 = (int)ceil(lo - 0.5), c1 = (int)floor(hi - 0.5);
+        float *depth = s->depth + offset + (size_t)r * R;
+        uint32_t *item = s->item + offset + (size_t)r * R;
+        float z0 = (float)(d0 + dy * py + dx * 0.5), zx = (float)dx;
+        for (int col = c0; col <= c1; col++) { /* branch-free: it vectorises */
+            float z = z0 + zx * (float)col;
+            bool closer = z > depth[col];
+            depth[col] = closer ? z : depth[col];
+            item[col] = closer ? id : item[col];
+        }
+    }
+}
+
+/* An orthonormal tangent pair (u, v) with u x v = n. */
+static void tangent_frame(vec3 n, vec3 *u, vec3 *v)
+{
+    vec3 a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
+    *u = v3_normalize(v3_sub(a, v3_scale(n, v3_dot(a, n))));
+    *v = v3_cross(n, *u);
+}
+
+/* Row i of F: one hemicube at element i's centroid.  Returns the element
+ * pairs projected (not behind the base). */
+static uint64_t hemicube_row(const hc_setup *hs, hc_scratch *s, const rad_mesh *mesh, size_t i,
+                             double lift, float *F)
+{
+    size_t n = mesh->element_count;
+    const rad_element *ei = &mesh->elements[i];
+    vec3 nz = ei->normal, ux, uy;
+    tangent_frame(nz, &ux, &uy);
+    vec3 apex = v3_mad(ei->centroid, nz, lift + rad_element_bend(mesh, ei));
+    for (size_t v = 0; v < mesh->vertex_count; v++) {
+        vec3 d = v3_sub(mesh->vertices[v], apex);
+        s->local[v] = v3(v3_dot(d, ux), v3_dot(d, uy), v3_dot(d, nz));
+    }
+    memset(s->depth, 0, hs->pixels * sizeof *s->depth);
+    memset(s->item, 0, hs->pixels * sizeof *s->item);
+    uint64_t pairs = 0;
+    for (size_t j = 0; j < n; j++) {
+        if (j == i)
+            continue;
+        const rad_element *ej = &mesh->elements[j];
+        vec3 corner[4];
+        bool above = false;
+        for (uint32_t k = 0; k < ej->vertex_count; k++) {
+            corner[k] = s->local[ej->vertex[k]];
+            above |= corner[k].z > 0.0;
+        }
+        if (!above)
+            continue; /* wholly under the base plane */
+        double c = v3_dot(ej->normal, v3_sub(ej->centroid, apex));
+        if (fabs(c) <= hs->edge_on)
+            continue; /* the apex lies in its plane: it projects to a line */
+        pairs++;
+        vec3 m_local = v3(v3_dot(ej->normal, ux), v3_dot(ej->normal, uy), v3_dot(ej->normal, nz));
+        /* c < 0: the apex is on j's front side. */
+        uint32_t id = c < 0.0 ? (uint32_t)j + 1 : (uint32_t)n + 1;
+        for (int face = 0; face < 5; face++)
+            raster_face(hs, s, face, corner, (int)ej->vertex_count, m_local, c, id);
+    }
+    /* Sum by runs of equal items: the running total stays in a register. */
+    memset(s->sum, 0, (n + 2) * sizeof *s->sum);
+    uint32_t run = s->item[0];
+    double total = 0.0;
+    for (size_t p = 0; p < hs->pixels; p++) {
+        if (s->item[p] != run) {
+            s->sum[run] += total;
+            run = s->item[p];
+            total = 0.0;
+        }
+        total += hs->delta[p];
+    }
+    s->sum[run] += total;
+    for (size_t j = 0; j < n; j++)
+        F[i * n + j] = (float)s->sum[j + 1];
+    return pairs;
+}
+
+static rad_result hemicube_compute(rad_context *ctx, const rad_ff_request *req, float *F,
+                                   float *variance, rad_ff_stats *stats)
+{
+    (void)variance;
+    const rad_mesh *mesh = req->mesh;
+    size_t n = mesh->element_count;
+    if (n >= UINT32_MAX - 1)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "hemicube: too many elements (%zu)", n);
+    hc_setup hs;
+    hs.R = req->hemicube_resolution > 0 ? req->hemicube_resolution : 256;
+    hs.R += hs.R & 1; /* side faces are R/2 high */
+    hs.H = hs.R / 2;
+    hs.pixels = 3 * (size_t)hs.R * (size_t)hs.R;
+    double *delta = rad_alloc_array(ctx, hs.pixels, sizeof *delta, "hemicube: delta form factors");
+    if (!delta)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_hemicube_deltas(hs.R, delta);
+    hs.delta = delta;
+    double eps = rad_vis_epsilon(mesh);
+    /* The apex is lifted by eps: nothing but degenerate geometry lies
+     * closer, and 1e-2 eps keeps 1/w finite. */
+    hs.near = 1e-2 * eps;
+    hs.edge_on = 1e-3 * eps;
+
+    uint64_t pairs = 0, rows_done = 0;
+    volatile int stop = 0, failed = 0;
+#pragma omp parallel num_threads(ctx->threads) reduction(+ : pairs)
+    {
+        hc_scratch s;
+        s.local = malloc((mesh->vertex_count ? mesh->vertex_count : 1) * sizeof *s.local);
+        s.depth = malloc(hs.pixels * sizeof *s.depth);
+        s.item = malloc(hs.pixels * sizeof *s.item);
+        s.sum = malloc((n + 2) * sizeof *s.sum);
+        if (!s.local || !s.depth || !s.item || !s.sum)
+            failed = 1;
+#pragma omp for schedule(dynamic, 4)
+        for (size_t i = 0; i < n; i++) {
+            if (stop || failed)
+                continue;
+            pairs += hemicube_row(&hs, &s, mesh, i, eps, F);
+            uint64_t done;
+#pragma omp atomic capture
+            done = ++rows_done;
+#ifdef _OPENMP
+            if (omp_get_thread_num() == 0)
+#endif
+            {
+                rad_progress(ctx, "form factors", done, n);
+                if (rad_cancelled(ctx))
+                    stop = 1;
+            }
+        }
+        free(s.local);
+        free(s.depth);
+        free(s.item);
+        free(s.sum);
+    }
+    free(delta);
+    stats->pairs = pairs;
+    if (failed)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hemicube: out of memory for %d x %d buffers",
+                        hs.R, hs.R);
+    if (stop)
+        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
+    rad_progress(ctx, "form factors", n, n);
+    return RAD_OK;
+}
+
+const rad_ff_method rad_ff_hemicube = {
+    "hemicube",
+    "hemicube at each element's centroid (Cohen & Greenberg 1985): z-buffered item buffer, "
+    "exact delta factors, deterministic; 5e-4 to 7e-3 at R=512 on the test cases, O(n^2 + n R^2)",
+    0,
+    hemicube_compute,
+};

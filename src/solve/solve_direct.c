@@ -1,0 +1,156 @@
+/*
+ * solve_direct.c -- the radiosity system solved exactly, by LU
+ * factorisation with partial pivoting (LAPACK dgesv), one colour channel
+ * at a time (Cohen & Wallace 1993, sec. 5.2; the notes' "Direct Methods"):
+ *
+ *     K_c B_c = E_c,   K_c = I - diag(rho_c) F       (n x n doubles)
+ *
+ * O(n^3) time and 8 n^2 bytes, but no tolerance: the answer is exact up to
+ * double rounding, so it is the reference the iterative solvers are tested
+ * against.  K_c is built from the float F in double, so the system solved
+ * is the engine's own; channels with the same reflectance everywhere (grey
+ * scenes) share one factorisation.  K is written column-major, as LAPACK
+ * keeps it, so LAPACKE makes no transposed copy of its own.  Above the
+ * memory limit (rad_system.max_memory) the solver refuses rather than
+ * swap; the iterative solvers need O(n) beside F.
+ */
+#include "solve/solve.h"
+
+#include <cblas.h>
+#include <lapacke.h>
+#include <limits.h>
+#include <stdlib.h>
+
+/* 64 x 64 doubles: one tile of K and of F stay in L1/L2 during the transposition. */
+enum { TILE = 64 };
+
+/* K = I - diag(rho) F in column-major order, by tiles (F is row-major). */
+static void build_matrix(const rad_system *sys, const double *rho, size_t stride, double *K)
+{
+    size_t n = sys->n;
+    size_t tiles = (n + TILE - 1) / TILE;
+#pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
+    for (size_t jt = 0; jt < tiles; jt++) {
+        size_t j0 = jt * TILE, j1 = j0 + TILE < n ? j0 + TILE : n;
+        for (size_t i0 = 0; i0 < n; i0 += TILE) {
+            size_t i1 = i0 + TILE < n ? i0 + TILE : n;
+            for (size_t i = i0; i < i1; i++) {
+                const float *Fi = sys->F + i * n;
+                double r = rho[stride * i];
+                for (size_t j = j0; j < j1; j++)
+                    K[j * n + i] = (i == j ? 1.0 : 0.0) - r * (double)Fi[j];
+            }
+        }
+    }
+}
+
+static bool same_channel(const rad_system *sys, int a, int b)
+{
+    for (size_t i = 0; i < sys->n; i++)
+        if (sys->reflectance[3 * i + a] != sys->reflectance[3 * i + b])
+            return false;
+    return true;
+}
+
+/* "12.3 MiB" or "4.50 GiB". */
+static void format_bytes(double bytes, char *out, size_t size)
+{
+    if (bytes >= 1073741824.0)
+        snprintf(out, size, "%.2f GiB", bytes / 1073741824.0);
+    else
+        snprintf(out, size, "%.2f MiB", bytes / 1048576.0);
+}
+
+static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
+                         double *B, rad_solve_stats *stats)
+{
+    size_t n = sys->n;
+    double t0 = rad_seconds();
+    /* K, the right-hand sides (up to 3 columns) and the pivots. */
+    double needed = 8.0 * (double)n * (double)n + 24.0 * (double)n + 4.0 * (double)n;
+    double limit = sys->max_memory > 0.0 ? sys->max_memory : 0.8 * (double)rad_physical_memory_bytes();
+    if (needed > limit || n > (size_t)INT_MAX) {
+        char need_text[32], limit_text[32];
+        format_bytes(needed, need_text, sizeof need_text);
+        format_bytes(limit, limit_text, sizeof limit_text);
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "solve: the direct solver's LU of the %zu x %zu system needs %s (8 n^2 bytes), "
+                        "above the memory limit of %s (--max-memory); use an iterative solver "
+                        "(--solver gauss-seidel, jacobi or conjugate-gradient) or fewer elements",
+                        n, n, need_text, limit_text);
+    }
+    if (n == 0) {
+        stats->residual = 0.0;
+        stats->converged = true;
+        return RAD_OK;
+    }
+    double *K = rad_alloc_array(ctx, n * n, sizeof *K, "solve: direct: LU matrix");
+    double *rhs = rad_alloc_array(ctx, 3 * n, sizeof *rhs, "solve: direct: right-hand sides");
+    lapack_int *pivots = rad_alloc_array(ctx, n, sizeof *pivots, "solve: direct: pivots");
+    if (!K || !rhs || !pivots) {
+        free(K);
+        free(rhs);
+        free(pivots);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    /* OpenBLAS keeps its thread count in a global: set it for the
+     * factorisation and give the caller's back afterwards. */
+    int blas_threads = openblas_get_num_threads();
+    openblas_set_num_threads(sys->threads > 0 ? sys->threads : 1);
+
+    rad_result result = RAD_OK;
+    bool solved[3] = {false, false, false};
+    for (int c = 0; c < 3 && result == RAD_OK; c++) {
+        if (solved[c])
+            continue;
+        int channels[3], m = 0;
+        for (int d = c; d < 3; d++)
+            if (!solved[d] && (d == c || same_channel(sys, c, d)))
+                channels[m++] = d;
+        build_matrix(sys, sys->reflectance + c, 3, K);
+        for (int k = 0; k < m; k++)
+            for (size_t i = 0; i < n; i++)
+                rhs[(size_t)k * n + i] = sys->emission[3 * i + channels[k]];
+        lapack_int info = LAPACKE_dgesv(LAPACK_COL_MAJOR, (lapack_int)n, m, K, (lapack_int)n, pivots,
+                                        rhs, (lapack_int)n);
+        if (info != 0) {
+            /* rho_i sum_j F_ij < 1 makes K strictly diagonally dominant, so
+             * a zero pivot means F is broken (row sums far above 1). */
+            result = rad_fail(ctx, RAD_ERROR_INTERNAL,
+                              "solve: direct: LAPACK dgesv failed (info %d) on channel %d: the "
+                              "matrix is singular; are the form-factor row sums above 1?",
+                              (int)info, c);
+            break;
+        }
+        for (int k = 0; k < m; k++) {
+            for (size_t i = 0; i < n; i++)
+                B[3 * i + channels[k]] = rhs[(size_t)k * n + i];
+            solved[channels[k]] = true;
+        }
+        rad_progress(ctx, "solve", (uint64_t)(c + 1), 3);
+        if (rad_cancelled(ctx) && !(solved[0] && solved[1] && solved[2]))
+            result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: direct: interrupted after channel %d", c);
+    }
+    openblas_set_num_threads(blas_threads > 0 ? blas_threads : 1);
+    free(K);
+    free(rhs);
+    free(pivots);
+
+    stats->iterations = result == RAD_OK ? 1 : 0;
+    stats->residual = rad_residual(sys, B);
+    stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    if (result == RAD_OK && p->monitor) {
+        rad_solve_step step = {1, rad_seconds() - t0, stats->residual, NAN};
+        if (p->monitor(p->monitor_user, &step, B, NULL))
+            return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: stopped after the direct solve");
+    }
+    return result;
+}
+
+const rad_solver rad_solver_direct = {
+    "direct",
+    "LU factorisation (LAPACK dgesv) per colour channel: exact, the reference; O(n^3) time, "
+    "8 n^2 bytes (refused above --max-memory)",
+    0,
+    direct,
+};

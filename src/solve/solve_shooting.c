@@ -1,0 +1,298 @@
+/*
+ * solve_shooting.c -- progressive refinement without a stored matrix:
+ * each shot's form-factor column is sampled on the fly by rays from the
+ * shooter, so memory is O(n) and scenes of 10^5 to 10^6 elements fit.
+ *
+ * A shot from element i casts N rays from stratified points of i in
+ * cosine-distributed directions (Malley's method); each carries 1/N of the
+ * unshot power A_i dB_i.  The element j a ray reaches first (front side)
+ * gains dB_j += rho_j (A_i dB_i / N) / A_j, and (1 - rho_j) of that power is
+ * absorbed.  Counting hits estimates F_ij without bias (the notes'
+ * "Form Factor - Hemisphere" from the shooter; Shirley 1990 for stochastic
+ * shooting), so the expected answer is progressive refinement's.
+ *
+ *     unshot heap --top K--> shooters --rays (parallel)--> hits
+ *          ^                                                 |
+ *          +------ deposits, applied in shooter order <------+
+ *
+ * Determinism: the K largest unshot powers are shot as one batch; each
+ * shooter's rays are keyed on (seed, batch, shooter), cast in parallel and
+ * their deposits applied in a fixed order, so results do not depend on the
+ * thread count.  An indexed max-heap picks shooters in O(log n); unshot
+ * power and the ambient term are kept as running sums, so a step costs
+ * O(K N log n), not O(n).
+ *
+ * Stopping: on unshot power / emitted power below the unshot tolerance
+ * (default 1e-3: the answer is a Monte Carlo estimate whose noise, ~1/sqrt
+ * of the rays an element receives, is far above what further shooting
+ * would change).  The residual needs F, so it is not measured (NAN).
+ */
+#include "solve/solve.h"
+#include "mesh/mesh.h"
+#include "vis/vis.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+enum { BATCH = 32, RAY_BLOCK = 64 };
+
+/* ---- an indexed max-heap of unshot power; ties broken by index ---- */
+
+typedef struct heap {
+    uint32_t *item;   /* heap order -> element */
+    uint32_t *slot;   /* element -> heap position */
+    double *key;      /* element -> unshot power (W, summed over RGB) */
+    size_t count;
+} heap;
+
+static bool heap_above(const heap *h, uint32_t a, uint32_t b)
+{
+    return h->key[a] > h->key[b] || (h->key[a] == h->key[b] && a < b);
+}
+
+static void heap_swap(heap *h, size_t x, size_t y)
+{
+    uint32_t a = h->item[x], b = h->item[y];
+    h->item[x] = b;
+    h->item[y] = a;
+    h->slot[a] = (uint32_t)y;
+    h->slot[b] = (uint32_t)x;
+}
+
+static void heap_fix(heap *h, uint32_t element)
+{
+    size_t k = h->slot[element];
+    while (k > 0 && heap_above(h, h->item[k], h->item[(k - 1) / 2])) {
+        heap_swap(h, k, (k - 1) / 2);
+        k = (k - 1) / 2;
+    }
+    for (;;) {
+        size_t l = 2 * k + 1, r = l + 1, best = k;
+        if (l < h->count && heap_above(h, h->item[l], h->item[best]))
+            best = l;
+        if (r < h->count && heap_above(h, h->item[r], h->item[best]))
+            best = r;
+        if (best == k)
+            break;
+        heap_swap(h, k, best);
+        k = best;
+    }
+}
+
+/* ---- one shot's rays ---- */
+
+typedef struct hit_record {
+    uint32_t element; /* UINT32_MAX: escaped or hit a back side */
+} hit_record;
+
+/* Cast N rays from element i; record the element each reaches. */
+static void shoot_rays(const rad_system *sys, uint32_t i, uint64_t key, int N, double eps,
+                       hit_record *out, rad_ray *rays, rad_hit *hits)
+{
+    const rad_mesh *mesh = sys->mesh;
+    const rad_element *e = &mesh->elements[i];
+    /* Lift by the element's own bend too (a bent quad's bilinear points can
+     * lie behind the flat pieces the ray backend holds). */
+    double lift = eps;
+    if (e->vertex_count == 4)
+        for (int k = 1; k < 4; k++)
+            lift += fabs(v3_dot(e->normal, v3_sub(mesh->vertices[e->vertex[k]], mesh->vertices[e->vertex[0]])));
+    vec3 n = e->normal;
+    vec3 t = v3_normalize(fabs(n.x) > 0.9 ? v3_cross(n, v3(0, 1, 0)) : v3_cross(n, v3(1, 0, 0)));
+    vec3 b = v3_cross(n, t);
+    rad_rng rng = rad_rng_keyed(sys->seed, key, i);
+    int side = (int)sqrt((double)N);
+    if (side < 1)
+        side = 1;
+    for (int first = 0; first < N; first += RAY_BLOCK) {
+        int count = N - first < RAY_BLOCK ? N - first : RAY_BLOCK;
+        for (int k = 0; k < count; k++) {
+            int s = first + k;
+            /* Directions stratified over the disk (Malley); origins uniform
+             * and independent of the direction (tying the two strata by a
+             * fixed rule would bias the estimate). */
+            int cell = s % (side * side);
+            double u = ((cell % side) + rad_rng_uniform(&rng)) / side;
+            double v = ((cell / side) + rad_rng_uniform(&rng)) / side;
+            double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
+            double r = sqrt(u), phi = 2.0 * M_PI * v;
+            double z = sqrt(fmax(0.0, 1.0 - u));
+            vec3 dir = v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(n, z));
+            rays[k].origin = v3_mad(rad_element_sample(mesh, e, pu, pv), n, lift);
+            rays[k].direction = dir;
+            rays[k].tnear = 0.0;
+            rays[k].tfar = INFINITY;
+        }
+        sys->vis->backend->intersect(sys->vis->state, rays, (size_t)count, hits);
+        for (int k = 0; k < count; k++) {
+            out[first + k].element = UINT32_MAX;
+            if (!isfinite(hits[k].t))
+                continue;
+            const rad_patch *p = &mesh->patches[hits[k].patch];
+            if (v3_dot(rays[k].direction, p->normal) >= 0.0)
+                continue; /* back side: absorbed by nothing we track */
+            vec3 q = v3_mad(rays[k].origin, rays[k].direction, hits[k].t);
+            double s0, t0, ls, lt;
+            rad_patch_parameters(p, q, &s0, &t0);
+            out[first + k].element = rad_patch_locate(p, s0, t0, &ls, &lt);
+        }
+    }
+}
+
+static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
+                           double *B, rad_solve_stats *stats)
+{
+    size_t n = sys->n;
+    if (!sys->mesh || !sys->vis)
+        return rad_fail(ctx, RAD_ERROR_INTERNAL, "shooting: needs the mesh and a ray backend");
+    int N = sys->samples > 0 ? sys->samples : 256;
+    double goal = p->unshot_tolerance > 0.0 ? p->unshot_tolerance : 1e-3;
+    int threads = sys->threads > 0 ? sys->threads : 1;
+    double *dB = rad_alloc_array(ctx, 3 * n, sizeof *dB, "shooting: unshot radiosity");
+    heap h = {0};
+    h.item = rad_alloc_array(ctx, n, sizeof *h.item, "shooting: heap");
+    h.slot = rad_alloc_array(ctx, n, sizeof *h.slot, "shooting: heap");
+    h.key = rad_alloc_array(ctx, n, sizeof *h.key, "shooting: heap");
+    hit_record *hits = rad_alloc_array(ctx, (size_t)BATCH * (size_t)N, sizeof *hits, "shooting: hits");
+    rad_ray *rays = rad_alloc_array(ctx, (size_t)threads * RAY_BLOCK, sizeof *rays, "shooting: rays");
+    rad_hit *rhits = rad_alloc_array(ctx, (size_t)threads * RAY_BLOCK, sizeof *rhits, "shooting: rays");
+    rad_result result = RAD_OK;
+    if (!dB || !h.item || !h.slot || !h.key || !hits || !rays || !rhits) {
+        result = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+
+    /* Running sums: emitted and unshot power per channel, area, rho-area. */
+    double emitted = 0.0, unshot_c[3] = {0, 0, 0}, area = 0.0, rho_area[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        area += sys->area[i];
+        for (int c = 0; c < 3; c++) {
+            dB[3 * i + c] = B[3 * i + c];
+            unshot_c[c] += sys->area[i] * dB[3 * i + c];
+            rho_area[c] += sys->area[i] * sys->reflectance[3 * i + c];
+            emitted += sys->area[i] * sys->emission[3 * i + c];
+        }
+        h.item[i] = h.slot[i] = (uint32_t)i;
+        h.key[i] = sys->area[i] * (dB[3 * i] + dB[3 * i + 1] + dB[3 * i + 2]);
+    }
+    h.count = n;
+    for (size_t k = n / 2; k-- > 0;) /* heapify */
+        heap_fix(&h, h.item[k]);
+    double absorbed = 0.0, t0 = rad_seconds();
+    double eps = rad_vis_epsilon(sys->mesh); /* O(vertices): once, not per shot */
+    long long max_batches = p->max_iterations > 0 ? p->max_iterations : 1000000000LL;
+    uint64_t rays_cast = 0;
+    long long batch = 0;
+    double unshot = emitted > 0.0 ? (unshot_c[0] + unshot_c[1] + unshot_c[2]) / emitted : 0.0;
+    uint32_t shooter[BATCH];
+    double power[BATCH][3];
+
+    for (; batch < max_batches && unshot > goal; batch++) {
+        /* The K largest unshot powers, removed from the books as they shoot. */
+        int K = 0;
+        while (K < BATCH && h.count > 0 && h.key[h.item[0]] > 0.0) {
+            uint32_t i = h.item[0];
+            shooter[K] = i;
+            for (int c = 0; c < 3; c++) {
+                power[K][c] = sys->area[i] * dB[3 * i + c];
+                unshot_c[c] -= power[K][c];
+                dB[3 * i + c] = 0.0;
+            }
+            h.key[i] = -1.0; /* sink, then restore to 0 after the batch */
+            heap_fix(&h, i);
+            K++;
+        }
+        if (K == 0)
+            break;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+        for (int k = 0; k < K; k++) {
+            int tid = 0;
+#ifdef _OPENMP
+            tid = omp_get_thread_num();
+#endif
+            shoot_rays(sys, shooter[k], (uint64_t)batch, N, eps, hits + (size_t)k * N,
+                       rays + (size_t)tid * RAY_BLOCK, rhits + (size_t)tid * RAY_BLOCK);
+        }
+        rays_cast += (uint64_t)K * (uint64_t)N;
+        /* Deposits, in shooter order (deterministic). */
+        for (int k = 0; k < K; k++) {
+            h.key[shooter[k]] = 0.0;
+            heap_fix(&h, shooter[k]);
+        }
+        for (int k = 0; k < K; k++) {
+            const hit_record *hk = hits + (size_t)k * N;
+            for (int r = 0; r < N; r++) {
+                uint32_t j = hk[r].element;
+                if (j == UINT32_MAX)
+                    continue; /* escaped: an open scene loses it */
+                double aj = sys->area[j];
+                for (int c = 0; c < 3; c++) {
+                    double arriving = power[k][c] / N; /* W */
+                    double rho = sys->reflectance[3 * j + c];
+                    double d = rho * arriving / aj;
+                    dB[3 * j + c] += d;
+                    B[3 * j + c] += d;
+                    unshot_c[c] += rho * arriving;
+                    absorbed += (1.0 - rho) * arriving;
+                }
+                h.key[j] = aj * (dB[3 * j] + dB[3 * j + 1] + dB[3 * j + 2]);
+                heap_fix(&h, j);
+            }
+        }
+        unshot = emitted > 0.0 ? (unshot_c[0] + unshot_c[1] + unshot_c[2]) / emitted : 0.0;
+        if (p->monitor) {
+            for (int c = 0; c < 3; c++) {
+                double rho_avg = rho_area[c] / area;
+                stats->ambient[c] = unshot_c[c] / area / (1.0 - rho_avg);
+            }
+            rad_solve_step step = {(int)(batch + 1 < 2147483647LL ? batch + 1 : 2147483647LL),
+                                   rad_seconds() - t0, NAN, unshot};
+            if (p->monitor(p->monitor_user, &step, B, stats->ambient)) {
+                batch++;
+                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: stopped after %lld batches", batch);
+                break;
+            }
+        }
+        if ((batch & 63) == 0) {
+            /* Progress on a log scale of the unshot power: 1 -> goal. */
+            double done = log(fmax(unshot, goal)) / log(goal);
+            rad_progress(ctx, "solve", (uint64_t)(1000.0 * fmax(done, 0.0)), 1000);
+            if (rad_cancelled(ctx)) {
+                batch++;
+                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %lld batches", batch);
+                break;
+            }
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        double rho_avg = rho_area[c] / area;
+        stats->ambient[c] = unshot_c[c] / area / (1.0 - rho_avg);
+    }
+    stats->iterations = batch > 2147483647LL ? 2147483647 : (int)batch;
+    stats->unshot = unshot;
+    stats->absorbed = absorbed / 3.0;
+    stats->residual = NAN;
+    stats->rays = rays_cast;
+    stats->converged = result == RAD_OK && unshot <= goal;
+done:
+    free(dB);
+    free(h.item);
+    free(h.slot);
+    free(h.key);
+    free(hits);
+    free(rays);
+    free(rhits);
+    return result;
+}
+
+const rad_solver rad_solver_shooting = {
+    "shooting",
+    "matrix-free progressive refinement: form-factor columns sampled by rays from the "
+    "shooter (--ff-samples per shot); O(n) memory, for 10^5-10^6 elements",
+    RAD_SOLVER_MATRIX_FREE,
+    shooting,
+};

@@ -1,0 +1,669 @@
+/*
+ * test_solvers.c -- every registered solver against the exact answers and
+ * against each other, through the same command users run.
+ *
+ * The solvers are read from `radiosity --list-methods` (matrix-free ones,
+ * which compute their own sampled factors, are left to their own suite),
+ * so a new solver is tested as soon as it is registered.  `direct` (LU) is
+ * the reference on scenes without a closed form.  The path of the
+ * radiosity binary is argv[1]; scenes are written from tests/data/cases.json.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static const char *radiosity_bin;
+static char workdir[256];
+static cJSON *cases;
+
+enum { MAX_SOLVERS = 32 };
+static char *solvers[MAX_SOLVERS]; /* owned, freed in teardown */
+static int solver_count;
+
+/* ---- helpers (as in test_accuracy.c) ---- */
+
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *buf = malloc((size_t)n + 1);
+    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        free(buf);
+        buf = NULL;
+    }
+    if (buf)
+        buf[n] = '\0';
+    fclose(f);
+    return buf;
+}
+
+static cJSON *read_json(const char *path)
+{
+    char *text = read_text(path);
+    if (!text)
+        return NULL;
+    cJSON *j = cJSON_Parse(text);
+    free(text);
+    return j;
+}
+
+static const cJSON *find_case(const char *id)
+{
+    const cJSON *c;
+    cJSON_ArrayForEach(c, cJSON_GetObjectItem(cases, "cases"))
+    {
+        if (strcmp(cJSON_GetObjectItem(c, "id")->valuestring, id) == 0)
+            return c;
+    }
+    fail_msg("case %s missing from cases.json", id);
+    return NULL;
+}
+
+typedef struct scene_writer {
+    FILE *obj, *mtl;
+    int vertices;
+    char obj_path[512];
+} scene_writer;
+
+static void scene_begin(scene_writer *w, const char *name)
+{
+    char mtl_path[512];
+    snprintf(w->obj_path, sizeof w->obj_path, "%s/%s.obj", workdir, name);
+    snprintf(mtl_path, sizeof mtl_path, "%s/%s.mtl", workdir, name);
+    w->obj = fopen(w->obj_path, "w");
+    w->mtl = fopen(mtl_path, "w");
+    assert_non_null(w->obj);
+    assert_non_null(w->mtl);
+    fprintf(w->obj, "mtllib %s.mtl\n", name);
+    w->vertices = 0;
+}
+
+/* RGB reflectance and emission (exitance, W/m^2); Ke = E / pi is emitted radiance. */
+static void scene_material(scene_writer *w, const char *name, const double rho[3], double E)
+{
+    fprintf(w->mtl, "newmtl %s\nKd %.17g %.17g %.17g\nKe %.17g %.17g %.17g\n\n", name, rho[0], rho[1],
+            rho[2], E / M_PI, E / M_PI, E / M_PI);
+}
+
+/* A polygon of the case geometry, moved by `offset`. */
+static void scene_case_surface(scene_writer *w, const cJSON *surface, const char *name,
+                               const char *material, const double offset[3])
+{
+    fprintf(w->obj, "o %s\nusemtl %s\n", name, material);
+    int n = 0;
+    const cJSON *p;
+    cJSON_ArrayForEach(p, cJSON_GetObjectItem(surface, "vertices"))
+    {
+        fprintf(w->obj, "v");
+        for (int c = 0; c < 3; c++)
+            fprintf(w->obj, " %.17g", cJSON_GetArrayItem(p, c)->valuedouble + offset[c]);
+        fprintf(w->obj, "\n");
+        n++;
+    }
+    fprintf(w->obj, "f");
+    for (int k = 0; k < n; k++)
+        fprintf(w->obj, " %d", w->vertices + k + 1);
+    fprintf(w->obj, "\n");
+    w->vertices += n;
+}
+
+static void scene_end(scene_writer *w)
+{
+    fclose(w->obj);
+    fclose(w->mtl);
+}
+
+/* Run the binary with arguments, stderr into `errors` when not NULL;
+ * returns its exit status. */
+static int run_capture(const char *errors, const char *fmt, ...)
+{
+    char args[2048], cmd[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    if (errors)
+        snprintf(cmd, sizeof cmd, "'%s' %s --quiet 2>'%s'", radiosity_bin, args, errors);
+    else
+        snprintf(cmd, sizeof cmd, "'%s' %s --quiet", radiosity_bin, args);
+    int status = system(cmd);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static double stats_number(const cJSON *stats, const char *object, const char *key)
+{
+    const cJSON *v = cJSON_GetObjectItem(cJSON_GetObjectItem(stats, object), key);
+    if (!cJSON_IsNumber(v))
+        fail_msg("stats: %s.%s missing", object, key);
+    return v->valuedouble;
+}
+
+/* Render `scene` ("" = the built-in Cornell box) with `extra` options and
+ * return the stats (caller frees); `tag` names the files. */
+static cJSON *render_stats(const char *scene, const char *tag, const char *extra)
+{
+    char stats[600], png[600];
+    snprintf(stats, sizeof stats, "%s/%s.stats.json", workdir, tag);
+    snprintf(png, sizeof png, "%s/%s.png", workdir, tag);
+    int status = run_capture(NULL, "render %s%s%s -o '%s' --stats '%s' --width 8 --height 8 %s",
+                             scene[0] ? "'" : "", scene, scene[0] ? "'" : "", png, stats, extra);
+    if (status != 0)
+        fail_msg("%s: radiosity render %s exited with %d", tag, extra, status);
+    cJSON *j = read_json(stats);
+    assert_non_null(j);
+    return j;
+}
+
+/* Per-surface mean radiosity, surface by surface in the order of the stats. */
+static int surface_radiosities(const cJSON *stats, double (*rgb)[3], char (*names)[64], int max)
+{
+    int count = 0;
+    const cJSON *s;
+    cJSON_ArrayForEach(s, cJSON_GetObjectItem(stats, "surfaces"))
+    {
+        assert_true(count < max);
+        for (int c = 0; c < 3; c++)
+            rgb[count][c] = cJSON_GetArrayItem(cJSON_GetObjectItem(s, "radiosity"), c)->valuedouble;
+        snprintf(names[count], 64, "%s", cJSON_GetObjectItem(s, "name")->valuestring);
+        count++;
+    }
+    return count;
+}
+
+static void surface_radiosity(const cJSON *stats, const char *name, double rgb[3])
+{
+    const cJSON *s;
+    cJSON_ArrayForEach(s, cJSON_GetObjectItem(stats, "surfaces"))
+    {
+        if (strcmp(cJSON_GetObjectItem(s, "name")->valuestring, name) == 0) {
+            for (int c = 0; c < 3; c++)
+                rgb[c] = cJSON_GetArrayItem(cJSON_GetObjectItem(s, "radiosity"), c)->valuedouble;
+            return;
+        }
+    }
+    fail_msg("surface %s not in stats", name);
+}
+
+/* Relative error below tol (absolute where the expected value is 0). */
+static void assert_relative(double got, double exact, double tol, const char *what)
+{
+    double rel = exact == 0.0 ? fabs(got) : fabs(got - exact) / fabs(exact);
+    if (!(rel <= tol))
+        fail_msg("%s: got %.12g, expected %.12g, relative error %.2e > %.1e", what, got, exact, rel, tol);
+}
+
+/* Every surface of `got` against the same surface of `want` (non-zero values). */
+static void assert_same_surfaces(const cJSON *got, const cJSON *want, double tol, const char *what)
+{
+    enum { MAX = 64 };
+    double a[MAX][3], b[MAX][3];
+    char na[MAX][64], nb[MAX][64];
+    int n = surface_radiosities(got, a, na, MAX), m = surface_radiosities(want, b, nb, MAX);
+    assert_int_equal(n, m);
+    assert_true(n > 0);
+    for (int k = 0; k < n; k++) {
+        assert_string_equal(na[k], nb[k]);
+        for (int c = 0; c < 3; c++) {
+            char label[256];
+            snprintf(label, sizeof label, "%s: %.63s[%d]", what, na[k], c);
+            assert_relative(a[k][c], b[k][c], tol, label);
+        }
+    }
+}
+
+/* ---- scenes ---- */
+
+static const char *cube_faces[6] = {"x0", "x1", "y0", "y1", "z0", "z1"};
+
+/* A cube of the case geometry: faces named prefix + face, rho and E from
+ * the case unless `rho` / `emitter` are given (then the face `emitter`
+ * emits E and reflects `emitter_rho`, the others reflect `rho`). */
+static void write_cube_faces(scene_writer *w, const char *case_id, const char *prefix,
+                             const double offset[3], const double *rho, const char *emitter, double E,
+                             const double *emitter_rho)
+{
+    const cJSON *g = cJSON_GetObjectItem(find_case(case_id), "geometry");
+    for (int f = 0; f < 6; f++) {
+        const cJSON *s = cJSON_GetObjectItem(g, cube_faces[f]);
+        const cJSON *rho_case = cJSON_GetObjectItem(s, "rho"), *E_case = cJSON_GetObjectItem(s, "E");
+        double r[3], e;
+        bool emits = emitter && strcmp(emitter, cube_faces[f]) == 0;
+        for (int c = 0; c < 3; c++)
+            r[c] = emits ? emitter_rho[c] : rho ? rho[c] : rho_case ? rho_case->valuedouble : 0.5;
+        e = emitter ? (emits ? E : 0.0) : E_case ? E_case->valuedouble : 0.0;
+        char name[64];
+        snprintf(name, sizeof name, "%s%s", prefix, cube_faces[f]);
+        scene_material(w, name, r, e);
+        scene_case_surface(w, s, name, name, offset);
+    }
+}
+
+static void write_case_cube(scene_writer *w, const char *name, const char *case_id)
+{
+    static const double zero[3] = {0, 0, 0};
+    scene_begin(w, name);
+    write_cube_faces(w, case_id, "", zero, NULL, NULL, 0.0, NULL);
+    scene_end(w);
+}
+
+/* Two closed rooms that cannot see each other: room a is the six-patch
+ * case (grey, lit from the ceiling), room b three metres along x, lit from
+ * a black floor, with walls that reflect no blue (rho = 0: solvers that
+ * eliminate such unknowns must still give B = E there). */
+static const double room_b_offset[3] = {3.0, 0.0, 0.0};
+static const double room_b_rho[3] = {0.7, 0.5, 0.0};
+static const double black[3] = {0.0, 0.0, 0.0};
+
+static void write_rooms(scene_writer *w, const char *name, bool room_a, bool room_b)
+{
+    static const double zero[3] = {0, 0, 0};
+    scene_begin(w, name);
+    if (room_a)
+        write_cube_faces(w, "cube_top_emitter_6patch", "a_", zero, NULL, NULL, 0.0, NULL);
+    if (room_b)
+        write_cube_faces(w, "cube_top_emitter_6patch", "b_", room_b_offset, room_b_rho, "z0", 2.0, black);
+    scene_end(w);
+}
+
+/* ---- the solver list ---- */
+
+static void test_registry(void **state)
+{
+    (void)state;
+    /* The registry is read in setup(); the solvers every build has must be there. */
+    static const char *required[] = {"gauss-seidel", "southwell", "jacobi", "direct", "conjugate-gradient"};
+    for (size_t r = 0; r < sizeof required / sizeof required[0]; r++) {
+        bool found = false;
+        for (int k = 0; k < solver_count; k++)
+            found = found || strcmp(solvers[k], required[r]) == 0;
+        if (!found)
+            fail_msg("solver %s is not listed by --list-methods", required[r]);
+    }
+}
+
+/* ---- (a) the Cornell box: every solver agrees with LU ---- */
+
+static void test_cornell_box_against_direct(void **state)
+{
+    (void)state;
+    cJSON *ref = render_stats("", "cornell_direct", "--elements 800 --solver direct");
+    assert_true(stats_number(ref, "solver", "residual") < 1e-12);
+    for (int k = 0; k < solver_count; k++) {
+        char extra[256], tag[128];
+        snprintf(extra, sizeof extra, "--elements 800 --solver %s --tolerance 1e-9", solvers[k]);
+        snprintf(tag, sizeof tag, "cornell_%s", solvers[k]);
+        cJSON *s = render_stats("", tag, extra);
+        assert_same_surfaces(s, ref, 1e-5, solvers[k]);
+        /* Converged, or near it: shooting bookkeeps F_ji through reciprocity,
+         * so its residual stops at the reciprocity error (~6e-9 here). */
+        if (!(stats_number(s, "solver", "residual") < 1e-7))
+            fail_msg("%s: residual %g", solvers[k], stats_number(s, "solver", "residual"));
+        cJSON_Delete(s);
+    }
+    cJSON_Delete(ref);
+}
+
+/* ---- (b) the six-patch cube: exact ---- */
+
+static void test_six_patch_exact(void **state)
+{
+    (void)state;
+    const cJSON *c = find_case("cube_top_emitter_6patch");
+    scene_writer w;
+    write_case_cube(&w, "six_patch", "cube_top_emitter_6patch");
+    for (int k = 0; k < solver_count; k++) {
+        char extra[256], tag[128];
+        /* --mesh-size 2: one element per face, as the exact solution assumes. */
+        snprintf(extra, sizeof extra, "--solver %s --mesh-size 2 --tolerance 1e-9", solvers[k]);
+        snprintf(tag, sizeof tag, "six_patch_%s", solvers[k]);
+        cJSON *stats = render_stats(w.obj_path, tag, extra);
+        assert_int_equal((int)cJSON_GetObjectItem(stats, "elements")->valuedouble, 6);
+        for (int f = 0; f < 6; f++) {
+            double B[3];
+            surface_radiosity(stats, cube_faces[f], B);
+            double exact = cJSON_GetObjectItem(cJSON_GetObjectItem(c, "exact"), cube_faces[f])->valuedouble;
+            char label[128];
+            snprintf(label, sizeof label, "%s: %s", solvers[k], cube_faces[f]);
+            for (int ch = 0; ch < 3; ch++)
+                assert_relative(B[ch], exact, 1e-6, label);
+        }
+        cJSON_Delete(stats);
+    }
+}
+
+/* ---- (c) the furnace: B = E / (1 - rho) = 2 everywhere ---- */
+
+static void test_furnace(void **state)
+{
+    (void)state;
+    double exact = cJSON_GetObjectItem(find_case("furnace_cube_rho0.5"), "exact")->valuedouble;
+    scene_writer w;
+    write_case_cube(&w, "furnace", "furnace_cube_rho0.5");
+    for (int k = 0; k < solver_count; k++) {
+        char extra[256], tag[128];
+        /* Closure correction: rows of F sum to 1 up to float rounding, so B = 2
+         * holds to ~1e-7; without it the row sums (1 +- 2e-5 at 300 elements)
+         * alone move B by ~3e-6, whatever the solver. */
+        snprintf(extra, sizeof extra, "--solver %s --elements 300 --tolerance 1e-9 --closure-correction",
+                 solvers[k]);
+        snprintf(tag, sizeof tag, "furnace_%s", solvers[k]);
+        cJSON *stats = render_stats(w.obj_path, tag, extra);
+        for (int f = 0; f < 6; f++) {
+            double B[3];
+            surface_radiosity(stats, cube_faces[f], B);
+            char label[128];
+            snprintf(label, sizeof label, "%s: furnace %s", solvers[k], cube_faces[f]);
+            for (int ch = 0; ch < 3; ch++)
+                assert_relative(B[ch], exact, 1e-6, label);
+        }
+        cJSON_Delete(stats);
+    }
+}
+
+/* ---- (d) two rooms: two components, each solved as if alone ---- */
+
+static void test_separate_rooms(void **state)
+{
+    (void)state;
+    scene_writer both, a, b;
+    write_rooms(&both, "rooms", true, true);
+    write_rooms(&a, "room_a", true, false);
+    write_rooms(&b, "room_b", false, true);
+    cJSON *ref = render_stats(both.obj_path, "rooms_reference", "--solver direct --mesh-size 0.25");
+    for (int k = 0; k < solver_count; k++) {
+        char extra[256], tag[128];
+        /* 0.25 m: 16 elements a face, the same grid together or alone. */
+        snprintf(extra, sizeof extra, "--solver %s --mesh-size 0.25 --tolerance 1e-9", solvers[k]);
+        snprintf(tag, sizeof tag, "rooms_%s", solvers[k]);
+        cJSON *sb = render_stats(both.obj_path, tag, extra);
+        snprintf(tag, sizeof tag, "room_a_%s", solvers[k]);
+        cJSON *sa = render_stats(a.obj_path, tag, extra);
+        snprintf(tag, sizeof tag, "room_b_%s", solvers[k]);
+        cJSON *sr = render_stats(b.obj_path, tag, extra);
+        assert_int_equal((int)stats_number(sb, "solver", "components"), 2);
+        assert_int_equal((int)stats_number(sa, "solver", "components"), 0); /* one room: not split */
+        assert_true(stats_number(sb, "solver", "residual") < 1e-8);
+        assert_same_surfaces(sb, ref, 1e-6, solvers[k]);
+        for (int f = 0; f < 6; f++) {
+            char name[16], label[160];
+            double together[3], alone[3];
+            snprintf(name, sizeof name, "a_%s", cube_faces[f]);
+            snprintf(label, sizeof label, "%s: %s", solvers[k], name);
+            surface_radiosity(sb, name, together);
+            surface_radiosity(sa, name, alone);
+            for (int c = 0; c < 3; c++)
+                assert_relative(together[c], alone[c], 1e-7, label);
+            snprintf(name, sizeof name, "b_%s", cube_faces[f]);
+            snprintf(label, sizeof label, "%s: %s", solvers[k], name);
+            surface_radiosity(sb, name, together);
+            surface_radiosity(sr, name, alone);
+            for (int c = 0; c < 3; c++)
+                assert_relative(together[c], alone[c], 1e-7, label);
+        }
+        /* Room b: red walls, no blue; its black floor sends out just E. */
+        double wall[3], floor[3];
+        surface_radiosity(sb, "b_x0", wall);
+        surface_radiosity(sb, "b_z0", floor);
+        assert_true(wall[0] > 1.5 * wall[1] && wall[2] == 0.0);
+        for (int c = 0; c < 3; c++)
+            assert_relative(floor[c], 2.0, 1e-7, "black emitter"); /* Ke is read as float */
+        cJSON_Delete(sb);
+        cJSON_Delete(sa);
+        cJSON_Delete(sr);
+    }
+    cJSON_Delete(ref);
+}
+
+/* ---- (e) over-relaxation: same answer, different path ---- */
+
+static void relaxed(const cJSON *ref, const char *solver, double omega)
+{
+    char extra[256], tag[128];
+    snprintf(extra, sizeof extra, "--elements 800 --solver %s --tolerance 1e-9", solver);
+    snprintf(tag, sizeof tag, "plain_%s", solver);
+    cJSON *plain = render_stats("", tag, extra);
+    snprintf(extra, sizeof extra, "--elements 800 --solver %s --tolerance 1e-9 --relaxation %g", solver,
+             omega);
+    snprintf(tag, sizeof tag, "relaxed_%s", solver);
+    cJSON *over = render_stats("", tag, extra);
+    assert_same_surfaces(over, ref, 1e-5, tag);
+    assert_true(stats_number(over, "solver", "relaxation") == omega);
+    /* omega was used: the iteration count moved. */
+    if (stats_number(over, "solver", "iterations") == stats_number(plain, "solver", "iterations"))
+        fail_msg("%s: --relaxation %g took as many iterations (%g) as omega = 1", solver, omega,
+                 stats_number(plain, "solver", "iterations"));
+    cJSON_Delete(plain);
+    cJSON_Delete(over);
+}
+
+static void test_relaxation(void **state)
+{
+    (void)state;
+    cJSON *ref = render_stats("", "relax_direct", "--elements 800 --solver direct");
+    relaxed(ref, "gauss-seidel", 1.2);
+    relaxed(ref, "southwell", 1.5);
+    relaxed(ref, "jacobi", 0.8); /* weighted Jacobi diverges above 2 / (1 + rho_max) */
+    cJSON_Delete(ref);
+}
+
+/* ---- (f) the convergence history ---- */
+
+/* Run with --history and check the CSV: its header, iterations strictly
+ * increasing, seconds not decreasing, the last row's residual that of the
+ * stats and below the tolerance 1e-6.  `split`: the scene has independent
+ * rooms, whose steps are numbered over the whole run (the stats keep the
+ * most any room took). */
+static void check_history(const char *scene, const char *solver, const char *tag, bool split)
+{
+    char extra[1024], csv[600];
+    snprintf(csv, sizeof csv, "%s/%s.csv", workdir, tag);
+    snprintf(extra, sizeof extra, "%s --solver %s --tolerance 1e-6 --history '%s'",
+             split ? "--mesh-size 0.25" : "--elements 300", solver, csv);
+    cJSON *stats = render_stats(scene, tag, extra);
+    char *text = read_text(csv);
+    assert_non_null(text);
+    char *save = NULL, *line = strtok_r(text, "\n", &save);
+    assert_non_null(line);
+    assert_string_equal(line, "iteration,seconds,residual,unshot");
+    long previous = 0, rows = 0;
+    double last_residual = NAN, previous_seconds = 0.0;
+    while ((line = strtok_r(NULL, "\n", &save)) != NULL) {
+        char *end;
+        long iteration = strtol(line, &end, 10);
+        if (*end != ',' || iteration <= previous)
+            fail_msg("%s: history row '%s' after iteration %ld", tag, line, previous);
+        double seconds = strtod(end + 1, &end);
+        assert_true(*end == ',' && seconds >= previous_seconds);
+        char *residual = end + 1;
+        last_residual = *residual == ',' ? NAN : strtod(residual, NULL);
+        previous = iteration;
+        previous_seconds = seconds;
+        rows++;
+    }
+    assert_true(rows >= 1);
+    if (!(last_residual < 1e-6))
+        fail_msg("%s: last residual in the history %g, not below the tolerance", tag, last_residual);
+    if (split)
+        assert_true(previous >= (long)stats_number(stats, "solver", "iterations"));
+    else
+        assert_int_equal(previous, (long)stats_number(stats, "solver", "iterations"));
+    assert_relative(last_residual, stats_number(stats, "solver", "residual"), 1e-8, tag);
+    free(text);
+    cJSON_Delete(stats);
+}
+
+static void test_history(void **state)
+{
+    (void)state;
+    for (int k = 0; k < solver_count; k++) {
+        char tag[128];
+        snprintf(tag, sizeof tag, "history_%s", solvers[k]);
+        check_history("", solvers[k], tag, false);
+    }
+    /* Two rooms solved one after the other: still one history. */
+    scene_writer rooms;
+    write_rooms(&rooms, "history_rooms", true, true);
+    check_history(rooms.obj_path, "gauss-seidel", "history_rooms_gauss-seidel", true);
+    check_history(rooms.obj_path, "southwell", "history_rooms_southwell", true);
+}
+
+/* ---- conjugate gradients beyond the symmetrised system ---- */
+
+static void test_conjugate_gradient_restarts(void **state)
+{
+    (void)state;
+    /* CG runs on (A_i F_ij + A_j F_ji) / 2; F is float, so reciprocity holds
+     * to ~1e-7 and plain CG stalls at a residual of ~8e-10 on this box.  The
+     * restarts on the true residual must take it well below that. */
+    cJSON *s = render_stats("", "cg_deep", "--elements 800 --solver conjugate-gradient --tolerance 1e-11");
+    const cJSON *converged = cJSON_GetObjectItem(cJSON_GetObjectItem(s, "solver"), "converged");
+    if (!(stats_number(s, "solver", "residual") < 1e-11) || !cJSON_IsTrue(converged))
+        fail_msg("conjugate-gradient: residual %g, not below 1e-11", stats_number(s, "solver", "residual"));
+    /* 17 iterations; a non-symmetric operator (say F p in place of F^T A p)
+     * still converges through the restarts, but takes over 40. */
+    if (!(stats_number(s, "solver", "iterations") < 30))
+        fail_msg("conjugate-gradient: %g iterations to 1e-11", stats_number(s, "solver", "iterations"));
+    cJSON_Delete(s);
+}
+
+/* ---- (g) the direct solver refuses what does not fit ---- */
+
+static void test_direct_memory_limit(void **state)
+{
+    (void)state;
+    scene_writer w;
+    write_case_cube(&w, "big_cube", "furnace_cube_rho0.5");
+    char errors[600], png[600];
+    snprintf(errors, sizeof errors, "%s/direct_memory.err", workdir);
+    snprintf(png, sizeof png, "%s/direct_memory.png", workdir);
+    /* 384 elements: F (4 n^2 = 0.56 MiB) fits in 1 MiB, LU (8 n^2 = 1.1 MiB) does not. */
+    int status = run_capture(errors, "render '%s' -o '%s' --width 8 --height 8 --mesh-size 0.125 "
+                                     "--solver direct --max-memory 1M", w.obj_path, png);
+    assert_int_equal(status, 1);
+    char *text = read_text(errors);
+    assert_non_null(text);
+    char *newline = strchr(text, '\n');
+    assert_non_null(newline);
+    assert_true(newline[1] == '\0'); /* one line */
+    if (!strstr(text, "1.00 MiB") || !strstr(text, "--max-memory") || !strstr(text, "direct") ||
+        !strstr(text, "384"))
+        fail_msg("the refusal should name the size, the limit and the way out: %s", text);
+    free(text);
+    /* The same limit lets an iterative solver through: the refusal was the LU's. */
+    status = run_capture(NULL, "render '%s' -o '%s' --width 8 --height 8 --mesh-size 0.125 "
+                               "--solver gauss-seidel --max-memory 1M", w.obj_path, png);
+    assert_int_equal(status, 0);
+}
+
+/* ---- results do not depend on the thread count ---- */
+
+static void test_thread_count(void **state)
+{
+    (void)state;
+    for (int k = 0; k < solver_count; k++) {
+        char extra[256], tag[128];
+        snprintf(extra, sizeof extra, "--elements 600 --solver %s --tolerance 1e-9 --threads 1", solvers[k]);
+        snprintf(tag, sizeof tag, "threads1_%s", solvers[k]);
+        cJSON *one = render_stats("", tag, extra);
+        snprintf(extra, sizeof extra, "--elements 600 --solver %s --tolerance 1e-9 --threads 3", solvers[k]);
+        snprintf(tag, sizeof tag, "threads3_%s", solvers[k]);
+        cJSON *three = render_stats("", tag, extra);
+        /* Bit for bit; but LU runs in OpenBLAS, whose partition of the
+         * factorisation among threads moves the last bit (~4e-16). */
+        bool lapack = strcmp(solvers[k], "direct") == 0;
+        assert_same_surfaces(three, one, lapack ? 1e-13 : 0.0, tag);
+        if (!lapack)
+            assert_true(stats_number(one, "solver", "residual") == stats_number(three, "solver", "residual"));
+        assert_true(stats_number(one, "solver", "iterations") == stats_number(three, "solver", "iterations"));
+        cJSON_Delete(one);
+        cJSON_Delete(three);
+    }
+}
+
+/* ---- setup: the work folder, the cases, the solver list ---- */
+
+static int read_solvers(void)
+{
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "'%s' --list-methods", radiosity_bin);
+    FILE *p = popen(cmd, "r");
+    if (!p)
+        return -1;
+    char line[1024];
+    bool in_solvers = false;
+    while (fgets(line, sizeof line, p)) {
+        if (line[0] != ' ') {
+            in_solvers = strncmp(line, "solvers", 7) == 0;
+            continue;
+        }
+        if (!in_solvers || strstr(line, "matrix-free") || solver_count == MAX_SOLVERS)
+            continue;
+        char name[64];
+        if (sscanf(line, " %63s", name) == 1)
+            solvers[solver_count++] = strdup(name);
+    }
+    return pclose(p) == 0 && solver_count > 0 ? 0 : -1;
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(workdir, sizeof workdir, "/tmp/radiosity-solvers-XXXXXX");
+    if (!mkdtemp(workdir))
+        return -1;
+    cases = read_json(RAD_TEST_DATA "/cases.json");
+    return cases && read_solvers() == 0 ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    cJSON_Delete(cases);
+    for (int k = 0; k < solver_count; k++)
+        free(solvers[k]);
+    char cmd[400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", workdir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_solvers PATH_TO_RADIOSITY\n");
+        return 2;
+    }
+    radiosity_bin = argv[1];
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_registry),
+        cmocka_unit_test(test_cornell_box_against_direct),
+        cmocka_unit_test(test_six_patch_exact),
+        cmocka_unit_test(test_furnace),
+        cmocka_unit_test(test_separate_rooms),
+        cmocka_unit_test(test_relaxation),
+        cmocka_unit_test(test_history),
+        cmocka_unit_test(test_conjugate_gradient_restarts),
+        cmocka_unit_test(test_direct_memory_limit),
+        cmocka_unit_test(test_thread_count),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
