@@ -24,6 +24,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cli_support.h"
+
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
@@ -34,176 +36,10 @@
 
 #include "formfactor/formfactor.h"
 
-static const char *radiosity_bin;
-static char workdir[256];
-static cJSON *cases;
-
-/* ---- helpers (as in test_accuracy.c) ---- */
-
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        free(buf);
-        buf = NULL;
-    }
-    if (buf)
-        buf[n] = '\0';
-    fclose(f);
-    return buf;
-}
-
-static cJSON *read_json(const char *path)
-{
-    char *text = read_text(path);
-    if (!text)
-        return NULL;
-    cJSON *j = cJSON_Parse(text);
-    free(text);
-    return j;
-}
-
-static const cJSON *find_case(const char *id)
-{
-    const cJSON *c;
-    cJSON_ArrayForEach(c, cJSON_GetObjectItem(cases, "cases"))
-    {
-        if (strcmp(cJSON_GetObjectItem(c, "id")->valuestring, id) == 0)
-            return c;
-    }
-    fail_msg("case %s missing from cases.json", id);
-    return NULL;
-}
-
-static double exact_value(const cJSON *c) { return cJSON_GetObjectItem(c, "exact")->valuedouble; }
-
-/* A scene being written: OBJ text and MTL text. */
-typedef struct scene_writer {
-    FILE *obj, *mtl;
-    int vertices;
-    char obj_path[512];
-} scene_writer;
-
-static void scene_begin(scene_writer *w, const char *name)
-{
-    char mtl_path[512];
-    snprintf(w->obj_path, sizeof w->obj_path, "%s/%s.obj", workdir, name);
-    snprintf(mtl_path, sizeof mtl_path, "%s/%s.mtl", workdir, name);
-    w->obj = fopen(w->obj_path, "w");
-    w->mtl = fopen(mtl_path, "w");
-    assert_non_null(w->obj);
-    assert_non_null(w->mtl);
-    fprintf(w->obj, "mtllib %s.mtl\n", name);
-    fprintf(w->mtl, "newmtl grey\nKd 0.5 0.5 0.5\nKe 0 0 0\n\n");
-    w->vertices = 0;
-}
-
-static void scene_polygon(scene_writer *w, const char *surface, const double (*v)[3], int n)
-{
-    fprintf(w->obj, "o %s\nusemtl grey\n", surface);
-    for (int k = 0; k < n; k++)
-        fprintf(w->obj, "v %.17g %.17g %.17g\n", v[k][0], v[k][1], v[k][2]);
-    fprintf(w->obj, "f");
-    for (int k = 0; k < n; k++)
-        fprintf(w->obj, " %d", w->vertices + k + 1);
-    fprintf(w->obj, "\n");
-    w->vertices += n;
-}
-
-/* A surface of the case geometry, as listed in cases.json. */
-static void scene_case_surface(scene_writer *w, const cJSON *surface, const char *name)
-{
-    double v[16][3];
-    int n = 0;
-    const cJSON *p;
-    cJSON_ArrayForEach(p, cJSON_GetObjectItem(surface, "vertices"))
-    {
-        for (int c = 0; c < 3; c++)
-            v[n][c] = cJSON_GetArrayItem(p, c)->valuedouble;
-        n++;
-    }
-    scene_polygon(w, name, (const double(*)[3])v, n);
-}
-
-static void scene_end(scene_writer *w)
-{
-    fclose(w->obj);
-    fclose(w->mtl);
-}
-
-/* Run the binary with arguments; returns its exit status. */
-static int run(const char *fmt, ...)
-{
-    char args[2048], cmd[4096];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args, sizeof args, fmt, ap);
-    va_end(ap);
-    snprintf(cmd, sizeof cmd, "'%s' %s --quiet", radiosity_bin, args);
-    int status = system(cmd);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-/* View factors of a written scene: returns the parsed JSON (caller frees). */
-static cJSON *view_factors(const scene_writer *w, const char *extra)
-{
-    char out[600];
-    snprintf(out, sizeof out, "%s.F.json", w->obj_path);
-    assert_int_equal(run("viewfactors '%s' -o '%s' %s", w->obj_path, out, extra), 0);
-    cJSON *j = read_json(out);
-    assert_non_null(j);
-    return j;
-}
-
-static int surface_index(const cJSON *vf, const char *name)
-{
-    int i = 0;
-    const cJSON *s;
-    cJSON_ArrayForEach(s, cJSON_GetObjectItem(vf, "surfaces"))
-    {
-        if (strcmp(cJSON_GetObjectItem(s, "name")->valuestring, name) == 0)
-            return i;
-        i++;
-    }
-    fail_msg("surface %s not in the output", name);
-    return -1;
-}
-
-static double matrix_get(const cJSON *vf, const char *key, const char *from, const char *to)
-{
-    const cJSON *M = cJSON_GetObjectItem(vf, key);
-    if (!M)
-        fail_msg("no \"%s\" in the view-factor file", key);
-    int i = surface_index(vf, from), j = surface_index(vf, to);
-    return cJSON_GetArrayItem(cJSON_GetArrayItem(M, i), j)->valuedouble;
-}
-
-static double vf_get(const cJSON *vf, const char *from, const char *to) { return matrix_get(vf, "F", from, to); }
-
 /* The reported standard error of F[from][to] (RAD_FF_VARIANCE methods). */
 static double vf_std_error(const cJSON *vf, const char *from, const char *to)
 {
-    return matrix_get(vf, "F_std_error", from, to);
-}
-
-static double vf_area(const cJSON *vf, const char *name)
-{
-    int i = surface_index(vf, name);
-    return cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(vf, "surfaces"), i), "area")
-        ->valuedouble;
-}
-
-static void assert_relative(double got, double exact, double tol, const char *what)
-{
-    double rel = fabs(got - exact) / fabs(exact);
-    if (!(rel <= tol))
-        fail_msg("%s: got %.9f, exact %.9f, relative error %.2e > %.1e", what, got, exact, rel, tol);
+    return cli_vf_matrix(vf, "F_std_error", from, to);
 }
 
 /* How a method's answer is judged. */
@@ -220,9 +56,9 @@ typedef struct judge {
 static void check_factor(const judge *jd, const cJSON *vf, const char *from, const char *to, double exact,
                          bool shared_edge, const char *what)
 {
-    double got = vf_get(vf, from, to);
+    double got = cli_vf_get(vf, from, to);
     if (jd->relative > 0.0)
-        assert_relative(got, exact, jd->relative, what);
+        cli_assert_relative(got, exact, jd->relative, what);
     if (jd->sigmas > 0.0) {
         double se = vf_std_error(vf, from, to), k = shared_edge ? jd->sigmas_shared : jd->sigmas;
         if (!(se > 0.0 && se <= jd->max_std_error * exact))
@@ -239,25 +75,26 @@ static void check_factor(const judge *jd, const cJSON *vf, const char *from, con
 /* Two surfaces (and the case's blocker, if any): F_12 and F_21. */
 static void two_surface_case(const judge *jd, const char *id, bool shared_edge)
 {
-    const cJSON *c = find_case(id);
+    const cJSON *c = cli_find_case(id);
     const cJSON *g = cJSON_GetObjectItem(c, "geometry");
     char name[128], options[256];
     snprintf(name, sizeof name, "%s_%s", id, jd->method);
-    scene_writer w;
-    scene_begin(&w, name);
-    scene_case_surface(&w, cJSON_GetObjectItem(g, "A1"), "A1");
-    scene_case_surface(&w, cJSON_GetObjectItem(g, "A2"), "A2");
+    cli_scene_writer w;
+    cli_scene_begin(&w, name);
+    cli_scene_material(&w, "grey", 0.5, 0.0);
+    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
+    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
     if (cJSON_GetObjectItem(g, "blocker"))
-        scene_case_surface(&w, cJSON_GetObjectItem(g, "blocker"), "blocker");
-    scene_end(&w);
+        cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
+    cli_scene_end(&w);
     snprintf(options, sizeof options, "--form-factors %s %s", jd->method, jd->options);
-    cJSON *vf = view_factors(&w, options);
+    cJSON *vf = cli_view_factors(&w, options);
     /* Equal areas: F_21 = F_12. */
-    check_factor(jd, vf, "A1", "A2", exact_value(c), shared_edge, id);
-    check_factor(jd, vf, "A2", "A1", exact_value(c), shared_edge, id);
+    check_factor(jd, vf, "A1", "A2", cli_exact_value(c), shared_edge, id);
+    check_factor(jd, vf, "A2", "A1", cli_exact_value(c), shared_edge, id);
     if (strcmp(jd->method, "montecarlo") == 0) /* one estimate per pair: reciprocal by construction */
-        assert_relative(vf_area(vf, "A1") * vf_get(vf, "A1", "A2"), vf_area(vf, "A2") * vf_get(vf, "A2", "A1"),
-                        1e-6, "reciprocity");
+        cli_assert_relative(cli_vf_area(vf, "A1") * cli_vf_get(vf, "A1", "A2"),
+                            cli_vf_area(vf, "A2") * cli_vf_get(vf, "A2", "A1"), 1e-6, "reciprocity");
     cJSON_Delete(vf);
 }
 
@@ -265,7 +102,7 @@ static void two_surface_case(const judge *jd, const char *id, bool shared_edge)
  * the polygons. */
 static void disks_case(const judge *jd)
 {
-    const cJSON *c = find_case("disks_r1_r1_h1");
+    const cJSON *c = cli_find_case("disks_r1_r1_h1");
     double exact = cJSON_GetObjectItem(cJSON_GetObjectItem(c, "tessellated_inscribed_regular_Ngon_F12"),
                                        "N=64")->valuedouble;
     enum { N = 64 };
@@ -277,13 +114,14 @@ static void disks_case(const judge *jd)
     }
     char name[128], options[256];
     snprintf(name, sizeof name, "disks_%s", jd->method);
-    scene_writer w;
-    scene_begin(&w, name);
-    scene_polygon(&w, "disk1", (const double(*)[3])d1, N);
-    scene_polygon(&w, "disk2", (const double(*)[3])d2, N);
-    scene_end(&w);
+    cli_scene_writer w;
+    cli_scene_begin(&w, name);
+    cli_scene_material(&w, "grey", 0.5, 0.0);
+    cli_scene_polygon(&w, "disk1", "grey", (const double(*)[3])d1, N);
+    cli_scene_polygon(&w, "disk2", "grey", (const double(*)[3])d2, N);
+    cli_scene_end(&w);
     snprintf(options, sizeof options, "--form-factors %s %s", jd->method, jd->options);
-    cJSON *vf = view_factors(&w, options);
+    cJSON *vf = cli_view_factors(&w, options);
     check_factor(jd, vf, "disk1", "disk2", exact, false, "disk1 -> disk2");
     check_factor(jd, vf, "disk2", "disk1", exact, false, "disk2 -> disk1");
     cJSON_Delete(vf);
@@ -295,22 +133,23 @@ static const char *cube_faces[6] = {"x0", "x1", "y0", "y1", "z0", "z1"};
  * ones share an edge, C-14) and the row sums, which must be 1. */
 static void cube_case(const judge *jd, double row_tolerance)
 {
-    const cJSON *c = find_case("cube_row_sum");
+    const cJSON *c = cli_find_case("cube_row_sum");
     const cJSON *g = cJSON_GetObjectItem(c, "geometry"), *M = cJSON_GetObjectItem(c, "full_matrix");
     char name[128], options[256];
     snprintf(name, sizeof name, "cube_%s", jd->method);
-    scene_writer w;
-    scene_begin(&w, name);
+    cli_scene_writer w;
+    cli_scene_begin(&w, name);
+    cli_scene_material(&w, "grey", 0.5, 0.0);
     for (int f = 0; f < 6; f++)
-        scene_case_surface(&w, cJSON_GetObjectItem(g, cube_faces[f]), cube_faces[f]);
-    scene_end(&w);
+        cli_scene_case_surface(&w, cJSON_GetObjectItem(g, cube_faces[f]), cube_faces[f], "grey");
+    cli_scene_end(&w);
     snprintf(options, sizeof options, "--form-factors %s %s", jd->method, jd->options);
-    cJSON *vf = view_factors(&w, options);
+    cJSON *vf = cli_view_factors(&w, options);
     for (int i = 0; i < 6; i++) {
         double row = 0.0, row_var = 0.0;
         for (int j = 0; j < 6; j++) {
             double exact = cJSON_GetArrayItem(cJSON_GetArrayItem(M, i), j)->valuedouble;
-            double got = vf_get(vf, cube_faces[i], cube_faces[j]);
+            double got = cli_vf_get(vf, cube_faces[i], cube_faces[j]);
             row += got;
             if (jd->sigmas > 0.0)
                 row_var += pow(vf_std_error(vf, cube_faces[i], cube_faces[j]), 2);
@@ -517,16 +356,17 @@ static void trapezoids_case(const judge *jd, double height, double shift)
                             {1.7, 1.2 + shift, height}, {2.3, 0.2 + shift, height}}; /* about -z */
     char name[128], options[256];
     snprintf(name, sizeof name, "trapezoids_%g_%s", height, jd->method);
-    scene_writer w;
-    scene_begin(&w, name);
-    scene_polygon(&w, "A1", a, 4);
-    scene_polygon(&w, "A2", b, 4);
-    scene_end(&w);
-    cJSON *ref = view_factors(&w, "--form-factors analytic --mesh-size 10");
+    cli_scene_writer w;
+    cli_scene_begin(&w, name);
+    cli_scene_material(&w, "grey", 0.5, 0.0);
+    cli_scene_polygon(&w, "A1", "grey", a, 4);
+    cli_scene_polygon(&w, "A2", "grey", b, 4);
+    cli_scene_end(&w);
+    cJSON *ref = cli_view_factors(&w, "--form-factors analytic --mesh-size 10");
     snprintf(options, sizeof options, "--form-factors %s --mesh-size 10 %s", jd->method, jd->options);
-    cJSON *vf = view_factors(&w, options);
-    check_factor(jd, vf, "A1", "A2", vf_get(ref, "A1", "A2"), false, name);
-    check_factor(jd, vf, "A2", "A1", vf_get(ref, "A2", "A1"), false, name);
+    cJSON *vf = cli_view_factors(&w, options);
+    check_factor(jd, vf, "A1", "A2", cli_vf_get(ref, "A1", "A2"), false, name);
+    check_factor(jd, vf, "A2", "A1", cli_vf_get(ref, "A2", "A1"), false, name);
     cJSON_Delete(ref);
     cJSON_Delete(vf);
 }
@@ -547,13 +387,13 @@ static void test_trapezoids(void **state)
 static cJSON *cornell_stats(const char *method, const char *extra)
 {
     char stats[600], png[600];
-    snprintf(stats, sizeof stats, "%s/cornell_%s.json", workdir, method);
-    snprintf(png, sizeof png, "%s/cornell_%s.png", workdir, method);
-    assert_int_equal(run("render -o '%s' --stats '%s' --width 16 --height 16 --elements 1000 "
-                         "--form-factors %s %s",
-                         png, stats, method, extra),
+    snprintf(stats, sizeof stats, "%s/cornell_%s.json", cli_workdir(), method);
+    snprintf(png, sizeof png, "%s/cornell_%s.png", cli_workdir(), method);
+    assert_int_equal(cli_run("render -o '%s' --stats '%s' --width 16 --height 16 --elements 1000 "
+                             "--form-factors %s %s",
+                             png, stats, method, extra),
                      0);
-    cJSON *j = read_json(stats);
+    cJSON *j = cli_read_json(stats);
     assert_non_null(j);
     return j;
 }
@@ -579,7 +419,7 @@ static void cross_method(const char *method, const char *extra, double tolerance
             double y = cJSON_GetArrayItem(cJSON_GetObjectItem(b, "radiosity"), c)->valuedouble;
             char what[128];
             snprintf(what, sizeof what, "Cornell box %s, channel %d: %s vs analytic", name, c, method);
-            assert_relative(y, x, tolerance, what);
+            cli_assert_relative(y, x, tolerance, what);
         }
     }
     cJSON_Delete(got);
@@ -619,21 +459,14 @@ static void test_cornell_montecarlo(void **state)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(workdir, sizeof workdir, "/tmp/radiosity-ff-methods-XXXXXX");
-    if (!mkdtemp(workdir))
-        return -1;
-    cases = read_json(RAD_TEST_DATA "/cases.json");
-    return cases ? 0 : -1;
+    return cli_setup("ff-methods");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    cJSON_Delete(cases);
     cJSON_Delete(cornell_analytic);
-    char cmd[400];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", workdir);
-    return system(cmd) == 0 ? 0 : -1;
+    return cli_teardown();
 }
 
 int main(int argc, char **argv)
@@ -642,7 +475,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: test_ff_methods PATH_TO_RADIOSITY\n");
         return 2;
     }
-    radiosity_bin = argv[1];
+    cli_set_binary(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hemicube_delta_factors),
         cmocka_unit_test(test_hemicube_parallel_squares),

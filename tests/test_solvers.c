@@ -14,6 +14,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cli_support.h"
+
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdbool.h>
@@ -28,148 +30,24 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static const char *radiosity_bin;
-static char workdir[256];
-static cJSON *cases;
-
 enum { MAX_SOLVERS = 32 };
 static char *solvers[MAX_SOLVERS]; /* owned, freed in teardown */
 static int solver_count;
 
-/* ---- helpers (as in test_accuracy.c) ---- */
-
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        free(buf);
-        buf = NULL;
-    }
-    if (buf)
-        buf[n] = '\0';
-    fclose(f);
-    return buf;
-}
-
-static cJSON *read_json(const char *path)
-{
-    char *text = read_text(path);
-    if (!text)
-        return NULL;
-    cJSON *j = cJSON_Parse(text);
-    free(text);
-    return j;
-}
-
-static const cJSON *find_case(const char *id)
-{
-    const cJSON *c;
-    cJSON_ArrayForEach(c, cJSON_GetObjectItem(cases, "cases"))
-    {
-        if (strcmp(cJSON_GetObjectItem(c, "id")->valuestring, id) == 0)
-            return c;
-    }
-    fail_msg("case %s missing from cases.json", id);
-    return NULL;
-}
-
-typedef struct scene_writer {
-    FILE *obj, *mtl;
-    int vertices;
-    char obj_path[512];
-} scene_writer;
-
-static void scene_begin(scene_writer *w, const char *name)
-{
-    char mtl_path[512];
-    snprintf(w->obj_path, sizeof w->obj_path, "%s/%s.obj", workdir, name);
-    snprintf(mtl_path, sizeof mtl_path, "%s/%s.mtl", workdir, name);
-    w->obj = fopen(w->obj_path, "w");
-    w->mtl = fopen(mtl_path, "w");
-    assert_non_null(w->obj);
-    assert_non_null(w->mtl);
-    fprintf(w->obj, "mtllib %s.mtl\n", name);
-    w->vertices = 0;
-}
-
-/* RGB reflectance and emission (exitance, W/m^2); Ke = E / pi is emitted radiance. */
-static void scene_material(scene_writer *w, const char *name, const double rho[3], double E)
-{
-    fprintf(w->mtl, "newmtl %s\nKd %.17g %.17g %.17g\nKe %.17g %.17g %.17g\n\n", name, rho[0], rho[1],
-            rho[2], E / M_PI, E / M_PI, E / M_PI);
-}
-
-/* A polygon of the case geometry, moved by `offset`. */
-static void scene_case_surface(scene_writer *w, const cJSON *surface, const char *name,
-                               const char *material, const double offset[3])
-{
-    fprintf(w->obj, "o %s\nusemtl %s\n", name, material);
-    int n = 0;
-    const cJSON *p;
-    cJSON_ArrayForEach(p, cJSON_GetObjectItem(surface, "vertices"))
-    {
-        fprintf(w->obj, "v");
-        for (int c = 0; c < 3; c++)
-            fprintf(w->obj, " %.17g", cJSON_GetArrayItem(p, c)->valuedouble + offset[c]);
-        fprintf(w->obj, "\n");
-        n++;
-    }
-    fprintf(w->obj, "f");
-    for (int k = 0; k < n; k++)
-        fprintf(w->obj, " %d", w->vertices + k + 1);
-    fprintf(w->obj, "\n");
-    w->vertices += n;
-}
-
-static void scene_end(scene_writer *w)
-{
-    fclose(w->obj);
-    fclose(w->mtl);
-}
-
-/* Run the binary with arguments, stderr into `errors` when not NULL;
- * returns its exit status. */
-static int run_capture(const char *errors, const char *fmt, ...)
-{
-    char args[2048], cmd[4096];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args, sizeof args, fmt, ap);
-    va_end(ap);
-    if (errors)
-        snprintf(cmd, sizeof cmd, "'%s' %s --quiet 2>'%s'", radiosity_bin, args, errors);
-    else
-        snprintf(cmd, sizeof cmd, "'%s' %s --quiet", radiosity_bin, args);
-    int status = system(cmd);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-static double stats_number(const cJSON *stats, const char *object, const char *key)
-{
-    const cJSON *v = cJSON_GetObjectItem(cJSON_GetObjectItem(stats, object), key);
-    if (!cJSON_IsNumber(v))
-        fail_msg("stats: %s.%s missing", object, key);
-    return v->valuedouble;
-}
+/* ---- helpers ---- */
 
 /* Render `scene` ("" = the built-in Cornell box) with `extra` options and
  * return the stats (caller frees); `tag` names the files. */
 static cJSON *render_stats(const char *scene, const char *tag, const char *extra)
 {
     char stats[600], png[600];
-    snprintf(stats, sizeof stats, "%s/%s.stats.json", workdir, tag);
-    snprintf(png, sizeof png, "%s/%s.png", workdir, tag);
-    int status = run_capture(NULL, "render %s%s%s -o '%s' --stats '%s' --width 8 --height 8 %s",
-                             scene[0] ? "'" : "", scene, scene[0] ? "'" : "", png, stats, extra);
+    snprintf(stats, sizeof stats, "%s/%s.stats.json", cli_workdir(), tag);
+    snprintf(png, sizeof png, "%s/%s.png", cli_workdir(), tag);
+    int status = cli_run_capture(NULL, "render %s%s%s -o '%s' --stats '%s' --width 8 --height 8 %s",
+                                 scene[0] ? "'" : "", scene, scene[0] ? "'" : "", png, stats, extra);
     if (status != 0)
         fail_msg("%s: radiosity render %s exited with %d", tag, extra, status);
-    cJSON *j = read_json(stats);
+    cJSON *j = cli_read_json(stats);
     assert_non_null(j);
     return j;
 }
@@ -190,21 +68,6 @@ static int surface_radiosities(const cJSON *stats, double (*rgb)[3], char (*name
     return count;
 }
 
-static void surface_radiosity(const cJSON *stats, const char *name, double rgb[3])
-{
-    const cJSON *s;
-    cJSON_ArrayForEach(s, cJSON_GetObjectItem(stats, "surfaces"))
-    {
-        if (strcmp(cJSON_GetObjectItem(s, "name")->valuestring, name) == 0) {
-            for (int c = 0; c < 3; c++)
-                rgb[c] = cJSON_GetArrayItem(cJSON_GetObjectItem(s, "radiosity"), c)->valuedouble;
-            return;
-        }
-    }
-    fail_msg("surface %s not in stats", name);
-}
-
-/* Relative error below tol (absolute where the expected value is 0). */
 static void assert_relative(double got, double exact, double tol, const char *what)
 {
     double rel = exact == 0.0 ? fabs(got) : fabs(got - exact) / fabs(exact);
@@ -238,11 +101,11 @@ static const char *cube_faces[6] = {"x0", "x1", "y0", "y1", "z0", "z1"};
 /* A cube of the case geometry: faces named prefix + face, rho and E from
  * the case unless `rho` / `emitter` are given (then the face `emitter`
  * emits E and reflects `emitter_rho`, the others reflect `rho`). */
-static void write_cube_faces(scene_writer *w, const char *case_id, const char *prefix,
+static void write_cube_faces(cli_scene_writer *w, const char *case_id, const char *prefix,
                              const double offset[3], const double *rho, const char *emitter, double E,
                              const double *emitter_rho)
 {
-    const cJSON *g = cJSON_GetObjectItem(find_case(case_id), "geometry");
+    const cJSON *g = cJSON_GetObjectItem(cli_find_case(case_id), "geometry");
     for (int f = 0; f < 6; f++) {
         const cJSON *s = cJSON_GetObjectItem(g, cube_faces[f]);
         const cJSON *rho_case = cJSON_GetObjectItem(s, "rho"), *E_case = cJSON_GetObjectItem(s, "E");
@@ -253,17 +116,17 @@ static void write_cube_faces(scene_writer *w, const char *case_id, const char *p
         e = emitter ? (emits ? E : 0.0) : E_case ? E_case->valuedouble : 0.0;
         char name[64];
         snprintf(name, sizeof name, "%s%s", prefix, cube_faces[f]);
-        scene_material(w, name, r, e);
-        scene_case_surface(w, s, name, name, offset);
+        cli_scene_material_rgb(w, name, r, e);
+        cli_scene_case_surface_moved(w, s, name, name, offset);
     }
 }
 
-static void write_case_cube(scene_writer *w, const char *name, const char *case_id)
+static void write_case_cube(cli_scene_writer *w, const char *name, const char *case_id)
 {
     static const double zero[3] = {0, 0, 0};
-    scene_begin(w, name);
+    cli_scene_begin(w, name);
     write_cube_faces(w, case_id, "", zero, NULL, NULL, 0.0, NULL);
-    scene_end(w);
+    cli_scene_end(w);
 }
 
 /* Two closed rooms that cannot see each other: room a is the six-patch
@@ -274,15 +137,15 @@ static const double room_b_offset[3] = {3.0, 0.0, 0.0};
 static const double room_b_rho[3] = {0.7, 0.5, 0.0};
 static const double black[3] = {0.0, 0.0, 0.0};
 
-static void write_rooms(scene_writer *w, const char *name, bool room_a, bool room_b)
+static void write_rooms(cli_scene_writer *w, const char *name, bool room_a, bool room_b)
 {
     static const double zero[3] = {0, 0, 0};
-    scene_begin(w, name);
+    cli_scene_begin(w, name);
     if (room_a)
         write_cube_faces(w, "cube_top_emitter_6patch", "a_", zero, NULL, NULL, 0.0, NULL);
     if (room_b)
         write_cube_faces(w, "cube_top_emitter_6patch", "b_", room_b_offset, room_b_rho, "z0", 2.0, black);
-    scene_end(w);
+    cli_scene_end(w);
 }
 
 /* ---- the solver list ---- */
@@ -307,7 +170,7 @@ static void test_cornell_box_against_direct(void **state)
 {
     (void)state;
     cJSON *ref = render_stats("", "cornell_direct", "--elements 800 --solver direct");
-    assert_true(stats_number(ref, "solver", "residual") < 1e-12);
+    assert_true(cli_stats_number(ref, "solver", "residual") < 1e-12);
     for (int k = 0; k < solver_count; k++) {
         char extra[256], tag[128];
         snprintf(extra, sizeof extra, "--elements 800 --solver %s --tolerance 1e-9", solvers[k]);
@@ -316,8 +179,8 @@ static void test_cornell_box_against_direct(void **state)
         assert_same_surfaces(s, ref, 1e-5, solvers[k]);
         /* Converged, or near it: shooting bookkeeps F_ji through reciprocity,
          * so its residual stops at the reciprocity error (~6e-9 here). */
-        if (!(stats_number(s, "solver", "residual") < 1e-7))
-            fail_msg("%s: residual %g", solvers[k], stats_number(s, "solver", "residual"));
+        if (!(cli_stats_number(s, "solver", "residual") < 1e-7))
+            fail_msg("%s: residual %g", solvers[k], cli_stats_number(s, "solver", "residual"));
         cJSON_Delete(s);
     }
     cJSON_Delete(ref);
@@ -328,8 +191,8 @@ static void test_cornell_box_against_direct(void **state)
 static void test_six_patch_exact(void **state)
 {
     (void)state;
-    const cJSON *c = find_case("cube_top_emitter_6patch");
-    scene_writer w;
+    const cJSON *c = cli_find_case("cube_top_emitter_6patch");
+    cli_scene_writer w;
     write_case_cube(&w, "six_patch", "cube_top_emitter_6patch");
     for (int k = 0; k < solver_count; k++) {
         char extra[256], tag[128];
@@ -340,7 +203,7 @@ static void test_six_patch_exact(void **state)
         assert_int_equal((int)cJSON_GetObjectItem(stats, "elements")->valuedouble, 6);
         for (int f = 0; f < 6; f++) {
             double B[3];
-            surface_radiosity(stats, cube_faces[f], B);
+            cli_stats_surface_radiosity(stats, cube_faces[f], B);
             double exact = cJSON_GetObjectItem(cJSON_GetObjectItem(c, "exact"), cube_faces[f])->valuedouble;
             char label[128];
             snprintf(label, sizeof label, "%s: %s", solvers[k], cube_faces[f]);
@@ -356,8 +219,8 @@ static void test_six_patch_exact(void **state)
 static void test_furnace(void **state)
 {
     (void)state;
-    double exact = cJSON_GetObjectItem(find_case("furnace_cube_rho0.5"), "exact")->valuedouble;
-    scene_writer w;
+    double exact = cJSON_GetObjectItem(cli_find_case("furnace_cube_rho0.5"), "exact")->valuedouble;
+    cli_scene_writer w;
     write_case_cube(&w, "furnace", "furnace_cube_rho0.5");
     for (int k = 0; k < solver_count; k++) {
         char extra[256], tag[128];
@@ -370,7 +233,7 @@ static void test_furnace(void **state)
         cJSON *stats = render_stats(w.obj_path, tag, extra);
         for (int f = 0; f < 6; f++) {
             double B[3];
-            surface_radiosity(stats, cube_faces[f], B);
+            cli_stats_surface_radiosity(stats, cube_faces[f], B);
             char label[128];
             snprintf(label, sizeof label, "%s: furnace %s", solvers[k], cube_faces[f]);
             for (int ch = 0; ch < 3; ch++)
@@ -385,7 +248,7 @@ static void test_furnace(void **state)
 static void test_separate_rooms(void **state)
 {
     (void)state;
-    scene_writer both, a, b;
+    cli_scene_writer both, a, b;
     write_rooms(&both, "rooms", true, true);
     write_rooms(&a, "room_a", true, false);
     write_rooms(&b, "room_b", false, true);
@@ -400,30 +263,30 @@ static void test_separate_rooms(void **state)
         cJSON *sa = render_stats(a.obj_path, tag, extra);
         snprintf(tag, sizeof tag, "room_b_%s", solvers[k]);
         cJSON *sr = render_stats(b.obj_path, tag, extra);
-        assert_int_equal((int)stats_number(sb, "solver", "components"), 2);
-        assert_int_equal((int)stats_number(sa, "solver", "components"), 0); /* one room: not split */
-        assert_true(stats_number(sb, "solver", "residual") < 1e-8);
+        assert_int_equal((int)cli_stats_number(sb, "solver", "components"), 2);
+        assert_int_equal((int)cli_stats_number(sa, "solver", "components"), 0); /* one room: not split */
+        assert_true(cli_stats_number(sb, "solver", "residual") < 1e-8);
         assert_same_surfaces(sb, ref, 1e-6, solvers[k]);
         for (int f = 0; f < 6; f++) {
             char name[16], label[160];
             double together[3], alone[3];
             snprintf(name, sizeof name, "a_%s", cube_faces[f]);
             snprintf(label, sizeof label, "%s: %s", solvers[k], name);
-            surface_radiosity(sb, name, together);
-            surface_radiosity(sa, name, alone);
+            cli_stats_surface_radiosity(sb, name, together);
+            cli_stats_surface_radiosity(sa, name, alone);
             for (int c = 0; c < 3; c++)
                 assert_relative(together[c], alone[c], 1e-7, label);
             snprintf(name, sizeof name, "b_%s", cube_faces[f]);
             snprintf(label, sizeof label, "%s: %s", solvers[k], name);
-            surface_radiosity(sb, name, together);
-            surface_radiosity(sr, name, alone);
+            cli_stats_surface_radiosity(sb, name, together);
+            cli_stats_surface_radiosity(sr, name, alone);
             for (int c = 0; c < 3; c++)
                 assert_relative(together[c], alone[c], 1e-7, label);
         }
         /* Room b: red walls, no blue; its black floor sends out just E. */
         double wall[3], floor[3];
-        surface_radiosity(sb, "b_x0", wall);
-        surface_radiosity(sb, "b_z0", floor);
+        cli_stats_surface_radiosity(sb, "b_x0", wall);
+        cli_stats_surface_radiosity(sb, "b_z0", floor);
         assert_true(wall[0] > 1.5 * wall[1] && wall[2] == 0.0);
         for (int c = 0; c < 3; c++)
             assert_relative(floor[c], 2.0, 1e-7, "black emitter"); /* Ke is read as float */
@@ -447,11 +310,11 @@ static void relaxed(const cJSON *ref, const char *solver, double omega)
     snprintf(tag, sizeof tag, "relaxed_%s", solver);
     cJSON *over = render_stats("", tag, extra);
     assert_same_surfaces(over, ref, 1e-5, tag);
-    assert_true(stats_number(over, "solver", "relaxation") == omega);
+    assert_true(cli_stats_number(over, "solver", "relaxation") == omega);
     /* omega was used: the iteration count moved. */
-    if (stats_number(over, "solver", "iterations") == stats_number(plain, "solver", "iterations"))
+    if (cli_stats_number(over, "solver", "iterations") == cli_stats_number(plain, "solver", "iterations"))
         fail_msg("%s: --relaxation %g took as many iterations (%g) as omega = 1", solver, omega,
-                 stats_number(plain, "solver", "iterations"));
+                 cli_stats_number(plain, "solver", "iterations"));
     cJSON_Delete(plain);
     cJSON_Delete(over);
 }
@@ -476,11 +339,11 @@ static void test_relaxation(void **state)
 static void check_history(const char *scene, const char *solver, const char *tag, bool split)
 {
     char extra[1024], csv[600];
-    snprintf(csv, sizeof csv, "%s/%s.csv", workdir, tag);
+    snprintf(csv, sizeof csv, "%s/%s.csv", cli_workdir(), tag);
     snprintf(extra, sizeof extra, "%s --solver %s --tolerance 1e-6 --history '%s'",
              split ? "--mesh-size 0.25" : "--elements 300", solver, csv);
     cJSON *stats = render_stats(scene, tag, extra);
-    char *text = read_text(csv);
+    char *text = cli_read_text(csv);
     assert_non_null(text);
     char *save = NULL, *line = strtok_r(text, "\n", &save);
     assert_non_null(line);
@@ -504,10 +367,10 @@ static void check_history(const char *scene, const char *solver, const char *tag
     if (!(last_residual < 1e-6))
         fail_msg("%s: last residual in the history %g, not below the tolerance", tag, last_residual);
     if (split)
-        assert_true(previous >= (long)stats_number(stats, "solver", "iterations"));
+        assert_true(previous >= (long)cli_stats_number(stats, "solver", "iterations"));
     else
-        assert_int_equal(previous, (long)stats_number(stats, "solver", "iterations"));
-    assert_relative(last_residual, stats_number(stats, "solver", "residual"), 1e-8, tag);
+        assert_int_equal(previous, (long)cli_stats_number(stats, "solver", "iterations"));
+    assert_relative(last_residual, cli_stats_number(stats, "solver", "residual"), 1e-8, tag);
     free(text);
     cJSON_Delete(stats);
 }
@@ -521,7 +384,7 @@ static void test_history(void **state)
         check_history("", solvers[k], tag, false);
     }
     /* Two rooms solved one after the other: still one history. */
-    scene_writer rooms;
+    cli_scene_writer rooms;
     write_rooms(&rooms, "history_rooms", true, true);
     check_history(rooms.obj_path, "gauss-seidel", "history_rooms_gauss-seidel", true);
     check_history(rooms.obj_path, "southwell", "history_rooms_southwell", true);
@@ -537,12 +400,13 @@ static void test_conjugate_gradient_restarts(void **state)
      * restarts on the true residual must take it well below that. */
     cJSON *s = render_stats("", "cg_deep", "--elements 800 --solver conjugate-gradient --tolerance 1e-11");
     const cJSON *converged = cJSON_GetObjectItem(cJSON_GetObjectItem(s, "solver"), "converged");
-    if (!(stats_number(s, "solver", "residual") < 1e-11) || !cJSON_IsTrue(converged))
-        fail_msg("conjugate-gradient: residual %g, not below 1e-11", stats_number(s, "solver", "residual"));
+    if (!(cli_stats_number(s, "solver", "residual") < 1e-11) || !cJSON_IsTrue(converged))
+        fail_msg("conjugate-gradient: residual %g, not below 1e-11",
+                 cli_stats_number(s, "solver", "residual"));
     /* 17 iterations; a non-symmetric operator (say F p in place of F^T A p)
      * still converges through the restarts, but takes over 40. */
-    if (!(stats_number(s, "solver", "iterations") < 30))
-        fail_msg("conjugate-gradient: %g iterations to 1e-11", stats_number(s, "solver", "iterations"));
+    if (!(cli_stats_number(s, "solver", "iterations") < 30))
+        fail_msg("conjugate-gradient: %g iterations to 1e-11", cli_stats_number(s, "solver", "iterations"));
     cJSON_Delete(s);
 }
 
@@ -551,16 +415,18 @@ static void test_conjugate_gradient_restarts(void **state)
 static void test_direct_memory_limit(void **state)
 {
     (void)state;
-    scene_writer w;
+    cli_scene_writer w;
     write_case_cube(&w, "big_cube", "furnace_cube_rho0.5");
     char errors[600], png[600];
-    snprintf(errors, sizeof errors, "%s/direct_memory.err", workdir);
-    snprintf(png, sizeof png, "%s/direct_memory.png", workdir);
+    snprintf(errors, sizeof errors, "%s/direct_memory.err", cli_workdir());
+    snprintf(png, sizeof png, "%s/direct_memory.png", cli_workdir());
     /* 384 elements: F (4 n^2 = 0.56 MiB) fits in 1 MiB, LU (8 n^2 = 1.1 MiB) does not. */
-    int status = run_capture(errors, "render '%s' -o '%s' --width 8 --height 8 --mesh-size 0.125 "
-                                     "--solver direct --max-memory 1M", w.obj_path, png);
+    int status = cli_run_capture(errors,
+                                 "render '%s' -o '%s' --width 8 --height 8 --mesh-size 0.125 "
+                                 "--solver direct --max-memory 1M",
+                                 w.obj_path, png);
     assert_int_equal(status, 1);
-    char *text = read_text(errors);
+    char *text = cli_read_text(errors);
     assert_non_null(text);
     char *newline = strchr(text, '\n');
     assert_non_null(newline);
@@ -570,8 +436,10 @@ static void test_direct_memory_limit(void **state)
         fail_msg("the refusal should name the size, the limit and the way out: %s", text);
     free(text);
     /* The same limit lets an iterative solver through: the refusal was the LU's. */
-    status = run_capture(NULL, "render '%s' -o '%s' --width 8 --height 8 --mesh-size 0.125 "
-                               "--solver gauss-seidel --max-memory 1M", w.obj_path, png);
+    status = cli_run_capture(NULL,
+                             "render '%s' -o '%s' --width 8 --height 8 --mesh-size 0.125 "
+                             "--solver gauss-seidel --max-memory 1M",
+                             w.obj_path, png);
     assert_int_equal(status, 0);
 }
 
@@ -593,8 +461,10 @@ static void test_thread_count(void **state)
         bool lapack = strcmp(solvers[k], "direct") == 0;
         assert_same_surfaces(three, one, lapack ? 1e-13 : 0.0, tag);
         if (!lapack)
-            assert_true(stats_number(one, "solver", "residual") == stats_number(three, "solver", "residual"));
-        assert_true(stats_number(one, "solver", "iterations") == stats_number(three, "solver", "iterations"));
+            assert_true(cli_stats_number(one, "solver", "residual") ==
+                        cli_stats_number(three, "solver", "residual"));
+        assert_true(cli_stats_number(one, "solver", "iterations") ==
+                    cli_stats_number(three, "solver", "iterations"));
         cJSON_Delete(one);
         cJSON_Delete(three);
     }
@@ -605,7 +475,7 @@ static void test_thread_count(void **state)
 static int read_solvers(void)
 {
     char cmd[600];
-    snprintf(cmd, sizeof cmd, "'%s' --list-methods", radiosity_bin);
+    snprintf(cmd, sizeof cmd, "'%s' --list-methods", cli_binary());
     FILE *p = popen(cmd, "r");
     if (!p)
         return -1;
@@ -628,22 +498,15 @@ static int read_solvers(void)
 static int setup(void **state)
 {
     (void)state;
-    snprintf(workdir, sizeof workdir, "/tmp/radiosity-solvers-XXXXXX");
-    if (!mkdtemp(workdir))
-        return -1;
-    cases = read_json(RAD_TEST_DATA "/cases.json");
-    return cases && read_solvers() == 0 ? 0 : -1;
+    return cli_setup("solvers") == 0 && read_solvers() == 0 ? 0 : -1;
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    cJSON_Delete(cases);
     for (int k = 0; k < solver_count; k++)
         free(solvers[k]);
-    char cmd[400];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", workdir);
-    return system(cmd) == 0 ? 0 : -1;
+    return cli_teardown();
 }
 
 int main(int argc, char **argv)
@@ -652,7 +515,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: test_solvers PATH_TO_RADIOSITY\n");
         return 2;
     }
-    radiosity_bin = argv[1];
+    cli_set_binary(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_registry),
         cmocka_unit_test(test_cornell_box_against_direct),
