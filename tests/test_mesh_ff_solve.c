@@ -278,6 +278,7 @@ static void test_analytic_cube(void **state)
                      RAD_ERROR_OUT_OF_MEMORY);
     assert_null(F);
     assert_non_null(strstr(rad_context_error(ctx), "--max-memory"));
+    assert_non_null(strstr(rad_context_error(ctx), "--solver shooting"));
     rad_mesh_destroy(mesh);
     rad_scene_destroy(scene);
 }
