@@ -398,17 +398,7 @@ static rad_result contour_compute(rad_context *ctx, const rad_ff_request *req, f
                 F[i * n + j] = (float)(g / area_i);
                 F[j * n + i] = (float)(g / mesh->elements[j].area);
             }
-            uint64_t done;
-#pragma omp atomic capture
-            done = ++rows_done;
-#ifdef _OPENMP
-            if (omp_get_thread_num() == 0)
-#endif
-            {
-                rad_progress(ctx, "form factors", done, n);
-                if (rad_cancelled(ctx))
-                    stop = 1;
-            }
+            rad_ff_row_done(ctx, &rows_done, n, &stop);
         }
     }
     stats->rays = rays;

@@ -201,17 +201,7 @@ static rad_result hemisphere_compute(rad_context *ctx, const rad_ff_request *req
             if (stop || failed)
                 continue;
             pairs += hemisphere_row(req, s, i, N, eps, F, variance);
-            uint64_t done;
-#pragma omp atomic capture
-            done = ++rows_done;
-#ifdef _OPENMP
-            if (omp_get_thread_num() == 0)
-#endif
-            {
-                rad_progress(ctx, "form factors", done, n);
-                if (rad_cancelled(ctx))
-                    stop = 1;
-            }
+            rad_ff_row_done(ctx, &rows_done, n, &stop);
         }
         free(perm);
         free(sum);

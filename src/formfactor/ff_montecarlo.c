@@ -346,17 +346,7 @@ static rad_result montecarlo_compute(rad_context *ctx, const rad_ff_request *req
                     variance[j * n + i] = (float)(var * ratio * ratio);
                 }
             }
-            uint64_t done;
-#pragma omp atomic capture
-            done = ++rows_done;
-#ifdef _OPENMP
-            if (omp_get_thread_num() == 0)
-#endif
-            {
-                rad_progress(ctx, "form factors", done, n);
-                if (rad_cancelled(ctx))
-                    stop = 1;
-            }
+            rad_ff_row_done(ctx, &rows_done, n, &stop);
         }
         free(perm);
         free(s);

@@ -8,6 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 extern const rad_ff_method rad_ff_analytic;
 extern const rad_ff_method rad_ff_hemicube;
 extern const rad_ff_method rad_ff_hemisphere;
@@ -67,6 +71,20 @@ static void diagnostics(const rad_mesh *mesh, const float *F, rad_ff_stats *s)
     s->row_sum_mean = n ? rsum / (double)n : 0.0;
     s->reciprocity_max = recip;
     s->diagonal_max = diag;
+}
+
+void rad_ff_row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatile int *stop)
+{
+    uint64_t done;
+#pragma omp atomic capture
+    done = ++*rows_done;
+#ifdef _OPENMP
+    if (omp_get_thread_num() != 0)
+        return;
+#endif
+    rad_progress(ctx, "form factors", done, rows);
+    if (rad_cancelled(ctx))
+        *stop = 1;
 }
 
 void rad_ff_close(const rad_mesh *mesh, float *F)

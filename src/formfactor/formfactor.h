@@ -66,6 +66,11 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
                             const rad_ff_request *req, double max_memory, bool close,
                             float **F_out, float **variance_out, rad_ff_stats *stats);
 
+/* For a method's parallel row loop: count one finished row; the master
+ * thread reports progress and polls cancellation, raising *stop.  Called
+ * from inside the OpenMP region.  Cannot fail. */
+void rad_ff_row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatile int *stop);
+
 /* Reciprocity-preserving closure correction for closed scenes: find x > 0
  * with sum_j x_i x_j A_i F_ij = A_i (symmetric Sinkhorn scaling of the
  * power-coupling matrix G = A F), then F_ij <- x_i x_j F_ij.  Keeps zeros,
