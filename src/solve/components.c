@@ -113,21 +113,6 @@ static int group_step(void *user, const rad_solve_step *step, const double *B_gr
     return g->outer->monitor(g->outer->monitor_user, &whole, g->B, ambient);
 }
 
-/* ---- per-row residual numerators, as rad_residual computes them ---- */
-
-static void row_residuals(const rad_system *sys, const double *B, double *row)
-{
-    size_t n = sys->n;
-#pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
-    for (size_t i = 0; i < n; i++) {
-        double g[3];
-        rad_gather(sys->F + i * n, B, n, g);
-        const double *rho = sys->reflectance + 3 * i, *E = sys->emission + 3 * i;
-        row[i] = sys->area[i] * (fabs(B[3 * i] - E[0] - rho[0] * g[0]) +
-                                 fabs(B[3 * i + 1] - E[1] - rho[1] * g[1]) +
-                                 fabs(B[3 * i + 2] - E[2] - rho[2] * g[2]));
-    }
-}
 
 static double emitted_power(const rad_system *sys, size_t i)
 {
@@ -230,7 +215,7 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
            *B_sub = emission + 3 * largest;
 
     /* Where every group starts: its residual and emitted power. */
-    row_residuals(sys, B, row);
+    rad_residual_rows(sys, B, row);
     double emitted_total = 0.0;
     for (size_t k = 0; k < g.count; k++) {
         g.emitted[k] = g.residual[k] = 0.0;

@@ -31,15 +31,9 @@ const rad_solver *rad_solver_find(const char *name)
     return NULL;
 }
 
-/* Rows in parallel, each into its own slot, then a sequential sum: the
- * result is bit-identical whatever the thread count (a reduction clause
- * would add in a thread-dependent order). */
-double rad_residual(const rad_system *sys, const double *B)
+void rad_residual_rows(const rad_system *sys, const double *B, double *row)
 {
     size_t n = sys->n;
-    double *row = malloc((n ? n : 1) * sizeof *row);
-    if (!row)
-        return INFINITY; /* cannot measure: never reported as converged */
 #pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
     for (size_t i = 0; i < n; i++) {
         double g[3];
@@ -49,6 +43,18 @@ double rad_residual(const rad_system *sys, const double *B)
                                  fabs(B[3 * i + 1] - E[1] - rho[1] * g[1]) +
                                  fabs(B[3 * i + 2] - E[2] - rho[2] * g[2]));
     }
+}
+
+/* Rows in parallel, each into its own slot, then a sequential sum: the
+ * result is bit-identical whatever the thread count (a reduction clause
+ * would add in a thread-dependent order). */
+double rad_residual(const rad_system *sys, const double *B)
+{
+    size_t n = sys->n;
+    double *row = malloc((n ? n : 1) * sizeof *row);
+    if (!row)
+        return INFINITY; /* cannot measure: never reported as converged */
+    rad_residual_rows(sys, B, row);
     double num = 0.0, den = 0.0;
     for (size_t i = 0; i < n; i++) {
         num += row[i];

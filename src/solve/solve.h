@@ -109,6 +109,10 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
 /* The residual measure above (O(n^2)). */
 double rad_residual(const rad_system *sys, const double *B);
 
+/* Its per-row numerators: row[i] = A_i sum_c |r_ic| (row holds n doubles).
+ * Parallel, thread-count independent.  Cannot fail. */
+void rad_residual_rows(const rad_system *sys, const double *B, double *row);
+
 /* The ambient term of progressive refinement for unshot radiosity dB
  * (solve_southwell.c). */
 void rad_southwell_ambient(const rad_system *sys, const double *dB, double ambient[3]);
