@@ -36,7 +36,7 @@ enum option_id {
     OPT_CAMERA, OPT_EXPOSURE, OPT_FLAT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_MAX_MEMORY,
     OPT_QUIET, OPT_HELP, OPT_VERSION, OPT_LIST_METHODS, OPT_HEMICUBE_RES, OPT_SAMPLES_FF,
     OPT_NEAR_FIELD, OPT_CLOSURE, OPT_RELAXATION, OPT_UNSHOT_TOLERANCE, OPT_HISTORY,
-    OPT_PROGRESS_IMAGES, OPT_EVERY, OPT_LEVEL
+    OPT_PROGRESS_IMAGES, OPT_EVERY, OPT_LEVEL, OPT_EPSILON, OPT_MIN_AREA, OPT_CLUSTERING
 };
 
 enum { CMD_RENDER = 1, CMD_VIEWFACTORS = 2, CMD_ALL = 3 };
@@ -71,6 +71,12 @@ static const option_def OPTIONS[] = {
      "rescale F so rows sum to 1 keeping reciprocity (closed scenes only; docs/methods.md)"},
     {OPT_LEVEL, 0, "level", "WHICH", CMD_VIEWFACTORS,
      "view factors between 'surface's (default) or 'element's"},
+    {OPT_EPSILON, 0, "epsilon", "X", CMD_RENDER,
+     "hierarchical: refine links whose error exceeds X x the mean emitted exitance (default 1e-3)"},
+    {OPT_MIN_AREA, 0, "min-area", "A", CMD_RENDER,
+     "hierarchical: smallest element area, m^2 (default 1e-4 x the total area)"},
+    {OPT_CLUSTERING, 0, "clustering", "WHEN", CMD_RENDER,
+     "hierarchical: start from a cluster hierarchy 'on', 'off' or 'auto' (> 64 patches; default)"},
     {OPT_TOLERANCE, 0, "tolerance", "X", CMD_RENDER,
      "stop when the residual (unaccounted power / emitted power) < X (default 1e-6)"},
     {OPT_MAX_ITERATIONS, 0, "max-iterations", "N", CMD_RENDER,
@@ -297,6 +303,22 @@ static int parse_args(int argc, char **argv, settings *s)
             break;
         case OPT_TOLERANCE:
             bad = parse_double(o->name, value, 1e-15, 0.5, &s->solve.tolerance);
+            break;
+        case OPT_EPSILON:
+            bad = parse_double(o->name, value, 1e-12, 1e3, &s->solve.epsilon);
+            break;
+        case OPT_MIN_AREA:
+            bad = parse_double(o->name, value, 1e-18, 1e18, &s->solve.min_area);
+            break;
+        case OPT_CLUSTERING:
+            if (strcmp(value, "on") == 0)
+                s->solve.clustering = 1;
+            else if (strcmp(value, "off") == 0)
+                s->solve.clustering = -1;
+            else if (strcmp(value, "auto") == 0)
+                s->solve.clustering = 0;
+            else
+                return usage_error("--clustering takes on, off or auto, got '%s'", value);
             break;
         case OPT_MAX_ITERATIONS:
             bad = parse_int(o->name, value, 0, 2000000000, &l);

@@ -177,6 +177,15 @@ typedef struct rad_options {
     int record_history;           /* nonzero: keep every step's residual in the history
                                      (gathering then measures the residual every sweep) */
 
+    /* Hierarchical radiosity (solver "hierarchical"): a link is refined while its
+     * estimated transport error, as a radiosity at the receiver, exceeds epsilon
+     * times the scene's mean emitted exitance (sum A E / sum A); elements are not
+     * split below min_area. */
+    double epsilon;               /* 0 = 1e-3 */
+    double min_area;              /* m^2; 0 = 1e-4 x the scene's total area */
+    int clustering;               /* 0 = automatic (when the scene has more than 64
+                                     patches), 1 = always, -1 = never */
+
     uint64_t seed;                /* all sampling is seeded per element pair: results do
                                      not depend on the thread count */
     double max_memory_bytes;      /* refuse to allocate more; 0 = 80% of physical memory */
