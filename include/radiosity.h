@@ -104,6 +104,30 @@ rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void 
  * Graphics), in metres, with its published camera. */
 rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **out);
 
+/* A procedural office floor (docs/scenes.md): `rooms` rooms of about
+ * 4-6 x 4-6 x 3 m on a grid, with doors between neighbours, daylight
+ * windows on the outside, ceiling lights, desks, chairs and shelves; about
+ * 110-220 polygons per room, surfaces named "room3/desk1/top".  The same
+ * seed gives the same scene bit for bit. */
+typedef struct rad_office_options {
+    int rooms;                   /* 1 to 100000; 0 = 4 */
+    uint64_t seed;               /* any value (0 included) */
+} rad_office_options;
+
+/* `options` may be NULL (the defaults).  Fails with
+ * RAD_ERROR_INVALID_ARGUMENT when rooms is out of range. */
+rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options *options,
+                                     rad_scene **out);
+
+/* Write a scene as OBJ + MTL: PATH (PATH.obj -> PATH.mtl beside it, named
+ * in `mtllib`), one `o` per surface (its name, blanks replaced by '_'),
+ * Kd = reflectance, Ke = emitted radiance = E / pi.  Coordinates are written
+ * in the shortest decimal that parses back to the same double (the loader
+ * reads them through assimp's float); the camera is not written.  Both
+ * files go to temporary names first and are renamed only when both are
+ * complete, so a failure leaves neither. */
+rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path);
+
 void rad_scene_destroy(rad_scene *scene);
 
 size_t rad_scene_surface_count(const rad_scene *scene);
@@ -178,10 +202,10 @@ typedef struct rad_options {
                                      (gathering then measures the residual every sweep) */
 
     /* Hierarchical radiosity (solver "hierarchical"): a link is refined while its
-     * estimated transport error, as a radiosity at the receiver, exceeds epsilon
-     * times the scene's mean emitted exitance (sum A E / sum A); elements are not
-     * split below min_area. */
-    double epsilon;               /* 0 = 1e-3 */
+     * estimated error, as power reflected by the receiver, exceeds epsilon times
+     * the power the scene emits; elements are not split below min_area.  Its
+     * progress reaches the history, not on_step (the mesh changes as it runs). */
+    double epsilon;               /* 0 = 1e-4 */
     double min_area;              /* m^2; 0 = 1e-4 x the scene's total area */
     int clustering;               /* 0 = automatic (when the scene has more than 64
                                      patches), 1 = always, -1 = never */

@@ -5,11 +5,16 @@
 #
 #   RADIOSITY_BUILD_DIR   build folder (default: build)
 #   RADIOSITY_CMAKE_ARGS  extra arguments for cmake's configure step
+#   RADIOSITY_FUZZ=1      also install clang 14 and build the libFuzzer
+#                         targets into build-fuzz/ (docs/testing.md, "Fuzzing")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake pkg-config libembree-dev libassimp-dev libstb-dev
           libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev)
+if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
+  packages+=(clang-14 libclang-rt-14-dev libomp-14-dev)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -29,3 +34,12 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release ${RADIOSITY_CMAKE_ARGS:-} >/de
 cmake --build "$build" -j "$(nproc)" 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make|Consolidate compiler' || true
 test -x "$build/radiosity" || { echo "setup: build failed" >&2; exit 1; }
 echo "setup: built $build/radiosity"
+
+if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
+  CC=clang-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRADIOSITY_FUZZ=ON \
+    -DRADIOSITY_BENCH=OFF >/dev/null
+  cmake --build build-fuzz -j "$(nproc)" --target fuzz_obj fuzz_mtl fuzz_gltf fuzz_glb fuzz_camera \
+    fuzz_cli_options 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make' || true
+  test -x build-fuzz/fuzz/fuzz_obj || { echo "setup: fuzz build failed" >&2; exit 1; }
+  echo "setup: built the fuzzers in build-fuzz/fuzz/"
+fi

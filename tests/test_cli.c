@@ -365,6 +365,71 @@ static void test_interrupt_writes_partial(void **state)
     interrupt_with(15, 143, "term"); /* SIGTERM */
 }
 
+/* ---- limits: every large allocation is estimated first, and refused with
+ * the option that avoids it (docs/robustness.md) ---- */
+
+static void too_big(const char *args, const char *needle1, const char *needle2)
+{
+    assert_int_equal(run("render %s -o big.png --stats big.json", args), 1);
+    assert_one_line_error(needle1, needle2);
+    assert_no_output("big");
+}
+
+static void test_limits(void **state)
+{
+    (void)state;
+    /* 8e10 elements: past uint32 element indices, refused before any
+     * allocation. */
+    too_big("--mesh-size 1e-9", "exceed the limit", "--mesh-size");
+    /* The dense matrix of the default 2000 elements (16 MB) in 1 MB. */
+    too_big("--max-memory 1M", "--max-memory", "--solver shooting");
+    /* A matrix-free run whose mesh alone is over the limit. */
+    too_big("--solver shooting --elements 300000 --max-memory 20M", "mesh:", "--elements");
+    /* Hit records of 10^8 rays a shot. */
+    too_big("--solver shooting --elements 200 --ff-samples 100000000 --max-memory 1G", "shooting:",
+            "--ff-samples");
+    /* A hemicube's buffers: 3 x 8192^2 pixels a thread. */
+    too_big("--elements 200 --form-factors hemicube --hemicube-res 8192 --max-memory 1G", "hemicube",
+            "--hemicube-res");
+    /* A 16384 x 16384 image. */
+    too_big("--elements 200 --width 16384 --height 16384 --max-memory 1G", "render:", "--width");
+    /* Element-to-element view factors: 3000^2 doubles. */
+    assert_int_equal(run("viewfactors --elements 3000 --level element --max-memory 60M -o big.csv"), 1);
+    assert_one_line_error("view factors:", "--level surface");
+    assert_no_output("big");
+}
+
+/* SIGTERM while the form factors are computed (the dense analytic matrix
+ * for 12,000 elements takes far longer than the 2 s we wait): exit 143,
+ * the stats say "partial" and name the phase, no image (there is no
+ * radiosity yet) and no temporary file is left. */
+static void test_interrupt_during_form_factors(void **state)
+{
+    (void)state;
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd,
+             "cd '%s' && ('%s' render --elements 12000 --width 32 --height 32 -o ffint.png "
+             "--stats ffint.json >ffint_out.txt 2>ffint_err.txt & pid=$!; sleep 2; kill -15 $pid; "
+             "wait $pid; echo $? > ffint_status.txt)",
+             workdir, radiosity_bin);
+    assert_int_equal(system(cmd), 0);
+    char path[600], text[8192];
+    snprintf(path, sizeof path, "%s/ffint_status.txt", workdir);
+    slurp(path, text, sizeof text);
+    assert_int_equal(atoi(text), 143);
+    assert_false(exists("ffint.png"));
+    snprintf(path, sizeof path, "%s/ffint.json", workdir);
+    slurp(path, text, sizeof text);
+    assert_non_null(strstr(text, "\"partial\":\ttrue"));
+    assert_non_null(strstr(text, "\"interrupted\":\t\"form factors\""));
+    assert_non_null(strstr(text, "\"surfaces\":\t8"));
+    assert_no_output("ffint.png");
+    assert_no_output("ffint.json.tmp");
+    snprintf(path, sizeof path, "%s/ffint_err.txt", workdir);
+    slurp(path, text, sizeof text);
+    assert_non_null(strstr(text, "interrupted while computing form factors; wrote partial stats"));
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -407,6 +472,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_viewfactors_csv),
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_interrupt_writes_partial),
+        cmocka_unit_test(test_interrupt_during_form_factors),
+        cmocka_unit_test(test_limits),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -81,6 +81,12 @@ static rad_result resolve_options(rad_context *ctx, const rad_options *in, rad_s
                         o.unshot_tolerance);
     if (o.max_memory_bytes == 0.0)
         o.max_memory_bytes = 0.8 * (double)rad_physical_memory_bytes();
+    if (!(o.epsilon >= 0.0 && o.epsilon < 1e6))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "epsilon must be positive, got %g", o.epsilon);
+    if (!(o.min_area >= 0.0) || !isfinite(o.min_area))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "min area must be a positive area in m^2");
+    if (o.clustering < -1 || o.clustering > 1)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "clustering must be -1, 0 or 1");
     if (!(o.max_memory_bytes > 0.0))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "max memory must be positive");
     copy_name(s->form_factor_name, sizeof s->form_factor_name, o.form_factors);
@@ -90,6 +96,35 @@ static rad_result resolve_options(rad_context *ctx, const rad_options *in, rad_s
     o.solver = s->solver_name;
     o.visibility = s->visibility_name;
     s->options = o;
+    return RAD_OK;
+}
+
+/* The sampling methods' per-thread scratch (ray permutations, a hemicube's
+ * depth and item buffers, a row of sums) beside the dense matrix the
+ * form-factor table checks: refused up front, naming the option that
+ * shrinks it.  The dense matrix's own check (formfactor.c) names its way
+ * out. */
+static rad_result check_ff_scratch(rad_context *ctx, const rad_options *o, size_t n, int threads)
+{
+    const char *method = o->form_factors, *option = NULL;
+    double per_thread = 8.0 * (double)n;
+    if (strcmp(method, "hemisphere") == 0 || strcmp(method, "montecarlo") == 0) {
+        per_thread += 4.0 * (double)(o->samples > 0 ? o->samples : 0);
+        option = "--ff-samples";
+    } else if (strcmp(method, "hemicube") == 0) {
+        double R = o->hemicube_resolution > 0 ? o->hemicube_resolution : 256;
+        per_thread += 3.0 * R * R * 8.0; /* depth (float) and item (uint32) per pixel */
+        option = "--hemicube-res";
+    }
+    double matrix = 4.0 * (double)n * (double)n;
+    double scratch = per_thread * (threads > 0 ? threads : 1);
+    if (option && matrix <= o->max_memory_bytes && matrix + scratch > o->max_memory_bytes)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "form factors: %s needs %.2f GiB of scratch on %d threads beside the "
+                        "%.2f GiB matrix, above the memory limit of %.2f GiB (--max-memory); "
+                        "use a smaller %s or fewer --threads",
+                        method, scratch / 1073741824.0, threads, matrix / 1073741824.0,
+                        o->max_memory_bytes / 1073741824.0, option);
     return RAD_OK;
 }
 
@@ -115,7 +150,10 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     double t = rad_seconds();
     rad_mesh_options mo = {s->options.mesh_size, s->options.target_elements,
                            s->options.crease_angle_degrees};
-    r = rad_mesh_build(ctx, scene, &mo, &s->mesh);
+    /* Hierarchical: the patches are the roots; it subdivides them itself. */
+    if (rad_solver_find(s->options.solver)->flags & RAD_SOLVER_HIERARCHICAL)
+        mo.mesh_size = 1e30, mo.target_elements = 0;
+    r = rad_mesh_build_within(ctx, scene, &mo, s->options.max_memory_bytes, &s->mesh);
     s->seconds.mesh = rad_seconds() - t;
     if (r != RAD_OK)
         goto fail;
@@ -149,6 +187,9 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
 
     /* 4. form factors (unless the solver computes its own on the fly) */
     if (!(rad_solver_find(s->options.solver)->flags & RAD_SOLVER_MATRIX_FREE)) {
+        r = check_ff_scratch(ctx, &s->options, n, s->threads);
+        if (r != RAD_OK)
+            goto fail;
         rad_ff_request req = {s->mesh, s->vis, s->options.seed, s->options.shadow_rays,
                               s->options.hemicube_resolution, s->options.samples, s->options.near_field};
         r = rad_form_factors(ctx, rad_ff_find(s->options.form_factors), &req, s->options.max_memory_bytes,
@@ -207,12 +248,97 @@ const rad_solve_step *rad_solution_history(const rad_solution *s, size_t *count)
     return s->history;
 }
 
+/* The hierarchical solver makes its own elements: the solution's mesh
+ * becomes its leaves (the patches, and the ray structure built on them,
+ * stay), and the per-element arrays follow.  Steps go to the history only:
+ * on_step would see a mesh that changes while the solver runs. */
+static int hier_monitor(void *user, const rad_solve_step *step, const double *B, const double *ambient)
+{
+    (void)B, (void)ambient;
+    rad_solution *s = user;
+    return s->options.record_history && !history_push(s, step);
+}
+
+static rad_result solve_hierarchical(rad_context *ctx, rad_solution *s)
+{
+    const rad_mesh *base = s->hier_base ? s->hier_base : s->mesh;
+    rad_hier_params hp = {.scene = s->scene,
+                          .base = base,
+                          .vis = s->vis,
+                          .epsilon = s->options.epsilon,
+                          .min_area = s->options.min_area,
+                          .clustering = s->options.clustering,
+                          .seed = s->options.seed,
+                          .shadow_rays = s->options.shadow_rays,
+                          .tolerance = s->options.tolerance,
+                          .max_iterations = s->options.max_iterations,
+                          .max_memory = s->options.max_memory_bytes,
+                          .crease_angle_degrees = s->options.crease_angle_degrees,
+                          .monitor = hier_monitor,
+                          .monitor_user = s};
+    memset(&s->solve_stats, 0, sizeof s->solve_stats);
+    s->solve_stats.method = "hierarchical";
+    s->solve_stats.unshot = NAN;
+    s->history_count = 0;
+    double t = rad_seconds();
+    rad_mesh *leaves = NULL;
+    double *B = NULL;
+    rad_result r = rad_hier_run(ctx, &hp, &leaves, &B, &s->solve_stats, &s->hier_stats);
+    s->solve_stats.seconds = rad_seconds() - t;
+    s->seconds.solve = s->solve_stats.seconds;
+    if (leaves) {
+        size_t n = leaves->element_count;
+        double *area = rad_alloc_array(ctx, n, sizeof *area, "solution: areas");
+        double *rho = rad_alloc_array(ctx, 3 * n, sizeof *rho, "solution: reflectance");
+        double *E = rad_alloc_array(ctx, 3 * n, sizeof *E, "solution: emission");
+        if (!area || !rho || !E) {
+            free(area);
+            free(rho);
+            free(E);
+            free(B);
+            rad_mesh_destroy(leaves);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        for (size_t i = 0; i < n; i++) {
+            const rad_element *e = &leaves->elements[i];
+            const rad_material *m = &s->scene->materials[e->material];
+            area[i] = e->area;
+            for (int c = 0; c < 3; c++) {
+                rho[3 * i + c] = m->reflectance[c];
+                E[3 * i + c] = m->emission[c];
+            }
+        }
+        if (!s->hier_base)
+            s->hier_base = s->mesh;
+        else
+            rad_mesh_destroy(s->mesh);
+        s->mesh = leaves;
+        free(s->area);
+        free(s->reflectance);
+        free(s->emission);
+        free(s->radiosity);
+        s->area = area;
+        s->reflectance = rho;
+        s->emission = E;
+        s->radiosity = B;
+    }
+    rad_solve_step last = {s->solve_stats.iterations, s->solve_stats.seconds, s->solve_stats.residual, NAN};
+    if (s->history_count == 0 || s->history[s->history_count - 1].iteration < last.iteration)
+        history_push(s, &last);
+    s->solved = r == RAD_OK;
+    free(s->vertex_radiosity);
+    s->vertex_radiosity = NULL;
+    return r;
+}
+
 rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
 {
     if (!rad_scene_has_emitter(s->scene))
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
                         s->scene->source);
+    if (rad_solver_find(s->options.solver)->flags & RAD_SOLVER_HIERARCHICAL)
+        return solve_hierarchical(ctx, s);
     rad_system sys = {.n = s->mesh->element_count,
                       .F = s->F,
                       .area = s->area,
@@ -269,6 +395,7 @@ void rad_solution_destroy(rad_solution *s)
         return;
     rad_vis_destroy(s->vis);
     rad_mesh_destroy(s->mesh);
+    rad_mesh_destroy(s->hier_base);
     free(s->F);
     free(s->F_variance);
     free(s->history);
@@ -393,6 +520,15 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     in.element_radiosity = display;
     in.vertex_radiosity = s->vertex_radiosity;
     int w = o.width > 0 ? o.width : 512, h = o.height > 0 ? o.height : 512;
+    /* The image (3 floats a pixel) and its 8-bit copy for PNG. */
+    double image_bytes = 15.0 * (double)w * (double)h;
+    if (w <= 16384 && h <= 16384 && image_bytes > s->options.max_memory_bytes) {
+        free(display);
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "render: a %dx%d image needs %.2f GiB, above the memory limit of %.2f GiB "
+                        "(--max-memory); use a smaller --width / --height",
+                        w, h, image_bytes / 1073741824.0, s->options.max_memory_bytes / 1073741824.0);
+    }
     if (o.camera)
         in.camera = *o.camera;
     else if (!rad_scene_camera(s->scene, &in.camera))

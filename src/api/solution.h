@@ -6,6 +6,7 @@
 #define RAD_SOLUTION_H
 
 #include "formfactor/formfactor.h"
+#include "hier/hier.h"
 #include "output/output.h"
 #include "solve/solve.h"
 
@@ -16,7 +17,9 @@ struct rad_solution {
     char form_factor_name[32];
     char solver_name[32];
     char visibility_name[32];
-    rad_mesh *mesh;
+    rad_mesh *mesh;            /* hierarchical: the leaves, after solving */
+    rad_mesh *hier_base;       /* hierarchical: the patches (one element each) vis is built on */
+    rad_hier_stats hier_stats;
     rad_vis *vis;
     float *F;                  /* n x n; NULL for matrix-free solvers */
     float *F_variance;         /* n x n for methods that estimate it, else NULL */

@@ -100,6 +100,12 @@ double rad_element_bend(const rad_mesh *mesh, const rad_element *e);
  * quad).  Cannot fail. */
 double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
 
+/* The four children of a quad (bilinear midpoints) or a triangle (midpoint
+ * subdivision, the middle child last), same orientation as the parent:
+ * the adaptive quadratures' refinement step (analytic, hemicube).  A
+ * triangle's children use corners 0-2 of each sub[k].  Cannot fail. */
+void rad_ff_split4(const vec3 *region, uint32_t corners, vec3 sub[4][4]);
+
 /* ---- the hemicube's delta form factors (ff_hemicube.c) ---- */
 
 /* Fill delta[] with the form factor of each pixel of a unit hemicube with

@@ -23,6 +23,8 @@
  */
 #include "formfactor/formfactor.h"
 
+#include <string.h>
+
 /* Clip to n.(y - x) >= 0.  `out` holds up to n + 1 vertices. */
 static size_t clip_to_hemisphere(vec3 x, vec3 normal, const vec3 *poly, size_t n, vec3 *out)
 {
@@ -93,4 +95,22 @@ double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, dou
     vec3 du = v3_add(v3_scale(v3_sub(p1, p0), 1.0 - v), v3_scale(v3_sub(p2, p3), v));
     vec3 dv = v3_sub(v3_lerp(p3, p2, u), v3_lerp(p0, p1, u));
     return v3_length(v3_cross(du, dv)) / e->area;
+}
+
+void rad_ff_split4(const vec3 *region, uint32_t corners, vec3 sub[4][4])
+{
+    if (corners == 4) {
+        vec3 m01 = v3_lerp(region[0], region[1], 0.5), m12 = v3_lerp(region[1], region[2], 0.5);
+        vec3 m23 = v3_lerp(region[2], region[3], 0.5), m30 = v3_lerp(region[3], region[0], 0.5);
+        vec3 mid = v3_lerp(m01, m23, 0.5);
+        vec3 q[4][4] = {{region[0], m01, mid, m30}, {m01, region[1], m12, mid},
+                        {mid, m12, region[2], m23}, {m30, mid, m23, region[3]}};
+        memcpy(sub, q, sizeof q);
+    } else {
+        vec3 m01 = v3_lerp(region[0], region[1], 0.5), m12 = v3_lerp(region[1], region[2], 0.5);
+        vec3 m20 = v3_lerp(region[2], region[0], 0.5);
+        vec3 q[4][4] = {{region[0], m01, m20, m20}, {m01, region[1], m12, m12},
+                        {m20, m12, region[2], region[2]}, {m01, m12, m20, m20}};
+        memcpy(sub, q, sizeof q);
+    }
 }

@@ -1,2 +1,569 @@
-/* placeholder */
-#include "core/core.h"
+/*
+ * hier.c -- the hierarchical radiosity solver: rounds of refinement and
+ * Jacobi sweeps over the links, then the leaves as the solution's mesh.
+ *
+ * One sweep (Hanrahan, Salzman & Aupperle 1991, "Gather" and
+ * "PushPullRad"):
+ *
+ *   gather     every node's irradiance H from its own links (in parallel
+ *              over receivers; links are sorted by receiver)
+ *   push       down the hierarchy, each node's total irradiance is its own
+ *              plus its parent's (a surface under a cluster reads the
+ *              cluster's six-direction bins with its normal); at a leaf,
+ *              B = E + rho H
+ *   pull       up the hierarchy, a node's B is the area average of its
+ *              children's, and a cluster's exitance bins the sum of its
+ *              members'
+ *
+ * Node numbers are a topological order (parents first), so push and pull
+ * are two loops over the node array.  The residual of a sweep is the
+ * change it made, sum_leaves A |B_new - B_old| / sum_leaves A E (channels
+ * summed): the notes' residual of the hierarchical system.
+ *
+ * Rounds ("BF refinement" with multigridding): refine against the current
+ * B (at first B = E: only links from emitters are refined), solve to 1e-3,
+ * refine again with the better B, ... until a round splits no link; then
+ * solve to the requested tolerance.
+ */
+#include "hier/hier.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct hr_state {
+    rad_context *ctx;
+    const rad_hier_params *p;
+    hr_tree tree;
+    hr_links links;
+    size_t *offset;       /* receiver k's links: [offset[k], offset[k + 1]) */
+    double *B, *H, *Ht;   /* 3 per node */
+    double *spread;       /* per node: max |B_child - B| over children and channels */
+    double *bins_in;      /* 18 per cluster: [channel][signed axis] */
+    double *bins_total;   /* 18 per cluster, pushed down */
+    double *bins_exit;    /* 18 per cluster, pulled up: sum A B |n_a| */
+    size_t values;        /* nodes the arrays cover */
+    double emitted;       /* sum_leaves A E, channels summed */
+    double absorbed;      /* W, channels summed */
+    int sweeps;
+    double start;
+} hr_state;
+
+static const double *node_emission(const hr_state *st, const hr_node *n)
+{
+    const rad_patch *pa = &st->tree.base->patches[n->patch];
+    return st->tree.scene->materials[pa->material].emission;
+}
+
+static const double *node_reflectance(const hr_state *st, const hr_node *n)
+{
+    const rad_patch *pa = &st->tree.base->patches[n->patch];
+    return st->tree.scene->materials[pa->material].reflectance;
+}
+
+/* Grow the per-node arrays to the tree; new nodes start from their
+ * parent's radiosity. */
+static rad_result ensure_values(hr_state *st)
+{
+    size_t n = st->tree.count;
+    if (n == st->values)
+        return RAD_OK;
+    double *B = realloc(st->B, 3 * n * sizeof *B);
+    if (B)
+        st->B = B;
+    double *H = realloc(st->H, 3 * n * sizeof *H);
+    if (H)
+        st->H = H;
+    double *Ht = realloc(st->Ht, 3 * n * sizeof *Ht);
+    if (Ht)
+        st->Ht = Ht;
+    double *sp = realloc(st->spread, n * sizeof *sp);
+    if (sp)
+        st->spread = sp;
+    if (!B || !H || !Ht || !sp)
+        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "hierarchical: out of memory for %zu nodes; use a larger --epsilon or --min-area", n);
+    for (size_t k = st->values; k < n; k++) {
+        const hr_node *nd = &st->tree.nodes[k];
+        for (int c = 0; c < 3; c++) {
+            st->B[3 * k + (size_t)c] = nd->parent != HR_NONE && st->tree.nodes[nd->parent].kind == HR_SURFACE
+                                           ? st->B[3 * (size_t)nd->parent + (size_t)c]
+                                           : (nd->kind == HR_SURFACE ? node_emission(st, nd)[c] : 0.0);
+            st->H[3 * k + (size_t)c] = 0.0;
+            st->Ht[3 * k + (size_t)c] = 0.0;
+        }
+        st->spread[k] = 0.0;
+    }
+    st->values = n;
+    return RAD_OK;
+}
+
+/* Counting sort of the links by receiver (stable: the refinement order is
+ * kept within a receiver, so sums are thread-count independent). */
+static rad_result sort_links(hr_state *st)
+{
+    size_t n = st->tree.count, L = st->links.count;
+    size_t *off = realloc(st->offset, (n + 1) * sizeof *off);
+    hr_link *sorted = malloc((L ? L : 1) * sizeof *sorted);
+    if (!off || !sorted) {
+        if (off)
+            st->offset = off;
+        free(sorted);
+        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory sorting %zu links", L);
+    }
+    st->offset = off;
+    memset(off, 0, (n + 1) * sizeof *off);
+    for (size_t i = 0; i < L; i++)
+        off[st->links.items[i].r + 1]++;
+    for (size_t k = 0; k < n; k++)
+        off[k + 1] += off[k];
+    size_t *fill = malloc((n ? n : 1) * sizeof *fill);
+    if (!fill) {
+        free(sorted);
+        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory sorting links");
+    }
+    memcpy(fill, off, n * sizeof *fill);
+    for (size_t i = 0; i < L; i++)
+        sorted[fill[st->links.items[i].r]++] = st->links.items[i];
+    free(fill);
+    free(st->links.items);
+    st->links.items = sorted;
+    st->links.capacity = L ? L : 1;
+    return RAD_OK;
+}
+
+/* Gather every receiver's links into H (surfaces) or bins_in (clusters). */
+static void gather(hr_state *st)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    const hr_link *links = st->links.items;
+    memset(st->bins_in, 0, 18 * t->clusters * sizeof *st->bins_in);
+#pragma omp parallel for schedule(dynamic, 256) num_threads(rad_context_threads(st->ctx))
+    for (size_t k = 0; k < n; k++) {
+        const hr_node *nr = &t->nodes[k];
+        double h[3] = {0.0, 0.0, 0.0};
+        double *bins = nr->kind == HR_CLUSTER ? &st->bins_in[18 * k] : NULL;
+        for (size_t i = st->offset[k]; i < st->offset[k + 1]; i++) {
+            const hr_link *l = &links[i];
+            const hr_node *ns = &t->nodes[l->s];
+            const double *Bs = &st->B[3 * (size_t)l->s];
+            double kk = l->k;
+            if (!bins && ns->kind == HR_SURFACE) {
+                h[0] += kk * Bs[0];
+                h[1] += kk * Bs[1];
+                h[2] += kk * Bs[2];
+                continue;
+            }
+            vec3 w = v3_normalize(v3_sub(ns->center, nr->center));
+            vec3 back = v3_scale(w, -1.0);
+            for (int c = 0; c < 3; c++) {
+                double e = ns->kind == HR_SURFACE ? kk * Bs[c]
+                                                  : kk * hr_bins_eval(&st->bins_exit[18 * (size_t)l->s + 6 * (size_t)c], back);
+                if (bins)
+                    hr_bins_add(bins + 6 * c, w, e);
+                else
+                    h[c] += e;
+            }
+        }
+        for (int c = 0; c < 3; c++)
+            st->H[3 * k + (size_t)c] = h[c];
+    }
+}
+
+/* Push down, update the leaves, pull up.  Returns the residual. */
+static double push_pull(hr_state *st)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    double change = 0.0, absorbed = 0.0;
+    for (size_t k = 0; k < n; k++) {
+        const hr_node *nd = &t->nodes[k];
+        uint32_t up = nd->parent;
+        if (nd->kind == HR_CLUSTER) {
+            for (int q = 0; q < 18; q++)
+                st->bins_total[18 * k + (size_t)q] =
+                    st->bins_in[18 * k + (size_t)q] + (up != HR_NONE ? st->bins_total[18 * (size_t)up + (size_t)q] : 0.0);
+            continue;
+        }
+        double *ht = &st->Ht[3 * k];
+        for (int c = 0; c < 3; c++) {
+            double from_parent = 0.0;
+            if (up != HR_NONE) {
+                if (t->nodes[up].kind == HR_CLUSTER)
+                    from_parent = hr_bins_eval(&st->bins_total[18 * (size_t)up + 6 * (size_t)c], nd->normal);
+                else
+                    from_parent = st->Ht[3 * (size_t)up + (size_t)c];
+            }
+            ht[c] = st->H[3 * k + (size_t)c] + from_parent;
+        }
+        if (nd->child[0] == 0) {
+            const double *E = node_emission(st, nd), *rho = node_reflectance(st, nd);
+            for (int c = 0; c < 3; c++) {
+                double b = E[c] + rho[c] * ht[c];
+                change += nd->area * fabs(b - st->B[3 * k + (size_t)c]);
+                absorbed += nd->area * (1.0 - rho[c]) * ht[c];
+                st->B[3 * k + (size_t)c] = b;
+            }
+        }
+    }
+    memset(st->bins_exit, 0, 18 * t->clusters * sizeof *st->bins_exit);
+    for (size_t k = n; k-- > 0;) {
+        const hr_node *nd = &t->nodes[k];
+        if (nd->kind == HR_SURFACE && nd->child[0]) {
+            double sum[3] = {0.0, 0.0, 0.0}, area = 0.0;
+            for (uint32_t c4 = 0; c4 < 4; c4++) {
+                uint32_t ch = nd->child[0] + c4;
+                double a = t->nodes[ch].area;
+                area += a;
+                for (int c = 0; c < 3; c++)
+                    sum[c] += a * st->B[3 * (size_t)ch + (size_t)c];
+            }
+            for (int c = 0; c < 3; c++)
+                st->B[3 * k + (size_t)c] = area > 0.0 ? sum[c] / area : 0.0;
+        }
+        if (nd->kind == HR_SURFACE && nd->parent != HR_NONE && t->nodes[nd->parent].kind == HR_CLUSTER) {
+            double *bins = &st->bins_exit[18 * (size_t)nd->parent];
+            for (int c = 0; c < 3; c++)
+                hr_bins_add(bins + 6 * c, nd->normal, nd->area * st->B[3 * k + (size_t)c]);
+        }
+        if (nd->kind == HR_CLUSTER) {
+            double sum[3] = {0.0, 0.0, 0.0};
+            for (int i = 0; i < 2; i++) {
+                uint32_t ch = nd->child[i];
+                for (int c = 0; c < 3; c++)
+                    sum[c] += t->nodes[ch].area * st->B[3 * (size_t)ch + (size_t)c];
+            }
+            for (int c = 0; c < 3; c++)
+                st->B[3 * k + (size_t)c] = nd->area > 0.0 ? sum[c] / nd->area : 0.0;
+            if (nd->parent != HR_NONE)
+                for (int q = 0; q < 18; q++)
+                    st->bins_exit[18 * (size_t)nd->parent + (size_t)q] += st->bins_exit[18 * k + (size_t)q];
+        }
+    }
+    st->absorbed = absorbed;
+    return st->emitted > 0.0 ? change / st->emitted : 0.0;
+}
+
+/* Sweeps until the residual is below `tol` (or `cap` sweeps). */
+static rad_result solve(hr_state *st, double tol, int cap, double *residual, bool *converged)
+{
+    *converged = false;
+    *residual = INFINITY;
+    for (int it = 0; it < cap; it++) {
+        if (rad_cancelled(st->ctx))
+            return RAD_ERROR_INTERRUPTED;
+        gather(st);
+        *residual = push_pull(st);
+        st->sweeps++;
+        if (st->p->monitor) {
+            rad_solve_step step = {st->sweeps, rad_seconds() - st->start, *residual, NAN};
+            if (st->p->monitor(st->p->monitor_user, &step, NULL, NULL))
+                return RAD_ERROR_INTERRUPTED;
+        }
+        if (*residual < tol) {
+            *converged = true;
+            return RAD_OK;
+        }
+    }
+    return RAD_OK;
+}
+
+/* How much each node's radiosity varies below it, max over its leaves and
+ * the channels of |B_leaf - B_node|: what the oracle charges a link for
+ * using the node as one source.  Bottom-up over the leaves' ranges. */
+static rad_result measure_spread(hr_state *st)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    double *lo = malloc(3 * n * sizeof *lo), *hi = malloc(3 * n * sizeof *hi);
+    if (!lo || !hi) {
+        free(lo);
+        free(hi);
+        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+    }
+    for (size_t k = n; k-- > 0;) {
+        const hr_node *nd = &t->nodes[k];
+        double *l = &lo[3 * k], *h = &hi[3 * k];
+        if (nd->kind == HR_SURFACE && !nd->child[0]) {
+            for (int c = 0; c < 3; c++)
+                l[c] = h[c] = st->B[3 * k + (size_t)c];
+        } else {
+            for (int c = 0; c < 3; c++) {
+                l[c] = INFINITY;
+                h[c] = -INFINITY;
+            }
+            int m = nd->kind == HR_CLUSTER ? 2 : 4;
+            for (int q = 0; q < m; q++) {
+                size_t ch = hr_child(t, (uint32_t)k, q);
+                for (int c = 0; c < 3; c++) {
+                    l[c] = fmin(l[c], lo[3 * ch + (size_t)c]);
+                    h[c] = fmax(h[c], hi[3 * ch + (size_t)c]);
+                }
+            }
+        }
+        double d = 0.0;
+        for (int c = 0; c < 3; c++)
+            d = fmax(d, fmax(h[c] - st->B[3 * k + (size_t)c], st->B[3 * k + (size_t)c] - l[c]));
+        st->spread[k] = d;
+    }
+    free(lo);
+    free(hi);
+    return RAD_OK;
+}
+
+/* ---- the leaves as a mesh ---- */
+
+typedef struct leaf_builder {
+    const hr_state *st;
+    rad_mesh_leaf *leaves;
+    double *radiosity;
+    size_t leaf_count;
+    uint32_t *tree;
+    size_t tree_count;
+} leaf_builder;
+
+static uint32_t encode(leaf_builder *lb, uint32_t k)
+{
+    const hr_node *n = &lb->st->tree.nodes[k];
+    if (n->child[0] == 0) {
+        size_t i = lb->leaf_count++;
+        rad_mesh_leaf *l = &lb->leaves[i];
+        l->patch = n->patch;
+        l->corner_count = n->corners;
+        memcpy(l->corner, n->corner, sizeof l->corner);
+        for (int c = 0; c < 3; c++)
+            lb->radiosity[3 * i + (size_t)c] = lb->st->B[3 * (size_t)k + (size_t)c];
+        return (uint32_t)i | RAD_TREE_LEAF;
+    }
+    size_t slot = lb->tree_count++;
+    for (uint32_t c = 0; c < 4; c++) {
+        uint32_t e = encode(lb, n->child[0] + c);
+        lb->tree[4 * slot + c] = e;
+    }
+    return (uint32_t)slot;
+}
+
+static rad_result build_leaf_mesh(hr_state *st, rad_mesh **mesh, double **radiosity, size_t *leaves_out)
+{
+    const hr_tree *t = &st->tree;
+    size_t leaves = 0, internal = 0;
+    for (size_t k = t->clusters; k < t->count; k++) {
+        if (t->nodes[k].kind != HR_SURFACE)
+            continue;
+        if (t->nodes[k].child[0])
+            internal++;
+        else
+            leaves++;
+    }
+    leaf_builder lb = {st, NULL, NULL, 0, NULL, 0};
+    lb.leaves = rad_alloc_array(st->ctx, leaves, sizeof *lb.leaves, "hierarchical: leaves");
+    lb.radiosity = rad_alloc_array(st->ctx, 3 * leaves, sizeof *lb.radiosity, "hierarchical: leaves");
+    lb.tree = rad_alloc_array(st->ctx, 4 * internal + 1, sizeof *lb.tree, "hierarchical: leaves");
+    size_t P = t->base->patch_count;
+    uint32_t *root = rad_alloc_array(st->ctx, P, sizeof *root, "hierarchical: leaves");
+    rad_result r = RAD_ERROR_OUT_OF_MEMORY;
+    if (lb.leaves && lb.radiosity && lb.tree && root) {
+        for (size_t p = 0; p < P; p++)
+            root[p] = encode(&lb, t->root_of_patch[p]);
+        r = rad_mesh_from_leaves(st->ctx, t->scene, t->base, lb.leaves, lb.leaf_count, lb.tree, lb.tree_count,
+                                 root, st->p->crease_angle_degrees, mesh);
+    }
+    free(lb.leaves);
+    free(lb.tree);
+    free(root);
+    if (r != RAD_OK) {
+        free(lb.radiosity);
+        return r;
+    }
+    *radiosity = lb.radiosity;
+    *leaves_out = leaves;
+    return RAD_OK;
+}
+
+/* ---- the driver ---- */
+
+static double bytes_in_use(const hr_state *st)
+{
+    return (double)st->tree.capacity * sizeof(hr_node) + (double)st->links.capacity * sizeof(hr_link) +
+           (double)st->values * 10.0 * sizeof(double) + (double)st->tree.clusters * 54.0 * sizeof(double) +
+           (double)(st->tree.count + 1) * sizeof(size_t);
+}
+
+rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **leaf_mesh, double **radiosity,
+                        rad_solve_stats *ss, rad_hier_stats *hs)
+{
+    *leaf_mesh = NULL;
+    *radiosity = NULL;
+    memset(hs, 0, sizeof *hs);
+    hr_state st = {0};
+    st.ctx = ctx;
+    st.p = p;
+    st.start = rad_seconds();
+    const rad_mesh *base = p->base;
+    const rad_scene *scene = p->scene;
+
+    /* Scale: the mean emitted exitance over all surfaces. */
+    double area = 0.0, power = 0.0;
+    for (size_t i = 0; i < base->element_count; i++) {
+        const rad_element *e = &base->elements[i];
+        const double *E = scene->materials[e->material].emission;
+        area += e->area;
+        power += e->area * (E[0] + E[1] + E[2]) / 3.0;
+    }
+    double epsilon_abs = (p->epsilon > 0.0 ? p->epsilon : 1e-4) * power;
+    double min_area = p->min_area > 0.0 ? p->min_area : 1e-4 * area;
+    bool clustered = p->clustering > 0 || (p->clustering == 0 && base->patch_count > 64);
+    hs->epsilon_abs = epsilon_abs;
+    hs->min_area = min_area;
+
+    double t0 = rad_seconds();
+    rad_result r = hr_tree_build(ctx, base, scene, clustered, min_area, p->vis ? rad_vis_epsilon(base) : 0.0,
+                                 &st.tree);
+    if (r != RAD_OK)
+        return r;
+    hs->clustered = st.tree.clusters > 0;
+    hs->clusters = st.tree.clusters;
+    st.bins_in = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
+    st.bins_total = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
+    st.bins_exit = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
+    if (!st.bins_in || !st.bins_total || !st.bins_exit) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    if ((r = ensure_values(&st)) != RAD_OK)
+        goto done;
+    /* B = E, clusters pulled up; emitted power over the roots. */
+    for (size_t k = st.tree.clusters; k < st.tree.count; k++) {
+        const double *E = node_emission(&st, &st.tree.nodes[k]);
+        for (int c = 0; c < 3; c++)
+            st.emitted += st.tree.nodes[k].area * E[c];
+    }
+    memset(st.bins_in, 0, 18 * st.tree.clusters * sizeof(double));
+    memset(st.H, 0, 3 * st.tree.count * sizeof(double));
+    push_pull(&st);
+
+    hr_refine_params rp = {.vis = p->vis,
+                           .seed = p->seed,
+                           /* 4 x --shadow-rays (16 by default): a link's rays
+                            * stand for all its descendants' */
+                           .shadow_rays = p->shadow_rays > 0 ? (4 * p->shadow_rays < 64 ? 4 * p->shadow_rays : 64) : 16,
+                           .epsilon = epsilon_abs,
+                           .tol = 1e-9 * rad_scene_diagonal(scene),
+                           .threads = rad_context_threads(ctx)};
+    hr_refine_stats rs = {0};
+    r = hr_links_initial(ctx, &st.tree, &rp, &st.links, &rs);
+    if (r != RAD_OK)
+        goto done;
+    hs->initial_links = st.links.count;
+    hs->seconds_refine += rad_seconds() - t0;
+
+    double residual = INFINITY;
+    bool converged = false;
+    const int max_rounds = 24;
+    for (int round = 0; round < max_rounds; round++) {
+        rad_progress(ctx, "hierarchical", (uint64_t)round, (uint64_t)max_rounds);
+        double t1 = rad_seconds();
+        size_t split = 0;
+        r = measure_spread(&st);
+        if (r == RAD_OK)
+            r = hr_refine(ctx, &st.tree, &rp, st.B, st.spread, &st.links, &split, &rs);
+        if (r == RAD_OK)
+            r = ensure_values(&st);
+        if (r == RAD_OK && split > 0)
+            r = sort_links(&st);
+        if (r == RAD_OK && bytes_in_use(&st) > p->max_memory)
+            r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                         "hierarchical: %zu links and %zu nodes need %.3g GB, over the limit of %.3g GB "
+                         "(--max-memory); use a larger --epsilon or --min-area",
+                         st.links.count, st.tree.count, bytes_in_use(&st) / 1e9, p->max_memory / 1e9);
+        hs->seconds_refine += rad_seconds() - t1;
+        if (r != RAD_OK)
+            goto done;
+        hs->refine_rounds = round + 1;
+        if (round == 0 && split == 0 && st.offset == NULL && (r = sort_links(&st)) != RAD_OK)
+            goto done;
+        bool last = split == 0 || round == max_rounds - 1;
+        if (last) {
+            /* Links whose rays were all blocked stay while they may be
+             * refined (refine.c); the final solve needs only the others. */
+            size_t m = 0;
+            for (size_t i = 0; i < st.links.count; i++)
+                if (st.links.items[i].k > 0.0f)
+                    st.links.items[m++] = st.links.items[i];
+            if (m < st.links.count) {
+                st.links.count = m;
+                if ((r = sort_links(&st)) != RAD_OK)
+                    goto done;
+            }
+        }
+        double t2 = rad_seconds();
+        double tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
+        int cap = p->max_iterations > 0 && last ? p->max_iterations : 10000;
+        r = solve(&st, tol, cap, &residual, &converged);
+        hs->seconds_solve += rad_seconds() - t2;
+        if (r != RAD_OK || last)
+            break;
+    }
+    rad_progress(ctx, "hierarchical", (uint64_t)max_rounds, (uint64_t)max_rounds);
+
+    hs->nodes = st.tree.count;
+    hs->links = st.links.count;
+    for (size_t i = 0; i < st.links.count; i++) {
+        const hr_link *l = &st.links.items[i];
+        int kind = (st.tree.nodes[l->r].kind == HR_CLUSTER) * 2 + (st.tree.nodes[l->s].kind == HR_CLUSTER);
+        hs->links_by_kind[kind]++;
+    }
+    hs->refine_passes = rs.passes;
+    hs->rays = rs.rays;
+    hs->shafts = rs.shafts;
+    hs->shafts_clear = rs.shafts_clear;
+    hs->bytes = bytes_in_use(&st);
+    hs->link_bytes = sizeof(hr_link);
+    ss->iterations = st.sweeps;
+    ss->residual = residual;
+    ss->converged = converged;
+    ss->rays = rs.rays;
+    ss->absorbed = st.absorbed / 3.0;
+    {
+        /* The leaves as the solution's mesh, also after an interruption
+         * (the current iterate is then what the caller writes). */
+        rad_result rm;
+        double t3 = rad_seconds();
+        size_t leaves = 0;
+        rm = build_leaf_mesh(&st, leaf_mesh, radiosity, &leaves);
+        hs->leaves = leaves;
+        hs->seconds_mesh = rad_seconds() - t3;
+        if (rm != RAD_OK)
+            r = rm;
+    }
+done:
+    hr_tree_free(&st.tree);
+    free(st.links.items);
+    free(st.offset);
+    free(st.B);
+    free(st.H);
+    free(st.Ht);
+    free(st.spread);
+    free(st.bins_in);
+    free(st.bins_total);
+    free(st.bins_exit);
+    return r;
+}
+
+/* The registry entry: rad_solution_solve sees RAD_SOLVER_HIERARCHICAL and
+ * calls rad_hier_run, since the element set is the solver's output. */
+static rad_result hierarchical_solve(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
+                                     double *B, rad_solve_stats *stats)
+{
+    (void)sys, (void)p, (void)B, (void)stats;
+    return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                    "the hierarchical solver runs through rad_solution_solve, not on a fixed system");
+}
+
+const rad_solver rad_solver_hierarchical = {
+    "hierarchical",
+    "matrix-free: Hanrahan-Salzman-Aupperle links between element quadtrees, clusters, "
+    "BF refinement; meshes as it solves; ~10 links per element (--epsilon, --min-area)",
+    RAD_SOLVER_MATRIX_FREE | RAD_SOLVER_HIERARCHICAL,
+    hierarchical_solve,
+};

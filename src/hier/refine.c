@@ -1,2 +1,585 @@
-/* placeholder */
-#include "core/core.h"
+/*
+ * refine.c -- links of hierarchical radiosity: what one carries, whether the
+ * two ends see each other, and when it must be split.
+ *
+ * A link r <- s carries k, the receiver's irradiance per unit of what the
+ * source sends (w = unit vector from r's centre to s's, d = distance,
+ * V = visibility fraction):
+ *
+ *   surface <- surface   k = V F_rs, the exact unoccluded area-to-area
+ *                        factor (contour integral, ff_contour.c); H_r += k B_s
+ *   surface <- cluster   k = V max(0, n_r.w) / (pi d^2);
+ *                        H_r += k f_s(-w), f_s the cluster's exitance bins
+ *   cluster <- surface   k = V A_s max(0, -n_s.w) / (pi d^2);
+ *                        bins_r += k B_s spread along w
+ *   cluster <- cluster   k = V / (pi d^2); bins_r += k f_s(-w) along w
+ *
+ * The oracle estimates the error a link leaves in the power its receiver
+ * reflects (rho_r A_r times an irradiance error: "BFA refinement",
+ * Hanrahan, Salzman & Aupperle 1991, sec. 4) from three causes, and splits
+ * the end responsible for the largest:
+ *
+ *   receiver too coarse   rho_r A_r B_s max_x |F(x -> s) - mean|, the exact
+ *                         point factor at the receiver's Gauss points: how
+ *                         much the irradiance varies over it
+ *   source too coarse     10 rho_r A_r F_rs max_leaf |B_leaf - B_s|: the
+ *                         source's radiosity varies below it (the weight:
+ *                         SOURCE_WEIGHT below)
+ *   uncertain visibility  rho_r A_r B_s F_unoccluded u, u from the pilot
+ *                         rays (below), charged to the larger end
+ *
+ * Links with a cluster end carry point-to-point estimates; their error is
+ * taken as their whole transfer, rho_r A_r B_s max(F_rs, F_sr) with the disc
+ * estimates F_rs ~ A_s c_r c_s / (pi d^2 + A_s) (cosines at the centres, 1
+ * for a cluster), and the end with the larger estimate is split.  Ends
+ * whose bounding spheres overlap always split: the point estimates mean
+ * nothing there.  A node is split no further below the minimum area.
+ *
+ * Visibility: a shaft test first (shaft.c); a clear shaft needs no rays,
+ * for the pair or any pair of descendants.  Otherwise shadow rays between
+ * random points of the two ends, keyed on (seed, r, s).  Two independent
+ * sets: a pilot of a quarter of the rays decides whether visibility is
+ * uncertain (4 V (1 - V), or 1 / (N + 2) when the pilot is unanimous), the
+ * full set gives k.  Were one set used for both, the links refined would
+ * be chosen by their own estimates, and the kept ones biased: a link whose
+ * rays all happened to be blocked would stay dark for good.  For the same
+ * reason a link whose estimate is 0 is kept (it may be refined later);
+ * only the final solve drops them.
+ *
+ * Passes are level-synchronous: decide every link's fate in parallel,
+ * subdivide nodes serially in link order, create the new links in parallel
+ * into slots fixed by a prefix sum.  Node numbers, rays and links are then
+ * the same for any thread count.
+ */
+#include "hier/hier.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+enum { KEEP = 0, SPLIT_R = 1, SPLIT_S = 2, SPLIT_BOTH = 3 };
+/* The source term's weight.  rho_r F_rs max|B_leaf - B_s| bounds the error
+ * of a link that uses the source's mean, but the errors it measures add up
+ * with one sign (the parts of a wall near a light are both brighter and,
+ * for the ceiling, nearer): on the Cornell box, weighting it 10x halves the
+ * per-surface error for the same number of links (docs/hierarchical.md). */
+static const double SOURCE_WEIGHT = 10.0;
+
+static const uint64_t HR_SALT = 0x4852414449554dULL;
+
+/* Visibility fraction between two nodes, at least one a cluster: `count`
+ * pairs of area-sampled points, those that face each other cast. */
+static double cluster_visibility(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s, int count,
+                                 rad_rng *rng, uint64_t *rays)
+{
+    rad_ray ray[64];
+    uint8_t hit[64];
+    if (count > 64)
+        count = 64;
+    int m = 0;
+    for (int k = 0; k < count; k++) {
+        vec3 p, q, np, nq;
+        double lp, lq;
+        hr_sample(t, r, rad_rng_uniform(rng), rad_rng_uniform(rng), rad_rng_uniform(rng), &p, &np, &lp);
+        hr_sample(t, s, rad_rng_uniform(rng), rad_rng_uniform(rng), rad_rng_uniform(rng), &q, &nq, &lq);
+        vec3 d = v3_sub(q, p);
+        if (!(v3_dot(np, d) > 0.0 && v3_dot(nq, d) < 0.0))
+            continue;
+        p = v3_mad(p, np, lp);
+        q = v3_mad(q, nq, lq);
+        ray[m].origin = p;
+        ray[m].direction = v3_sub(q, p);
+        ray[m].tnear = 0.0;
+        ray[m].tfar = 1.0;
+        m++;
+    }
+    if (m == 0)
+        return 1.0;
+    vis->backend->occluded(vis->state, ray, (size_t)m, hit);
+    *rays += (uint64_t)m;
+    int pass = 0;
+    for (int k = 0; k < m; k++)
+        pass += !hit[k];
+    return (double)pass / m;
+}
+
+/* A ray end on a surface node at unit-square parameters: lifted off it and
+ * pulled toward its centre by the patch's lift (visibility.c explains
+ * both). */
+static vec3 surface_end(const hr_tree *t, const hr_node *n, double u, double v)
+{
+    const vec3 *c = n->corner;
+    vec3 p;
+    if (n->corners == 3) {
+        if (u + v > 1.0) {
+            u = 1.0 - u;
+            v = 1.0 - v;
+        }
+        p = v3_add(c[0], v3_add(v3_scale(v3_sub(c[1], c[0]), u), v3_scale(v3_sub(c[2], c[0]), v)));
+    } else {
+        p = v3_lerp(v3_lerp(c[0], c[1], u), v3_lerp(c[3], c[2], u), v);
+    }
+    double lift = t->lift[n->patch];
+    vec3 in = v3_sub(n->center, p);
+    double d = v3_length(in);
+    p = d > lift ? v3_mad(p, in, lift / d) : n->center;
+    return v3_mad(p, n->normal, lift);
+}
+
+/* Visibility between two surface nodes from `count` stratified point pairs
+ * (strata of the far end shuffled): the fraction of the facing pairs that
+ * pass, each weighted by its point-to-point kernel cos cos / d^2 (d^2 kept
+ * above a sixteenth of the smaller node's area, so no pair dominates).
+ * Weighting by the kernel makes k V estimate int int K V / int int K, the
+ * visibility the transfer needs: a plain fraction would misjudge pairs
+ * where the near, strongly coupled points are the hidden ones.  *facing =
+ * pairs cast; returns 1 when none faces. */
+static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s, int count,
+                                 rad_rng *rng, uint64_t *rays, int *facing)
+{
+    enum { MAX = 64 };
+    rad_ray ray[MAX];
+    uint8_t hit[MAX];
+    double weight[MAX];
+    int perm[MAX];
+    if (count > MAX)
+        count = MAX;
+    const hr_node *a = &t->nodes[r], *b = &t->nodes[s];
+    double floor2 = fmin(a->area, b->area) / 16.0;
+    int side = (int)ceil(sqrt((double)count));
+    for (int k = 0; k < count; k++)
+        perm[k] = k;
+    for (int k = count - 1; k > 0; k--) {
+        int m = (int)(rad_rng_uniform(rng) * (k + 1)), tmp = perm[k];
+        perm[k] = perm[m];
+        perm[m] = tmp;
+    }
+    int m = 0;
+    for (int k = 0; k < count; k++) {
+        int sj = perm[k];
+        double u1 = ((k % side) + rad_rng_uniform(rng)) / side, v1 = ((k / side) + rad_rng_uniform(rng)) / side;
+        double u2 = ((sj % side) + rad_rng_uniform(rng)) / side, v2 = ((sj / side) + rad_rng_uniform(rng)) / side;
+        vec3 p = surface_end(t, a, u1, v1), q = surface_end(t, b, u2, v2);
+        vec3 d = v3_sub(q, p);
+        double ca = v3_dot(a->normal, d), cb = -v3_dot(b->normal, d);
+        if (!(ca > 0.0 && cb > 0.0))
+            continue;
+        double d2 = v3_dot(d, d);
+        weight[m] = ca * cb / (d2 * fmax(d2, floor2));
+        ray[m].origin = p;
+        ray[m].direction = d;
+        ray[m].tnear = 0.0;
+        ray[m].tfar = 1.0;
+        m++;
+    }
+    *facing = m;
+    if (m == 0)
+        return 1.0;
+    vis->backend->occluded(vis->state, ray, (size_t)m, hit);
+    *rays += (uint64_t)m;
+    double pass = 0.0, all = 0.0;
+    for (int k = 0; k < m; k++) {
+        all += weight[k];
+        if (!hit[k])
+            pass += weight[k];
+    }
+    return all > 0.0 ? pass / all : 1.0;
+}
+
+/* Largest signed distance of a node's points from the plane (point o,
+ * normal n). */
+static double front_extent(const hr_node *x, vec3 o, vec3 n)
+{
+    double best = -INFINITY;
+    if (x->kind == HR_SURFACE) {
+        for (int c = 0; c < x->corners; c++)
+            best = fmax(best, v3_dot(n, v3_sub(x->corner[c], o)));
+        return best;
+    }
+    for (int c = 0; c < 8; c++) {
+        vec3 p = v3(c & 1 ? x->hi.x : x->lo.x, c & 2 ? x->hi.y : x->lo.y, c & 4 ? x->hi.z : x->lo.z);
+        best = fmax(best, v3_dot(n, v3_sub(p, o)));
+    }
+    return best;
+}
+
+/* The mean over a receiver polygon of the exact point-to-polygon factor to
+ * s: the 2 x 2 Gauss rule on quads (points 1/sqrt(3) of the way from the
+ * centre to the corners) or the 3-point rule exact for quadratics on
+ * triangles (half way).  *spread = the largest deviation from the mean of
+ * the point value there or at the centre. */
+static double gauss_factor(const hr_node *r, const hr_node *s, double *spread)
+{
+    double f[4], mean = 0.0, t = r->corners == 4 ? 0.5773502691896258 : 0.5;
+    for (int c = 0; c < r->corners; c++) {
+        f[c] = rad_point_polygon_ff(v3_lerp(r->center, r->corner[c], t), r->normal, s->corner, s->corners);
+        mean += f[c];
+    }
+    mean /= r->corners;
+    /* The centre too: on symmetric pairs the Gauss points all agree. */
+    double dev = fabs(rad_point_polygon_ff(r->center, r->normal, s->corner, s->corners) - mean);
+    for (int c = 0; c < r->corners; c++)
+        dev = fmax(dev, fabs(f[c] - mean));
+    *spread = dev;
+    return mean;
+}
+
+/* Lowest signed distance of a surface node's corners from a plane. */
+static double plane_low(const hr_node *x, vec3 o, vec3 n)
+{
+    double least = INFINITY;
+    for (int c = 0; c < x->corners; c++)
+        least = fmin(least, v3_dot(n, v3_sub(x->corner[c], o)));
+    return least;
+}
+
+typedef struct link_ctx {
+    const hr_tree *tree;
+    const hr_refine_params *p;
+} link_ctx;
+
+/* Fill link r <- s (parent_flags from the link it refines); false when it
+ * carries nothing (back to back, behind, hidden). */
+static bool make_link(const link_ctx *lc, uint32_t r, uint32_t s, uint32_t parent_flags, hr_link *out,
+                      uint64_t *rays, uint64_t *shafts, uint64_t *clear)
+{
+    const hr_tree *t = lc->tree;
+    const hr_refine_params *p = lc->p;
+    const hr_node *nr = &t->nodes[r], *ns = &t->nodes[s];
+    if (r == s && nr->kind == HR_SURFACE)
+        return false; /* a flat surface does not see itself */
+    /* Each end must reach in front of the other's plane. */
+    if (nr->kind == HR_SURFACE && front_extent(ns, nr->center, nr->normal) <= p->tol)
+        return false;
+    if (ns->kind == HR_SURFACE && front_extent(nr, ns->center, ns->normal) <= p->tol)
+        return false;
+    vec3 w = v3_sub(ns->center, nr->center);
+    double d2 = v3_dot(w, w);
+    double k;
+    double spread = 0.0;
+    if (nr->kind == HR_SURFACE && ns->kind == HR_SURFACE) {
+        /* k: the Gauss mean of the exact point factor where it varies by
+         * less than 1% over r (far pairs: the rule's error is then far
+         * smaller); else the exact area-to-area factor by the double
+         * contour integral (ff_contour.c), which also holds for pairs
+         * sharing an edge: there a fixed rule falls short (by 0.7% on a
+         * unit-cube face pair, always low, and the shortfalls add up).
+         * Pairs that straddle each other's planes take it too: their
+         * factor drops to 0 inside r, which no fixed rule sees. */
+        k = gauss_factor(nr, ns, &spread);
+        bool straddle = plane_low(nr, ns->center, ns->normal) < -p->tol ||
+                        plane_low(ns, nr->center, nr->normal) < -p->tol;
+        if ((straddle || spread > 0.01 * k) && nr->area > 0.0)
+            k = rad_polygon_coupling(nr->corner, nr->corners, nr->normal, ns->corner, ns->corners, ns->normal,
+                                     p->tol) / nr->area;
+        if (!(k > 0.0) && spread > 0.0)
+            k = 1e-30; /* seen from part of the receiver only: keep it, to be refined */
+    } else {
+        if (!(d2 > 0.0))
+            d2 = 1e-300;
+        vec3 u = v3_scale(w, 1.0 / sqrt(d2));
+        if (nr->kind == HR_SURFACE)
+            k = fmax(0.0, v3_dot(nr->normal, u)) / (M_PI * d2);
+        else if (ns->kind == HR_SURFACE)
+            k = ns->area * fmax(0.0, -v3_dot(ns->normal, u)) / (M_PI * d2);
+        else
+            k = 1.0 / (M_PI * d2);
+    }
+    if (!(k > 0.0))
+        return false;
+    double v = 1.0, uncertainty = 0.0;
+    uint32_t flags = 0;
+    if (parent_flags & HR_LINK_CLEAR) {
+        flags = HR_LINK_CLEAR;
+    } else if (p->vis) {
+        bool both_surfaces = nr->kind == HR_SURFACE && ns->kind == HR_SURFACE;
+        if (both_surfaces) {
+            (*shafts)++;
+            if (hr_shaft_clear(t, r, s, p->tol)) {
+                flags = HR_LINK_CLEAR;
+                (*clear)++;
+            }
+        }
+        if (!flags) {
+            rad_rng rng = rad_rng_keyed(p->seed ^ HR_SALT, r, s);
+            if (both_surfaces) {
+                int facing = 0;
+                int pilot_rays = p->shadow_rays / 4 > 4 ? p->shadow_rays / 4 : 4;
+                double vp = surface_visibility(t, p->vis, r, s, pilot_rays, &rng, rays, &facing);
+                if (facing > 0)
+                    uncertainty = vp > 0.0 && vp < 1.0 ? 4.0 * vp * (1.0 - vp) : 1.0 / (facing + 2);
+                v = surface_visibility(t, p->vis, r, s, p->shadow_rays, &rng, rays, &facing);
+            } else {
+                v = cluster_visibility(t, p->vis, r, s, p->shadow_rays, &rng, rays);
+            }
+        }
+    }
+    out->r = r;
+    out->s = s;
+    out->k = (float)(k * v);
+    out->spread = (float)spread;
+    out->vis_err = (float)(k * uncertainty);
+    out->flags = flags;
+    return true;
+}
+
+/* ---- the oracle ---- */
+
+static int decide(const hr_tree *t, const hr_refine_params *p, const double *B, const double *spread,
+                  const hr_link *l)
+{
+    const hr_node *nr = &t->nodes[l->r], *ns = &t->nodes[l->s];
+    if (l->r == l->s)
+        return SPLIT_BOTH; /* a cluster's self-link: its members' interactions */
+    const double *Bs = &B[3 * (size_t)l->s];
+    double bs = fmax(Bs[0], fmax(Bs[1], Bs[2]));
+    double rho = nr->rho;
+    if (!(rho > 0.0))
+        return KEEP; /* nothing reflected: the receiver's B is its E */
+    double e_r, e_s;
+    if (nr->kind == HR_SURFACE && ns->kind == HR_SURFACE) {
+        e_r = rho * bs * l->spread * nr->area;
+        e_s = SOURCE_WEIGHT * rho * l->k * spread[l->s] * nr->area;
+        double e_v = rho * bs * l->vis_err * nr->area;
+        if (nr->area >= ns->area)
+            e_r += e_v;
+        else
+            e_s += e_v;
+    } else {
+        vec3 w = v3_sub(ns->center, nr->center);
+        double d2 = v3_dot(w, w);
+        double reach = nr->radius + ns->radius;
+        if (d2 <= reach * reach) {
+            /* Overlapping bounds: split the larger end (a cluster if equal). */
+            bool r_larger = nr->radius > ns->radius ||
+                            (nr->radius == ns->radius && nr->kind == HR_CLUSTER);
+            e_r = r_larger ? INFINITY : 0.0;
+            e_s = r_larger ? 0.0 : INFINITY;
+        } else {
+            double d = sqrt(d2);
+            vec3 u = v3_scale(w, 1.0 / d);
+            double cr = nr->kind == HR_SURFACE ? fmax(0.0, v3_dot(nr->normal, u)) : 1.0;
+            double cs = ns->kind == HR_SURFACE ? fmax(0.0, -v3_dot(ns->normal, u)) : 1.0;
+            double g = rho * bs * cr * cs * nr->area;
+            e_s = g * ns->area / (M_PI * d2 + ns->area);
+            e_r = g * nr->area / (M_PI * d2 + nr->area);
+        }
+    }
+    if (fmax(e_r, e_s) <= p->epsilon)
+        return KEEP;
+    bool rs = hr_splittable(t, l->r), ss = hr_splittable(t, l->s);
+    if (e_r >= e_s) {
+        if (rs)
+            return SPLIT_R;
+        return ss && e_s > p->epsilon ? SPLIT_S : KEEP;
+    }
+    if (ss)
+        return SPLIT_S;
+    return rs && e_r > p->epsilon ? SPLIT_R : KEEP;
+}
+
+/* ---- link lists ---- */
+
+static rad_result links_reserve(rad_context *ctx, hr_links *l, size_t count)
+{
+    if (count <= l->capacity)
+        return RAD_OK;
+    size_t cap = l->capacity ? l->capacity : 1024;
+    while (cap < count)
+        cap *= 2;
+    hr_link *items = realloc(l->items, cap * sizeof *items);
+    if (!items)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "hierarchical: out of memory for %zu links; use a larger --epsilon or --min-area",
+                        count);
+    l->items = items;
+    l->capacity = cap;
+    return RAD_OK;
+}
+
+rad_result hr_links_initial(rad_context *ctx, hr_tree *t, const hr_refine_params *p, hr_links *links,
+                            hr_refine_stats *st)
+{
+    links->count = 0;
+    if (t->clusters > 0) {
+        rad_result r = links_reserve(ctx, links, 1);
+        if (r != RAD_OK)
+            return r;
+        links->items[0] = (hr_link){0, 0, 0.0f, 0.0f, 0.0f, 0};
+        links->count = 1;
+        return RAD_OK;
+    }
+    /* Every ordered pair of root patches: row i in parallel into its slots. */
+    size_t P = t->base->patch_count;
+    if ((double)P * (double)P * sizeof(hr_link) > 0.5 * 1e12)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "hierarchical: %zu patches make too many initial links; use --clustering on", P);
+    hr_link *all = rad_alloc_array(ctx, P * P, sizeof *all, "hierarchical: initial links");
+    uint8_t *keep = rad_alloc_array(ctx, P * P, 1, "hierarchical: initial links");
+    rad_result r = !all || !keep ? RAD_ERROR_OUT_OF_MEMORY : RAD_OK;
+    uint64_t rays = 0, shafts = 0, clear = 0;
+    link_ctx lc = {t, p};
+    if (r == RAD_OK) {
+#pragma omp parallel for schedule(dynamic, 1) num_threads(p->threads) reduction(+ : rays, shafts, clear)
+        for (size_t i = 0; i < P; i++)
+            for (size_t j = 0; j < P; j++) {
+                uint32_t ri = t->root_of_patch[i], sj = t->root_of_patch[j];
+                keep[i * P + j] = i != j && make_link(&lc, ri, sj, 0, &all[i * P + j], &rays, &shafts, &clear);
+            }
+        size_t m = 0;
+        for (size_t q = 0; q < P * P; q++)
+            m += keep[q];
+        r = links_reserve(ctx, links, m);
+        if (r == RAD_OK)
+            for (size_t q = 0; q < P * P; q++)
+                if (keep[q])
+                    links->items[links->count++] = all[q];
+    }
+    st->rays += rays;
+    st->shafts += shafts;
+    st->shafts_clear += clear;
+    st->links_created += links->count;
+    free(all);
+    free(keep);
+    return r;
+}
+
+rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, const double *B,
+                     const double *spread, hr_links *links, size_t *split, hr_refine_stats *st)
+{
+    *split = 0;
+    uint8_t *action = NULL;
+    size_t *first = NULL;
+    hr_links next = {0};
+    rad_result r = RAD_OK;
+    /* B covers the nodes that existed when it was computed; new nodes take
+     * their parent's value (children of a node average to it). */
+    size_t known = t->count;
+    double *Bx = NULL, *Sx = NULL;
+    for (;;) {
+        size_t L = links->count;
+        if (rad_cancelled(ctx)) {
+            r = RAD_ERROR_INTERRUPTED;
+            break;
+        }
+        uint8_t *a = realloc(action, (L ? L : 1) * sizeof *a);
+        size_t *f = realloc(first, (L + 1) * sizeof *f);
+        if (!a || !f) {
+            free(a ? a : action);
+            free(f ? f : first);
+            action = NULL;
+            first = NULL;
+            r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory refining %zu links", L);
+            break;
+        }
+        action = a;
+        first = f;
+        /* Values for nodes made in earlier passes of this call. */
+        if (t->count > known) {
+            double *nb = realloc(Bx, 3 * t->count * sizeof *nb);
+            if (nb && !Bx)
+                memcpy(nb, B, 3 * known * sizeof *nb);
+            if (nb)
+                Bx = nb;
+            double *ns = realloc(Sx, t->count * sizeof *ns);
+            if (ns && !Sx)
+                memcpy(ns, spread, known * sizeof *ns);
+            if (ns)
+                Sx = ns;
+            if (!nb || !ns) {
+                r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+                break;
+            }
+            for (size_t k = known; k < t->count; k++) {
+                for (int c = 0; c < 3; c++)
+                    Bx[3 * k + (size_t)c] = Bx[3 * (size_t)t->nodes[k].parent + (size_t)c];
+                Sx[k] = 0.0;
+            }
+            known = t->count;
+        }
+        const double *Bv = Bx ? Bx : B, *Sv = Sx ? Sx : spread;
+        size_t splits = 0;
+#pragma omp parallel for schedule(static) num_threads(p->threads) reduction(+ : splits)
+        for (size_t i = 0; i < L; i++) {
+            action[i] = (uint8_t)decide(t, p, Bv, Sv, &links->items[i]);
+            splits += action[i] != KEEP;
+        }
+        if (splits == 0)
+            break;
+        *split += splits;
+        st->passes++;
+        /* Serial: children, in link order (node numbers are deterministic). */
+        size_t total = 0;
+        for (size_t i = 0; i < L && r == RAD_OK; i++) {
+            const hr_link *l = &links->items[i];
+            first[i] = total;
+            if (action[i] == KEEP) {
+                total += 1;
+                continue;
+            }
+            if (action[i] & SPLIT_R)
+                r = hr_subdivide(ctx, t, l->r);
+            if (r == RAD_OK && (action[i] & SPLIT_S))
+                r = hr_subdivide(ctx, t, l->s);
+            int cr = action[i] & SPLIT_R ? hr_children(t, l->r) : 1;
+            int cs = action[i] & SPLIT_S ? hr_children(t, l->s) : 1;
+            total += (size_t)(cr * cs);
+        }
+        first[L] = total;
+        if (r != RAD_OK)
+            break;
+        if ((double)total * sizeof(hr_link) > 0.5 * 1e12 ||
+            (r = links_reserve(ctx, &next, total)) != RAD_OK) {
+            if (r == RAD_OK)
+                r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: %zu links", total);
+            break;
+        }
+        uint64_t rays = 0, shafts = 0, clear = 0, created = 0, dropped = 0;
+        link_ctx lc = {t, p};
+        hr_link *out = next.items;
+#pragma omp parallel for schedule(dynamic, 64) num_threads(p->threads) \
+    reduction(+ : rays, shafts, clear, created, dropped)
+        for (size_t i = 0; i < L; i++) {
+            const hr_link *l = &links->items[i];
+            size_t o = first[i];
+            if (action[i] == KEEP) {
+                out[o] = *l;
+                continue;
+            }
+            int cr = action[i] & SPLIT_R ? hr_children(t, l->r) : 1;
+            int cs = action[i] & SPLIT_S ? hr_children(t, l->s) : 1;
+            for (int x = 0; x < cr; x++)
+                for (int y = 0; y < cs; y++) {
+                    uint32_t rr = action[i] & SPLIT_R ? hr_child(t, l->r, x) : l->r;
+                    uint32_t ss = action[i] & SPLIT_S ? hr_child(t, l->s, y) : l->s;
+                    hr_link nl;
+                    if (make_link(&lc, rr, ss, l->flags, &nl, &rays, &shafts, &clear)) {
+                        out[o] = nl;
+                        created++;
+                    } else {
+                        out[o].r = HR_NONE;
+                        dropped++;
+                    }
+                    o++;
+                }
+        }
+        st->rays += rays;
+        st->shafts += shafts;
+        st->shafts_clear += clear;
+        st->links_created += created;
+        st->links_dropped += dropped;
+        size_t m = 0;
+        for (size_t i = 0; i < total; i++)
+            if (out[i].r != HR_NONE)
+                out[m++] = out[i];
+        next.count = m;
+        hr_links tmp = *links;
+        *links = next;
+        next = tmp;
+    }
+    free(next.items);
+    free(action);
+    free(first);
+    free(Bx);
+    free(Sx);
+    return r;
+}

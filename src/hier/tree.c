@@ -1,2 +1,333 @@
-/* placeholder */
-#include "core/core.h"
+/*
+ * tree.c -- the node hierarchy of hierarchical radiosity.
+ *
+ * Roots.  Every base patch (a planar quad or triangle, mesh.h) is the root
+ * of a quadtree of surface nodes.  A quad splits at its edge midpoints and
+ * bilinear centre into the four parameter quadrants; a triangle into its
+ * three corner triangles and the medial one:
+ *
+ *     c3 +----m23----+ c2          c2
+ *        |  3  |  2  |               |\
+ *    m30 +----mc-----+ m12       m20 +--+ m12      children: 0 (c0 m01 m20)
+ *        |  0  |  1  |               |\3|\                   1 (m01 c1 m12)
+ *     c0 +----m01----+ c1         c0 +--+--+ c1              2 (m20 m12 c2)
+ *                                      m01                   3 (m12 m20 m01)
+ *
+ * so a child's parameters follow from its parent's (mesh.c locates leaves
+ * the same way).  Children are created on demand, four consecutive nodes,
+ * always after their parent: index order is a topological order.
+ *
+ * Clusters.  With clustering, a binary bounding-volume hierarchy is built
+ * over the patches (median split of the centroids along the longest axis of
+ * their bounds; ties broken by patch index, so it is deterministic).  Its
+ * P - 1 clusters come first, in pre-order (node 0 is the top), then the P
+ * roots in cluster order, so every cluster's patches are one range of
+ * order[].
+ */
+#include "hier/hier.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static void surface_geometry(hr_node *n)
+{
+    vec3 a = n->corner[0], b = n->corner[1], c = n->corner[2];
+    vec3 lo = v3_min(a, v3_min(b, c)), hi = v3_max(a, v3_max(b, c));
+    if (n->corners == 3) {
+        n->area = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        n->center = v3_scale(v3_add(a, v3_add(b, c)), 1.0 / 3.0);
+    } else {
+        vec3 d = n->corner[3];
+        lo = v3_min(lo, d);
+        hi = v3_max(hi, d);
+        double a1 = 0.5 * v3_length(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+        double a2 = 0.5 * v3_length(v3_cross(v3_sub(c, a), v3_sub(d, a)));
+        n->area = a1 + a2;
+        vec3 c1 = v3_scale(v3_add(a, v3_add(b, c)), 1.0 / 3.0);
+        vec3 c2 = v3_scale(v3_add(a, v3_add(c, d)), 1.0 / 3.0);
+        n->center = n->area > 0.0 ? v3_scale(v3_add(v3_scale(c1, a1), v3_scale(c2, a2)), 1.0 / n->area)
+                                  : c1;
+    }
+    n->lo = lo;
+    n->hi = hi;
+    double r = 0.0;
+    for (int k = 0; k < n->corners; k++)
+        r = fmax(r, v3_length(v3_sub(n->corner[k], n->center)));
+    n->radius = r;
+}
+
+static rad_result reserve(rad_context *ctx, hr_tree *t, size_t extra)
+{
+    if (t->count + extra <= t->capacity)
+        return RAD_OK;
+    size_t cap = t->capacity ? t->capacity : 1024;
+    while (cap < t->count + extra)
+        cap *= 2;
+    hr_node *n = realloc(t->nodes, cap * sizeof *n);
+    if (!n)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "hierarchical: out of memory for %zu nodes; use a larger --min-area or --epsilon",
+                        cap);
+    t->nodes = n;
+    t->capacity = cap;
+    return RAD_OK;
+}
+
+/* ---- the cluster hierarchy ---- */
+
+typedef struct sort_item {
+    double key;
+    uint32_t patch;
+} sort_item;
+
+static int sort_item_cmp(const void *pa, const void *pb)
+{
+    const sort_item *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
+    return (a->patch > b->patch) - (a->patch < b->patch);
+}
+
+typedef struct bvh_builder {
+    hr_tree *tree;
+    hr_node *roots;           /* per patch, placed after the build */
+    sort_item *scratch;
+    uint32_t next_cluster;    /* pre-order counter */
+    uint32_t first_root;      /* P - 1 */
+} bvh_builder;
+
+/* A node being built: a cluster, or (index >= first_root) the root at that
+ * position of order[]. */
+static const hr_node *bvh_node(const bvh_builder *b, uint32_t index)
+{
+    if (index >= b->first_root)
+        return &b->roots[b->tree->order[index - b->first_root]];
+    return &b->tree->nodes[index];
+}
+
+/* Build the subtree over order[first, first + count); returns its node. */
+static uint32_t bvh_build(bvh_builder *b, uint32_t parent, uint32_t first, uint32_t count)
+{
+    hr_tree *t = b->tree;
+    if (count == 1) {
+        b->roots[t->order[first]].parent = parent;
+        return b->first_root + first;
+    }
+    uint32_t k = b->next_cluster++;
+    vec3 clo = v3(INFINITY, INFINITY, INFINITY), chi = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (uint32_t i = first; i < first + count; i++) {
+        vec3 c = b->roots[t->order[i]].center;
+        clo = v3_min(clo, c);
+        chi = v3_max(chi, c);
+    }
+    vec3 ext = v3_sub(chi, clo);
+    int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+    for (uint32_t i = 0; i < count; i++) {
+        uint32_t p = t->order[first + i];
+        vec3 c = b->roots[p].center;
+        b->scratch[i].key = axis == 0 ? c.x : (axis == 1 ? c.y : c.z);
+        b->scratch[i].patch = p;
+    }
+    qsort(b->scratch, count, sizeof *b->scratch, sort_item_cmp);
+    for (uint32_t i = 0; i < count; i++)
+        t->order[first + i] = b->scratch[i].patch;
+    uint32_t half = count / 2;
+    uint32_t c0 = bvh_build(b, k, first, half);
+    uint32_t c1 = bvh_build(b, k, first + half, count - half);
+    const hr_node *a = bvh_node(b, c0), *d = bvh_node(b, c1);
+    hr_node *n = &t->nodes[k];
+    memset(n, 0, sizeof *n);
+    n->kind = HR_CLUSTER;
+    n->parent = parent;
+    n->patch = first;
+    n->patch_count = count;
+    n->child[0] = c0;
+    n->child[1] = c1;
+    n->lo = v3_min(a->lo, d->lo);
+    n->hi = v3_max(a->hi, d->hi);
+    n->center = v3_scale(v3_add(n->lo, n->hi), 0.5);
+    n->radius = 0.5 * v3_length(v3_sub(n->hi, n->lo));
+    n->area = a->area + d->area;
+    n->rho = fmaxf(a->rho, d->rho);
+    return k;
+}
+
+rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene *scene, bool clustered,
+                         double min_area, double eps, hr_tree *t)
+{
+    memset(t, 0, sizeof *t);
+    t->base = base;
+    t->scene = scene;
+    t->min_area = min_area;
+    size_t P = base->patch_count;
+    if (P == 0 || P > (size_t)(UINT32_MAX / 8))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "hierarchical: %zu patches (1 to %u allowed)", P,
+                        UINT32_MAX / 8);
+    if (P < 2)
+        clustered = false;
+    size_t clusters = clustered ? P - 1 : 0;
+    t->root_of_patch = rad_alloc_array(ctx, P, sizeof *t->root_of_patch, "hierarchical: roots");
+    t->order = rad_alloc_array(ctx, P, sizeof *t->order, "hierarchical: cluster order");
+    t->order_area = rad_alloc_array(ctx, P + 1, sizeof *t->order_area, "hierarchical: cluster order");
+    t->lift = rad_alloc_array(ctx, P, sizeof *t->lift, "hierarchical: lifts");
+    hr_node *roots = rad_alloc_array(ctx, P, sizeof *roots, "hierarchical: roots");
+    sort_item *scratch = clustered ? rad_alloc_array(ctx, P, sizeof *scratch, "hierarchical: sort") : NULL;
+    rad_result r = RAD_OK;
+    if (!t->root_of_patch || !t->order || !t->order_area || !t->lift || !roots ||
+        (clustered && !scratch) || (r = reserve(ctx, t, clusters + P)) != RAD_OK) {
+        free(roots);
+        free(scratch);
+        hr_tree_free(t);
+        return r != RAD_OK ? r : RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t p = 0; p < P; p++) {
+        const rad_patch *pa = &base->patches[p];
+        const rad_element *e = &base->elements[pa->first_element];
+        t->lift[p] = eps + rad_element_bend(base, e);
+        t->order[p] = (uint32_t)p;
+        hr_node *n = &roots[p];
+        memset(n, 0, sizeof *n);
+        n->kind = HR_SURFACE;
+        n->corners = (uint8_t)pa->corner_count;
+        for (uint32_t c = 0; c < pa->corner_count; c++)
+            n->corner[c] = pa->corner[c];
+        n->normal = pa->normal;
+        n->patch = (uint32_t)p;
+        n->parent = HR_NONE;
+        const double *rho = scene->materials[pa->material].reflectance;
+        n->rho = (float)fmax(rho[0], fmax(rho[1], rho[2]));
+        surface_geometry(n);
+    }
+    if (clustered) {
+        bvh_builder b = {t, roots, scratch, 0, (uint32_t)clusters};
+        bvh_build(&b, HR_NONE, 0, (uint32_t)P);
+    }
+    /* Roots after the clusters, in order[] order. */
+    for (size_t i = 0; i < P; i++) {
+        t->nodes[clusters + i] = roots[t->order[i]];
+        t->root_of_patch[t->order[i]] = (uint32_t)(clusters + i);
+    }
+    t->count = clusters + P;
+    t->clusters = clusters;
+    t->order_area[0] = 0.0;
+    for (size_t i = 0; i < P; i++)
+        t->order_area[i + 1] = t->order_area[i] + roots[t->order[i]].area;
+    free(roots);
+    free(scratch);
+    return RAD_OK;
+}
+
+void hr_tree_free(hr_tree *t)
+{
+    free(t->nodes);
+    free(t->root_of_patch);
+    free(t->order);
+    free(t->order_area);
+    free(t->lift);
+    memset(t, 0, sizeof *t);
+}
+
+int hr_children(const hr_tree *t, uint32_t k)
+{
+    const hr_node *n = &t->nodes[k];
+    if (n->kind == HR_CLUSTER)
+        return 2;
+    return n->child[0] ? 4 : 0;
+}
+
+bool hr_splittable(const hr_tree *t, uint32_t k)
+{
+    const hr_node *n = &t->nodes[k];
+    if (n->kind == HR_CLUSTER)
+        return true;
+    return n->child[0] != 0 || (n->level < 40 && 0.25 * n->area >= t->min_area);
+}
+
+uint32_t hr_child(const hr_tree *t, uint32_t k, int c)
+{
+    const hr_node *n = &t->nodes[k];
+    return n->kind == HR_CLUSTER ? n->child[c] : n->child[0] + (uint32_t)c;
+}
+
+rad_result hr_subdivide(rad_context *ctx, hr_tree *t, uint32_t k)
+{
+    if (t->nodes[k].kind != HR_SURFACE || t->nodes[k].child[0])
+        return RAD_OK;
+    if (t->count + 4 > (size_t)UINT32_MAX - 1)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "hierarchical: more than %u nodes; use a larger --min-area or --epsilon",
+                        UINT32_MAX - 1);
+    rad_result r = reserve(ctx, t, 4);
+    if (r != RAD_OK)
+        return r;
+    hr_node parent = t->nodes[k];
+    uint32_t first = (uint32_t)t->count;
+    vec3 q[4][4];
+    const vec3 *c = parent.corner;
+    if (parent.corners == 4) {
+        vec3 m01 = v3_lerp(c[0], c[1], 0.5), m12 = v3_lerp(c[1], c[2], 0.5);
+        vec3 m23 = v3_lerp(c[3], c[2], 0.5), m30 = v3_lerp(c[0], c[3], 0.5);
+        vec3 mc = v3_lerp(m01, m23, 0.5);
+        vec3 child[4][4] = {{c[0], m01, mc, m30}, {m01, c[1], m12, mc}, {mc, m12, c[2], m23},
+                            {m30, mc, m23, c[3]}};
+        memcpy(q, child, sizeof q);
+    } else {
+        vec3 m01 = v3_lerp(c[0], c[1], 0.5), m12 = v3_lerp(c[1], c[2], 0.5), m20 = v3_lerp(c[2], c[0], 0.5);
+        vec3 child[4][4] = {{c[0], m01, m20, m20}, {m01, c[1], m12, m12}, {m20, m12, c[2], c[2]},
+                            {m12, m20, m01, m01}};
+        memcpy(q, child, sizeof q);
+    }
+    for (int i = 0; i < 4; i++) {
+        hr_node *n = &t->nodes[first + (uint32_t)i];
+        memset(n, 0, sizeof *n);
+        n->kind = HR_SURFACE;
+        n->corners = parent.corners;
+        memcpy(n->corner, q[i], sizeof n->corner);
+        n->normal = parent.normal;
+        n->patch = parent.patch;
+        n->parent = k;
+        n->level = (uint8_t)(parent.level + 1);
+        n->rho = parent.rho;
+        surface_geometry(n);
+    }
+    t->nodes[k].child[0] = first;
+    t->count += 4;
+    return RAD_OK;
+}
+
+/* A point of a surface node at unit-square parameters (bilinear on quads,
+ * the folded square on triangles). */
+static vec3 surface_point(const hr_node *n, double u, double v)
+{
+    const vec3 *c = n->corner;
+    if (n->corners == 3) {
+        if (u + v > 1.0) {
+            u = 1.0 - u;
+            v = 1.0 - v;
+        }
+        return v3_add(c[0], v3_add(v3_scale(v3_sub(c[1], c[0]), u), v3_scale(v3_sub(c[2], c[0]), v)));
+    }
+    return v3_lerp(v3_lerp(c[0], c[1], u), v3_lerp(c[3], c[2], u), v);
+}
+
+void hr_sample(const hr_tree *t, uint32_t k, double u, double v, double w, vec3 *point, vec3 *normal,
+               double *lift)
+{
+    const hr_node *n = &t->nodes[k];
+    if (n->kind == HR_CLUSTER) {
+        /* A patch of the cluster's range, chosen by area. */
+        uint32_t lo = n->patch, hi = n->patch + n->patch_count; /* order[lo, hi) */
+        double target = t->order_area[lo] + w * (t->order_area[hi] - t->order_area[lo]);
+        while (hi - lo > 1) {
+            uint32_t mid = lo + (hi - lo) / 2;
+            if (t->order_area[mid] <= target)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        n = &t->nodes[t->root_of_patch[t->order[lo]]];
+    }
+    *point = surface_point(n, u, v);
+    *normal = n->normal;
+    *lift = t->lift[n->patch];
+}

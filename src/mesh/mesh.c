@@ -14,9 +14,10 @@
  * count is given, h is found by bisection on the exact count.
  *
  * Welding.  Grid points are merged when they lie within 1e-6 x the scene
- * diagonal of each other, belong to the same surface, and their patches'
- * normals differ by less than the crease angle: shading is then smooth
- * within a surface but keeps the physical discontinuity at corners.
+ * diagonal of each other (less for slivers: weld_tolerance), belong to the
+ * same surface, and their patches' normals differ by less than the crease
+ * angle: shading is then smooth within a surface but keeps the physical
+ * discontinuity at corners.
  */
 #include "mesh/mesh.h"
 
@@ -130,6 +131,40 @@ uint32_t rad_patch_locate(const rad_patch *p, double s, double t, double *ls, do
     *ls = fx + fy - 1.0;
     *lt = 1.0 - fx;
     return p->first_element + row_start + (k - row) + col;
+}
+
+uint32_t rad_mesh_locate(const rad_mesh *mesh, uint32_t patch, double s, double t, double *ls,
+                         double *lt)
+{
+    const rad_patch *p = &mesh->patches[patch];
+    if (!mesh->tree)
+        return rad_patch_locate(p, s, t, ls, lt);
+    /* Descend the quadtree with the point's coordinates relative to the
+     * current node (hier/tree.c gives the children's layout). */
+    double x = s, y = t;
+    uint32_t entry = p->tree_root;
+    for (int depth = 0; !(entry & RAD_TREE_LEAF) && depth < 64; depth++) {
+        const uint32_t *child = &mesh->tree[4 * (size_t)entry];
+        int c;
+        if (p->corner_count == 4) {
+            int i = x >= 0.5, j = y >= 0.5;
+            c = j ? (i ? 2 : 3) : (i ? 1 : 0);
+            x = 2.0 * x - i;
+            y = 2.0 * y - j;
+        } else if (x + y < 0.5) {
+            c = 0, x = 2.0 * x, y = 2.0 * y;
+        } else if (x >= 0.5) {
+            c = 1, x = 2.0 * x - 1.0, y = 2.0 * y;
+        } else if (y >= 0.5) {
+            c = 2, x = 2.0 * x, y = 2.0 * y - 1.0;
+        } else {
+            c = 3, x = 1.0 - 2.0 * x, y = 1.0 - 2.0 * y;
+        }
+        entry = child[c];
+    }
+    *ls = fmin(fmax(x, 0.0), 1.0);
+    *lt = fmin(fmax(y, 0.0), 1.0);
+    return entry & ~RAD_TREE_LEAF;
 }
 
 vec3 rad_element_sample(const rad_mesh *mesh, const rad_element *e, double u, double v)
@@ -363,6 +398,12 @@ static double count_elements(rad_patch *patches, size_t count, double h)
 static double size_for_target(rad_patch *patches, size_t count, double total_area, double target)
 {
     double lo = sqrt(total_area / target) * 0.05, hi = sqrt(total_area / target) * 20.0;
+    /* Long thin patches need h up to their length: one element each (the
+     * fewest there can be) is reached at the longest patch edge. */
+    for (size_t i = 0; i < count; i++)
+        for (uint32_t k = 0; k < patches[i].corner_count; k++)
+            hi = fmax(hi, 1.01 * v3_length(v3_sub(patches[i].corner[(k + 1) % patches[i].corner_count],
+                                                  patches[i].corner[k])));
     for (int it = 0; it < 60; it++) {
         double mid = sqrt(lo * hi);
         if (count_elements(patches, count, mid) > target)
@@ -386,6 +427,17 @@ static uint64_t cell_key(int64_t x, int64_t y, int64_t z)
 {
     return rad_mix64((uint64_t)x * 0x9e3779b97f4a7c15ULL ^ rad_mix64((uint64_t)y) ^
                      rad_mix64((uint64_t)z * 0xc2b2ae3d27d4eb4fULL));
+}
+
+/* The grid cell of coordinate x for cells 1/inv wide.  Clamped to +-2^62
+ * so that a coordinate far from the cell size (a tiny weld tolerance in a
+ * scene far from the origin) never overflows the conversion. */
+static int64_t cell_of(double x, double inv)
+{
+    double c = floor(x * inv);
+    if (!(c > -4.6e18))
+        return c < 0.0 ? -(INT64_C(1) << 62) : 0; /* -inf, or NaN */
+    return c < 4.6e18 ? (int64_t)c : (INT64_C(1) << 62);
 }
 
 static int cell_entry_cmp(const void *a, const void *b)
@@ -455,6 +507,37 @@ static void element_geometry(rad_element *e, const vec3 *P)
                                 : c1;
 }
 
+/* The distance within which grid points are one vertex: 1e-6 x the scene
+ * diagonal (far above the round-off of grid points computed from
+ * different patches), but below 1e-3 x the narrowest element, so that the
+ * corners of a sliver's elements (a 1 km x 1 um strip) never merge into
+ * zero-area elements.  The narrowest element is estimated per patch as
+ * its width (2 x area / longest edge) or its shortest edge, whichever is
+ * less, over its cells along the longest side. */
+static double weld_tolerance(const rad_mesh *mesh, double diag)
+{
+    double narrowest = HUGE_VAL;
+    for (size_t i = 0; i < mesh->patch_count; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        vec3 n = p->corner_count == 4
+                     ? v3_cross(v3_sub(p->corner[2], p->corner[0]), v3_sub(p->corner[3], p->corner[1]))
+                     : v3_cross(v3_sub(p->corner[1], p->corner[0]), v3_sub(p->corner[2], p->corner[0]));
+        double area = 0.5 * v3_length(n), longest = 0.0, shortest = HUGE_VAL;
+        for (uint32_t k = 0; k < p->corner_count; k++) {
+            double edge = v3_length(v3_sub(p->corner[(k + 1) % p->corner_count], p->corner[k]));
+            longest = fmax(longest, edge);
+            shortest = fmin(shortest, edge);
+        }
+        uint32_t cells = p->nu > p->nv ? p->nu : p->nv;
+        if (longest > 0.0)
+            narrowest = fmin(narrowest, fmin(shortest, 2.0 * area / longest) / (double)cells);
+    }
+    double tol = 1e-6 * diag;
+    if (narrowest > 0.0 && 1e-3 * narrowest < tol)
+        tol = 1e-3 * narrowest;
+    return tol;
+}
+
 /* Weld raw grid points; fills weld[raw] = welded index and the positions. */
 static rad_result weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *raw, size_t nraw,
                        double tol, double cos_crease, uint32_t *weld_of, vec3 **positions,
@@ -470,8 +553,7 @@ static rad_result weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex 
     double inv = 1.0 / tol;
     for (size_t r = 0; r < nraw; r++) {
         vec3 p = raw[r].position;
-        cells[r].key = cell_key((int64_t)floor(p.x * inv), (int64_t)floor(p.y * inv),
-                                (int64_t)floor(p.z * inv));
+        cells[r].key = cell_key(cell_of(p.x, inv), cell_of(p.y, inv), cell_of(p.z, inv));
         cells[r].item = (uint32_t)r;
     }
     qsort(cells, nraw, sizeof *cells, cell_entry_cmp);
@@ -479,8 +561,7 @@ static rad_result weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex 
     for (size_t r = 0; r < nraw; r++) {
         vec3 p = raw[r].position;
         const rad_patch *pr = &mesh->patches[raw[r].patch];
-        int64_t cx = (int64_t)floor(p.x * inv), cy = (int64_t)floor(p.y * inv),
-                cz = (int64_t)floor(p.z * inv);
+        int64_t cx = cell_of(p.x, inv), cy = cell_of(p.y, inv), cz = cell_of(p.z, inv);
         uint32_t best = UINT32_MAX;
         for (int dz = -1; dz <= 1; dz++)
             for (int dy = -1; dy <= 1; dy++)
@@ -582,14 +663,21 @@ static rad_result find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, d
     for (size_t i = 0; i < mesh->element_count; i++)
         for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++)
             vsurf[mesh->elements[i].vertex[c]] = mesh->elements[i].surface;
-    double inv = 1.0 / h;
+    /* Cells as wide as the longest boundary edge, so that an edge spans at
+     * most 2 cells a side: that is h, except where a patch reached the cap
+     * on cells per side (cells_for) and its elements are longer. */
+    double cell = h;
+    for (size_t bi = 0; bi < nb; bi++) {
+        const edge_rec *ed = &edges[order[bi].item];
+        cell = fmax(cell, v3_length(v3_sub(mesh->vertices[ed->b], mesh->vertices[ed->a])));
+    }
+    double inv = 1.0 / cell;
     size_t g = 0;
     for (size_t v = 0; v < mesh->vertex_count; v++) {
         if (!on_boundary[v])
             continue;
         vec3 p = mesh->vertices[v];
-        grid[g].key = cell_key((int64_t)floor(p.x * inv), (int64_t)floor(p.y * inv),
-                               (int64_t)floor(p.z * inv));
+        grid[g].key = cell_key(cell_of(p.x, inv), cell_of(p.y, inv), cell_of(p.z, inv));
         grid[g].item = (uint32_t)v;
         g++;
     }
@@ -606,9 +694,9 @@ static rad_result find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, d
         if (!(len2 > 0.0))
             continue;
         vec3 lo = v3_min(a, b), hi = v3_max(a, b);
-        int64_t x0 = (int64_t)floor((lo.x - tol) * inv), x1 = (int64_t)floor((hi.x + tol) * inv);
-        int64_t y0 = (int64_t)floor((lo.y - tol) * inv), y1 = (int64_t)floor((hi.y + tol) * inv);
-        int64_t z0 = (int64_t)floor((lo.z - tol) * inv), z1 = (int64_t)floor((hi.z + tol) * inv);
+        int64_t x0 = cell_of(lo.x - tol, inv), x1 = cell_of(hi.x + tol, inv);
+        int64_t y0 = cell_of(lo.y - tol, inv), y1 = cell_of(hi.y + tol, inv);
+        int64_t z0 = cell_of(lo.z - tol, inv), z1 = cell_of(hi.z + tol, inv);
         for (int64_t z = z0; z <= z1; z++)
             for (int64_t y = y0; y <= y1; y++)
                 for (int64_t x = x0; x <= x1; x++) {
@@ -648,6 +736,13 @@ static rad_result find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, d
 
 rad_result rad_mesh_build(rad_context *ctx, const rad_scene *scene, const rad_mesh_options *opt,
                           rad_mesh **out)
+{
+    return rad_mesh_build_within(ctx, scene, opt, 0.0, out);
+}
+
+rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
+                                 const rad_mesh_options *opt, double max_memory_bytes,
+                                 rad_mesh **out)
 {
     *out = NULL;
     rad_mesh_options o = opt ? *opt : (rad_mesh_options){0};
@@ -689,10 +784,23 @@ rad_result rad_mesh_build(rad_context *ctx, const rad_scene *scene, const rad_me
     }
     mesh->mesh_size = h;
 
-    /* Elements and raw grid points, patch by patch. */
+    /* Elements and raw grid points, patch by patch.  The estimate counts
+     * the elements, the raw grid points with their weld tables, and the
+     * edge tables of the T-vertex search (4 edges of 2 x 16 bytes per
+     * element), which all exist at once. */
     size_t nraw = 0;
     for (size_t i = 0; i < mesh->patch_count; i++)
         nraw += patch_point_count(&mesh->patches[i]);
+    double bytes = nelem * ((double)sizeof(rad_element) + 4.0 * 32.0) +
+                   (double)nraw * (double)(sizeof(raw_vertex) + sizeof(uint32_t) +
+                                           sizeof(cell_entry) + sizeof(vec3));
+    if (max_memory_bytes > 0.0 && bytes > max_memory_bytes) {
+        rad_mesh_destroy(mesh);
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "mesh: %.0f elements need about %.2f GiB, above the memory limit of "
+                        "%.2f GiB (--max-memory); use a larger --mesh-size or fewer --elements",
+                        nelem, bytes / 1073741824.0, max_memory_bytes / 1073741824.0);
+    }
     mesh->element_count = (size_t)nelem;
     mesh->elements = rad_alloc_array(ctx, mesh->element_count, sizeof *mesh->elements, "mesh: elements");
     raw_vertex *raw = rad_alloc_array(ctx, nraw, sizeof *raw, "mesh: grid points");
@@ -760,7 +868,7 @@ rad_result rad_mesh_build(rad_context *ctx, const rad_scene *scene, const rad_me
     }
 
     double diag = rad_scene_diagonal(scene);
-    double tol = 1e-6 * (diag > 0.0 ? diag : 1.0);
+    double tol = weld_tolerance(mesh, diag > 0.0 ? diag : 1.0);
     r = weld(ctx, mesh, raw, nraw, tol, cos(o.crease_angle_degrees * M_PI / 180.0), weld_of,
              &mesh->vertices, &mesh->vertex_count);
     if (r == RAD_OK) {
@@ -782,6 +890,90 @@ rad_result rad_mesh_build(rad_context *ctx, const rad_scene *scene, const rad_me
     return RAD_OK;
 }
 
+rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const rad_mesh *base,
+                                const rad_mesh_leaf *leaves, size_t leaf_count, const uint32_t *tree,
+                                size_t tree_count, const uint32_t *patch_root, double crease,
+                                rad_mesh **out)
+{
+    *out = NULL;
+    if (crease == 0.0)
+        crease = 30.0;
+    if (leaf_count >= RAD_TREE_LEAF || tree_count >= RAD_TREE_LEAF)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "mesh: %zu leaves exceed the limit of %u",
+                        leaf_count, RAD_TREE_LEAF - 1);
+    rad_mesh *mesh = calloc(1, sizeof *mesh);
+    if (!mesh)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+    size_t nraw = 0;
+    for (size_t i = 0; i < leaf_count; i++)
+        nraw += leaves[i].corner_count;
+    mesh->patch_count = base->patch_count;
+    mesh->patches = rad_alloc_array(ctx, base->patch_count, sizeof *mesh->patches, "mesh: patches");
+    mesh->elements = rad_alloc_array(ctx, leaf_count ? leaf_count : 1, sizeof *mesh->elements,
+                                     "mesh: elements");
+    mesh->tree = rad_alloc_array(ctx, 4 * tree_count + 1, sizeof *mesh->tree, "mesh: quadtree");
+    raw_vertex *raw = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *raw, "mesh: leaf corners");
+    uint32_t *weld_of = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *weld_of, "mesh: leaf corners");
+    if (!mesh->patches || !mesh->elements || !mesh->tree || !raw || !weld_of) {
+        free(raw);
+        free(weld_of);
+        rad_mesh_destroy(mesh);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memcpy(mesh->patches, base->patches, base->patch_count * sizeof *mesh->patches);
+    memcpy(mesh->tree, tree, 4 * tree_count * sizeof *mesh->tree);
+    mesh->tree_count = tree_count;
+    mesh->element_count = leaf_count;
+    for (size_t p = 0; p < mesh->patch_count; p++) {
+        mesh->patches[p].tree_root = patch_root[p];
+        mesh->patches[p].element_count = 0;
+        mesh->patches[p].first_element = 0;
+    }
+    size_t k = 0;
+    double area = 0.0;
+    for (size_t i = 0; i < leaf_count; i++) {
+        const rad_mesh_leaf *l = &leaves[i];
+        rad_patch *p = &mesh->patches[l->patch];
+        if (p->element_count++ == 0)
+            p->first_element = (uint32_t)i;
+        rad_element *e = &mesh->elements[i];
+        e->patch = l->patch;
+        e->surface = p->surface;
+        e->material = p->material;
+        e->vertex_count = l->corner_count;
+        for (uint32_t c = 0; c < l->corner_count; c++) {
+            raw[k].position = l->corner[c];
+            raw[k].patch = l->patch;
+            e->vertex[c] = (uint32_t)k++;
+        }
+    }
+    double diag = rad_scene_diagonal(scene);
+    double tol = 1e-6 * (diag > 0.0 ? diag : 1.0);
+    rad_result r = weld(ctx, mesh, raw, nraw, tol, cos(crease * M_PI / 180.0), weld_of, &mesh->vertices,
+                        &mesh->vertex_count);
+    if (r == RAD_OK) {
+        for (size_t i = 0; i < leaf_count; i++) {
+            rad_element *e = &mesh->elements[i];
+            for (uint32_t c = 0; c < e->vertex_count; c++)
+                e->vertex[c] = weld_of[e->vertex[c]];
+            element_geometry(e, mesh->vertices);
+            area += e->area;
+        }
+        /* The T-vertex search grid: about the typical leaf size. */
+        double h = leaf_count ? sqrt(area / (double)leaf_count) : 1.0;
+        mesh->mesh_size = h;
+        r = find_tvertices(ctx, mesh, tol, h > tol ? h : tol);
+    }
+    free(raw);
+    free(weld_of);
+    if (r != RAD_OK) {
+        rad_mesh_destroy(mesh);
+        return r;
+    }
+    *out = mesh;
+    return RAD_OK;
+}
+
 void rad_mesh_destroy(rad_mesh *mesh)
 {
     if (!mesh)
@@ -790,5 +982,6 @@ void rad_mesh_destroy(rad_mesh *mesh)
     free(mesh->elements);
     free(mesh->vertices);
     free(mesh->tvertices);
+    free(mesh->tree);
     free(mesh);
 }

@@ -36,6 +36,7 @@ typedef struct rad_patch {
     uint32_t nu, nv;         /* quad: grid cells along c0->c1 and c0->c3; triangle: nu = nv = k */
     uint32_t first_element;  /* elements of this patch are contiguous */
     uint32_t element_count;
+    uint32_t tree_root;      /* leaf meshes (rad_mesh.tree != NULL): the patch's quadtree */
 } rad_patch;
 
 typedef struct rad_element {
@@ -67,7 +68,17 @@ typedef struct rad_mesh {
     rad_tvertex *tvertices;
     size_t tvertex_count;
     double mesh_size;        /* the edge length actually used, m */
+    /* Leaf meshes of hierarchical radiosity: instead of a grid, each patch's
+     * elements are the leaves of a quadtree (quads split at the parameter
+     * midpoints, triangles into their corner and medial triangles; hier/tree.c).
+     * Internal node k has children tree[4k .. 4k+3]; an entry (or a patch's
+     * tree_root) with RAD_TREE_LEAF set is the element (entry & ~RAD_TREE_LEAF).
+     * NULL for grid meshes. */
+    uint32_t *tree;
+    size_t tree_count;       /* internal nodes */
 } rad_mesh;
+
+#define RAD_TREE_LEAF 0x80000000u
 
 typedef struct rad_mesh_options {
     double mesh_size;        /* m; 0 = derive from target_elements */
@@ -77,6 +88,12 @@ typedef struct rad_mesh_options {
 
 rad_result rad_mesh_build(rad_context *ctx, const rad_scene *scene,
                           const rad_mesh_options *options, rad_mesh **out);
+/* As rad_mesh_build, but first estimates the mesh's memory and fails with
+ * RAD_ERROR_OUT_OF_MEMORY (naming --max-memory, --mesh-size, --elements)
+ * when it exceeds max_memory_bytes (0 = no limit). */
+rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
+                                 const rad_mesh_options *options, double max_memory_bytes,
+                                 rad_mesh **out);
 void rad_mesh_destroy(rad_mesh *mesh);
 
 /* The element of `patch` containing the point with patch parameters (s, t)
@@ -86,6 +103,28 @@ void rad_mesh_destroy(rad_mesh *mesh);
  * clamped. */
 uint32_t rad_patch_locate(const rad_patch *patch, double s, double t,
                           double *local_s, double *local_t);
+
+/* As rad_patch_locate, for patch `patch` of any mesh: grid meshes locate in
+ * O(1), leaf meshes descend the patch's quadtree.  Cannot fail. */
+uint32_t rad_mesh_locate(const rad_mesh *mesh, uint32_t patch, double s, double t,
+                         double *local_s, double *local_t);
+
+/* A leaf of a hierarchical solution, as rad_mesh_from_leaves takes it. */
+typedef struct rad_mesh_leaf {
+    uint32_t patch;
+    uint32_t corner_count;   /* 3 or 4, as its patch */
+    vec3 corner[4];          /* counter-clockwise, in the patch's parameter orientation */
+} rad_mesh_leaf;
+
+/* The mesh of a hierarchical solution: `base`'s patches, with `leaves` as
+ * elements (grouped by patch, in patch order) located through `tree`
+ * (tree_count internal nodes, 4 entries each, encoded as in rad_mesh) from
+ * patch_root[p].  Vertices are welded and T-vertices found as in
+ * rad_mesh_build.  The arrays are copied.  Fails only for memory. */
+rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const rad_mesh *base,
+                                const rad_mesh_leaf *leaves, size_t leaf_count, const uint32_t *tree,
+                                size_t tree_count, const uint32_t *patch_root,
+                                double crease_angle_degrees, rad_mesh **out);
 
 /* Patch parameters (s, t) of a point on (or near) the patch plane. */
 void rad_patch_parameters(const rad_patch *patch, vec3 p, double *s, double *t);

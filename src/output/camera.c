@@ -96,6 +96,12 @@ rad_result rad_camera_parse(rad_context *ctx, const char *text, rad_camera *came
     if (v3_length(forward) == 0.0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "--camera: position and look-at point coincide in '%s'", text);
+    /* Finite numbers can still be too far apart for a finite view
+     * direction (1e308 and -1e308), or too large for the cross product
+     * below: the renderer would get infinities. */
+    if (!isfinite(v3_length(forward)) || !isfinite(v3_length(v3_cross(forward, up))))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "--camera: position, look-at point or up vector too large in '%s'", text);
     /* Up must leave a sideways direction: |f x u| against |f||u|, with
      * room for round-off in a nearly parallel pair. */
     if (v3_length(v3_cross(forward, up)) <= 1e-9 * v3_length(forward) * v3_length(up))

@@ -94,7 +94,7 @@ static void shade(const rad_render_input *input, rad_shading shading, const rad_
     vec3 p = v3_mad(ray->origin, ray->direction, hit->t);
     double s, t, local_s, local_t;
     rad_patch_parameters(patch, p, &s, &t);
-    uint32_t e = rad_patch_locate(patch, s, t, &local_s, &local_t);
+    uint32_t e = rad_mesh_locate(mesh, hit->patch, s, t, &local_s, &local_t);
     if (shading == RAD_SHADING_SMOOTH && input->vertex_radiosity) {
         rad_element_interpolate(mesh, &mesh->elements[e], input->vertex_radiosity, local_s,
                                 local_t, rgb);

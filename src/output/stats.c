@@ -104,6 +104,36 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     cJSON_AddNumberToObject(so, "components", (double)s->solve_stats.components);
     cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve_stats.ambient));
     cJSON_AddNumberToObject(so, "seconds", s->solve_stats.seconds);
+    if (s->hier_base) {
+        const rad_hier_stats *h = &s->hier_stats;
+        cJSON *hi = cJSON_AddObjectToObject(so, "hierarchical");
+        cJSON_AddNumberToObject(hi, "epsilon", s->options.epsilon > 0.0 ? s->options.epsilon : 1e-4);
+        cJSON_AddNumberToObject(hi, "epsilon_W", h->epsilon_abs);
+        cJSON_AddNumberToObject(hi, "min_area_m2", h->min_area);
+        cJSON_AddBoolToObject(hi, "clustered", h->clustered);
+        cJSON_AddNumberToObject(hi, "patches", (double)s->hier_base->patch_count);
+        cJSON_AddNumberToObject(hi, "clusters", (double)h->clusters);
+        cJSON_AddNumberToObject(hi, "nodes", (double)h->nodes);
+        cJSON_AddNumberToObject(hi, "leaves", (double)h->leaves);
+        cJSON_AddNumberToObject(hi, "links", (double)h->links);
+        cJSON_AddNumberToObject(hi, "initial_links", (double)h->initial_links);
+        cJSON *kinds = cJSON_AddObjectToObject(hi, "links_by_kind");
+        cJSON_AddNumberToObject(kinds, "surface_from_surface", (double)h->links_by_kind[0]);
+        cJSON_AddNumberToObject(kinds, "surface_from_cluster", (double)h->links_by_kind[1]);
+        cJSON_AddNumberToObject(kinds, "cluster_from_surface", (double)h->links_by_kind[2]);
+        cJSON_AddNumberToObject(kinds, "cluster_from_cluster", (double)h->links_by_kind[3]);
+        cJSON_AddNumberToObject(hi, "links_per_leaf", h->leaves ? (double)h->links / (double)h->leaves : 0.0);
+        cJSON_AddNumberToObject(hi, "bytes_per_link", h->link_bytes);
+        cJSON_AddNumberToObject(hi, "memory_bytes", h->bytes);
+        cJSON_AddNumberToObject(hi, "refine_rounds", h->refine_rounds);
+        cJSON_AddNumberToObject(hi, "refine_passes", h->refine_passes);
+        cJSON_AddNumberToObject(hi, "rays", (double)h->rays);
+        cJSON_AddNumberToObject(hi, "shafts", (double)h->shafts);
+        cJSON_AddNumberToObject(hi, "shafts_clear", (double)h->shafts_clear);
+        cJSON_AddNumberToObject(hi, "seconds_refine", h->seconds_refine);
+        cJSON_AddNumberToObject(hi, "seconds_solve", h->seconds_solve);
+        cJSON_AddNumberToObject(hi, "seconds_mesh", h->seconds_mesh);
+    }
 
     double emitted, absorbed;
     rad_solution_power(s, &emitted, &absorbed);
@@ -213,10 +243,17 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, int ele
     memset(r, 0, sizeof *r);
     size_t n = s->mesh->element_count, S = s->scene->surface_count;
     r->count = elements ? n : S;
+    bool with_err = s->F_variance != NULL;
+    double bytes = (double)r->count * (double)r->count * sizeof *r->F * (with_err ? 2.0 : 1.0);
+    if (bytes > s->options.max_memory_bytes)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "view factors: the %zu x %zu table needs %.2f GiB, above the memory limit "
+                        "of %.2f GiB (--max-memory); use --level surface or fewer --elements",
+                        r->count, r->count, bytes / 1073741824.0,
+                        s->options.max_memory_bytes / 1073741824.0);
     r->names = rad_alloc_array(ctx, r->count, sizeof *r->names, "view factors");
     r->area = rad_alloc_array(ctx, r->count, sizeof *r->area, "view factors");
     r->F = rad_alloc_array(ctx, r->count * r->count, sizeof *r->F, "view factors");
-    bool with_err = s->F_variance != NULL;
     if (with_err)
         r->err = rad_alloc_array(ctx, r->count * r->count, sizeof *r->err, "view factors");
     if (!r->names || !r->area || !r->F || (with_err && !r->err)) {

@@ -284,12 +284,13 @@ static rad_result prescan_obj(rad_context *ctx, const char *path, const char *te
     return RAD_OK;
 }
 
-/* Check an MTL: Kd (reflectance) and Ke (emitted radiance) are 3 finite
- * numbers, Kd in [0, 1) and Ke >= 0. */
+/* Check an MTL: nothing before the first newmtl; Kd (reflectance) and Ke
+ * (emitted radiance) are 3 finite numbers, Kd in [0, 1) and Ke >= 0. */
 static rad_result prescan_mtl(rad_context *ctx, const char *path, const char *text, size_t size)
 {
     char token[TOKEN_SIZE], material[64] = "";
     const char *p, *end;
+    bool seen_newmtl = false;
     text_lines lines = text_lines_of(text, size);
     while (next_line(&lines, &p, &end)) {
         if (has_nul(p, end))
@@ -299,8 +300,15 @@ static rad_result prescan_mtl(rad_context *ctx, const char *path, const char *te
             continue;
         if (strcmp(token, "newmtl") == 0) {
             rest_of_line(p, end, material, sizeof material);
+            seen_newmtl = true;
             continue;
         }
+        /* Every statement belongs to a material; assimp 5.2 dereferences a
+         * null material for a texture map (map_Kd ...) before the first
+         * newmtl (found by fuzz_mtl). */
+        if (!seen_newmtl)
+            return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: '%s' before any 'newmtl'", path,
+                            lines.number, token);
         bool is_kd = strcasecmp(token, "Kd") == 0, is_ke = strcasecmp(token, "Ke") == 0;
         if (!is_kd && !is_ke)
             continue;
@@ -334,6 +342,12 @@ static rad_result prescan_mtl(rad_context *ctx, const char *path, const char *te
 
 /* ---- glTF JSON: what assimp 5.2 does not pass on ---- */
 
+/* A little-endian 32-bit number, as GLB headers store them. */
+static size_t le32(const unsigned char *p)
+{
+    return (size_t)p[0] | (size_t)p[1] << 8 | (size_t)p[2] << 16 | (size_t)p[3] << 24;
+}
+
 /* The JSON of a .gltf (all of it) or a .glb (its first chunk), parsed;
  * NULL if it is not JSON (assimp then reports the problem). */
 static cJSON *gltf_json(const char *data, size_t size, bool binary)
@@ -344,11 +358,41 @@ static cJSON *gltf_json(const char *data, size_t size, bool binary)
     const unsigned char *bytes = (const unsigned char *)data;
     if (size < 20 || memcmp(bytes, "glTF", 4) != 0 || memcmp(bytes + 16, "JSON", 4) != 0)
         return NULL;
-    size_t length = (size_t)bytes[12] | (size_t)bytes[13] << 8 | (size_t)bytes[14] << 16 |
-                    (size_t)bytes[15] << 24;
+    size_t length = le32(bytes + 12);
     if (length > size - 20)
         return NULL;
     return cJSON_ParseWithLength(data + 20, length);
+}
+
+/* Check the framing of a GLB file before assimp reads it: assimp 5.2
+ * allocates what the header and chunk headers claim before comparing it
+ * with the file's size, so a 40-byte file claiming a 4 GiB chunk costs
+ * 4 GiB.  Header: magic "glTF", version, total length; then chunks of
+ * (length, type, data), each within the file. */
+static rad_result check_glb_framing(rad_context *ctx, const char *name, const char *data,
+                                    size_t size)
+{
+    const unsigned char *bytes = (const unsigned char *)data;
+    if (size < 12 || memcmp(bytes, "glTF", 4) != 0)
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s: not a binary glTF file (no 'glTF' header)",
+                        name);
+    size_t declared = le32(bytes + 8);
+    if (declared > size)
+        return rad_fail(ctx, RAD_ERROR_PARSE,
+                        "%s: GLB header claims %zu bytes, the file has %zu", name, declared, size);
+    size_t offset = 12;
+    for (int chunk = 0; offset < declared; chunk++) {
+        if (declared - offset < 8)
+            return rad_fail(ctx, RAD_ERROR_PARSE, "%s: GLB chunk %d is cut short at byte %zu",
+                            name, chunk, offset);
+        size_t length = le32(bytes + offset);
+        if (length > declared - offset - 8)
+            return rad_fail(ctx, RAD_ERROR_PARSE,
+                            "%s: GLB chunk %d claims %zu bytes, %zu are left in the file", name,
+                            chunk, length, declared - offset - 8);
+        offset += 8 + length;
+    }
+    return RAD_OK;
 }
 
 /* KHR_materials_emissive_strength of the glTF material assimp imported as
@@ -628,7 +672,13 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
     char extension[16];
     rad_path_extension(name, extension, sizeof extension);
     bool gltf = strcmp(extension, "gltf") == 0 || strcmp(extension, "glb") == 0;
-    cJSON *json = gltf && data ? gltf_json(data, size, strcmp(extension, "glb") == 0) : NULL;
+    bool glb = strcmp(extension, "glb") == 0;
+    if (glb && data) {
+        rad_result framing = check_glb_framing(ctx, name, data, size);
+        if (framing != RAD_OK)
+            return framing;
+    }
+    cJSON *json = gltf && data ? gltf_json(data, size, glb) : NULL;
 
     struct aiPropertyStore *properties = aiCreatePropertyStore();
     if (!properties) {

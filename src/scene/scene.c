@@ -8,8 +8,10 @@
  *
  *   rad_scene_builder_polygon:
  *     finite coordinates -> drop repeated vertices -> at least 3 left
- *       -> non-zero area -> simple (no self-intersection)
- *       -> planar?  yes: kept as one polygon   no: split into triangles
+ *       -> non-zero area -> drop vertices in line with their neighbours
+ *       -> simple (no self-intersection)
+ *       -> planar (and not twisted)?  yes: kept as one polygon
+ *                                     no: split into triangles
  *   rad_scene_builder_finish:
  *     not empty -> drop surfaces without polygons and unused materials
  *       -> surface areas, bounds -> the immutable rad_scene
@@ -281,6 +283,23 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
         return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE, "has zero area");
     vec3 normal = v3_scale(newell, 0.5 / area);
 
+    /* Drop vertices in line with their neighbours (a vertex in the middle of
+     * an edge, or the tip of a zero-width spike): they add no area, and
+     * would turn a quad into a pentagon the mesher must fan.  1e-12
+     * relative: the sine of the angle at the vertex, far below any corner a
+     * modeller draws and far above round-off in the cross product. */
+    for (size_t i = 0; n > 3 && i < n;) {
+        vec3 prev = polygon[(i + n - 1) % n], next = polygon[(i + 1) % n];
+        vec3 in = v3_sub(polygon[i], prev), out = v3_sub(next, polygon[i]);
+        if (v3_length(v3_cross(in, out)) <= 1e-12 * v3_length(in) * v3_length(out)) {
+            memmove(&polygon[i], &polygon[i + 1], (n - i - 1) * sizeof *polygon);
+            n--;
+            i = i > 0 ? i - 1 : 0; /* the previous vertex may now be in line */
+        } else {
+            i++;
+        }
+    }
+
     size_t triangle_count = 0;
     if (n > 3) {
         uint32_t *triangles = reserve(b, b->triangle_scratch, &b->triangle_scratch_capacity,
@@ -300,7 +319,20 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
     double max_distance = 0.0;
     for (size_t i = 0; i < n; i++)
         max_distance = fmax(max_distance, fabs(v3_dot(v3_sub(polygon[i], centroid), normal)));
-    if (max_distance <= 1e-4 * diameter || n == 3)
+    /* A thin polygon can pass the distance test yet be twisted (a 1 km x
+     * 0.1 mm strip whose ends lie in different planes): its triangles then
+     * have more area than its projection (Newell's), and the mesher's
+     * elements would not add up to the area recorded here.  1e-9 relative
+     * is far above double round-off (1e-15) and the float coordinates of
+     * glTF files (twist 1e-7, area excess 1e-14). */
+    double triangles_area = 0.0;
+    for (size_t t = 0; t < triangle_count; t++) {
+        const uint32_t *k = &b->triangle_scratch[3 * t];
+        vec3 triangle[3] = {polygon[k[0]], polygon[k[1]], polygon[k[2]]};
+        triangles_area += 0.5 * v3_length(rad_polygon_newell(triangle, 3));
+    }
+    bool twisted = triangles_area > area * (1.0 + 1e-9);
+    if ((max_distance <= 1e-4 * diameter && !twisted) || n == 3)
         return append_polygon(b, surface, material, polygon, n, normal, area);
 
     for (size_t t = 0; t < triangle_count; t++) {

@@ -61,7 +61,9 @@ typedef struct rad_solve_stats {
 
 /* Solver flags. */
 enum {
-    RAD_SOLVER_MATRIX_FREE = 1u << 0 /* needs no F: rad_solution_create skips the matrix */
+    RAD_SOLVER_MATRIX_FREE = 1u << 0, /* needs no F: rad_solution_create skips the matrix */
+    RAD_SOLVER_HIERARCHICAL = 1u << 1 /* meshes as it solves (hier/): rad_solution_solve runs
+                                         rad_hier_run instead of `solve` */
 };
 
 typedef struct rad_solver {

@@ -152,6 +152,15 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     int N = sys->samples > 0 ? sys->samples : 256;
     double goal = p->unshot_tolerance > 0.0 ? p->unshot_tolerance : 1e-3;
     int threads = sys->threads > 0 ? sys->threads : 1;
+    /* O(n) vectors and the hit records of BATCH shots in flight: check the
+     * estimate first, so that a huge --ff-samples is refused with a way out. */
+    double limit = sys->max_memory > 0.0 ? sys->max_memory : 0.8 * (double)rad_physical_memory_bytes();
+    double bytes = (double)BATCH * (double)N * (double)sizeof(hit_record) + 64.0 * (double)n;
+    if (bytes > limit)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "shooting: %d rays per shot for %zu elements need %.2f GiB, above the "
+                        "memory limit of %.2f GiB (--max-memory); use fewer --ff-samples",
+                        N, n, bytes / 1073741824.0, limit / 1073741824.0);
     double *dB = rad_alloc_array(ctx, 3 * n, sizeof *dB, "shooting: unshot radiosity");
     heap h = {0};
     h.item = rad_alloc_array(ctx, n, sizeof *h.item, "shooting: heap");

@@ -1,0 +1,151 @@
+/*
+ * bench_hier.c -- the hierarchical solver's figures (docs/hierarchical.md):
+ *
+ *   1. the Cornell box at falling epsilon: leaves, links, seconds and the
+ *      worst per-surface error against the uniform 16k-element solution;
+ *   2. generated offices (radiosity generate office) of 1, 10, 100 rooms
+ *      (and 1000 with --big) at a fixed epsilon and minimum area: leaves,
+ *      links, seconds and memory, and the fitted exponents of links and
+ *      seconds against leaves.
+ *
+ *   ./build/bench/bench_hier [--big] [--threads N] [--csv FILE]
+ *
+ * Fixed scenes, seeds and options: the counts are reproducible, the
+ * seconds are this machine's.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "api/solution.h"
+
+/* `radiosity render --elements 16000 --stats s.json` (tests/test_hier.c). */
+static const struct {
+    const char *name;
+    double B[3];
+} REF[] = {
+    {"floor", {0.341265, 0.230563, 0.054476}},       {"ceiling", {0.296770, 0.189049, 0.040970}},
+    {"back_wall", {0.516638, 0.345292, 0.081467}},   {"right_wall", {0.067887, 0.204937, 0.010718}},
+    {"left_wall", {0.320233, 0.020442, 0.005289}},   {"short_block", {0.340573, 0.245550, 0.055724}},
+    {"tall_block", {0.482032, 0.297611, 0.072377}},
+};
+
+static double worst_error(const rad_solution *s)
+{
+    double worst = 0.0;
+    for (size_t i = 0; i < sizeof REF / sizeof REF[0]; i++)
+        for (size_t k = 0; k < s->scene->surface_count; k++) {
+            if (strcmp(s->scene->surfaces[k].name, REF[i].name))
+                continue;
+            double B[3];
+            rad_solution_surface_radiosity(s, k, B);
+            for (int c = 0; c < 3; c++)
+                worst = fmax(worst, fabs(B[c] - REF[i].B[c]) / REF[i].B[c]);
+        }
+    return worst;
+}
+
+static int run(rad_context *ctx, const rad_scene *scene, double epsilon, double min_area, rad_solution **out)
+{
+    rad_options o = {0};
+    o.solver = "hierarchical";
+    o.epsilon = epsilon;
+    o.min_area = min_area;
+    rad_solution *s = NULL;
+    if (rad_solution_create(ctx, scene, &o, &s) != RAD_OK || rad_solution_solve(ctx, s) != RAD_OK) {
+        fprintf(stderr, "bench_hier: %s\n", rad_context_error(ctx));
+        rad_solution_destroy(s);
+        return 1;
+    }
+    *out = s;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    int threads = 0, big = 0;
+    const char *csv = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--big") == 0)
+            big = 1;
+        else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc)
+            threads = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc)
+            csv = argv[++i];
+        else {
+            fprintf(stderr, "usage: bench_hier [--big] [--threads N] [--csv FILE]\n");
+            return 2;
+        }
+    }
+    rad_context *ctx = NULL;
+    rad_context_options co = {0};
+    co.threads = threads;
+    if (rad_context_create(&co, &ctx) != RAD_OK)
+        return 1;
+    FILE *out = csv ? fopen(csv, "w") : NULL;
+    if (out)
+        fprintf(out, "scene,epsilon,leaves,links,seconds,bytes,error\n");
+
+    printf("Cornell box (%d threads), error = worst per-surface channel vs 16k uniform\n",
+           rad_context_threads(ctx));
+    printf("%9s %8s %9s %8s %9s %8s\n", "epsilon", "leaves", "links", "links/el", "seconds", "error");
+    rad_scene *box = NULL;
+    if (rad_scene_create_cornell_box(ctx, &box) != RAD_OK)
+        return 1;
+    const double eps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
+    for (size_t i = 0; i < sizeof eps / sizeof eps[0]; i++) {
+        rad_solution *s = NULL;
+        if (run(ctx, box, eps[i], 0.0, &s))
+            return 1;
+        const rad_hier_stats *h = &s->hier_stats;
+        printf("%9.0e %8zu %9zu %8.1f %9.3f %7.2f%%\n", eps[i], h->leaves, h->links,
+               (double)h->links / (double)h->leaves, s->solve_stats.seconds, 100.0 * worst_error(s));
+        if (out)
+            fprintf(out, "cornell,%g,%zu,%zu,%.4f,%.0f,%.5f\n", eps[i], h->leaves, h->links, s->solve_stats.seconds,
+                    h->bytes, worst_error(s));
+        rad_solution_destroy(s);
+    }
+    rad_scene_destroy(box);
+
+    printf("\nOffices (seed 0, epsilon 1e-3, min area 0.02 m^2)\n");
+    printf("%6s %8s %9s %9s %8s %9s %9s\n", "rooms", "patches", "leaves", "links", "links/el", "seconds", "MB");
+    const int rooms[] = {1, 10, 100, 1000};
+    double lx[4], ll[4], lt[4];
+    int runs = 0;
+    for (int i = 0; i < (big ? 4 : 3); i++) {
+        rad_office_options oo = {rooms[i], 0};
+        rad_scene *scene = NULL;
+        if (rad_scene_generate_office(ctx, &oo, &scene) != RAD_OK)
+            return 1;
+        rad_solution *s = NULL;
+        if (run(ctx, scene, 1e-3, 0.02, &s))
+            return 1;
+        const rad_hier_stats *h = &s->hier_stats;
+        printf("%6d %8zu %9zu %9zu %8.1f %9.2f %9.1f\n", rooms[i], s->hier_base->patch_count, h->leaves, h->links,
+               (double)h->links / (double)h->leaves, s->solve_stats.seconds, h->bytes / 1e6);
+        if (out)
+            fprintf(out, "office%d,%g,%zu,%zu,%.4f,%.0f,\n", rooms[i], 1e-3, h->leaves, h->links, s->solve_stats.seconds,
+                    h->bytes);
+        lx[runs] = log((double)h->leaves);
+        ll[runs] = log((double)h->links);
+        lt[runs] = log(s->solve_stats.seconds);
+        runs++;
+        rad_solution_destroy(s);
+        rad_scene_destroy(scene);
+    }
+    /* Least-squares slopes in log-log. */
+    double mx = 0, ml = 0, mt = 0;
+    for (int i = 0; i < runs; i++)
+        mx += lx[i] / runs, ml += ll[i] / runs, mt += lt[i] / runs;
+    double sxx = 0, sxl = 0, sxt = 0;
+    for (int i = 0; i < runs; i++) {
+        sxx += (lx[i] - mx) * (lx[i] - mx);
+        sxl += (lx[i] - mx) * (ll[i] - ml);
+        sxt += (lx[i] - mx) * (lt[i] - mt);
+    }
+    printf("fitted exponents against leaves: links %.2f, seconds %.2f\n", sxl / sxx, sxt / sxx);
+    if (out)
+        fclose(out);
+    rad_context_destroy(ctx);
+    return 0;
+}

@@ -1,0 +1,209 @@
+/*
+ * hier.h -- hierarchical radiosity (Hanrahan, Salzman & Aupperle, SIGGRAPH
+ * 1991; the lecture notes' "Multi-Resolution Approach"), with clusters for
+ * scenes of many small polygons (after Smits, Arvo & Greenberg, SIGGRAPH
+ * 1994, and Sillion, IEEE TVCG 1995).
+ *
+ * Instead of an n x n matrix between equal elements, energy moves along
+ * LINKS between nodes of a hierarchy, each link at the coarsest level whose
+ * estimated transport error is below epsilon:
+ *
+ *          cluster (box around patches)            o top cluster
+ *            /            \                       / \
+ *        cluster        patch (root)             o   P1 ---link--- P7.2.0
+ *         /   \          quadtree of             |                (a child
+ *       P4    P9         surface nodes           P4 --link-- o     of P7)
+ *
+ * Pipeline of one solve (hier.c):
+ *
+ *   tree.c    base patches -> root surface nodes; a bounding-volume
+ *             hierarchy of clusters over them (or root pairs without);
+ *             on-demand quadtree subdivision (quads into 4, triangles
+ *             into 4)
+ *   refine.c  links: transfer coefficient, visibility (shaft culling, then
+ *             shadow rays), the error oracle (F and B F), level-synchronous
+ *             refinement passes
+ *   hier.c    gather along links, push-pull, Jacobi sweeps; B F refinement
+ *             rounds as the radiosity converges; the leaves as a mesh
+ *   shaft.c   shaft culling (Haines & Wallace 1994)
+ *
+ * Clusters exchange energy through six-direction distributions (one value
+ * per signed axis): a cluster's exitance toward direction w is
+ * sum_a |w_a| C[a, sign w_a] with C[a, +-] = sum_m A_m B_m max(0, +-n_m.a),
+ * and what it receives from direction u is spread as |u_a| into the same
+ * bins and read back by a member of normal n as sum_a |n_a| H[a, sign n_a].
+ * Both are exact when the members' normals lie along the axes, and exact
+ * for any normal whose octant matches the direction's; links through
+ * clusters are kept only where the oracle says their transfer is small.
+ */
+#ifndef RAD_HIER_H
+#define RAD_HIER_H
+
+#include "formfactor/formfactor.h"
+#include "solve/solve.h"
+
+/* ---- nodes (tree.c) ---- */
+
+enum { HR_SURFACE = 0, HR_CLUSTER = 1 };
+#define HR_NONE UINT32_MAX
+
+typedef struct hr_node {
+    vec3 corner[4];       /* surface: the polygon, counter-clockwise */
+    vec3 center;          /* surface: centroid; cluster: box centre */
+    vec3 normal;          /* surface: unit normal */
+    vec3 lo, hi;          /* bounding box */
+    double area;          /* m^2; cluster: its patches' total */
+    double radius;        /* bounding sphere about center */
+    uint32_t parent;      /* HR_NONE for a top node */
+    uint32_t child[2];    /* surface: child[0] = first of 4 consecutive (0 = leaf);
+                             cluster: its two children */
+    uint32_t patch;       /* surface: base patch; cluster: first entry in order[] */
+    uint32_t patch_count; /* cluster: entries in order[] */
+    uint8_t kind;         /* HR_SURFACE or HR_CLUSTER */
+    uint8_t corners;      /* 3 or 4 */
+    uint8_t level;        /* subdivisions below the patch */
+    uint8_t pad;
+    float rho;            /* largest reflectance (any channel) on or below it */
+} hr_node;
+
+typedef struct hr_tree {
+    const rad_mesh *base;      /* one element per patch */
+    const rad_scene *scene;
+    hr_node *nodes;
+    size_t count, capacity;
+    size_t clusters;           /* nodes [0, clusters) are clusters (0 = top), or 0 */
+    uint32_t *root_of_patch;   /* patch -> its root surface node */
+    uint32_t *order;           /* patches in cluster order */
+    double *order_area;        /* prefix sums of patch areas along order[] */
+    double *lift;              /* per patch: shadow-ray lift, m (epsilon + bend) */
+    double min_area;           /* m^2: no child smaller than this */
+} hr_tree;
+
+/* Root surface nodes for every base patch, and (clustered) a binary
+ * bounding-volume hierarchy over them with median splits along the longest
+ * axis.  Deterministic.  Fails only for memory. */
+rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene *scene,
+                         bool clustered, double min_area, double eps, hr_tree *tree);
+void hr_tree_free(hr_tree *tree);
+
+/* Number of children of node k (0, 2 or 4) and whether it may be split. */
+int hr_children(const hr_tree *tree, uint32_t k);
+bool hr_splittable(const hr_tree *tree, uint32_t k);
+/* Give surface node k its 4 children (no-op if it has them).  Serial only:
+ * it may move tree->nodes.  Fails only for memory. */
+rad_result hr_subdivide(rad_context *ctx, hr_tree *tree, uint32_t k);
+/* The c-th child of node k. */
+uint32_t hr_child(const hr_tree *tree, uint32_t k, int c);
+
+/* A random point on the surfaces below node k and its normal, from two
+ * uniform numbers (clusters pick a patch by area). */
+void hr_sample(const hr_tree *tree, uint32_t k, double u, double v, double w, vec3 *point,
+               vec3 *normal, double *lift);
+
+/* ---- shaft culling (shaft.c) ---- */
+
+/* Is the region between the boxes of nodes a and b free of every patch
+ * (other than those of a and b)?  Conservative: false means "maybe not".
+ * Walks the cluster hierarchy, or all patches without one. */
+bool hr_shaft_clear(const hr_tree *tree, uint32_t a, uint32_t b, double tol);
+
+/* ---- links (refine.c) ---- */
+
+enum { HR_LINK_CLEAR = 1 }; /* flags: the shaft is empty; so are the children's */
+
+typedef struct hr_link {
+    uint32_t r, s;        /* receiver and source nodes */
+    float k;              /* transfer coefficient, visibility included (kinds: refine.c) */
+    float spread;         /* surface <- surface: how much the unoccluded factor varies
+                             over the receiver (max |F(x) - F(centre)|) */
+    float vis_err;        /* surface <- surface: unoccluded factor x the visibility's
+                             uncertainty, from pilot rays independent of k's */
+    uint32_t flags;
+} hr_link;
+
+typedef struct hr_links {
+    hr_link *items;
+    size_t count, capacity;
+} hr_links;
+
+typedef struct hr_refine_params {
+    const rad_vis *vis;
+    uint64_t seed;
+    int shadow_rays;      /* per link whose shaft is not empty */
+    double epsilon;       /* power error allowed per link, W */
+    double tol;           /* geometric tolerance, m */
+    int threads;
+} hr_refine_params;
+
+typedef struct hr_refine_stats {
+    uint64_t rays, shafts, shafts_clear, links_created, links_dropped;
+    int passes;
+} hr_refine_stats;
+
+/* The initial links: one self-link of the top cluster, or every pair of
+ * root patches that face each other. */
+rad_result hr_links_initial(rad_context *ctx, hr_tree *tree, const hr_refine_params *p,
+                            hr_links *links, hr_refine_stats *st);
+
+/* Refine until no link's error (given B, the per-node radiosity, 3 per
+ * node, area-averaged; and spread, per node the largest difference between
+ * a child's radiosity and its own) exceeds epsilon.
+ * Returns the number of links split via *split.  Level-synchronous passes:
+ * decide in parallel, subdivide in order, create the children's links in
+ * parallel: the result does not depend on the thread count. */
+rad_result hr_refine(rad_context *ctx, hr_tree *tree, const hr_refine_params *p, const double *B,
+                     const double *spread, hr_links *links, size_t *split, hr_refine_stats *st);
+
+/* Six-direction bins: index of signed axis (a, sign) = 2a + (sign < 0). */
+static inline double hr_bins_eval(const double *bins, vec3 d)
+{
+    return fabs(d.x) * bins[d.x >= 0.0 ? 0 : 1] + fabs(d.y) * bins[d.y >= 0.0 ? 2 : 3] +
+           fabs(d.z) * bins[d.z >= 0.0 ? 4 : 5];
+}
+static inline void hr_bins_add(double *bins, vec3 d, double value)
+{
+    bins[d.x >= 0.0 ? 0 : 1] += fabs(d.x) * value;
+    bins[d.y >= 0.0 ? 2 : 3] += fabs(d.y) * value;
+    bins[d.z >= 0.0 ? 4 : 5] += fabs(d.z) * value;
+}
+
+/* ---- the solver (hier.c) ---- */
+
+typedef struct rad_hier_params {
+    const rad_scene *scene;
+    const rad_mesh *base;      /* one element per patch */
+    const rad_vis *vis;
+    double epsilon;            /* relative: times the emitted power */
+    double min_area;           /* m^2 */
+    int clustering;            /* 1 on, -1 off, 0 automatic */
+    uint64_t seed;
+    int shadow_rays;
+    double tolerance;          /* on the residual */
+    int max_iterations;        /* Jacobi sweeps in the final solve; 0 = automatic */
+    double max_memory;         /* bytes */
+    double crease_angle_degrees;
+    rad_solve_monitor_fn monitor; /* steps only (B is NULL) */
+    void *monitor_user;
+} rad_hier_params;
+
+typedef struct rad_hier_stats {
+    size_t nodes, clusters, leaves, links, initial_links;
+    size_t links_by_kind[4];   /* surface<-surface, surface<-cluster, cluster<-surface,
+                                  cluster<-cluster (receiver<-source) */
+    int refine_rounds, refine_passes;
+    uint64_t rays, shafts, shafts_clear;
+    double bytes;              /* nodes + links + per-node values at the end */
+    double link_bytes;         /* bytes per link */
+    double seconds_refine, seconds_solve, seconds_mesh;
+    double epsilon_abs;        /* W: epsilon x the emitted power */
+    double min_area;           /* m^2 */
+    bool clustered;
+} rad_hier_stats;
+
+/* Solve; on success *leaf_mesh is the mesh of the leaves (patches as in
+ * base, elements = leaves, located through the quadtree) and *radiosity
+ * their B (3 per leaf).  stats->iterations etc. go into *solve_stats. */
+rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **leaf_mesh,
+                        double **radiosity, rad_solve_stats *solve_stats, rad_hier_stats *stats);
+
+#endif /* RAD_HIER_H */
