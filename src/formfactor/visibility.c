@@ -58,6 +58,18 @@ static vec3 end_point(const rad_ff_end *end, double u, double v)
     return v3_mad(p, end->normal, end->lift);
 }
 
+/* A random permutation of 0 .. n-1 (Fisher-Yates). */
+static void shuffle_strata(int *perm, int n, rad_rng *rng)
+{
+    for (int k = 0; k < n; k++)
+        perm[k] = k;
+    for (int k = n - 1; k > 0; k--) {
+        int m = (int)(rad_rng_uniform(rng) * (k + 1)), t = perm[k];
+        perm[k] = perm[m];
+        perm[m] = t;
+    }
+}
+
 int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, int count,
                 rad_rng *rng, uint64_t *rays_cast, int *facing)
 {
@@ -72,17 +84,20 @@ int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, in
     /* Stratified on both ends, the far end's strata shuffled (Fisher-Yates):
      * pairing strata by a fixed rule would tie each ray's end to its start
      * and bias the estimate. */
-    int perm[RAD_FF_MAX_RAYS];
-    for (int k = 0; k < count; k++)
-        perm[k] = k;
-    for (int k = count - 1; k > 0; k--) {
-        int m = (int)(rad_rng_uniform(rng) * (k + 1)), t = perm[k];
-        perm[k] = perm[m];
-        perm[m] = t;
-    }
+    int perm[RAD_FF_MAX_RAYS], first[RAD_FF_MAX_RAYS];
+    int cells = side * side;
+    shuffle_strata(perm, cells, rng);
+    /* With fewer rays than cells (count not a square), the near end's
+     * strata are a random subset too: a fixed subset would never sample
+     * the cells left over, and bias the fraction. */
+    if (count < cells)
+        shuffle_strata(first, cells, rng);
+    else
+        for (int k = 0; k < cells; k++)
+            first[k] = k;
     int m = 0;
     for (int k = 0; k < count; k++) {
-        int si = k, sj = perm[k];
+        int si = first[k], sj = perm[k];
         double u1 = ((si % side) + rad_rng_uniform(rng)) / side;
         double v1 = ((si / side) + rad_rng_uniform(rng)) / side;
         double u2 = ((sj % side) + rad_rng_uniform(rng)) / side;

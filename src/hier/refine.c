@@ -145,18 +145,24 @@ static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t 
         count = MAX;
     const hr_node *a = &t->nodes[r], *b = &t->nodes[s];
     double floor2 = fmin(a->area, b->area) / 16.0;
-    int side = (int)ceil(sqrt((double)count));
-    for (int k = 0; k < count; k++)
-        perm[k] = k;
-    for (int k = count - 1; k > 0; k--) {
+    int side = (int)ceil(sqrt((double)count)), cells = side * side;
+    int first[MAX];
+    /* Both ends' strata shuffled (a count that is not a square leaves
+     * cells over, which a fixed subset would never sample). */
+    for (int k = 0; k < cells; k++)
+        perm[k] = first[k] = k;
+    for (int k = cells - 1; k > 0; k--) {
         int m = (int)(rad_rng_uniform(rng) * (k + 1)), tmp = perm[k];
         perm[k] = perm[m];
         perm[m] = tmp;
+        m = (int)(rad_rng_uniform(rng) * (k + 1)), tmp = first[k];
+        first[k] = first[m];
+        first[m] = tmp;
     }
     int m = 0;
     for (int k = 0; k < count; k++) {
-        int sj = perm[k];
-        double u1 = ((k % side) + rad_rng_uniform(rng)) / side, v1 = ((k / side) + rad_rng_uniform(rng)) / side;
+        int si = first[k], sj = perm[k];
+        double u1 = ((si % side) + rad_rng_uniform(rng)) / side, v1 = ((si / side) + rad_rng_uniform(rng)) / side;
         double u2 = ((sj % side) + rad_rng_uniform(rng)) / side, v2 = ((sj / side) + rad_rng_uniform(rng)) / side;
         vec3 p = surface_end(t, a, u1, v1), q = surface_end(t, b, u2, v2);
         vec3 d = v3_sub(q, p);

@@ -36,6 +36,8 @@ struct rad_scene_builder {
     size_t polygon_count, polygon_capacity;
     rad_surface *surfaces;
     size_t surface_count, surface_capacity;
+    uint32_t *surface_hash;  /* open addressing: surface index + 1, 0 = empty */
+    size_t surface_hash_size; /* a power of two, > 2 x surface_count */
     rad_material *materials;
     size_t material_count, material_capacity;
     vec3 *polygon_scratch; /* the polygon being added, repeats dropped */
@@ -97,6 +99,7 @@ void rad_scene_builder_destroy(rad_scene_builder *b)
     free(b->indices);
     free(b->polygons);
     free(b->surfaces);
+    free(b->surface_hash);
     free(b->materials);
     free(b->polygon_scratch);
     free(b->triangle_scratch);
@@ -148,6 +151,15 @@ int rad_scene_builder_material(rad_scene_builder *b, const char *name,
     return (int)b->material_count++;
 }
 
+/* FNV-1a. */
+static uint64_t name_hash(const char *name)
+{
+    uint64_t h = 1469598103934665603ULL;
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++)
+        h = (h ^ *c) * 1099511628211ULL;
+    return h;
+}
+
 int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
 {
     if (!b)
@@ -157,11 +169,18 @@ int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
         snprintf(fallback, sizeof fallback, "surface_%zu", b->surface_count);
         name = fallback;
     }
-    /* A linear search: importers ask once per mesh, and scenes that a
-     * radiosity solve can handle have hundreds of surfaces, not millions. */
-    for (size_t i = 0; i < b->surface_count; i++)
-        if (strcmp(b->surfaces[i].name, name) == 0)
-            return (int)i;
+    /* Names are hashed (FNV-1a, open addressing): generated scenes have
+     * 10^5 surfaces, where a linear search per polygon takes minutes. */
+    uint64_t h = name_hash(name);
+    if (b->surface_hash_size) {
+        for (size_t k = h & (b->surface_hash_size - 1);; k = (k + 1) & (b->surface_hash_size - 1)) {
+            uint32_t e = b->surface_hash[k];
+            if (!e)
+                break;
+            if (strcmp(b->surfaces[e - 1].name, name) == 0)
+                return (int)(e - 1);
+        }
+    }
     if (b->surface_count >= INT_MAX) {
         rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: too many surfaces", b->source);
         return -1;
@@ -178,6 +197,29 @@ int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
         rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
         return -1;
     }
+    /* Grow the table to keep it under half full, then insert. */
+    if (2 * (b->surface_count + 1) >= b->surface_hash_size) {
+        size_t size = b->surface_hash_size ? 2 * b->surface_hash_size : 64;
+        uint32_t *table = calloc(size, sizeof *table);
+        if (!table) {
+            free(s->name);
+            rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+            return -1;
+        }
+        for (size_t i = 0; i < b->surface_count; i++) {
+            size_t k = name_hash(b->surfaces[i].name) & (size - 1);
+            while (table[k])
+                k = (k + 1) & (size - 1);
+            table[k] = (uint32_t)(i + 1);
+        }
+        free(b->surface_hash);
+        b->surface_hash = table;
+        b->surface_hash_size = size;
+    }
+    size_t k = h & (b->surface_hash_size - 1);
+    while (b->surface_hash[k])
+        k = (k + 1) & (b->surface_hash_size - 1);
+    b->surface_hash[k] = (uint32_t)(b->surface_count + 1);
     return (int)b->surface_count++;
 }
 
