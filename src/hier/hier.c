@@ -449,6 +449,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                            .shadow_rays = p->shadow_rays > 0 ? (4 * p->shadow_rays < 64 ? 4 * p->shadow_rays : 64) : 16,
                            .epsilon = epsilon_abs,
                            .tol = 1e-9 * rad_scene_diagonal(scene),
+                           .max_memory = p->max_memory,
                            .threads = rad_context_threads(ctx)};
     hr_refine_stats rs = {0};
     r = hr_links_initial(ctx, &st.tree, &rp, &st.links, &rs);

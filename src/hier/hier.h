@@ -132,6 +132,7 @@ typedef struct hr_refine_params {
     int shadow_rays;      /* per link whose shaft is not empty */
     double epsilon;       /* power error allowed per link, W */
     double tol;           /* geometric tolerance, m */
+    double max_memory;    /* bytes the link lists may take */
     int threads;
 } hr_refine_params;
 

@@ -455,7 +455,7 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
     *split = 0;
     uint8_t *action = NULL;
     size_t *first = NULL;
-    hr_links next = {0};
+    hr_links next = {0}, done = {0};
     rad_result r = RAD_OK;
     /* B covers the nodes that existed when it was computed; new nodes take
      * their parent's value (children of a node average to it). */
@@ -513,13 +513,18 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
             break;
         *split += splits;
         st->passes++;
-        /* Serial: children, in link order (node numbers are deterministic). */
+        /* Serial: links kept are final for this call (B and the spreads do
+         * not change within it), so they leave the active set; children are
+         * made in link order (node numbers are deterministic). */
+        size_t keep = L - splits;
+        if ((r = links_reserve(ctx, &done, done.count + keep)) != RAD_OK)
+            break;
         size_t total = 0;
         for (size_t i = 0; i < L && r == RAD_OK; i++) {
             const hr_link *l = &links->items[i];
             first[i] = total;
             if (action[i] == KEEP) {
-                total += 1;
+                done.items[done.count++] = *l;
                 continue;
             }
             if (action[i] & SPLIT_R)
@@ -533,10 +538,14 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
         first[L] = total;
         if (r != RAD_OK)
             break;
-        if ((double)total * sizeof(hr_link) > 0.5 * 1e12 ||
+        if ((double)(total + done.count) * sizeof(hr_link) > p->max_memory ||
             (r = links_reserve(ctx, &next, total)) != RAD_OK) {
             if (r == RAD_OK)
-                r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: %zu links", total);
+                r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                             "hierarchical: %zu links need %.3g GB, over the limit of %.3g GB (--max-memory); "
+                             "use a larger --epsilon or --min-area",
+                             total + done.count, (double)(total + done.count) * sizeof(hr_link) / 1e9,
+                             p->max_memory / 1e9);
             break;
         }
         uint64_t rays = 0, shafts = 0, clear = 0, created = 0, dropped = 0;
@@ -547,10 +556,8 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
         for (size_t i = 0; i < L; i++) {
             const hr_link *l = &links->items[i];
             size_t o = first[i];
-            if (action[i] == KEEP) {
-                out[o] = *l;
+            if (action[i] == KEEP)
                 continue;
-            }
             int cr = action[i] & SPLIT_R ? hr_children(t, l->r) : 1;
             int cs = action[i] & SPLIT_S ? hr_children(t, l->s) : 1;
             for (int x = 0; x < cr; x++)
@@ -582,6 +589,15 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
         *links = next;
         next = tmp;
     }
+    /* The links still active are kept too; the result is all of them. */
+    if (r == RAD_OK && (r = links_reserve(ctx, &done, done.count + links->count)) == RAD_OK) {
+        memcpy(done.items + done.count, links->items, links->count * sizeof *links->items);
+        done.count += links->count;
+        hr_links tmp = *links;
+        *links = done;
+        done = tmp;
+    }
+    free(done.items);
     free(next.items);
     free(action);
     free(first);
