@@ -163,8 +163,8 @@ static int interrupted_status(void) { return cancel_signal == SIGTERM ? 143 : 13
  * "partial": true and the phase it stopped in).  Written to a temporary
  * name and renamed, as every output is, so it is whole or absent.  Returns
  * 0 when written. */
-static int write_interrupted_stats(const char *path, const char *phase, const rad_scene *scene,
-                                   double seconds)
+static int write_interrupted_stats(const char *path, const char *phase, const char *scene_name,
+                                   const rad_scene *scene, double seconds)
 {
     char temp[PATH_MAX];
     if (snprintf(temp, sizeof temp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof temp)
@@ -172,11 +172,13 @@ static int write_interrupted_stats(const char *path, const char *phase, const ra
     FILE *f = fopen(temp, "w");
     if (!f)
         return -1;
-    fprintf(f,
-            "{\n\t\"partial\":\ttrue,\n\t\"interrupted\":\t\"%s\",\n\t\"converged\":\tfalse,\n"
-            "\t\"scene\":\t{\n\t\t\"surfaces\":\t%zu,\n\t\t\"polygons\":\t%zu\n\t},\n"
-            "\t\"seconds\":\t{\n\t\t\"total\":\t%.6g\n\t}\n}\n",
-            phase, rad_scene_surface_count(scene), rad_scene_polygon_count(scene), seconds);
+    fprintf(f, "{\n\t\"version\":\t\"%s\",\n\t\"partial\":\ttrue,\n\t\"interrupted\":\t\"%s\",\n"
+               "\t\"converged\":\tfalse,\n\t\"scene\":\t\"",
+            RAD_VERSION_STRING, phase);
+    for (const unsigned char *c = (const unsigned char *)scene_name; *c; c++) /* JSON string */
+        fprintf(f, *c == '"' || *c == '\\' ? "\\%c" : *c < 0x20 ? "\\u%04x" : "%c", *c);
+    fprintf(f, "\",\n\t\"surfaces\":\t%zu,\n\t\"seconds\":\t{\n\t\t\"total\":\t%.6g\n\t}\n}\n",
+            rad_scene_surface_count(scene), seconds);
     int failed = ferror(f);
     failed |= fclose(f) != 0;
     if (failed || rename(temp, path) != 0) {
@@ -273,8 +275,9 @@ int main(int argc, char **argv)
     progress_end(&progress);
     if (r == RAD_ERROR_INTERRUPTED) {
         /* No radiosity yet, so no image: only the stats say what happened. */
-        int wrote = s.stats && write_interrupted_stats(s.stats, "form factors", scene,
-                                                       now_seconds() - t0) == 0;
+        int wrote = s.stats && write_interrupted_stats(s.stats, "form factors",
+                                                       s.scene_path ? s.scene_path : "cornell-box",
+                                                       scene, now_seconds() - t0) == 0;
         fprintf(stderr, "radiosity: interrupted while computing form factors; %s\n",
                 wrote ? "wrote partial stats only" : "nothing written");
         status = interrupted_status();

@@ -422,6 +422,7 @@ static void test_interrupt_during_form_factors(void **state)
     slurp(path, text, sizeof text);
     assert_non_null(strstr(text, "\"partial\":\ttrue"));
     assert_non_null(strstr(text, "\"interrupted\":\t\"form factors\""));
+    assert_non_null(strstr(text, "\"scene\":\t\"cornell-box\""));
     assert_non_null(strstr(text, "\"surfaces\":\t8"));
     assert_no_output("ffint.png");
     assert_no_output("ffint.json.tmp");

@@ -504,6 +504,7 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
     scene->camera = b->camera;
     free(b->polygon_scratch);
     free(b->triangle_scratch);
+    free(b->surface_hash);
     memset(b, 0, sizeof *b); /* all moved or freed: the destroy below frees the shell */
     *out = scene;
     scene = NULL;
