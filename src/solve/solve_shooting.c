@@ -90,7 +90,7 @@ typedef struct hit_record {
 } hit_record;
 
 /* Cast N rays from element i; record the element each reaches. */
-static void shoot_rays(const rad_system *sys, uint32_t i, uint64_t key, int N, double eps,
+static void shoot_rays(const rad_context *ctx, const rad_system *sys, uint32_t i, uint64_t key, int N, double eps,
                        hit_record *out, rad_ray *rays, rad_hit *hits)
 {
     const rad_mesh *mesh = sys->mesh;
@@ -109,6 +109,8 @@ static void shoot_rays(const rad_system *sys, uint32_t i, uint64_t key, int N, d
     if (side < 1)
         side = 1;
     for (int first = 0; first < N; first += RAY_BLOCK) {
+        if (rad_cancelled(ctx))
+            return; /* the caller discards the batch */
         int count = N - first < RAY_BLOCK ? N - first : RAY_BLOCK;
         for (int k = 0; k < count; k++) {
             int s = first + k;
@@ -223,8 +225,24 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
 #ifdef _OPENMP
             tid = omp_get_thread_num();
 #endif
-            shoot_rays(sys, shooter[k], (uint64_t)batch, N, eps, hits + (size_t)k * N,
+            shoot_rays(ctx, sys, shooter[k], (uint64_t)batch, N, eps, hits + (size_t)k * N,
                        rays + (size_t)tid * RAY_BLOCK, rhits + (size_t)tid * RAY_BLOCK);
+        }
+        if (rad_cancelled(ctx)) {
+            /* Interrupted inside the batch (a shot of 10^8 rays takes
+             * seconds): its hits are incomplete, so the shooters get their
+             * unshot power back and B stays the last whole batch's. */
+            for (int k = 0; k < K; k++) {
+                uint32_t i = shooter[k];
+                for (int c = 0; c < 3; c++) {
+                    dB[3 * i + c] = power[k][c] / sys->area[i];
+                    unshot_c[c] += power[k][c];
+                }
+                h.key[i] = sys->area[i] * (dB[3 * i] + dB[3 * i + 1] + dB[3 * i + 2]);
+                heap_fix(&h, i);
+            }
+            result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %lld batches", batch);
+            break;
         }
         rays_cast += (uint64_t)K * (uint64_t)N;
         /* Deposits, in shooter order (deterministic). */
