@@ -38,6 +38,9 @@ typedef struct hr_state {
     size_t *offset;       /* receiver k's links: [offset[k], offset[k + 1]) */
     double *B, *H, *Ht;   /* 3 per node */
     double *spread;       /* per node: max |B_child - B| over children and channels */
+    float *open;          /* per node: fraction of its area outside every solid; -1 for a
+                             leaf not measured yet (see measure_open) */
+    float *send;          /* per node: 1 / open (0 when closed): the gather's source scale */
     double *bins_in;      /* 18 per cluster: [channel][signed axis] */
     double *bins_total;   /* 18 per cluster, pushed down */
     double *bins_exit;    /* 18 per cluster, pulled up: sum A B |n_a| */
@@ -79,7 +82,13 @@ static rad_result ensure_values(hr_state *st)
     double *sp = realloc(st->spread, n * sizeof *sp);
     if (sp)
         st->spread = sp;
-    if (!B || !H || !Ht || !sp)
+    float *op = realloc(st->open, n * sizeof *op);
+    if (op)
+        st->open = op;
+    float *se = realloc(st->send, n * sizeof *se);
+    if (se)
+        st->send = se;
+    if (!B || !H || !Ht || !sp || !op || !se)
         return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "hierarchical: out of memory for %zu nodes; use a larger --epsilon or --min-area", n);
     for (size_t k = st->values; k < n; k++) {
@@ -92,6 +101,8 @@ static rad_result ensure_values(hr_state *st)
             st->Ht[3 * k + (size_t)c] = 0.0;
         }
         st->spread[k] = 0.0;
+        st->open[k] = -1.0f;
+        st->send[k] = 1.0f;
     }
     st->values = n;
     return RAD_OK;
@@ -148,6 +159,8 @@ static void gather(hr_state *st)
             const hr_node *ns = &t->nodes[l->s];
             const double *Bs = &st->B[3 * (size_t)l->s];
             double kk = l->k;
+            if (ns->kind == HR_SURFACE)
+                kk *= st->send[l->s]; /* what it reflects leaves from its open part */
             if (!bins && ns->kind == HR_SURFACE) {
                 h[0] += kk * Bs[0];
                 h[1] += kk * Bs[1];
@@ -266,6 +279,80 @@ static rad_result solve(hr_state *st, double tol, int cap, double *residual, boo
         }
     }
     return RAD_OK;
+}
+
+/* Contact lines.  A leaf that runs under a block resting on it is partly
+ * inside a solid: its links' visibility is 0 from the hidden part, so what
+ * it reflects, averaged over its whole area, would leave from the open part
+ * only and the rest vanish (0.3% of the power for one box on a floor).  So
+ * each leaf's open fraction is measured (cosine-weighted rays from random
+ * points; a point is inside when its ray first meets the back of a
+ * surface), and a source's radiosity is sent as B / open: the power it
+ * reflects, from the part that can send it.  Internal nodes take the area
+ * mean of their children's open fractions. */
+static void measure_open(hr_state *st, const rad_vis *vis, uint64_t seed)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    enum { RAYS = 16 };
+#pragma omp parallel for schedule(dynamic, 64) num_threads(rad_context_threads(st->ctx))
+    for (size_t k = 0; k < n; k++) {
+        const hr_node *nd = &t->nodes[k];
+        if (nd->kind != HR_SURFACE || nd->child[0] || st->open[k] >= 0.0f)
+            continue;
+        if (!vis) {
+            st->open[k] = 1.0f;
+            continue;
+        }
+        rad_rng rng = rad_rng_keyed(seed ^ 0x4f50454eULL, k, 0);
+        rad_ray ray[RAYS];
+        rad_hit hit[RAYS];
+        vec3 tn = v3_normalize(fabs(nd->normal.x) > 0.9 ? v3_cross(nd->normal, v3(0, 1, 0))
+                                                        : v3_cross(nd->normal, v3(1, 0, 0)));
+        vec3 bn = v3_cross(nd->normal, tn);
+        double lift = t->lift[nd->patch];
+        for (int r = 0; r < RAYS; r++) {
+            double u = ((r % 4) + rad_rng_uniform(&rng)) / 4.0, v = ((r / 4) + rad_rng_uniform(&rng)) / 4.0;
+            vec3 p;
+            double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
+            if (nd->corners == 3) {
+                if (pu + pv > 1.0)
+                    pu = 1.0 - pu, pv = 1.0 - pv;
+                p = v3_add(nd->corner[0], v3_add(v3_scale(v3_sub(nd->corner[1], nd->corner[0]), pu),
+                                                 v3_scale(v3_sub(nd->corner[2], nd->corner[0]), pv)));
+            } else {
+                p = v3_lerp(v3_lerp(nd->corner[0], nd->corner[1], pu), v3_lerp(nd->corner[3], nd->corner[2], pu), pv);
+            }
+            double rr = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
+            ray[r].origin = v3_mad(p, nd->normal, lift);
+            ray[r].direction = v3_add(v3_add(v3_scale(tn, rr * cos(phi)), v3_scale(bn, rr * sin(phi))),
+                                      v3_scale(nd->normal, z));
+            ray[r].tnear = 0.0;
+            ray[r].tfar = INFINITY;
+        }
+        vis->backend->intersect(vis->state, ray, RAYS, hit);
+        int open = 0;
+        for (int r = 0; r < RAYS; r++)
+            open += !(isfinite(hit[r].t) &&
+                      v3_dot(ray[r].direction, t->base->patches[hit[r].patch].normal) > 0.0);
+        st->open[k] = (float)open / RAYS;
+    }
+    /* Internal nodes: area means, bottom-up. */
+    for (size_t k = n; k-- > 0;) {
+        const hr_node *nd = &t->nodes[k];
+        if (nd->kind != HR_SURFACE || !nd->child[0])
+            continue;
+        double a = 0.0, f = 0.0;
+        for (uint32_t q = 0; q < 4; q++) {
+            a += t->nodes[nd->child[0] + q].area;
+            f += t->nodes[nd->child[0] + q].area * st->open[nd->child[0] + q];
+        }
+        st->open[k] = (float)(a > 0.0 ? f / a : 1.0);
+    }
+    for (size_t k = 0; k < n; k++) {
+        float o = t->nodes[k].kind == HR_SURFACE ? st->open[k] : 1.0f;
+        st->send[k] = o > 1e-3f ? 1.0f / o : 0.0f;
+    }
 }
 
 /* How much each node's radiosity varies below it, max over its leaves and
@@ -470,6 +557,8 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
             r = hr_refine(ctx, &st.tree, &rp, st.B, st.spread, &st.links, &split, &rs);
         if (r == RAD_OK)
             r = ensure_values(&st);
+        if (r == RAD_OK)
+            measure_open(&st, p->vis, p->seed);
         if (r == RAD_OK && split > 0)
             r = sort_links(&st);
         if (r == RAD_OK && bytes_in_use(&st) > p->max_memory)
@@ -545,6 +634,8 @@ done:
     free(st.H);
     free(st.Ht);
     free(st.spread);
+    free(st.open);
+    free(st.send);
     free(st.bins_in);
     free(st.bins_total);
     free(st.bins_exit);
