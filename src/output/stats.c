@@ -32,24 +32,34 @@ static rad_result write_json(rad_context *ctx, cJSON *root, const char *path)
 }
 
 /* Area-weighted material figures of one surface, over its elements. */
-static void surface_materials(const rad_solution *s, size_t surface, double rho[3], double E[3])
+/* Area-weighted means per surface of reflectance, emission and radiosity,
+ * in one pass over the elements (9 doubles per surface: rho, E, B), so
+ * that scenes of 10^5 surfaces and 10^6 elements are not S x n.  NULL when
+ * out of memory. */
+static double *surface_means(const rad_solution *s)
 {
-    double area = 0.0;
-    for (int c = 0; c < 3; c++)
-        rho[c] = E[c] = 0.0;
+    size_t S = s->scene->surface_count;
+    double *m = calloc(S ? 9 * S : 1, sizeof *m), *area = calloc(S ? S : 1, sizeof *area);
+    if (!m || !area) {
+        free(m);
+        free(area);
+        return NULL;
+    }
     for (size_t i = 0; i < s->mesh->element_count; i++) {
-        if (s->mesh->elements[i].surface != surface)
-            continue;
-        area += s->area[i];
+        size_t k = s->mesh->elements[i].surface;
+        double a = s->area[i];
+        area[k] += a;
         for (int c = 0; c < 3; c++) {
-            rho[c] += s->area[i] * s->reflectance[3 * i + c];
-            E[c] += s->area[i] * s->emission[3 * i + c];
+            m[9 * k + (size_t)c] += a * s->reflectance[3 * i + (size_t)c];
+            m[9 * k + 3 + (size_t)c] += a * s->emission[3 * i + (size_t)c];
+            m[9 * k + 6 + (size_t)c] += a * s->radiosity[3 * i + (size_t)c];
         }
     }
-    for (int c = 0; c < 3; c++) {
-        rho[c] = area > 0.0 ? rho[c] / area : 0.0;
-        E[c] = area > 0.0 ? E[c] / area : 0.0;
-    }
+    for (size_t k = 0; k < S; k++)
+        for (int q = 0; q < 9; q++)
+            m[9 * k + (size_t)q] = area[k] > 0.0 ? m[9 * k + (size_t)q] / area[k] : 0.0;
+    free(area);
+    return m;
 }
 
 rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, const char *path,
@@ -143,18 +153,21 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     cJSON_AddNumberToObject(power, "escaped", emitted - absorbed);
 
     cJSON *surfaces = cJSON_AddArrayToObject(root, "surfaces");
+    double *means = surface_means(s);
+    if (!means) {
+        cJSON_Delete(root);
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
     for (size_t k = 0; k < s->scene->surface_count; k++) {
         cJSON *o = cJSON_CreateObject();
-        double rho[3], E[3], B[3];
-        surface_materials(s, k, rho, E);
-        rad_solution_surface_radiosity(s, k, B);
         cJSON_AddStringToObject(o, "name", s->scene->surfaces[k].name);
         cJSON_AddNumberToObject(o, "area", s->scene->surfaces[k].area);
-        cJSON_AddItemToObject(o, "reflectance", rgb_array(rho));
-        cJSON_AddItemToObject(o, "emission", rgb_array(E));
-        cJSON_AddItemToObject(o, "radiosity", rgb_array(B));
+        cJSON_AddItemToObject(o, "reflectance", rgb_array(&means[9 * k]));
+        cJSON_AddItemToObject(o, "emission", rgb_array(&means[9 * k + 3]));
+        cJSON_AddItemToObject(o, "radiosity", rgb_array(&means[9 * k + 6]));
         cJSON_AddItemToArray(surfaces, o);
     }
+    free(means);
 
     cJSON *sec = cJSON_AddObjectToObject(root, "seconds");
     cJSON_AddNumberToObject(sec, "load", s->seconds.load);
