@@ -310,19 +310,11 @@ static void measure_open(hr_state *st, const rad_vis *vis, uint64_t seed)
         vec3 tn = v3_normalize(fabs(nd->normal.x) > 0.9 ? v3_cross(nd->normal, v3(0, 1, 0))
                                                         : v3_cross(nd->normal, v3(1, 0, 0)));
         vec3 bn = v3_cross(nd->normal, tn);
-        double lift = t->lift[nd->patch];
         for (int r = 0; r < RAYS; r++) {
             double u = ((r % 4) + rad_rng_uniform(&rng)) / 4.0, v = ((r / 4) + rad_rng_uniform(&rng)) / 4.0;
-            vec3 p;
-            double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
-            if (nd->corners == 3) {
-                if (pu + pv > 1.0)
-                    pu = 1.0 - pu, pv = 1.0 - pv;
-                p = v3_add(nd->corner[0], v3_add(v3_scale(v3_sub(nd->corner[1], nd->corner[0]), pu),
-                                                 v3_scale(v3_sub(nd->corner[2], nd->corner[0]), pv)));
-            } else {
-                p = v3_lerp(v3_lerp(nd->corner[0], nd->corner[1], pu), v3_lerp(nd->corner[3], nd->corner[2], pu), pv);
-            }
+            vec3 p, normal;
+            double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng), lift;
+            hr_sample(t, (uint32_t)k, pu, pv, 0.0, &p, &normal, &lift);
             double rr = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
             ray[r].origin = v3_mad(p, nd->normal, lift);
             ray[r].direction = v3_add(v3_add(v3_scale(tn, rr * cos(phi)), v3_scale(bn, rr * sin(phi))),
