@@ -58,7 +58,7 @@ static const option_def OPTIONS[] = {
     {OPT_EPSILON, 0, "epsilon", "X", CLI_RENDER,
      "hierarchical: refine links whose error exceeds X x the mean emitted exitance (default 1e-3)"},
     {OPT_MIN_AREA, 0, "min-area", "A", CLI_RENDER,
-     "hierarchical: smallest element area, m^2 (default 1e-4 x the total area)"},
+     "hierarchical: smallest element area, m^2 (default 1e-4 x the total area x min(1, 100 / patches))"},
     {OPT_CLUSTERING, 0, "clustering", "WHEN", CLI_RENDER,
      "hierarchical: start from a cluster hierarchy 'on', 'off' or 'auto' (> 64 patches; default)"},
     {OPT_TOLERANCE, 0, "tolerance", "X", CLI_RENDER,

@@ -206,7 +206,8 @@ typedef struct rad_options {
      * the power the scene emits; elements are not split below min_area.  Its
      * progress reaches the history, not on_step (the mesh changes as it runs). */
     double epsilon;               /* 0 = 1e-4 */
-    double min_area;              /* m^2; 0 = 1e-4 x the scene's total area */
+    double min_area;              /* m^2; 0 = 1e-4 x the scene's total area, divided by
+                                     patches / 100 when there are more than 100 */
     int clustering;               /* 0 = automatic (when the scene has more than 64
                                      patches), 1 = always, -1 = never */
 

@@ -490,7 +490,10 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         power += e->area * (E[0] + E[1] + E[2]) / 3.0;
     }
     double epsilon_abs = (p->epsilon > 0.0 ? p->epsilon : 1e-4) * power;
-    double min_area = p->min_area > 0.0 ? p->min_area : 1e-4 * area;
+    /* Default: 1e-4 of the area, per 100 patches beyond the first 100, so
+     * that a building of 10^5 polygons is not held to rooms' worth of area. */
+    double patches = (double)base->patch_count;
+    double min_area = p->min_area > 0.0 ? p->min_area : 1e-4 * area * fmin(1.0, 100.0 / patches);
     bool clustered = p->clustering > 0 || (p->clustering == 0 && base->patch_count > 64);
     hs->epsilon_abs = epsilon_abs;
     hs->min_area = min_area;
