@@ -247,9 +247,63 @@ static void test_cornell_converges(void **state)
     rad_scene_destroy(scene);
 }
 
+/* A closed tetrahedron, normals inward, one face emitting: triangle
+ * patches only (no pair is coplanar, so none merges into a quad). */
+static rad_scene *tetrahedron(void)
+{
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "tetrahedron");
+    double r[3] = {0.5, 0.5, 0.5}, e0[3] = {0, 0, 0}, e1[3] = {1, 1, 1};
+    int m0 = rad_scene_builder_material(b, "wall", r, e0), m1 = rad_scene_builder_material(b, "lamp", r, e1);
+    const vec3 v[4] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    const int f[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+    const char *names[4] = {"z0", "y0", "x0", "slope"};
+    for (int k = 0; k < 4; k++) {
+        vec3 tri[3] = {v[f[k][0]], v[f[k][1]], v[f[k][2]]};
+        vec3 n = v3_cross(v3_sub(tri[1], tri[0]), v3_sub(tri[2], tri[0]));
+        if (v3_dot(n, v3_sub(v3(0.25, 0.25, 0.25), tri[0])) < 0.0) { /* face inward */
+            vec3 t = tri[1];
+            tri[1] = tri[2];
+            tri[2] = t;
+        }
+        assert_int_equal(rad_scene_builder_polygon(b, rad_scene_builder_surface(b, names[k]), k == 3 ? m1 : m0,
+                                                   tri, 3, 0),
+                         RAD_OK);
+    }
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_OK);
+    return scene;
+}
+
+static void assert_leaves_locate(const rad_solution *s)
+{
+    const rad_mesh *mesh = s->mesh;
+    assert_non_null(mesh->tree);
+    for (size_t i = 0; i < mesh->element_count; i++) {
+        const rad_element *e = &mesh->elements[i];
+        double ps, pt, ls, lt;
+        rad_patch_parameters(&mesh->patches[e->patch], e->centroid, &ps, &pt);
+        assert_int_equal(rad_mesh_locate(mesh, e->patch, ps, pt, &ls, &lt), i);
+        /* The centroid's local coordinates: (1/3, 1/3) on triangles; about
+         * (1/2, 1/2) on quads (the area centroid of a trapezoid is not the
+         * bilinear centre). */
+        double want = e->vertex_count == 4 ? 0.5 : 1.0 / 3.0, tol = e->vertex_count == 4 ? 0.05 : 1e-6;
+        if (!(fabs(ls - want) < tol && fabs(lt - want) < tol))
+            fail_msg("leaf %zu (%u corners): local (%g, %g), want (%g, %g)", i, e->vertex_count, ls, lt, want,
+                     want);
+    }
+}
+
 static void test_leaves_locate(void **state)
 {
     (void)state;
+    rad_scene *tet = tetrahedron();
+    rad_solution *ts = solve(tet, 1e-5, 0);
+    assert_true(ts->mesh->element_count > 16);
+    assert_int_equal(ts->mesh->elements[0].vertex_count, 3);
+    assert_leaves_locate(ts);
+    rad_solution_destroy(ts);
+    rad_scene_destroy(tet);
+
     rad_scene *scene = cornell(false);
     rad_solution *s = solve(scene, 1e-4, 0);
     const rad_mesh *mesh = s->mesh;
@@ -257,13 +311,7 @@ static void test_leaves_locate(void **state)
     assert_int_equal(mesh->element_count, s->hier_stats.leaves);
     assert_true(mesh->tvertex_count > 0); /* neighbours at different levels */
     /* Each leaf's centre locates to that leaf. */
-    for (size_t i = 0; i < mesh->element_count; i++) {
-        const rad_element *e = &mesh->elements[i];
-        const rad_patch *p = &mesh->patches[e->patch];
-        double ps, pt, ls, lt;
-        rad_patch_parameters(p, e->centroid, &ps, &pt);
-        assert_int_equal(rad_mesh_locate(mesh, e->patch, ps, pt, &ls, &lt), i);
-    }
+    assert_leaves_locate(s);
     /* Leaves tile their patches: areas add up to the base patch areas. */
     const rad_mesh *base = s->hier_base;
     for (size_t p = 0; p < base->patch_count; p++) {

@@ -128,6 +128,36 @@ static rad_result check_ff_scratch(rad_context *ctx, const rad_options *o, size_
     return RAD_OK;
 }
 
+/* Area, reflectance and emission per element of `mesh` (3 per element for
+ * the last two); nothing is allocated on failure. */
+static rad_result element_arrays(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh, double **area,
+                                 double **reflectance, double **emission)
+{
+    size_t n = mesh->element_count;
+    double *a = rad_alloc_array(ctx, n, sizeof *a, "solution: areas");
+    double *rho = rad_alloc_array(ctx, 3 * n, sizeof *rho, "solution: reflectance");
+    double *E = rad_alloc_array(ctx, 3 * n, sizeof *E, "solution: emission");
+    if (!a || !rho || !E) {
+        free(a);
+        free(rho);
+        free(E);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const rad_element *e = &mesh->elements[i];
+        const rad_material *m = &scene->materials[e->material];
+        a[i] = e->area;
+        for (int c = 0; c < 3; c++) {
+            rho[3 * i + (size_t)c] = m->reflectance[c];
+            E[3 * i + (size_t)c] = m->emission[c];
+        }
+    }
+    *area = a;
+    *reflectance = rho;
+    *emission = E;
+    return RAD_OK;
+}
+
 rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const rad_options *options,
                                rad_solution **out)
 {
@@ -166,24 +196,12 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->seconds.visibility = s->vis->build_seconds;
 
     /* 3. per-element materials */
-    s->area = rad_alloc_array(ctx, n, sizeof *s->area, "solution: areas");
-    s->reflectance = rad_alloc_array(ctx, 3 * n, sizeof *s->reflectance, "solution: reflectance");
-    s->emission = rad_alloc_array(ctx, 3 * n, sizeof *s->emission, "solution: emission");
     s->radiosity = rad_alloc_array(ctx, 3 * n, sizeof *s->radiosity, "solution: radiosity");
-    if (!s->area || !s->reflectance || !s->emission || !s->radiosity) {
+    if (!s->radiosity || element_arrays(ctx, scene, s->mesh, &s->area, &s->reflectance, &s->emission) != RAD_OK) {
         r = RAD_ERROR_OUT_OF_MEMORY;
         goto fail;
     }
-    for (size_t i = 0; i < n; i++) {
-        const rad_element *e = &s->mesh->elements[i];
-        const rad_material *m = &scene->materials[e->material];
-        s->area[i] = e->area;
-        for (int c = 0; c < 3; c++) {
-            s->reflectance[3 * i + c] = m->reflectance[c];
-            s->emission[3 * i + c] = m->emission[c];
-            s->radiosity[3 * i + c] = m->emission[c];
-        }
-    }
+    memcpy(s->radiosity, s->emission, 3 * n * sizeof *s->radiosity);
 
     /* 4. form factors (unless the solver computes its own on the fly) */
     if (!(rad_solver_find(s->options.solver)->flags & RAD_SOLVER_MATRIX_FREE)) {
@@ -287,26 +305,11 @@ static rad_result solve_hierarchical(rad_context *ctx, rad_solution *s)
     s->solve_stats.seconds = rad_seconds() - t;
     s->seconds.solve = s->solve_stats.seconds;
     if (leaves) {
-        size_t n = leaves->element_count;
-        double *area = rad_alloc_array(ctx, n, sizeof *area, "solution: areas");
-        double *rho = rad_alloc_array(ctx, 3 * n, sizeof *rho, "solution: reflectance");
-        double *E = rad_alloc_array(ctx, 3 * n, sizeof *E, "solution: emission");
-        if (!area || !rho || !E) {
-            free(area);
-            free(rho);
-            free(E);
+        double *area, *rho, *E;
+        if (element_arrays(ctx, s->scene, leaves, &area, &rho, &E) != RAD_OK) {
             free(B);
             rad_mesh_destroy(leaves);
             return RAD_ERROR_OUT_OF_MEMORY;
-        }
-        for (size_t i = 0; i < n; i++) {
-            const rad_element *e = &leaves->elements[i];
-            const rad_material *m = &s->scene->materials[e->material];
-            area[i] = e->area;
-            for (int c = 0; c < 3; c++) {
-                rho[3 * i + c] = m->reflectance[c];
-                E[3 * i + c] = m->emission[c];
-            }
         }
         if (!s->hier_base)
             s->hier_base = s->mesh;

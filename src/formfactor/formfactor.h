@@ -141,6 +141,11 @@ void rad_ff_end_element(const rad_mesh *mesh, uint32_t e, double eps, rad_ff_end
  * rays of the pairs that face each other (each end in front of the other's
  * plane); *facing = how many were cast (also added to *rays_cast).
  * Returns how many pass.  Cannot fail. */
+/* The rays of rad_ff_rays without casting them: fills rays[] (room for
+ * RAD_FF_MAX_RAYS) with the facing pairs, ray k from a's point to b's
+ * (tnear 0, tfar 1), and returns how many.  Cannot fail. */
+int rad_ff_pairs(const rad_ff_end *a, const rad_ff_end *b, int count, rad_rng *rng, rad_ray *rays);
+
 int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, int count,
                 rad_rng *rng, uint64_t *rays_cast, int *facing);
 

@@ -70,12 +70,8 @@ static void shuffle_strata(int *perm, int n, rad_rng *rng)
     }
 }
 
-int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, int count,
-                rad_rng *rng, uint64_t *rays_cast, int *facing)
+int rad_ff_pairs(const rad_ff_end *a, const rad_ff_end *b, int count, rad_rng *rng, rad_ray *rays)
 {
-    rad_ray rays[RAD_FF_MAX_RAYS];
-    uint8_t hit[RAD_FF_MAX_RAYS];
-    *facing = 0;
     if (count <= 0)
         return 0;
     if (count > RAD_FF_MAX_RAYS)
@@ -114,6 +110,16 @@ int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, in
         rays[m].tfar = 1.0;
         m++;
     }
+    return m;
+}
+
+int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, int count,
+                rad_rng *rng, uint64_t *rays_cast, int *facing)
+{
+    rad_ray rays[RAD_FF_MAX_RAYS];
+    uint8_t hit[RAD_FF_MAX_RAYS];
+    int m = rad_ff_pairs(a, b, count, rng, rays);
+    *facing = 0;
     if (m == 0)
         return 0;
     vis->backend->occluded(vis->state, rays, (size_t)m, hit);

@@ -102,91 +102,47 @@ static double cluster_visibility(const hr_tree *t, const rad_vis *vis, uint32_t 
     return (double)pass / m;
 }
 
-/* A ray end on a surface node at unit-square parameters: lifted off it and
- * pulled toward its centre by the patch's lift (visibility.c explains
- * both). */
-static vec3 surface_end(const hr_tree *t, const hr_node *n, double u, double v)
+/* A surface node as a ray end (visibility.c), lifted by its patch's lift. */
+static void end_of(const hr_tree *t, const hr_node *n, rad_ff_end *e)
 {
-    const vec3 *c = n->corner;
-    vec3 p;
-    if (n->corners == 3) {
-        if (u + v > 1.0) {
-            u = 1.0 - u;
-            v = 1.0 - v;
-        }
-        p = v3_add(c[0], v3_add(v3_scale(v3_sub(c[1], c[0]), u), v3_scale(v3_sub(c[2], c[0]), v)));
-    } else {
-        p = v3_lerp(v3_lerp(c[0], c[1], u), v3_lerp(c[3], c[2], u), v);
-    }
-    double lift = t->lift[n->patch];
-    vec3 in = v3_sub(n->center, p);
-    double d = v3_length(in);
-    p = d > lift ? v3_mad(p, in, lift / d) : n->center;
-    return v3_mad(p, n->normal, lift);
+    e->corners = n->corners;
+    for (int c = 0; c < 4; c++)
+        e->corner[c] = n->corner[c < n->corners ? c : 0];
+    e->normal = n->normal;
+    e->lift = t->lift[n->patch];
 }
 
 /* Visibility between two surface nodes from `count` stratified point pairs
- * (strata of the far end shuffled): the fraction of the facing pairs that
- * pass, each weighted by its point-to-point kernel cos cos / d^2 (d^2 kept
- * above a sixteenth of the smaller node's area, so no pair dominates).
- * Weighting by the kernel makes k V estimate int int K V / int int K, the
- * visibility the transfer needs: a plain fraction would misjudge pairs
- * where the near, strongly coupled points are the hidden ones.  *facing =
- * pairs cast; returns 1 when none faces. */
+ * (rad_ff_pairs): the fraction of the facing pairs that pass, each
+ * weighted by its point-to-point kernel cos cos / d^2 (d^2 kept above a
+ * sixteenth of the smaller node's area, so no pair dominates).  Weighting
+ * by the kernel makes k V estimate int int K V / int int K, the visibility
+ * the transfer needs: a plain fraction would misjudge pairs where the near,
+ * strongly coupled points are the hidden ones.  *facing = pairs cast;
+ * returns 1 when none faces. */
 static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s, int count,
                                  rad_rng *rng, uint64_t *rays, int *facing)
 {
-    enum { MAX = 64 };
-    rad_ray ray[MAX];
-    uint8_t hit[MAX];
-    double weight[MAX];
-    int perm[MAX];
-    if (count > MAX)
-        count = MAX;
+    rad_ray ray[RAD_FF_MAX_RAYS];
+    uint8_t hit[RAD_FF_MAX_RAYS];
     const hr_node *a = &t->nodes[r], *b = &t->nodes[s];
-    double floor2 = fmin(a->area, b->area) / 16.0;
-    int side = (int)ceil(sqrt((double)count)), cells = side * side;
-    int first[MAX];
-    /* Both ends' strata shuffled (a count that is not a square leaves
-     * cells over, which a fixed subset would never sample). */
-    for (int k = 0; k < cells; k++)
-        perm[k] = first[k] = k;
-    for (int k = cells - 1; k > 0; k--) {
-        int m = (int)(rad_rng_uniform(rng) * (k + 1)), tmp = perm[k];
-        perm[k] = perm[m];
-        perm[m] = tmp;
-        m = (int)(rad_rng_uniform(rng) * (k + 1)), tmp = first[k];
-        first[k] = first[m];
-        first[m] = tmp;
-    }
-    int m = 0;
-    for (int k = 0; k < count; k++) {
-        int si = first[k], sj = perm[k];
-        double u1 = ((si % side) + rad_rng_uniform(rng)) / side, v1 = ((si / side) + rad_rng_uniform(rng)) / side;
-        double u2 = ((sj % side) + rad_rng_uniform(rng)) / side, v2 = ((sj / side) + rad_rng_uniform(rng)) / side;
-        vec3 p = surface_end(t, a, u1, v1), q = surface_end(t, b, u2, v2);
-        vec3 d = v3_sub(q, p);
-        double ca = v3_dot(a->normal, d), cb = -v3_dot(b->normal, d);
-        if (!(ca > 0.0 && cb > 0.0))
-            continue;
-        double d2 = v3_dot(d, d);
-        weight[m] = ca * cb / (d2 * fmax(d2, floor2));
-        ray[m].origin = p;
-        ray[m].direction = d;
-        ray[m].tnear = 0.0;
-        ray[m].tfar = 1.0;
-        m++;
-    }
+    rad_ff_end ea, eb;
+    end_of(t, a, &ea);
+    end_of(t, b, &eb);
+    int m = rad_ff_pairs(&ea, &eb, count, rng, ray);
     *facing = m;
     if (m == 0)
         return 1.0;
     vis->backend->occluded(vis->state, ray, (size_t)m, hit);
     *rays += (uint64_t)m;
-    double pass = 0.0, all = 0.0;
+    double floor2 = fmin(a->area, b->area) / 16.0, pass = 0.0, all = 0.0;
     for (int k = 0; k < m; k++) {
-        all += weight[k];
+        vec3 d = ray[k].direction;
+        double d2 = v3_dot(d, d);
+        double w = v3_dot(a->normal, d) * -v3_dot(b->normal, d) / (d2 * fmax(d2, floor2));
+        all += w;
         if (!hit[k])
-            pass += weight[k];
+            pass += w;
     }
     return all > 0.0 ? pass / all : 1.0;
 }

@@ -11,10 +11,10 @@
  *    m30 +----mc-----+ m12       m20 +--+ m12      children: 0 (c0 m01 m20)
  *        |  0  |  1  |               |\3|\                   1 (m01 c1 m12)
  *     c0 +----m01----+ c1         c0 +--+--+ c1              2 (m20 m12 c2)
- *                                      m01                   3 (m12 m20 m01)
+ *                                      m01                   3 (m01 m12 m20)
  *
- * so a child's parameters follow from its parent's (mesh.c locates leaves
- * the same way).  Children are created on demand, four consecutive nodes,
+ * (rad_ff_split4, the quadratures' refinement step), so a child's
+ * parameters follow from its parent's (mesh.c locates leaves the same way).  Children are created on demand, four consecutive nodes,
  * always after their parent: index order is a topological order.
  *
  * Clusters.  With clustering, a binary bounding-volume hierarchy is built
@@ -263,20 +263,7 @@ rad_result hr_subdivide(rad_context *ctx, hr_tree *t, uint32_t k)
     hr_node parent = t->nodes[k];
     uint32_t first = (uint32_t)t->count;
     vec3 q[4][4];
-    const vec3 *c = parent.corner;
-    if (parent.corners == 4) {
-        vec3 m01 = v3_lerp(c[0], c[1], 0.5), m12 = v3_lerp(c[1], c[2], 0.5);
-        vec3 m23 = v3_lerp(c[3], c[2], 0.5), m30 = v3_lerp(c[0], c[3], 0.5);
-        vec3 mc = v3_lerp(m01, m23, 0.5);
-        vec3 child[4][4] = {{c[0], m01, mc, m30}, {m01, c[1], m12, mc}, {mc, m12, c[2], m23},
-                            {m30, mc, m23, c[3]}};
-        memcpy(q, child, sizeof q);
-    } else {
-        vec3 m01 = v3_lerp(c[0], c[1], 0.5), m12 = v3_lerp(c[1], c[2], 0.5), m20 = v3_lerp(c[2], c[0], 0.5);
-        vec3 child[4][4] = {{c[0], m01, m20, m20}, {m01, c[1], m12, m12}, {m20, m12, c[2], c[2]},
-                            {m12, m20, m01, m01}};
-        memcpy(q, child, sizeof q);
-    }
+    rad_ff_split4(parent.corner, parent.corners, q);
     for (int i = 0; i < 4; i++) {
         hr_node *n = &t->nodes[first + (uint32_t)i];
         memset(n, 0, sizeof *n);

@@ -157,8 +157,9 @@ uint32_t rad_mesh_locate(const rad_mesh *mesh, uint32_t patch, double s, double 
             c = 1, x = 2.0 * x - 1.0, y = 2.0 * y;
         } else if (y >= 0.5) {
             c = 2, x = 2.0 * x, y = 2.0 * y - 1.0;
-        } else {
-            c = 3, x = 1.0 - 2.0 * x, y = 1.0 - 2.0 * y;
+        } else { /* the medial child (m01, m12, m20) */
+            double lx = 2.0 * x + 2.0 * y - 1.0, ly = 1.0 - 2.0 * x;
+            c = 3, x = lx, y = ly;
         }
         entry = child[c];
     }
