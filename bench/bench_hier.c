@@ -4,11 +4,13 @@
  *   1. the Cornell box at falling epsilon: leaves, links, seconds and the
  *      worst per-surface error against the uniform 16k-element solution;
  *   2. generated offices (radiosity generate office) of 1, 10, 100 rooms
- *      (and 1000 with --big) at a fixed epsilon and minimum area: leaves,
- *      links, seconds and memory, and the fitted exponents of links and
- *      seconds against leaves.
+ *      (and 1000 with --big, 1000 and 1800 with --huge: about 10^6
+ *      leaves) at a fixed epsilon and minimum area: leaves, links,
+ *      seconds, memory, the energy balance (|absorbed - emitted| /
+ *      emitted: the building is closed) and the link closure, and the
+ *      fitted exponents of links and seconds against leaves.
  *
- *   ./build/bench/bench_hier [--big] [--threads N] [--csv FILE]
+ *   ./build/bench/bench_hier [--big | --huge] [--threads N] [--csv FILE]
  *
  * Fixed scenes, seeds and options: the counts are reproducible, the
  * seconds are this machine's.
@@ -68,12 +70,14 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--big") == 0)
             big = 1;
+        else if (strcmp(argv[i], "--huge") == 0)
+            big = 2;
         else if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc)
             threads = atoi(argv[++i]);
         else if (strcmp(argv[i], "--csv") == 0 && i + 1 < argc)
             csv = argv[++i];
         else {
-            fprintf(stderr, "usage: bench_hier [--big] [--threads N] [--csv FILE]\n");
+            fprintf(stderr, "usage: bench_hier [--big | --huge] [--threads N] [--csv FILE]\n");
             return 2;
         }
     }
@@ -84,7 +88,7 @@ int main(int argc, char **argv)
         return 1;
     FILE *out = csv ? fopen(csv, "w") : NULL;
     if (out)
-        fprintf(out, "scene,epsilon,leaves,links,seconds,bytes,error\n");
+        fprintf(out, "scene,epsilon,leaves,links,seconds,bytes,error,power\n");
 
     printf("Cornell box (%d threads), error = worst per-surface channel vs 16k uniform\n",
            rad_context_threads(ctx));
@@ -101,18 +105,19 @@ int main(int argc, char **argv)
         printf("%9.0e %8zu %9zu %8.1f %9.3f %7.2f%%\n", eps[i], h->leaves, h->links,
                (double)h->links / (double)h->leaves, s->solve_stats.seconds, 100.0 * worst_error(s));
         if (out)
-            fprintf(out, "cornell,%g,%zu,%zu,%.4f,%.0f,%.5f\n", eps[i], h->leaves, h->links, s->solve_stats.seconds,
+            fprintf(out, "cornell,%g,%zu,%zu,%.4f,%.0f,%.5f,\n", eps[i], h->leaves, h->links, s->solve_stats.seconds,
                     h->bytes, worst_error(s));
         rad_solution_destroy(s);
     }
     rad_scene_destroy(box);
 
     printf("\nOffices (seed 0, epsilon 1e-3, min area 0.02 m^2)\n");
-    printf("%6s %8s %9s %9s %8s %9s %9s\n", "rooms", "patches", "leaves", "links", "links/el", "seconds", "MB");
-    const int rooms[] = {1, 10, 100, 1000};
-    double lx[4], ll[4], lt[4];
+    printf("%6s %8s %9s %9s %8s %9s %9s %8s %8s\n", "rooms", "patches", "leaves", "links", "links/el", "seconds", "MB",
+           "power", "closure");
+    const int rooms[] = {1, 10, 100, 1000, 1800};
+    double lx[5], ll[5], lt[5];
     int runs = 0;
-    for (int i = 0; i < (big ? 4 : 3); i++) {
+    for (int i = 0; i < 3 + big; i++) {
         rad_office_options oo = {rooms[i], 0};
         rad_scene *scene = NULL;
         if (rad_scene_generate_office(ctx, &oo, &scene) != RAD_OK)
@@ -121,11 +126,15 @@ int main(int argc, char **argv)
         if (run(ctx, scene, 1e-3, 0.02, &s))
             return 1;
         const rad_hier_stats *h = &s->hier_stats;
-        printf("%6d %8zu %9zu %9zu %8.1f %9.2f %9.1f\n", rooms[i], s->hier_base->patch_count, h->leaves, h->links,
-               (double)h->links / (double)h->leaves, s->solve_stats.seconds, h->bytes / 1e6);
+        double emitted, absorbed;
+        rad_solution_power(s, &emitted, &absorbed);
+        double power = fabs(absorbed - emitted) / emitted;
+        printf("%6d %8zu %9zu %9zu %8.1f %9.2f %9.1f %7.2f%% %8.4f\n", rooms[i], s->hier_base->patch_count, h->leaves,
+               h->links, (double)h->links / (double)h->leaves, s->solve_stats.seconds, h->bytes / 1e6, 100.0 * power,
+               h->closure_power);
         if (out)
-            fprintf(out, "office%d,%g,%zu,%zu,%.4f,%.0f,\n", rooms[i], 1e-3, h->leaves, h->links, s->solve_stats.seconds,
-                    h->bytes);
+            fprintf(out, "office%d,%g,%zu,%zu,%.4f,%.0f,,%.5f\n", rooms[i], 1e-3, h->leaves, h->links,
+                    s->solve_stats.seconds, h->bytes, power);
         lx[runs] = log((double)h->leaves);
         ll[runs] = log((double)h->links);
         lt[runs] = log(s->solve_stats.seconds);

@@ -12,7 +12,9 @@
  *                    centre; leaves cover each patch's area exactly
  *   determinism      1 and 2 threads give bit-identical radiosities
  *   clustering       an office scene solved with and without clusters
- *                    conserves energy and agrees on the room's big surfaces
+ *                    conserves energy and agrees on the room's big surfaces;
+ *                    a furnace corridor and a 10-room building keep their
+ *                    power through cluster links (energy balance, closure)
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -370,13 +372,14 @@ static void test_clusters_office(void **state)
     assert_true(without->hier_stats.initial_links > 1000);
     double emitted, absorbed;
     rad_solution_power(with, &emitted, &absorbed);
-    assert_true(relative(absorbed, emitted) < 0.03);
+    assert_true(relative(absorbed, emitted) < 0.015); /* measured 0.69% */
     rad_solution_power(without, &emitted, &absorbed);
-    assert_true(relative(absorbed, emitted) < 0.03);
+    assert_true(relative(absorbed, emitted) < 0.015); /* 0.62% */
     /* The room's large surfaces agree with the uniform-mesh solution
-     * (measured against 6,000 elements: within 4.7% with clusters, whose
-     * six-direction bins and point estimates stand in for far transfers,
-     * and 1.6% without). */
+     * (measured against 3,000 elements: within 1.7% with clusters, whose
+     * six-direction bins share far transfers among members, and 1.3%
+     * without; 4.7% with clusters when their links were point estimates
+     * from the centres). */
     rad_options uo = {0};
     uo.target_elements = 3000;
     rad_solution *uniform = NULL;
@@ -393,14 +396,94 @@ static void test_clusters_office(void **state)
         rad_solution_surface_radiosity(uniform, k, u);
         if (!(u[1] > 0.05 * emitted / scene->surfaces[k].area / 100.0))
             continue; /* a dim sliver of wall: relative errors mean little */
-        assert_true(relative(a[1], u[1]) < 0.08);
-        assert_true(relative(b[1], u[1]) < 0.04);
+        assert_true(relative(a[1], u[1]) < 0.03);
+        assert_true(relative(b[1], u[1]) < 0.025);
         checked++;
     }
     assert_true(checked >= 4);
     rad_solution_destroy(uniform);
     rad_solution_destroy(with);
     rad_solution_destroy(without);
+    rad_scene_destroy(scene);
+}
+
+/* A closed corridor 8 m long, 1 m square, its four long walls cut into
+ * unit squares (34 patches), normals inward, rho 0.5 and E 1: the furnace
+ * again, B = 2 everywhere, now with patches far enough apart to be linked
+ * through clusters. */
+static rad_scene *furnace_corridor(void)
+{
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "corridor");
+    double r[3] = {0.5, 0.5, 0.5}, e[3] = {1.0, 1.0, 1.0};
+    int m = rad_scene_builder_material(b, "m", r, e);
+    int walls = rad_scene_builder_surface(b, "walls"), ends = rad_scene_builder_surface(b, "ends");
+    for (int i = 0; i < 8; i++) {
+        double x0 = i, x1 = i + 1;
+        const vec3 q[4][4] = {
+            {{x0, 0, 0}, {x0, 0, 1}, {x1, 0, 1}, {x1, 0, 0}}, /* y = 0, facing +y */
+            {{x0, 1, 0}, {x1, 1, 0}, {x1, 1, 1}, {x0, 1, 1}}, /* y = 1, facing -y */
+            {{x0, 0, 0}, {x1, 0, 0}, {x1, 1, 0}, {x0, 1, 0}}, /* z = 0, facing +z */
+            {{x0, 0, 1}, {x0, 1, 1}, {x1, 1, 1}, {x1, 0, 1}}, /* z = 1, facing -z */
+        };
+        for (int f = 0; f < 4; f++)
+            assert_int_equal(rad_scene_builder_polygon(b, walls, m, q[f], 4, 0), RAD_OK);
+    }
+    const vec3 cap0[4] = {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}};
+    const vec3 cap1[4] = {{8, 0, 0}, {8, 0, 1}, {8, 1, 1}, {8, 1, 0}};
+    assert_int_equal(rad_scene_builder_polygon(b, ends, m, cap0, 4, 0), RAD_OK);
+    assert_int_equal(rad_scene_builder_polygon(b, ends, m, cap1, 4, 0), RAD_OK);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_OK);
+    return scene;
+}
+
+/* The corridor with clusters: the transfers of cluster links are Monte
+ * Carlo estimates (refine.c, hr_transfer), so B is 2 only to their noise,
+ * but no power may be made or lost on the way. */
+static void test_furnace_clusters(void **state)
+{
+    (void)state;
+    rad_scene *scene = furnace_corridor();
+    rad_solution *s = solve(scene, 1e-2, 1);
+    assert_true(s->hier_stats.clustered);
+    double err = 0.0;
+    for (size_t k = 0; k < scene->surface_count; k++) {
+        double B[3];
+        rad_solution_surface_radiosity(s, k, B);
+        err = fmax(err, relative(B[0], 2.0));
+    }
+    double emitted, absorbed;
+    rad_solution_power(s, &emitted, &absorbed);
+    /* Measured: worst surface 0.9%, power 0.18%, closure 1.0009. */
+    assert_true(s->hier_stats.links_by_kind[1] > 0 && s->hier_stats.links_by_kind[2] > 0 &&
+                s->hier_stats.links_by_kind[3] > 0);
+    assert_true(err < 0.02);
+    assert_true(relative(absorbed, emitted) < 0.01);
+    assert_true(fabs(s->hier_stats.closure_power - 1.0) < 0.01);
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+}
+
+/* A building of 10 rooms (1,600 polygons) with clusters: the power that
+ * reaches receivers along the links (the closure) and the energy balance.
+ * Cluster links with point estimates from the clusters' centres drifted by
+ * 3% here (7% at 100 rooms), and a lamp clustered with furniture lost a
+ * quarter of its power before sources were sampled by power. */
+static void test_office_energy(void **state)
+{
+    (void)state;
+    rad_office_options oo = {10, 0};
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_generate_office(ctx, &oo, &scene), RAD_OK);
+    rad_solution *s = solve(scene, 1e-3, 0);
+    assert_true(s->hier_stats.clustered);
+    double emitted, absorbed;
+    rad_solution_power(s, &emitted, &absorbed);
+    /* Measured: 0.74% of the power, closure 0.9966 (the point estimates:
+     * 4.9%). */
+    assert_true(relative(absorbed, emitted) < 0.015);
+    assert_true(fabs(s->hier_stats.closure_power - 1.0) < 0.01);
+    rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }
 
@@ -436,6 +519,8 @@ int main(void)
         cmocka_unit_test(test_leaves_locate),
         cmocka_unit_test(test_thread_count_independent),
         cmocka_unit_test(test_clusters_office),
+        cmocka_unit_test(test_furnace_clusters),
+        cmocka_unit_test(test_office_energy),
         cmocka_unit_test(test_bad_options),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

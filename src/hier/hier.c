@@ -167,7 +167,7 @@ static void gather(hr_state *st)
                 h[2] += kk * Bs[2];
                 continue;
             }
-            vec3 w = v3_normalize(v3_sub(ns->center, nr->center));
+            vec3 w = hr_link_direction(l);
             vec3 back = v3_scale(w, -1.0);
             for (int c = 0; c < 3; c++) {
                 double e = ns->kind == HR_SURFACE ? kk * Bs[c]
@@ -236,8 +236,8 @@ static double push_pull(hr_state *st)
         }
         if (nd->kind == HR_SURFACE && nd->parent != HR_NONE && t->nodes[nd->parent].kind == HR_CLUSTER) {
             double *bins = &st->bins_exit[18 * (size_t)nd->parent];
-            for (int c = 0; c < 3; c++)
-                hr_bins_add(bins + 6 * c, nd->normal, nd->area * st->B[3 * k + (size_t)c]);
+            for (int c = 0; c < 3; c++) /* from its open part, as for surface sources */
+                hr_bins_add(bins + 6 * c, nd->normal, nd->area * st->B[3 * k + (size_t)c] * st->send[k]);
         }
         if (nd->kind == HR_CLUSTER) {
             double sum[3] = {0.0, 0.0, 0.0};
@@ -314,7 +314,7 @@ static void measure_open(hr_state *st, const rad_vis *vis, uint64_t seed)
             double u = ((r % 4) + rad_rng_uniform(&rng)) / 4.0, v = ((r / 4) + rad_rng_uniform(&rng)) / 4.0;
             vec3 p, normal;
             double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng), lift;
-            hr_sample(t, (uint32_t)k, pu, pv, 0.0, &p, &normal, &lift);
+            hr_sample(t, (uint32_t)k, pu, pv, 0.0, false, &p, &normal, &lift);
             double rr = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
             ray[r].origin = v3_mad(p, nd->normal, lift);
             ray[r].direction = v3_add(v3_add(v3_scale(tn, rr * cos(phi)), v3_scale(bn, rr * sin(phi))),
@@ -387,6 +387,95 @@ static rad_result measure_spread(hr_state *st)
     }
     free(lo);
     free(hi);
+    return RAD_OK;
+}
+
+/* ---- closure ---- */
+
+/* Six bins of a unit vector: |d_a| in the bin of d_a's sign. */
+static void bins_of(vec3 d, double *out)
+{
+    for (int q = 0; q < 6; q++)
+        out[q] = 0.0;
+    hr_bins_add(out, d, 1.0);
+}
+
+/* Closure of the link set (the hierarchical counterpart of the row sums of
+ * F): for every leaf m, the fraction of the power it sends, A_m B_m, that
+ * its links and its ancestors' carry to some receiver.  1 in a closed
+ * scene, less where power escapes (or is lost), more where it is made up.
+ * A receiver's share is its area times k (surfaces), or k times its
+ * members' projected area toward the source as the bins read it
+ * (clusters); a leaf under a cluster source takes the share its normal
+ * has in the cluster's exitance bins.  Reports the area-weighted mean and
+ * range over leaves, and the power-weighted mean (weights A B, channels
+ * summed).  O(links + nodes). */
+static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count, C = t->clusters;
+    double *acc = calloc(n ? n : 1, sizeof *acc);   /* surfaces: per unit A B, pushed down */
+    const double *area_bins = t->cluster_bins;
+    double *x = calloc(6 * C + 1, sizeof *x);        /* clusters: sum k P_r bins(-w), pushed down */
+    if (!acc || !x) {
+        free(acc);
+        free(x);
+        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+    }
+    for (size_t i = 0; i < st->links.count; i++) {
+        const hr_link *l = &st->links.items[i];
+        const hr_node *nr = &t->nodes[l->r], *ns = &t->nodes[l->s];
+        vec3 w = nr->kind == HR_SURFACE && ns->kind == HR_SURFACE ? v3(0.0, 0.0, 1.0) : hr_link_direction(l);
+        double share = nr->kind == HR_SURFACE ? nr->area : hr_bins_eval(&area_bins[6 * (size_t)l->r], w);
+        share *= l->k;
+        if (ns->kind == HR_SURFACE) {
+            acc[l->s] += share * st->send[l->s] / ns->area;
+        } else {
+            double d[6];
+            bins_of(v3_scale(w, -1.0), d);
+            for (int q = 0; q < 6; q++)
+                x[6 * (size_t)l->s + (size_t)q] += share * d[q];
+        }
+    }
+    double a_sum = 0.0, c_sum = 0.0, p_sum = 0.0, pc_sum = 0.0, lo = INFINITY, hi = -INFINITY;
+    for (size_t k = 0; k < n; k++) {
+        const hr_node *nd = &t->nodes[k];
+        uint32_t up = nd->parent;
+        if (nd->kind == HR_CLUSTER) {
+            if (up != HR_NONE)
+                for (int q = 0; q < 6; q++)
+                    x[6 * k + (size_t)q] += x[6 * (size_t)up + (size_t)q];
+            continue;
+        }
+        if (up != HR_NONE) {
+            if (t->nodes[up].kind == HR_CLUSTER) {
+                double nb[6];
+                bins_of(nd->normal, nb);
+                double f = 0.0;
+                for (int q = 0; q < 6; q++)
+                    f += nb[q] * x[6 * (size_t)up + (size_t)q];
+                acc[k] += f * st->send[k];
+            } else {
+                acc[k] += acc[up];
+            }
+        }
+        if (nd->child[0] == 0 && st->open[k] > 0.0f) {
+            const double *B = &st->B[3 * k];
+            double power = nd->area * (B[0] + B[1] + B[2]);
+            a_sum += nd->area;
+            c_sum += nd->area * acc[k];
+            p_sum += power;
+            pc_sum += power * acc[k];
+            lo = fmin(lo, acc[k]);
+            hi = fmax(hi, acc[k]);
+        }
+    }
+    hs->closure_mean = a_sum > 0.0 ? c_sum / a_sum : 1.0;
+    hs->closure_power = p_sum > 0.0 ? pc_sum / p_sum : 1.0;
+    hs->closure_min = isfinite(lo) ? lo : 1.0;
+    hs->closure_max = isfinite(hi) ? hi : 1.0;
+    free(acc);
+    free(x);
     return RAD_OK;
 }
 
@@ -549,6 +638,8 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         size_t split = 0;
         r = measure_spread(&st);
         if (r == RAD_OK)
+            hr_tree_set_power(&st.tree, st.B, st.send);
+        if (r == RAD_OK)
             r = hr_refine(ctx, &st.tree, &rp, st.B, st.spread, &st.links, &split, &rs);
         if (r == RAD_OK)
             r = ensure_values(&st);
@@ -618,6 +709,8 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         rm = build_leaf_mesh(&st, leaf_mesh, radiosity, &leaves);
         hs->leaves = leaves;
         hs->seconds_mesh = rad_seconds() - t3;
+        if (rm == RAD_OK && r == RAD_OK)
+            rm = measure_closure(&st, hs);
         if (rm != RAD_OK)
             r = rm;
     }

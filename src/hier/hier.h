@@ -33,7 +33,10 @@
  * and what it receives from direction u is spread as |u_a| into the same
  * bins and read back by a member of normal n as sum_a |n_a| H[a, sign n_a].
  * Both are exact when the members' normals lie along the axes, and exact
- * for any normal whose octant matches the direction's; links through
+ * for any normal whose octant matches the direction's.  How much a link
+ * through a cluster carries is a Monte Carlo estimate of the transfer
+ * between its ends (refine.c, hr_transfer), so no power is made or lost on
+ * the way; the bins only share it among the members.  Links through
  * clusters are kept only where the oracle says their transfer is small.
  */
 #ifndef RAD_HIER_H
@@ -76,6 +79,9 @@ typedef struct hr_tree {
     uint32_t *order;           /* patches in cluster order */
     double *order_area;        /* prefix sums of patch areas along order[] */
     double *lift;              /* per patch: shadow-ray lift, m (epsilon + bend) */
+    double *cluster_bins;      /* 6 per cluster: sum A |n_a| of its patches, by signed axis */
+    double *order_power;       /* prefix sums of patch power along order[] (hr_tree_set_power) */
+    double *power_bins;        /* 6 per cluster: its patches' power A B / open as bins */
     double min_area;           /* m^2: no child smaller than this */
 } hr_tree;
 
@@ -95,12 +101,27 @@ rad_result hr_subdivide(rad_context *ctx, hr_tree *tree, uint32_t k);
 /* The c-th child of node k. */
 uint32_t hr_child(const hr_tree *tree, uint32_t k, int c);
 
-/* A random point on the surfaces below node k and its normal, from two
- * uniform numbers (clusters pick a patch by area). */
-void hr_sample(const hr_tree *tree, uint32_t k, double u, double v, double w, vec3 *point,
+/* The power each patch sends, A B / open (B: 3 per node, summed over the
+ * channels; open: per node, see hier.c), for sampling source clusters by
+ * power and for their exitance bins. */
+void hr_tree_set_power(hr_tree *tree, const double *B, const float *send);
+/* Total power below cluster k (0 for a surface or before set_power). */
+double hr_cluster_power(const hr_tree *tree, uint32_t k);
+
+/* A random point on the surfaces below node k and its normal, from three
+ * uniform numbers (clusters pick a patch by area, or by power). */
+void hr_sample(const hr_tree *tree, uint32_t k, double u, double v, double w, bool by_power, vec3 *point,
                vec3 *normal, double *lift);
 
 /* ---- shaft culling (shaft.c) ---- */
+
+/* The transfer between nodes r and s by Monte Carlo (refine.c): the power r
+ * receives from s per unit of the source's radiosity (surface source), or
+ * per unit of the source cluster's power weights (*by_power) or area; and
+ * the direction it flows along (transfer-weighted, from r toward s). */
+double hr_transfer(const hr_tree *tree, const rad_vis *vis, uint32_t r, uint32_t s, int count, rad_rng *rng,
+                   uint64_t *rays, bool *by_power, vec3 *direction);
+
 
 /* Is the region between the boxes of nodes a and b free of every patch
  * (other than those of a and b)?  Conservative: false means "maybe not".
@@ -109,17 +130,32 @@ bool hr_shaft_clear(const hr_tree *tree, uint32_t a, uint32_t b, double tol);
 
 /* ---- links (refine.c) ---- */
 
-enum { HR_LINK_CLEAR = 1 }; /* flags: the shaft is empty; so are the children's */
+enum {
+    HR_LINK_CLEAR = 1, /* the shaft is empty; so are the children's */
+    HR_LINK_SPLIT = 2, /* a cluster link the bins cannot carry: must be split */
+    HR_LINK_ZNEG = 4   /* a cluster link's direction has z < 0 (hr_link_direction) */
+};
 
 typedef struct hr_link {
     uint32_t r, s;        /* receiver and source nodes */
     float k;              /* transfer coefficient, visibility included (kinds: refine.c) */
     float spread;         /* surface <- surface: how much the unoccluded factor varies
-                             over the receiver (max |F(x) - F(centre)|) */
+                             over the receiver (max |F(x) - F(centre)|);
+                             with a cluster end: x of the direction (below) */
     float vis_err;        /* surface <- surface: unoccluded factor x the visibility's
-                             uncertainty, from pilot rays independent of k's */
+                             uncertainty, from pilot rays independent of k's;
+                             with a cluster end: y of the direction */
     uint32_t flags;
 } hr_link;
+
+/* A link with a cluster end carries energy along one direction, from the
+ * receiver toward the source: the mean direction of the point pairs that
+ * carry its transfer (hr_transfer), kept as x, y and the sign of z. */
+static inline vec3 hr_link_direction(const hr_link *l)
+{
+    double x = l->spread, y = l->vis_err, z = sqrt(fmax(0.0, 1.0 - x * x - y * y));
+    return v3(x, y, (l->flags & HR_LINK_ZNEG) ? -z : z);
+}
 
 typedef struct hr_links {
     hr_link *items;
@@ -196,6 +232,9 @@ typedef struct rad_hier_stats {
     double bytes;              /* nodes + links + per-node values at the end */
     double link_bytes;         /* bytes per link */
     double seconds_refine, seconds_solve, seconds_mesh;
+    double closure_mean;       /* link closure over leaves (measure_closure): area mean */
+    double closure_min, closure_max;
+    double closure_power;      /* ... weighted by A B */
     double epsilon_abs;        /* W: epsilon x the emitted power */
     double min_area;           /* m^2 */
     bool clustered;

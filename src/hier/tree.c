@@ -209,6 +209,30 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
     }
     t->count = clusters + P;
     t->clusters = clusters;
+    /* Projected-area bins, bottom-up (children follow their parent). */
+    t->cluster_bins = rad_alloc_array(ctx, 6 * clusters + 1, sizeof *t->cluster_bins, "hierarchical: cluster bins");
+    t->power_bins = rad_alloc_array(ctx, 6 * clusters + 1, sizeof *t->power_bins, "hierarchical: cluster bins");
+    t->order_power = rad_alloc_array(ctx, P + 1, sizeof *t->order_power, "hierarchical: cluster order");
+    if (!t->cluster_bins || !t->power_bins || !t->order_power) {
+        free(roots);
+        free(scratch);
+        hr_tree_free(t);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    memset(t->cluster_bins, 0, (6 * clusters + 1) * sizeof *t->cluster_bins);
+    memset(t->power_bins, 0, (6 * clusters + 1) * sizeof *t->power_bins);
+    memset(t->order_power, 0, (P + 1) * sizeof *t->order_power);
+    for (size_t k = clusters + P; k-- > 0;) {
+        const hr_node *n = &t->nodes[k];
+        if (n->parent == HR_NONE)
+            continue;
+        double *pb = &t->cluster_bins[6 * (size_t)n->parent];
+        if (n->kind == HR_SURFACE)
+            hr_bins_add(pb, n->normal, n->area);
+        else
+            for (int q = 0; q < 6; q++)
+                pb[q] += t->cluster_bins[6 * k + (size_t)q];
+    }
     t->order_area[0] = 0.0;
     for (size_t i = 0; i < P; i++)
         t->order_area[i + 1] = t->order_area[i] + roots[t->order[i]].area;
@@ -224,6 +248,9 @@ void hr_tree_free(hr_tree *t)
     free(t->order);
     free(t->order_area);
     free(t->lift);
+    free(t->cluster_bins);
+    free(t->power_bins);
+    free(t->order_power);
     memset(t, 0, sizeof *t);
 }
 
@@ -297,17 +324,46 @@ static vec3 surface_point(const hr_node *n, double u, double v)
     return v3_lerp(v3_lerp(c[0], c[1], u), v3_lerp(c[3], c[2], u), v);
 }
 
-void hr_sample(const hr_tree *t, uint32_t k, double u, double v, double w, vec3 *point, vec3 *normal,
-               double *lift)
+void hr_tree_set_power(hr_tree *t, const double *B, const float *send)
+{
+    size_t P = t->base->patch_count, C = t->clusters;
+    if (C == 0)
+        return;
+    memset(t->power_bins, 0, 6 * C * sizeof *t->power_bins);
+    t->order_power[0] = 0.0;
+    for (size_t i = 0; i < P; i++) {
+        uint32_t k = t->root_of_patch[t->order[i]];
+        const double *b = &B[3 * (size_t)k];
+        double power = t->nodes[k].area * (b[0] + b[1] + b[2]) * send[k];
+        t->order_power[i + 1] = t->order_power[i] + power;
+        hr_bins_add(&t->power_bins[6 * (size_t)t->nodes[k].parent], t->nodes[k].normal, power);
+    }
+    /* Up the clusters: children after their parent in pre-order. */
+    for (size_t k = C; k-- > 1;)
+        for (int q = 0; q < 6; q++)
+            t->power_bins[6 * (size_t)t->nodes[k].parent + (size_t)q] += t->power_bins[6 * k + (size_t)q];
+}
+
+double hr_cluster_power(const hr_tree *t, uint32_t k)
+{
+    const hr_node *n = &t->nodes[k];
+    if (n->kind != HR_CLUSTER)
+        return 0.0;
+    return t->order_power[n->patch + n->patch_count] - t->order_power[n->patch];
+}
+
+void hr_sample(const hr_tree *t, uint32_t k, double u, double v, double w, bool by_power, vec3 *point,
+               vec3 *normal, double *lift)
 {
     const hr_node *n = &t->nodes[k];
     if (n->kind == HR_CLUSTER) {
-        /* A patch of the cluster's range, chosen by area. */
+        /* A patch of the cluster's range, chosen by area or power. */
+        const double *sum = by_power ? t->order_power : t->order_area;
         uint32_t lo = n->patch, hi = n->patch + n->patch_count; /* order[lo, hi) */
-        double target = t->order_area[lo] + w * (t->order_area[hi] - t->order_area[lo]);
+        double target = sum[lo] + w * (sum[hi] - sum[lo]);
         while (hi - lo > 1) {
             uint32_t mid = lo + (hi - lo) / 2;
-            if (t->order_area[mid] <= target)
+            if (sum[mid] <= target)
                 lo = mid;
             else
                 hi = mid;

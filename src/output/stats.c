@@ -135,6 +135,11 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
         cJSON_AddNumberToObject(hi, "links_per_leaf", h->leaves ? (double)h->links / (double)h->leaves : 0.0);
         cJSON_AddNumberToObject(hi, "bytes_per_link", h->link_bytes);
         cJSON_AddNumberToObject(hi, "memory_bytes", h->bytes);
+        cJSON *closure = cJSON_AddObjectToObject(hi, "closure");
+        cJSON_AddNumberToObject(closure, "mean", h->closure_mean);
+        cJSON_AddNumberToObject(closure, "power_weighted", h->closure_power);
+        cJSON_AddNumberToObject(closure, "min", h->closure_min);
+        cJSON_AddNumberToObject(closure, "max", h->closure_max);
         cJSON_AddNumberToObject(hi, "refine_rounds", h->refine_rounds);
         cJSON_AddNumberToObject(hi, "refine_passes", h->refine_passes);
         cJSON_AddNumberToObject(hi, "rays", (double)h->rays);

@@ -65,7 +65,7 @@ enum {
  * for every ray that meets them, and half the rays of a room would find the
  * back of its neighbour's face (17% of the power of 4 rooms was lost so with
  * the shooting solver).  10 cm is also far above the shadow-ray lift
- * (1e-4 x the scene diagonal: 2.5 cm at 1000 rooms). */
+ * (1e-5 x the scene diagonal, vis.c: about 2 mm at 1000 rooms). */
 #define HALF_WALL 0.05     /* m, half a wall's thickness */
 #define MARGIN 0.05        /* m, furniture to wall: a gap, so nothing touches a wall */
 #define GAP 0.10           /* m, between pieces of furniture */
