@@ -56,7 +56,7 @@ static const option_def OPTIONS[] = {
     {OPT_LEVEL, 0, "level", "WHICH", CLI_VIEWFACTORS,
      "view factors between 'surface's (default) or 'element's"},
     {OPT_EPSILON, 0, "epsilon", "X", CLI_RENDER,
-     "hierarchical: refine links whose error exceeds X x the mean emitted exitance (default 1e-3)"},
+     "hierarchical: refine a link while its error (power its receiver reflects) exceeds X x the emitted power (default 1e-4)"},
     {OPT_MIN_AREA, 0, "min-area", "A", CLI_RENDER,
      "hierarchical: smallest element area, m^2 (default 1e-4 x the total area x min(1, 100 / patches))"},
     {OPT_CLUSTERING, 0, "clustering", "WHEN", CLI_RENDER,

@@ -570,7 +570,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     const rad_mesh *base = p->base;
     const rad_scene *scene = p->scene;
 
-    /* Scale: the mean emitted exitance over all surfaces. */
+    /* Scale: the emitted power, W (channels averaged); epsilon is relative to it. */
     double area = 0.0, power = 0.0;
     for (size_t i = 0; i < base->element_count; i++) {
         const rad_element *e = &base->elements[i];
