@@ -101,8 +101,8 @@ static double projected(const hr_tree *t, uint32_t k, vec3 d)
  * same way for a given layout, and summed over 10^5 cluster links it made
  * the power of a building drift by 7%.  Why weigh by power: the gather
  * shares a cluster's transfer among its members by their projected areas
- * along the line of centres, which is not how each member sees the
- * receiver; estimated for uniform radiosity, a lamp among furniture lost a
+ * along one direction, which is not how each member sees the receiver;
+ * estimated for uniform radiosity, a lamp clustered with a chair lost a
  * quarter of its power so.  *by_power: the weighting used; *direction:
  * the transfer-weighted mean direction from r's points to s's (the
  * centres' direction when nothing passes). */
