@@ -454,12 +454,13 @@ static void test_furnace_clusters(void **state)
     }
     double emitted, absorbed;
     rad_solution_power(s, &emitted, &absorbed);
-    /* Measured: worst surface 0.9%, power 0.18%, closure 1.0009. */
+    /* Measured: worst surface 0.9%, power 0.18%, closure 1.0009; cluster
+     * links 10% low would put the closure at 0.994. */
     assert_true(s->hier_stats.links_by_kind[1] > 0 && s->hier_stats.links_by_kind[2] > 0 &&
                 s->hier_stats.links_by_kind[3] > 0);
     assert_true(err < 0.02);
-    assert_true(relative(absorbed, emitted) < 0.01);
-    assert_true(fabs(s->hier_stats.closure_power - 1.0) < 0.01);
+    assert_true(relative(absorbed, emitted) < 0.005);
+    assert_true(fabs(s->hier_stats.closure_power - 1.0) < 0.004);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }

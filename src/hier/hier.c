@@ -415,7 +415,6 @@ static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
     const hr_tree *t = &st->tree;
     size_t n = t->count, C = t->clusters;
     double *acc = calloc(n ? n : 1, sizeof *acc);   /* surfaces: per unit A B, pushed down */
-    const double *area_bins = t->cluster_bins;
     double *x = calloc(6 * C + 1, sizeof *x);        /* clusters: sum k P_r bins(-w), pushed down */
     if (!acc || !x) {
         free(acc);
@@ -426,7 +425,7 @@ static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
         const hr_link *l = &st->links.items[i];
         const hr_node *nr = &t->nodes[l->r], *ns = &t->nodes[l->s];
         vec3 w = nr->kind == HR_SURFACE && ns->kind == HR_SURFACE ? v3(0.0, 0.0, 1.0) : hr_link_direction(l);
-        double share = nr->kind == HR_SURFACE ? nr->area : hr_bins_eval(&area_bins[6 * (size_t)l->r], w);
+        double share = nr->kind == HR_SURFACE ? nr->area : hr_projected(t, l->r, w);
         share *= l->k;
         if (ns->kind == HR_SURFACE) {
             acc[l->s] += share * st->send[l->s] / ns->area;

@@ -92,6 +92,16 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
                          bool clustered, double min_area, double eps, hr_tree *tree);
 void hr_tree_free(hr_tree *tree);
 
+/* Grow an array of `size`-byte items, capacity *capacity < count, to hold
+ * `count` (doubling from 1024): the new array, or NULL when out of memory
+ * (the old one and *capacity then unchanged). */
+void *hr_grow(void *items, size_t *capacity, size_t count, size_t size);
+
+/* Projected area of node k toward unit direction d: A max(0, n.d) for a
+ * surface; a cluster's members' as its area bins see it (exact for
+ * axis-aligned members). */
+double hr_projected(const hr_tree *tree, uint32_t k, vec3 d);
+
 /* Number of children of node k (0, 2 or 4) and whether it may be split. */
 int hr_children(const hr_tree *tree, uint32_t k);
 bool hr_splittable(const hr_tree *tree, uint32_t k);

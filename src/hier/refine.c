@@ -73,17 +73,6 @@ static const double SOURCE_WEIGHT = 10.0;
 
 static const uint64_t HR_SALT = 0x4852414449554dULL;
 
-/* Six-direction projected area of node k toward unit direction d: its
- * members' sum A max(0, n.d) as the bins see it (exact for axis-aligned
- * members), or A max(0, n.d) for a surface. */
-static double projected(const hr_tree *t, uint32_t k, vec3 d)
-{
-    const hr_node *n = &t->nodes[k];
-    if (n->kind == HR_SURFACE)
-        return n->area * fmax(0.0, v3_dot(n->normal, d));
-    return hr_bins_eval(&t->cluster_bins[6 * (size_t)k], d);
-}
-
 /* The transfer between two nodes, at least one a cluster, by Monte Carlo:
  *
  *   T = sum over member pairs of  W_q int int cos_p cos_q V / (pi |pq|^2)
@@ -318,10 +307,10 @@ static bool make_link(const link_ctx *lc, uint32_t r, uint32_t s, uint32_t paren
         vec3 u;
         double transfer = hr_transfer(t, p->vis, r, s, p->shadow_rays, &rng, rays, &by_power, &u);
         vec3 back = v3_scale(u, -1.0);
-        double gr = nr->kind == HR_SURFACE ? nr->area : projected(t, r, u);
+        double gr = nr->kind == HR_SURFACE ? nr->area : hr_projected(t, r, u);
         double gs = ns->kind == HR_SURFACE ? 1.0
                     : by_power         ? hr_bins_eval(&t->power_bins[6 * (size_t)s], back)
-                                       : projected(t, s, back);
+                                       : hr_projected(t, s, back);
         uint32_t flags = u.z < 0.0 ? HR_LINK_ZNEG : 0;
         /* Each cluster end must face along u with at least a twentieth of
          * its weight: else k = T / (gr gs) is ill-conditioned (members that
@@ -430,16 +419,12 @@ static rad_result links_reserve(rad_context *ctx, hr_links *l, size_t count)
 {
     if (count <= l->capacity)
         return RAD_OK;
-    size_t cap = l->capacity ? l->capacity : 1024;
-    while (cap < count)
-        cap *= 2;
-    hr_link *items = realloc(l->items, cap * sizeof *items);
+    hr_link *items = hr_grow(l->items, &l->capacity, count, sizeof *items);
     if (!items)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "hierarchical: out of memory for %zu links; use a larger --epsilon or --min-area",
                         count);
     l->items = items;
-    l->capacity = cap;
     return RAD_OK;
 }
 

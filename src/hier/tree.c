@@ -26,6 +26,7 @@
  */
 #include "hier/hier.h"
 
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -56,21 +57,36 @@ static void surface_geometry(hr_node *n)
     n->radius = r;
 }
 
+void *hr_grow(void *items, size_t *capacity, size_t count, size_t size)
+{
+    size_t cap = *capacity ? *capacity : 1024;
+    while (cap < count)
+        cap *= 2;
+    void *grown = cap <= SIZE_MAX / size ? realloc(items, cap * size) : NULL;
+    if (grown)
+        *capacity = cap;
+    return grown;
+}
+
 static rad_result reserve(rad_context *ctx, hr_tree *t, size_t extra)
 {
     if (t->count + extra <= t->capacity)
         return RAD_OK;
-    size_t cap = t->capacity ? t->capacity : 1024;
-    while (cap < t->count + extra)
-        cap *= 2;
-    hr_node *n = realloc(t->nodes, cap * sizeof *n);
-    if (!n)
+    hr_node *nodes = hr_grow(t->nodes, &t->capacity, t->count + extra, sizeof *nodes);
+    if (!nodes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "hierarchical: out of memory for %zu nodes; use a larger --min-area or --epsilon",
-                        cap);
-    t->nodes = n;
-    t->capacity = cap;
+                        t->count + extra);
+    t->nodes = nodes;
     return RAD_OK;
+}
+
+double hr_projected(const hr_tree *t, uint32_t k, vec3 d)
+{
+    const hr_node *n = &t->nodes[k];
+    if (n->kind == HR_SURFACE)
+        return n->area * fmax(0.0, v3_dot(n->normal, d));
+    return hr_bins_eval(&t->cluster_bins[6 * (size_t)k], d);
 }
 
 /* ---- the cluster hierarchy ---- */
