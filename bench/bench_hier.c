@@ -8,7 +8,10 @@
  *      leaves) at a fixed epsilon and minimum area: leaves, links,
  *      seconds, memory, the energy balance (|absorbed - emitted| /
  *      emitted: the building is closed) and the link closure, and the
- *      fitted exponents of links and seconds against leaves.
+ *      fitted exponents of links and seconds against leaves;
+ *   3. the Cornell box at about the peer's element count (issue #5: a
+ *      hierarchical Galerkin solver measured at 5,398 elements, 42,475
+ *      links, 0.55 s) with the classic oracle and the default one.
  *
  *   ./build/bench/bench_hier [--big | --huge] [--threads N] [--csv FILE]
  *
@@ -47,12 +50,14 @@ static double worst_error(const rad_solution *s)
     return worst;
 }
 
-static int run(rad_context *ctx, const rad_scene *scene, double epsilon, double min_area, rad_solution **out)
+static int run(rad_context *ctx, const rad_scene *scene, double epsilon, double min_area, int classic,
+               rad_solution **out)
 {
     rad_options o = {0};
     o.solver = "hierarchical";
     o.epsilon = epsilon;
     o.min_area = min_area;
+    o.classic_oracle = classic;
     rad_solution *s = NULL;
     if (rad_solution_create(ctx, scene, &o, &s) != RAD_OK || rad_solution_solve(ctx, s) != RAD_OK) {
         fprintf(stderr, "bench_hier: %s\n", rad_context_error(ctx));
@@ -99,7 +104,7 @@ int main(int argc, char **argv)
     const double eps[] = {1e-3, 3e-4, 1e-4, 3e-5, 1e-5};
     for (size_t i = 0; i < sizeof eps / sizeof eps[0]; i++) {
         rad_solution *s = NULL;
-        if (run(ctx, box, eps[i], 0.0, &s))
+        if (run(ctx, box, eps[i], 0.0, 0, &s))
             return 1;
         const rad_hier_stats *h = &s->hier_stats;
         printf("%9.0e %8zu %9zu %8.1f %9.3f %7.2f%%\n", eps[i], h->leaves, h->links,
@@ -107,6 +112,27 @@ int main(int argc, char **argv)
         if (out)
             fprintf(out, "cornell,%g,%zu,%zu,%.4f,%.0f,%.5f,\n", eps[i], h->leaves, h->links, s->solve_stats.seconds,
                     h->bytes, worst_error(s));
+        rad_solution_destroy(s);
+    }
+
+    /* The epsilons that give about the peer's 5,398 elements. */
+    printf("\nCornell box near the peer's element count (peer: 5398 elements, 42475 links, 0.55 s)\n");
+    printf("%8s %9s %8s %9s %8s %9s %8s\n", "oracle", "epsilon", "leaves", "links", "links/el", "seconds", "error");
+    const struct {
+        const char *name;
+        double epsilon;
+        int classic;
+    } peer[] = {{"classic", 1.65e-5, 1}, {"sources", 1e-5, 0}};
+    for (size_t i = 0; i < sizeof peer / sizeof peer[0]; i++) {
+        rad_solution *s = NULL;
+        if (run(ctx, box, peer[i].epsilon, 0.0, peer[i].classic, &s))
+            return 1;
+        const rad_hier_stats *h = &s->hier_stats;
+        printf("%8s %9.2e %8zu %9zu %8.1f %9.3f %7.2f%%\n", peer[i].name, peer[i].epsilon, h->leaves, h->links,
+               (double)h->links / (double)h->leaves, s->solve_stats.seconds, 100.0 * worst_error(s));
+        if (out)
+            fprintf(out, "cornell_%s,%g,%zu,%zu,%.4f,%.0f,%.5f,\n", peer[i].name, peer[i].epsilon, h->leaves,
+                    h->links, s->solve_stats.seconds, h->bytes, worst_error(s));
         rad_solution_destroy(s);
     }
     rad_scene_destroy(box);
@@ -123,7 +149,7 @@ int main(int argc, char **argv)
         if (rad_scene_generate_office(ctx, &oo, &scene) != RAD_OK)
             return 1;
         rad_solution *s = NULL;
-        if (run(ctx, scene, 1e-3, 0.02, &s))
+        if (run(ctx, scene, 1e-3, 0.02, 0, &s))
             return 1;
         const rad_hier_stats *h = &s->hier_stats;
         double emitted, absorbed;

@@ -17,13 +17,19 @@ def main():
         sys.exit("usage: plot_hier.py hier.csv out.png")
     rows = list(csv.DictReader(open(sys.argv[1])))
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    for kind, marker in (("cornell", "o"), ("office", "s")):
-        sel = [r for r in rows if r["scene"].startswith(kind)]
+    series = (("Cornell box", "o", lambda n: n == "cornell"),
+              ("offices", "s", lambda n: n.startswith("office")),
+              ("Cornell, --oracle classic", "^", lambda n: n == "cornell_classic"))
+    for label, marker, pick in series:
+        sel = [r for r in rows if pick(r["scene"])]
         if not sel:
             continue
         leaves = [float(r["leaves"]) for r in sel]
-        axes[0].loglog(leaves, [float(r["links"]) for r in sel], marker=marker, label=kind)
-        axes[1].loglog(leaves, [float(r["seconds"]) for r in sel], marker=marker, label=kind)
+        axes[0].loglog(leaves, [float(r["links"]) for r in sel], marker=marker, label=label)
+        axes[1].loglog(leaves, [float(r["seconds"]) for r in sel], marker=marker, label=label)
+    # The peer hierarchical Galerkin solver of issue #5, measured elsewhere.
+    axes[0].loglog([5398], [42475], "kx", label="peer")
+    axes[1].loglog([5398], [0.55], "kx", label="peer")
     lo = min(float(r["leaves"]) for r in rows)
     hi = max(float(r["leaves"]) for r in rows)
     axes[0].loglog([lo, hi], [10 * lo, 10 * hi], "k:", label="10 links per leaf")

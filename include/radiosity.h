@@ -210,6 +210,10 @@ typedef struct rad_options {
                                      patches / 100 when there are more than 100 */
     int clustering;               /* 0 = automatic (when the scene has more than 64
                                      patches), 1 = always, -1 = never */
+    int classic_oracle;           /* nonzero: refine on the receiver's irradiance variation
+                                     and visibility only (Hanrahan et al. 1991), not also on
+                                     the source's radiosity variation: fewer links per
+                                     element, per-surface means ~3x less accurate */
 
     uint64_t seed;                /* all sampling is seeded per element pair: results do
                                      not depend on the thread count */

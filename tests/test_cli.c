@@ -227,6 +227,8 @@ static void test_usage_errors(void **state)
     assert_one_line_error("more than one scene", NULL);
     assert_int_equal(run("render --solver"), 2);
     assert_one_line_error("--solver", NULL);
+    assert_int_equal(run("render --oracle nosuch"), 2);
+    assert_one_line_error("--oracle", "nosuch");
     assert_int_equal(run(""), 2);
     assert_no_output("radiosity.png");
 }

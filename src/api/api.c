@@ -286,6 +286,7 @@ static rad_result solve_hierarchical(rad_context *ctx, rad_solution *s)
                           .epsilon = s->options.epsilon,
                           .min_area = s->options.min_area,
                           .clustering = s->options.clustering,
+                          .classic_oracle = s->options.classic_oracle != 0,
                           .seed = s->options.seed,
                           .shadow_rays = s->options.shadow_rays,
                           .tolerance = s->options.tolerance,

@@ -592,6 +592,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     if (r != RAD_OK)
         return r;
     hs->clustered = st.tree.clusters > 0;
+    hs->classic_oracle = p->classic_oracle;
     hs->clusters = st.tree.clusters;
     st.bins_in = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
     st.bins_total = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
@@ -618,6 +619,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                             * stand for all its descendants' */
                            .shadow_rays = p->shadow_rays > 0 ? (4 * p->shadow_rays < 64 ? 4 * p->shadow_rays : 64) : 16,
                            .epsilon = epsilon_abs,
+                           .source_weight = p->classic_oracle ? 0.0 : HR_SOURCE_WEIGHT,
                            .tol = 1e-9 * rad_scene_diagonal(scene),
                            .max_memory = p->max_memory,
                            .threads = rad_context_threads(ctx)};

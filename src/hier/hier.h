@@ -172,11 +172,21 @@ typedef struct hr_links {
     size_t count, capacity;
 } hr_links;
 
+/* The weight of the oracle's source term (refine.c).  rho_r F_rs max|B_leaf
+ * - B_s| bounds the error of a link that uses the source's mean, but the
+ * errors it measures add up with one sign: the parts of a floor under a
+ * light are both brighter and better seen from the ceiling than its edges,
+ * at every level.  On the Cornell box, weighting it 10x cuts the worst
+ * per-surface error from 1.7-2.2% (no term, the classic oracle) to
+ * 0.4-0.7% (docs/hierarchical.md). */
+#define HR_SOURCE_WEIGHT 10.0
+
 typedef struct hr_refine_params {
     const rad_vis *vis;
     uint64_t seed;
     int shadow_rays;      /* per link whose shaft is not empty */
     double epsilon;       /* power error allowed per link, W */
+    double source_weight; /* of the oracle's source term (refine.c); 0: classic */
     double tol;           /* geometric tolerance, m */
     double max_memory;    /* bytes the link lists may take */
     int threads;
@@ -223,6 +233,7 @@ typedef struct rad_hier_params {
     double epsilon;            /* relative: times the emitted power */
     double min_area;           /* m^2 */
     int clustering;            /* 1 on, -1 off, 0 automatic */
+    bool classic_oracle;       /* no source term (refine.c) */
     uint64_t seed;
     int shadow_rays;
     double tolerance;          /* on the residual */
@@ -248,6 +259,7 @@ typedef struct rad_hier_stats {
     double epsilon_abs;        /* W: epsilon x the emitted power */
     double min_area;           /* m^2 */
     bool clustered;
+    bool classic_oracle;
 } rad_hier_stats;
 
 /* Solve; on success *leaf_mesh is the mesh of the leaves (patches as in

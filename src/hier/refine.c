@@ -29,7 +29,8 @@
  *                         much the irradiance varies over it
  *   source too coarse     10 rho_r A_r F_rs max_leaf |B_leaf - B_s|: the
  *                         source's radiosity varies below it (the weight:
- *                         SOURCE_WEIGHT below)
+ *                         HR_SOURCE_WEIGHT, hier.h; 0 for the classic
+ *                         oracle, which stops here)
  *   uncertain visibility  rho_r A_r B_s F_unoccluded u, u from the pilot
  *                         rays (below), charged to the larger end
  *
@@ -64,12 +65,6 @@
 #include <string.h>
 
 enum { KEEP = 0, SPLIT_R = 1, SPLIT_S = 2, SPLIT_BOTH = 3 };
-/* The source term's weight.  rho_r F_rs max|B_leaf - B_s| bounds the error
- * of a link that uses the source's mean, but the errors it measures add up
- * with one sign (the parts of a wall near a light are both brighter and,
- * for the ceiling, nearer): on the Cornell box, weighting it 10x halves the
- * per-surface error for the same number of links (docs/hierarchical.md). */
-static const double SOURCE_WEIGHT = 10.0;
 
 static const uint64_t HR_SALT = 0x4852414449554dULL;
 
@@ -371,7 +366,7 @@ static int decide(const hr_tree *t, const hr_refine_params *p, const double *B, 
     double e_r, e_s;
     if (nr->kind == HR_SURFACE && ns->kind == HR_SURFACE) {
         e_r = rho * bs * l->spread * nr->area;
-        e_s = SOURCE_WEIGHT * rho * l->k * spread[l->s] * nr->area;
+        e_s = p->source_weight * rho * l->k * spread[l->s] * nr->area;
         double e_v = rho * bs * l->vis_err * nr->area;
         if (nr->area >= ns->area)
             e_r += e_v;
