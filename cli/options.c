@@ -52,7 +52,7 @@ static const option_def OPTIONS[] = {
     {OPT_NEAR_FIELD, 0, "near-field", "X", CLI_ALL,
      "hybrid: pairs closer than X element sizes use the exact method (default 3)"},
     {OPT_CLOSURE, 0, "closure-correction", NULL, CLI_ALL,
-     "rescale F so rows sum to 1 keeping reciprocity (closed scenes only; docs/methods.md)"},
+     "rescale F so rows sum to 1 keeping reciprocity; hierarchical: scale each patch's sending by its link closure (closed scenes only; docs/methods.md)"},
     {OPT_LEVEL, 0, "level", "WHICH", CLI_VIEWFACTORS,
      "view factors between 'surface's (default) or 'element's"},
     {OPT_EPSILON, 0, "epsilon", "X", CLI_RENDER,

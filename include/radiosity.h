@@ -184,7 +184,9 @@ typedef struct rad_options {
     double near_field;            /* hybrid: pairs closer than this many element sizes use
                                      the exact method; 0 = 3 */
     int closure_correction;       /* nonzero: rescale F symmetrically so rows of a closed
-                                     scene sum to 1 while A_i F_ij = A_j F_ji (thermal use) */
+                                     scene sum to 1 while A_i F_ij = A_j F_ji (thermal use);
+                                     hierarchical: each patch sends B / its link closure;
+                                     refused by shooting */
 
     const char *solver;           /* NULL = "gauss-seidel" */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */

@@ -229,6 +229,9 @@ static void test_usage_errors(void **state)
     assert_one_line_error("--solver", NULL);
     assert_int_equal(run("render --oracle nosuch"), 2);
     assert_one_line_error("--oracle", "nosuch");
+    assert_int_equal(run("render --solver shooting --closure-correction -o cc.png"), 1);
+    assert_one_line_error("closure correction", "shooting");
+    assert_no_output("cc.png");
     assert_int_equal(run(""), 2);
     assert_no_output("radiosity.png");
 }

@@ -48,6 +48,12 @@ static rad_result resolve_options(rad_context *ctx, const rad_options *in, rad_s
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "unknown solver '%s' (known: %s)", o.solver,
                         known);
     }
+    unsigned flags = rad_solver_find(o.solver)->flags;
+    if (o.closure_correction && (flags & RAD_SOLVER_MATRIX_FREE) && !(flags & RAD_SOLVER_HIERARCHICAL))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "closure correction rescales form factors, and solver '%s' computes them afresh for "
+                        "every shot: use a gathering solver or hierarchical",
+                        o.solver);
     if (!rad_vis_find(o.visibility)) {
         list_methods(RAD_METHOD_VISIBILITY, known, sizeof known);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
@@ -287,6 +293,7 @@ static rad_result solve_hierarchical(rad_context *ctx, rad_solution *s)
                           .min_area = s->options.min_area,
                           .clustering = s->options.clustering,
                           .classic_oracle = s->options.classic_oracle != 0,
+                          .closure_correction = s->options.closure_correction != 0,
                           .seed = s->options.seed,
                           .shadow_rays = s->options.shadow_rays,
                           .tolerance = s->options.tolerance,

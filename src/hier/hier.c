@@ -41,6 +41,9 @@ typedef struct hr_state {
     float *open;          /* per node: fraction of its area outside every solid; -1 for a
                              leaf not measured yet (see measure_open) */
     float *send;          /* per node: 1 / open (0 when closed): the gather's source scale */
+    float *corr;          /* per leaf: closure correction, 1 / closure (NULL when off) */
+    double *Bsend;        /* 3 per node: what sources send, B with the leaves' corr
+                             pulled up (= B when corr is NULL) */
     double *bins_in;      /* 18 per cluster: [channel][signed axis] */
     double *bins_total;   /* 18 per cluster, pushed down */
     double *bins_exit;    /* 18 per cluster, pulled up: sum A B |n_a| */
@@ -88,7 +91,16 @@ static rad_result ensure_values(hr_state *st)
     float *se = realloc(st->send, n * sizeof *se);
     if (se)
         st->send = se;
-    if (!B || !H || !Ht || !sp || !op || !se)
+    bool correct = st->p->closure_correction;
+    double *Bs = correct ? realloc(st->Bsend, 3 * n * sizeof *Bs) : st->B;
+    if (correct && Bs)
+        st->Bsend = Bs;
+    float *co = correct ? realloc(st->corr, n * sizeof *co) : NULL;
+    if (co)
+        st->corr = co;
+    if (!correct)
+        st->Bsend = st->B;
+    if (!B || !H || !Ht || !sp || !op || !se || !Bs || (correct && !co))
         return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "hierarchical: out of memory for %zu nodes; use a larger --epsilon or --min-area", n);
     for (size_t k = st->values; k < n; k++) {
@@ -103,6 +115,11 @@ static rad_result ensure_values(hr_state *st)
         st->spread[k] = 0.0;
         st->open[k] = -1.0f;
         st->send[k] = 1.0f;
+        if (st->corr) {
+            st->corr[k] = 1.0f;
+            for (int c = 0; c < 3; c++)
+                st->Bsend[3 * k + (size_t)c] = st->B[3 * k + (size_t)c];
+        }
     }
     st->values = n;
     return RAD_OK;
@@ -157,7 +174,7 @@ static void gather(hr_state *st)
         for (size_t i = st->offset[k]; i < st->offset[k + 1]; i++) {
             const hr_link *l = &links[i];
             const hr_node *ns = &t->nodes[l->s];
-            const double *Bs = &st->B[3 * (size_t)l->s];
+            const double *Bs = &st->Bsend[3 * (size_t)l->s];
             double kk = l->k;
             if (ns->kind == HR_SURFACE)
                 kk *= st->send[l->s]; /* what it reflects leaves from its open part */
@@ -223,21 +240,29 @@ static double push_pull(hr_state *st)
     for (size_t k = n; k-- > 0;) {
         const hr_node *nd = &t->nodes[k];
         if (nd->kind == HR_SURFACE && nd->child[0]) {
-            double sum[3] = {0.0, 0.0, 0.0}, area = 0.0;
+            double sum[3] = {0.0, 0.0, 0.0}, sent[3] = {0.0, 0.0, 0.0}, area = 0.0;
             for (uint32_t c4 = 0; c4 < 4; c4++) {
                 uint32_t ch = nd->child[0] + c4;
                 double a = t->nodes[ch].area;
                 area += a;
-                for (int c = 0; c < 3; c++)
+                for (int c = 0; c < 3; c++) {
                     sum[c] += a * st->B[3 * (size_t)ch + (size_t)c];
+                    sent[c] += a * st->Bsend[3 * (size_t)ch + (size_t)c];
+                }
             }
-            for (int c = 0; c < 3; c++)
+            for (int c = 0; c < 3; c++) {
                 st->B[3 * k + (size_t)c] = area > 0.0 ? sum[c] / area : 0.0;
+                if (st->corr)
+                    st->Bsend[3 * k + (size_t)c] = area > 0.0 ? sent[c] / area : 0.0;
+            }
+        } else if (nd->kind == HR_SURFACE && st->corr) {
+            for (int c = 0; c < 3; c++)
+                st->Bsend[3 * k + (size_t)c] = st->B[3 * k + (size_t)c] * st->corr[k];
         }
         if (nd->kind == HR_SURFACE && nd->parent != HR_NONE && t->nodes[nd->parent].kind == HR_CLUSTER) {
             double *bins = &st->bins_exit[18 * (size_t)nd->parent];
             for (int c = 0; c < 3; c++) /* from its open part, as for surface sources */
-                hr_bins_add(bins + 6 * c, nd->normal, nd->area * st->B[3 * k + (size_t)c] * st->send[k]);
+                hr_bins_add(bins + 6 * c, nd->normal, nd->area * st->Bsend[3 * k + (size_t)c] * st->send[k]);
         }
         if (nd->kind == HR_CLUSTER) {
             double sum[3] = {0.0, 0.0, 0.0};
@@ -407,20 +432,17 @@ static void bins_of(vec3 d, double *out)
  * A receiver's share is its area times k (surfaces), or k times its
  * members' projected area toward the source as the bins read it
  * (clusters); a leaf under a cluster source takes the share its normal
- * has in the cluster's exitance bins.  Reports the area-weighted mean and
- * range over leaves, and the power-weighted mean (weights A B, channels
- * summed).  O(links + nodes). */
-static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
+ * has in the cluster's exitance bins.  acc: n values, the closure of each
+ * surface node (its ancestors' links included); the leaves' are the ones
+ * that count.  O(links + nodes). */
+static rad_result link_closure(const hr_state *st, double *acc)
 {
     const hr_tree *t = &st->tree;
     size_t n = t->count, C = t->clusters;
-    double *acc = calloc(n ? n : 1, sizeof *acc);   /* surfaces: per unit A B, pushed down */
-    double *x = calloc(6 * C + 1, sizeof *x);        /* clusters: sum k P_r bins(-w), pushed down */
-    if (!acc || !x) {
-        free(acc);
-        free(x);
+    double *x = calloc(6 * C + 1, sizeof *x); /* clusters: sum k P_r bins(-w), pushed down */
+    if (!x)
         return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
-    }
+    memset(acc, 0, n * sizeof *acc);
     for (size_t i = 0; i < st->links.count; i++) {
         const hr_link *l = &st->links.items[i];
         const hr_node *nr = &t->nodes[l->r], *ns = &t->nodes[l->s];
@@ -436,7 +458,6 @@ static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
                 x[6 * (size_t)l->s + (size_t)q] += share * d[q];
         }
     }
-    double a_sum = 0.0, c_sum = 0.0, p_sum = 0.0, pc_sum = 0.0, lo = INFINITY, hi = -INFINITY;
     for (size_t k = 0; k < n; k++) {
         const hr_node *nd = &t->nodes[k];
         uint32_t up = nd->parent;
@@ -446,36 +467,108 @@ static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
                     x[6 * k + (size_t)q] += x[6 * (size_t)up + (size_t)q];
             continue;
         }
-        if (up != HR_NONE) {
-            if (t->nodes[up].kind == HR_CLUSTER) {
-                double nb[6];
-                bins_of(nd->normal, nb);
-                double f = 0.0;
-                for (int q = 0; q < 6; q++)
-                    f += nb[q] * x[6 * (size_t)up + (size_t)q];
-                acc[k] += f * st->send[k];
-            } else {
-                acc[k] += acc[up];
-            }
+        if (up == HR_NONE)
+            continue;
+        if (t->nodes[up].kind == HR_CLUSTER) {
+            double nb[6];
+            bins_of(nd->normal, nb);
+            double f = 0.0;
+            for (int q = 0; q < 6; q++)
+                f += nb[q] * x[6 * (size_t)up + (size_t)q];
+            acc[k] += f * st->send[k];
+        } else {
+            acc[k] += acc[up];
         }
-        if (nd->child[0] == 0 && st->open[k] > 0.0f) {
-            const double *B = &st->B[3 * k];
-            double power = nd->area * (B[0] + B[1] + B[2]);
-            a_sum += nd->area;
-            c_sum += nd->area * acc[k];
-            p_sum += power;
-            pc_sum += power * acc[k];
-            lo = fmin(lo, acc[k]);
-            hi = fmax(hi, acc[k]);
-        }
+    }
+    free(x);
+    return RAD_OK;
+}
+
+/* The closure's area-weighted mean and range over leaves, and its
+ * power-weighted mean (weights A B, channels summed), into the stats. */
+static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
+{
+    const hr_tree *t = &st->tree;
+    double *acc = malloc((t->count ? t->count : 1) * sizeof *acc);
+    if (!acc)
+        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+    rad_result r = link_closure(st, acc);
+    double a_sum = 0.0, c_sum = 0.0, p_sum = 0.0, pc_sum = 0.0, lo = INFINITY, hi = -INFINITY;
+    for (size_t k = 0; r == RAD_OK && k < t->count; k++) {
+        const hr_node *nd = &t->nodes[k];
+        if (nd->kind != HR_SURFACE || nd->child[0] != 0 || !(st->open[k] > 0.0f))
+            continue;
+        const double *B = &st->B[3 * k];
+        double power = nd->area * (B[0] + B[1] + B[2]);
+        a_sum += nd->area;
+        c_sum += nd->area * acc[k];
+        p_sum += power;
+        pc_sum += power * acc[k];
+        lo = fmin(lo, acc[k]);
+        hi = fmax(hi, acc[k]);
     }
     hs->closure_mean = a_sum > 0.0 ? c_sum / a_sum : 1.0;
     hs->closure_power = p_sum > 0.0 ? pc_sum / p_sum : 1.0;
     hs->closure_min = isfinite(lo) ? lo : 1.0;
     hs->closure_max = isfinite(hi) ? hi : 1.0;
     free(acc);
-    free(x);
-    return RAD_OK;
+    return r;
+}
+
+/* Closure correction (--closure-correction, closed scenes only): the
+ * leaves of every patch send B / c instead of B, c the patch's closure
+ * (its leaves' closures weighted by the power they send), so that the
+ * links deliver exactly the power each patch reflects.  The counterpart of
+ * the matrix methods' row scaling (formfactor/): what the links' estimates
+ * lose (partial visibility along contact edges runs low, docs/
+ * hierarchical.md) is put back in proportion to what they carry.  Per
+ * patch, not per leaf: a leaf's own closure mixes its own factors (links
+ * made at its level) with its ancestors' means (links made above it), so
+ * it is not 1 even when the patch's is: a corner leaf reads high, its
+ * siblings low.  Closures outside [0.5, 2] are taken as a patch that does
+ * not face a closed scene, and left alone. */
+static rad_result correct_closure(hr_state *st, size_t *corrected)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    double *acc = malloc((n ? n : 1) * sizeof *acc), *sum = calloc(2 * n + 1, sizeof *sum);
+    uint32_t *root = malloc((n ? n : 1) * sizeof *root);
+    if (!acc || !sum || !root) {
+        free(acc);
+        free(sum);
+        free(root);
+        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+    }
+    rad_result r = link_closure(st, acc);
+    *corrected = 0;
+    /* Parents come before their children. */
+    for (size_t k = 0; r == RAD_OK && k < n; k++) {
+        const hr_node *nd = &t->nodes[k];
+        uint32_t up = nd->parent;
+        root[k] = up == HR_NONE || t->nodes[up].kind == HR_CLUSTER ? (uint32_t)k : root[up];
+        if (nd->kind != HR_SURFACE || nd->child[0] != 0 || !(st->open[k] > 0.0f))
+            continue;
+        const double *B = &st->B[3 * k];
+        double power = nd->area * (B[0] + B[1] + B[2]);
+        sum[2 * (size_t)root[k]] += power * acc[k];
+        sum[2 * (size_t)root[k] + 1] += power;
+    }
+    for (size_t k = 0; r == RAD_OK && k < n; k++) {
+        const hr_node *nd = &t->nodes[k];
+        st->corr[k] = 1.0f;
+        if (nd->kind != HR_SURFACE || nd->child[0] != 0)
+            continue;
+        double delivered = sum[2 * (size_t)root[k]], power = sum[2 * (size_t)root[k] + 1];
+        double c = power > 0.0 ? delivered / power : 1.0;
+        if (c >= 0.5 && c <= 2.0 && c != 1.0) {
+            st->corr[k] = (float)(1.0 / c);
+            (*corrected)++;
+        }
+    }
+    free(acc);
+    free(sum);
+    free(root);
+    return r;
 }
 
 /* ---- the leaves as a mesh ---- */
@@ -672,6 +765,8 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                 if ((r = sort_links(&st)) != RAD_OK)
                     goto done;
             }
+            if (p->closure_correction && (r = correct_closure(&st, &hs->closure_corrected)) != RAD_OK)
+                goto done;
         }
         double t2 = rad_seconds();
         double tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
@@ -725,6 +820,9 @@ done:
     free(st.spread);
     free(st.open);
     free(st.send);
+    if (p->closure_correction)
+        free(st.Bsend);
+    free(st.corr);
     free(st.bins_in);
     free(st.bins_total);
     free(st.bins_exit);

@@ -234,6 +234,7 @@ typedef struct rad_hier_params {
     double min_area;           /* m^2 */
     int clustering;            /* 1 on, -1 off, 0 automatic */
     bool classic_oracle;       /* no source term (refine.c) */
+    bool closure_correction;   /* leaves send B / closure (closed scenes; hier.c) */
     uint64_t seed;
     int shadow_rays;
     double tolerance;          /* on the residual */
@@ -260,6 +261,7 @@ typedef struct rad_hier_stats {
     double min_area;           /* m^2 */
     bool clustered;
     bool classic_oracle;
+    size_t closure_corrected;  /* leaves whose sending was scaled by 1 / closure */
 } rad_hier_stats;
 
 /* Solve; on success *leaf_mesh is the mesh of the leaves (patches as in

@@ -122,6 +122,7 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
         cJSON_AddNumberToObject(hi, "min_area_m2", h->min_area);
         cJSON_AddBoolToObject(hi, "clustered", h->clustered);
         cJSON_AddStringToObject(hi, "oracle", h->classic_oracle ? "classic" : "sources");
+        cJSON_AddNumberToObject(hi, "closure_corrected_leaves", (double)h->closure_corrected);
         cJSON_AddNumberToObject(hi, "patches", (double)s->hier_base->patch_count);
         cJSON_AddNumberToObject(hi, "clusters", (double)h->clusters);
         cJSON_AddNumberToObject(hi, "nodes", (double)h->nodes);
