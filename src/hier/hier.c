@@ -36,6 +36,8 @@ typedef struct hr_state {
     hr_tree tree;
     hr_links links;
     size_t *offset;       /* receiver k's links: [offset[k], offset[k + 1]) */
+    size_t *live;         /* ... of which [offset[k], live[k]) carry something (k > 0):
+                             the gather's; blocked links follow, kept for refinement */
     double *B, *H, *Ht;   /* 3 per node */
     double *spread;       /* per node: max |B_child - B| over children and channels */
     float *open;          /* per node: fraction of its area outside every solid; -1 for a
@@ -125,33 +127,45 @@ static rad_result ensure_values(hr_state *st)
     return RAD_OK;
 }
 
-/* Counting sort of the links by receiver (stable: the refinement order is
- * kept within a receiver, so sums are thread-count independent). */
+/* Counting sort of the links by receiver, those that carry something
+ * first (stable: the refinement order is kept within each part, so sums
+ * are thread-count independent).  Links whose rays were all blocked (k =
+ * 0) stay for refinement (refine.c) but the gather skips them: in a
+ * building they are most of the links (76% of 4.4 M at 100 rooms). */
 static rad_result sort_links(hr_state *st)
 {
     size_t n = st->tree.count, L = st->links.count;
     size_t *off = realloc(st->offset, (n + 1) * sizeof *off);
+    if (off)
+        st->offset = off;
+    size_t *live = realloc(st->live, (n ? n : 1) * sizeof *live);
+    if (live)
+        st->live = live;
     hr_link *sorted = malloc((L ? L : 1) * sizeof *sorted);
-    if (!off || !sorted) {
-        if (off)
-            st->offset = off;
+    size_t *fill = malloc((n ? n : 1) * sizeof *fill);
+    if (!off || !live || !sorted || !fill) {
         free(sorted);
+        free(fill);
         return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory sorting %zu links", L);
     }
-    st->offset = off;
     memset(off, 0, (n + 1) * sizeof *off);
-    for (size_t i = 0; i < L; i++)
+    memset(live, 0, n * sizeof *live);
+    for (size_t i = 0; i < L; i++) {
         off[st->links.items[i].r + 1]++;
-    for (size_t k = 0; k < n; k++)
-        off[k + 1] += off[k];
-    size_t *fill = malloc((n ? n : 1) * sizeof *fill);
-    if (!fill) {
-        free(sorted);
-        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory sorting links");
+        live[st->links.items[i].r] += st->links.items[i].k > 0.0f;
     }
+    for (size_t k = 0; k < n; k++) {
+        off[k + 1] += off[k];
+        live[k] += off[k];
+    }
+    /* Carrying links fill [off, live), blocked ones [live, off[k + 1]). */
     memcpy(fill, off, n * sizeof *fill);
     for (size_t i = 0; i < L; i++)
-        sorted[fill[st->links.items[i].r]++] = st->links.items[i];
+        if (st->links.items[i].k > 0.0f)
+            sorted[fill[st->links.items[i].r]++] = st->links.items[i];
+    for (size_t i = 0; i < L; i++)
+        if (!(st->links.items[i].k > 0.0f))
+            sorted[fill[st->links.items[i].r]++] = st->links.items[i];
     free(fill);
     free(st->links.items);
     st->links.items = sorted;
@@ -171,7 +185,7 @@ static void gather(hr_state *st)
         const hr_node *nr = &t->nodes[k];
         double h[3] = {0.0, 0.0, 0.0};
         double *bins = nr->kind == HR_CLUSTER ? &st->bins_in[18 * k] : NULL;
-        for (size_t i = st->offset[k]; i < st->offset[k + 1]; i++) {
+        for (size_t i = st->offset[k]; i < st->live[k]; i++) {
             const hr_link *l = &links[i];
             const hr_node *ns = &t->nodes[l->s];
             const double *Bs = &st->Bsend[3 * (size_t)l->s];
@@ -646,7 +660,7 @@ static double bytes_in_use(const hr_state *st)
 {
     return (double)st->tree.capacity * sizeof(hr_node) + (double)st->links.capacity * sizeof(hr_link) +
            (double)st->values * 10.0 * sizeof(double) + (double)st->tree.clusters * 54.0 * sizeof(double) +
-           (double)(st->tree.count + 1) * sizeof(size_t);
+           2.0 * (double)(st->tree.count + 1) * sizeof(size_t);
 }
 
 rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **leaf_mesh, double **radiosity,
@@ -752,7 +766,12 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         hs->refine_rounds = round + 1;
         if (round == 0 && split == 0 && st.offset == NULL && (r = sort_links(&st)) != RAD_OK)
             goto done;
-        bool last = split == 0 || round == max_rounds - 1;
+        /* Settled once a round splits under 1e-4 of the links (the ones it
+         * split are kept; the final solve follows).  Measured on 100 rooms
+         * at epsilon 1e-5: rounds 7 to 23 split 2 to 300 of 4.4 M links
+         * each and took a quarter of the time; stopping at round 6 moved no
+         * surface by more than 0.01%. */
+        bool last = split == 0 || (double)split <= 1e-4 * (double)st.links.count || round == max_rounds - 1;
         if (last) {
             /* Links whose rays were all blocked stay while they may be
              * refined (refine.c); the final solve needs only the others. */
@@ -814,6 +833,7 @@ done:
     hr_tree_free(&st.tree);
     free(st.links.items);
     free(st.offset);
+    free(st.live);
     free(st.B);
     free(st.H);
     free(st.Ht);
