@@ -659,8 +659,10 @@ static rad_result build_leaf_mesh(hr_state *st, rad_mesh **mesh, double **radios
 static double bytes_in_use(const hr_state *st)
 {
     return (double)st->tree.capacity * sizeof(hr_node) + (double)st->links.capacity * sizeof(hr_link) +
-           (double)st->values * 10.0 * sizeof(double) + (double)st->tree.clusters * 54.0 * sizeof(double) +
-           2.0 * (double)(st->tree.count + 1) * sizeof(size_t);
+           (double)st->values * (10.0 * sizeof(double) + 2.0 * sizeof(float)) +
+           (double)st->tree.clusters * 54.0 * sizeof(double) +
+           2.0 * (double)(st->tree.count + 1) * sizeof(size_t) +
+           (st->corr ? (double)st->values * (3.0 * sizeof(double) + sizeof(float)) : 0.0);
 }
 
 rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **leaf_mesh, double **radiosity,
