@@ -22,8 +22,10 @@
  *
  * Rounds ("BF refinement" with multigridding): refine against the current
  * B (at first B = E: only links from emitters are refined), solve to 1e-3,
- * refine again with the better B, ... until a round splits no link; then
- * solve to the requested tolerance.
+ * refine again with the better B, ... until a round splits under 1e-4 of
+ * the links; then solve to the requested tolerance.  With
+ * --closure-correction, each patch then sends B / its link closure
+ * (correct_closure).
  */
 #include "hier/hier.h"
 

@@ -51,8 +51,8 @@
  * full set gives k.  Were one set used for both, the links refined would
  * be chosen by their own estimates, and the kept ones biased: a link whose
  * rays all happened to be blocked would stay dark for good.  For the same
- * reason a link whose estimate is 0 is kept (it may be refined later);
- * only the final solve drops them.
+ * reason links whose estimate is 0 are kept (they may be refined later);
+ * the gather skips them and the final solve drops them (hier.c).
  *
  * Passes are level-synchronous: decide every link's fate in parallel,
  * subdivide nodes serially in link order, create the new links in parallel
