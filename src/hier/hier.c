@@ -261,10 +261,11 @@ static double push_pull(hr_state *st)
                 uint32_t ch = nd->child[0] + c4;
                 double a = t->nodes[ch].area;
                 area += a;
-                for (int c = 0; c < 3; c++) {
+                for (int c = 0; c < 3; c++)
                     sum[c] += a * st->B[3 * (size_t)ch + (size_t)c];
-                    sent[c] += a * st->Bsend[3 * (size_t)ch + (size_t)c];
-                }
+                if (st->corr)
+                    for (int c = 0; c < 3; c++)
+                        sent[c] += a * st->Bsend[3 * (size_t)ch + (size_t)c];
             }
             for (int c = 0; c < 3; c++) {
                 st->B[3 * k + (size_t)c] = area > 0.0 ? sum[c] / area : 0.0;
