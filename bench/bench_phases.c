@@ -30,8 +30,11 @@ static void make_rays(const rad_mesh *mesh, size_t count, rad_ray *rays)
     for (size_t k = 0; k < count; k++) {
         const rad_element *a = &mesh->elements[(size_t)(rad_rng_uniform(&rng) * n)];
         const rad_element *b = &mesh->elements[(size_t)(rad_rng_uniform(&rng) * n)];
-        vec3 p = v3_mad(rad_element_sample(mesh, a, rad_rng_uniform(&rng), rad_rng_uniform(&rng)), a->normal, eps);
-        vec3 q = v3_mad(rad_element_sample(mesh, b, rad_rng_uniform(&rng), rad_rng_uniform(&rng)), b->normal, eps);
+        /* One draw per declarator: a call's arguments are unsequenced. */
+        double s0 = rad_rng_uniform(&rng), t0 = rad_rng_uniform(&rng);
+        double s1 = rad_rng_uniform(&rng), t1 = rad_rng_uniform(&rng);
+        vec3 p = v3_mad(rad_element_sample(mesh, a, s0, t0), a->normal, eps);
+        vec3 q = v3_mad(rad_element_sample(mesh, b, s1, t1), b->normal, eps);
         rays[k].origin = p;
         rays[k].direction = v3_sub(q, p);
         rays[k].tnear = 0.0;

@@ -355,8 +355,10 @@ static void measure_open(hr_state *st, const rad_vis *vis, uint64_t seed)
         for (int r = 0; r < RAYS; r++) {
             double u = ((r % 4) + rad_rng_uniform(&rng)) / 4.0, v = ((r / 4) + rad_rng_uniform(&rng)) / 4.0;
             vec3 p, normal;
-            double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng), lift;
-            hr_sample(t, (uint32_t)k, pu, pv, 0.0, false, &p, &normal, &lift);
+            double uvw[3] = {0.0, 0.0, 0.0}, lift;
+            uvw[0] = rad_rng_uniform(&rng); /* one statement each: initialisers are unsequenced */
+            uvw[1] = rad_rng_uniform(&rng);
+            hr_sample(t, (uint32_t)k, 1, uvw, false, &p, &normal, &lift);
             double rr = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
             ray[r].origin = v3_mad(p, nd->normal, lift);
             ray[r].direction = v3_add(v3_add(v3_scale(tn, rr * cos(phi)), v3_scale(bn, rr * sin(phi))),

@@ -118,9 +118,12 @@ void hr_tree_set_power(hr_tree *tree, const double *B, const float *send);
 /* Total power below cluster k (0 for a surface or before set_power). */
 double hr_cluster_power(const hr_tree *tree, uint32_t k);
 
-/* A random point on the surfaces below node k and its normal, from three
- * uniform numbers (clusters pick a patch by area, or by power). */
-void hr_sample(const hr_tree *tree, uint32_t k, double u, double v, double w, bool by_power, vec3 *point,
+/* `count` (<= HR_SAMPLE_MAX) random points on the surfaces below node k,
+ * their normals and ray lifts, from three uniform numbers each (uvw[3 i ..
+ * 3 i + 2]: u, v on the patch; w picks the patch of a cluster, by area or
+ * by power). */
+enum { HR_SAMPLE_MAX = 64 };
+void hr_sample(const hr_tree *tree, uint32_t k, int count, const double *uvw, bool by_power, vec3 *point,
                vec3 *normal, double *lift);
 
 /* ---- shaft culling (shaft.c) ---- */

@@ -94,7 +94,7 @@ double hr_transfer(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s,
                    uint64_t *rays, bool *by_power, vec3 *direction)
 {
     *direction = v3_normalize(v3_sub(t->nodes[s].center, t->nodes[r].center));
-    enum { MAX = 64 };
+    enum { MAX = HR_SAMPLE_MAX };
     rad_ray ray[MAX];
     uint8_t hit[MAX];
     double g[MAX];
@@ -113,13 +113,24 @@ double hr_transfer(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s,
         perm[i] = perm[j];
         perm[j] = tmp;
     }
+    /* Point i: the patch at stratum i of r's and perm[i] of s's weights. */
+    double ur[3 * MAX], us[3 * MAX];
+    for (int i = 0; i < count; i++) {
+        ur[3 * i + 2] = (i + rad_rng_uniform(rng)) / count;
+        us[3 * i + 2] = (perm[i] + rad_rng_uniform(rng)) / count;
+        for (int c = 0; c < 2; c++)
+            ur[3 * i + c] = rad_rng_uniform(rng);
+        for (int c = 0; c < 2; c++)
+            us[3 * i + c] = rad_rng_uniform(rng);
+    }
+    vec3 pr[MAX], nr[MAX], ps[MAX], ns[MAX];
+    double lr[MAX], ls[MAX];
+    hr_sample(t, r, count, ur, false, pr, nr, lr);
+    hr_sample(t, s, count, us, *by_power, ps, ns, ls);
     int m = 0;
     for (int i = 0; i < count; i++) {
-        vec3 p, q, np, nq;
-        double lp, lq;
-        double wr = (i + rad_rng_uniform(rng)) / count, ws = (perm[i] + rad_rng_uniform(rng)) / count;
-        hr_sample(t, r, rad_rng_uniform(rng), rad_rng_uniform(rng), wr, false, &p, &np, &lp);
-        hr_sample(t, s, rad_rng_uniform(rng), rad_rng_uniform(rng), ws, *by_power, &q, &nq, &lq);
+        vec3 p = pr[i], q = ps[i], np = nr[i], nq = ns[i];
+        double lp = lr[i], lq = ls[i];
         vec3 d = v3_sub(q, p);
         double d2 = v3_dot(d, d);
         double cp = v3_dot(np, d), cq = -v3_dot(nq, d);

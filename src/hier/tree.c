@@ -368,25 +368,37 @@ double hr_cluster_power(const hr_tree *t, uint32_t k)
     return t->order_power[n->patch + n->patch_count] - t->order_power[n->patch];
 }
 
-void hr_sample(const hr_tree *t, uint32_t k, double u, double v, double w, bool by_power, vec3 *point,
+void hr_sample(const hr_tree *t, uint32_t k, int count, const double *uvw, bool by_power, vec3 *point,
                vec3 *normal, double *lift)
 {
     const hr_node *n = &t->nodes[k];
+    uint32_t at[HR_SAMPLE_MAX];
+    if (count > HR_SAMPLE_MAX)
+        count = HR_SAMPLE_MAX;
     if (n->kind == HR_CLUSTER) {
-        /* A patch of the cluster's range, chosen by area or power. */
+        /* A patch of the cluster's range, order[first, first + width),
+         * chosen by area or power: for each point the last patch whose
+         * prefix sum is <= its target.  The searches halve the same width
+         * in lockstep, so their memory loads overlap instead of waiting on
+         * each other (a building's top clusters span 10^5 patches). */
         const double *sum = by_power ? t->order_power : t->order_area;
-        uint32_t lo = n->patch, hi = n->patch + n->patch_count; /* order[lo, hi) */
-        double target = sum[lo] + w * (sum[hi] - sum[lo]);
-        while (hi - lo > 1) {
-            uint32_t mid = lo + (hi - lo) / 2;
-            if (sum[mid] <= target)
-                lo = mid;
-            else
-                hi = mid;
+        uint32_t first = n->patch, width = n->patch_count;
+        double target[HR_SAMPLE_MAX];
+        for (int i = 0; i < count; i++) {
+            at[i] = first;
+            target[i] = sum[first] + uvw[3 * i + 2] * (sum[first + width] - sum[first]);
         }
-        n = &t->nodes[t->root_of_patch[t->order[lo]]];
+        while (width > 1) {
+            uint32_t half = width / 2;
+            for (int i = 0; i < count; i++)
+                at[i] = sum[at[i] + half] <= target[i] ? at[i] + half : at[i];
+            width -= half;
+        }
     }
-    *point = surface_point(n, u, v);
-    *normal = n->normal;
-    *lift = t->lift[n->patch];
+    for (int i = 0; i < count; i++) {
+        const hr_node *m = n->kind == HR_CLUSTER ? &t->nodes[t->root_of_patch[t->order[at[i]]]] : n;
+        point[i] = surface_point(m, uvw[3 * i], uvw[3 * i + 1]);
+        normal[i] = m->normal;
+        lift[i] = t->lift[m->patch];
+    }
 }
