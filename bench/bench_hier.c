@@ -8,7 +8,9 @@
  *      leaves) at a fixed epsilon and minimum area: leaves, links,
  *      seconds, memory, the energy balance (|absorbed - emitted| /
  *      emitted: the building is closed) and the link closure, and the
- *      fitted exponents of links and seconds against leaves;
+ *      fitted exponents of links and seconds against leaves; then 1, 10
+ *      and 100 rooms again at the same tolerance per room (epsilon 1e-3 /
+ *      rooms: epsilon is relative to the whole building's power);
  *   3. the Cornell box at about the peer's element count (issue #5: a
  *      hierarchical Galerkin solver measured at 5,398 elements, 42,475
  *      links, 0.55 s) with the classic oracle and the default one.
@@ -65,6 +67,56 @@ static int run(rad_context *ctx, const rad_scene *scene, double epsilon, double 
         return 1;
     }
     *out = s;
+    return 0;
+}
+
+/* Generated offices of rooms[0 .. count): leaves, links, seconds, memory,
+ * the power balance (the building is closed) and the closure, then the
+ * fitted exponents of links and seconds against leaves.  epsilon 1e-3, or
+ * 1e-3 / rooms when per_room. */
+static int offices(rad_context *ctx, const int *rooms, int count, bool per_room, FILE *out, const char *tag)
+{
+    printf("%6s %9s %8s %9s %9s %8s %9s %9s %8s %8s\n", "rooms", "epsilon", "patches", "leaves", "links", "links/el",
+           "seconds", "MB", "power", "closure");
+    double lx[8], ll[8], lt[8];
+    int runs = 0;
+    for (int i = 0; i < count && i < 8; i++) {
+        rad_office_options oo = {rooms[i], 0};
+        rad_scene *scene = NULL;
+        if (rad_scene_generate_office(ctx, &oo, &scene) != RAD_OK)
+            return 1;
+        double epsilon = per_room ? 1e-3 / rooms[i] : 1e-3;
+        rad_solution *s = NULL;
+        if (run(ctx, scene, epsilon, 0.02, 0, &s))
+            return 1;
+        const rad_hier_stats *h = &s->hier_stats;
+        double emitted, absorbed;
+        rad_solution_power(s, &emitted, &absorbed);
+        double power = fabs(absorbed - emitted) / emitted;
+        printf("%6d %9.0e %8zu %9zu %9zu %8.1f %9.2f %9.1f %7.2f%% %8.4f\n", rooms[i], epsilon,
+               s->hier_base->patch_count, h->leaves, h->links, (double)h->links / (double)h->leaves,
+               s->solve_stats.seconds, h->bytes / 1e6, 100.0 * power, h->closure_power);
+        if (out)
+            fprintf(out, "%s%d,%g,%zu,%zu,%.4f,%.0f,,%.5f\n", tag, rooms[i], epsilon, h->leaves, h->links,
+                    s->solve_stats.seconds, h->bytes, power);
+        lx[runs] = log((double)h->leaves);
+        ll[runs] = log((double)h->links);
+        lt[runs] = log(s->solve_stats.seconds);
+        runs++;
+        rad_solution_destroy(s);
+        rad_scene_destroy(scene);
+    }
+    /* Least-squares slopes in log-log. */
+    double mx = 0, ml = 0, mt = 0;
+    for (int i = 0; i < runs; i++)
+        mx += lx[i] / runs, ml += ll[i] / runs, mt += lt[i] / runs;
+    double sxx = 0, sxl = 0, sxt = 0;
+    for (int i = 0; i < runs; i++) {
+        sxx += (lx[i] - mx) * (lx[i] - mx);
+        sxl += (lx[i] - mx) * (ll[i] - ml);
+        sxt += (lx[i] - mx) * (lt[i] - mt);
+    }
+    printf("fitted exponents against leaves: links %.2f, seconds %.2f\n", sxl / sxx, sxt / sxx);
     return 0;
 }
 
@@ -138,47 +190,14 @@ int main(int argc, char **argv)
     rad_scene_destroy(box);
 
     printf("\nOffices (seed 0, epsilon 1e-3, min area 0.02 m^2)\n");
-    printf("%6s %8s %9s %9s %8s %9s %9s %8s %8s\n", "rooms", "patches", "leaves", "links", "links/el", "seconds", "MB",
-           "power", "closure");
     const int rooms[] = {1, 10, 100, 1000, 1800};
-    double lx[5], ll[5], lt[5];
-    int runs = 0;
-    for (int i = 0; i < 3 + big; i++) {
-        rad_office_options oo = {rooms[i], 0};
-        rad_scene *scene = NULL;
-        if (rad_scene_generate_office(ctx, &oo, &scene) != RAD_OK)
-            return 1;
-        rad_solution *s = NULL;
-        if (run(ctx, scene, 1e-3, 0.02, 0, &s))
-            return 1;
-        const rad_hier_stats *h = &s->hier_stats;
-        double emitted, absorbed;
-        rad_solution_power(s, &emitted, &absorbed);
-        double power = fabs(absorbed - emitted) / emitted;
-        printf("%6d %8zu %9zu %9zu %8.1f %9.2f %9.1f %7.2f%% %8.4f\n", rooms[i], s->hier_base->patch_count, h->leaves,
-               h->links, (double)h->links / (double)h->leaves, s->solve_stats.seconds, h->bytes / 1e6, 100.0 * power,
-               h->closure_power);
-        if (out)
-            fprintf(out, "office%d,%g,%zu,%zu,%.4f,%.0f,,%.5f\n", rooms[i], 1e-3, h->leaves, h->links,
-                    s->solve_stats.seconds, h->bytes, power);
-        lx[runs] = log((double)h->leaves);
-        ll[runs] = log((double)h->links);
-        lt[runs] = log(s->solve_stats.seconds);
-        runs++;
-        rad_solution_destroy(s);
-        rad_scene_destroy(scene);
-    }
-    /* Least-squares slopes in log-log. */
-    double mx = 0, ml = 0, mt = 0;
-    for (int i = 0; i < runs; i++)
-        mx += lx[i] / runs, ml += ll[i] / runs, mt += lt[i] / runs;
-    double sxx = 0, sxl = 0, sxt = 0;
-    for (int i = 0; i < runs; i++) {
-        sxx += (lx[i] - mx) * (lx[i] - mx);
-        sxl += (lx[i] - mx) * (ll[i] - ml);
-        sxt += (lx[i] - mx) * (lt[i] - mt);
-    }
-    printf("fitted exponents against leaves: links %.2f, seconds %.2f\n", sxl / sxx, sxt / sxx);
+    if (offices(ctx, rooms, 3 + big, false, out, "office"))
+        return 1;
+    /* The same tolerance per room: epsilon (relative to the whole building)
+     * falls as 1 / rooms, so every room is solved about as accurately. */
+    printf("\nOffices at the same tolerance per room (epsilon 1e-3 / rooms, min area 0.02 m^2)\n");
+    if (offices(ctx, rooms, 3, true, out, "perroom"))
+        return 1;
     if (out)
         fclose(out);
     rad_context_destroy(ctx);

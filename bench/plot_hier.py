@@ -18,7 +18,8 @@ def main():
     rows = list(csv.DictReader(open(sys.argv[1])))
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     series = (("Cornell box", "o", lambda n: n == "cornell"),
-              ("offices", "s", lambda n: n.startswith("office")),
+              ("offices, epsilon 1e-3", "s", lambda n: n.startswith("office")),
+              ("offices, epsilon 1e-3 / rooms", "D", lambda n: n.startswith("perroom")),
               ("Cornell, --oracle classic", "^", lambda n: n == "cornell_classic"))
     for label, marker, pick in series:
         sel = [r for r in rows if pick(r["scene"])]
