@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "api/solution.h"
+#include "hier/hier.h"
 
 static rad_context *ctx;
 
@@ -500,6 +501,71 @@ static void test_furnace_clusters(void **state)
     rad_scene_destroy(scene);
 }
 
+/* hr_sample picks a cluster's patches by binary searches run in lockstep:
+ * each point must lie on the patch a plain scan of the prefix sums picks
+ * (the last whose sum is <= the target), by area and by power, including
+ * targets on the sums themselves (patches of zero power are never picked
+ * then, since their sums tie with the next). */
+static void test_cluster_sampling(void **state)
+{
+    (void)state;
+    rad_scene *scene = furnace_corridor();
+    rad_mesh_options mo = {1e30, 0, 0.0};
+    rad_mesh *base = NULL;
+    assert_int_equal(rad_mesh_build(ctx, scene, &mo, &base), RAD_OK);
+    hr_tree t;
+    assert_int_equal(hr_tree_build(ctx, base, scene, true, 1e-3, 0.0, &t), RAD_OK);
+    assert_true(t.clusters > 4);
+    /* Power: every third patch dark, the rest by their index. */
+    double *B = calloc(3 * t.count, sizeof *B);
+    float *send = malloc(t.count * sizeof *send);
+    assert_non_null(B);
+    assert_non_null(send);
+    for (size_t k = 0; k < t.count; k++) {
+        send[k] = 1.0f;
+        if (t.nodes[k].kind == HR_SURFACE)
+            for (int c = 0; c < 3; c++)
+                B[3 * k + (size_t)c] = t.nodes[k].patch % 3 ? (double)t.nodes[k].patch : 0.0;
+    }
+    hr_tree_set_power(&t, B, send);
+    rad_rng rng = rad_rng_keyed(7, 1, 2);
+    for (uint32_t k = 0; k < t.clusters; k++) {
+        const hr_node *n = &t.nodes[k];
+        for (int by_power = 0; by_power < 2; by_power++) {
+            const double *sum = by_power ? t.order_power : t.order_area;
+            enum { N = 24 };
+            double uvw[3 * N];
+            for (int i = 0; i < N; i++) {
+                uvw[3 * i] = rad_rng_uniform(&rng);
+                uvw[3 * i + 1] = rad_rng_uniform(&rng);
+                /* Half the targets exactly on a prefix sum. */
+                uint32_t j = n->patch + (uint32_t)(rad_rng_uniform(&rng) * n->patch_count);
+                double span = sum[n->patch + n->patch_count] - sum[n->patch];
+                uvw[3 * i + 2] = i % 2 ? (sum[j] - sum[n->patch]) / span : rad_rng_uniform(&rng);
+            }
+            vec3 p[N], nn[N];
+            double lift[N];
+            hr_sample(&t, k, N, uvw, by_power, p, nn, lift);
+            for (int i = 0; i < N; i++) {
+                double target = sum[n->patch] + uvw[3 * i + 2] * (sum[n->patch + n->patch_count] - sum[n->patch]);
+                uint32_t want = n->patch;
+                for (uint32_t j = n->patch; j < n->patch + n->patch_count; j++)
+                    if (sum[j] <= target)
+                        want = j;
+                vec3 q, nq;
+                double lq;
+                hr_sample(&t, t.root_of_patch[t.order[want]], 1, &uvw[3 * i], false, &q, &nq, &lq);
+                assert_true(v3_length(v3_sub(p[i], q)) == 0.0);
+            }
+        }
+    }
+    free(B);
+    free(send);
+    hr_tree_free(&t);
+    rad_mesh_destroy(base);
+    rad_scene_destroy(scene);
+}
+
 /* A building of 10 rooms (1,600 polygons) with clusters: the power that
  * reaches receivers along the links (the closure) and the energy balance.
  * Cluster links with point estimates from the clusters' centres drifted by
@@ -573,6 +639,7 @@ int main(void)
         cmocka_unit_test(test_thread_count_independent),
         cmocka_unit_test(test_clusters_office),
         cmocka_unit_test(test_furnace_clusters),
+        cmocka_unit_test(test_cluster_sampling),
         cmocka_unit_test(test_office_energy),
         cmocka_unit_test(test_bad_options),
     };
