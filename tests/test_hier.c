@@ -70,16 +70,19 @@ static rad_scene *furnace_cube(void)
     return scene;
 }
 
-static rad_solution *solve(const rad_scene *scene, double epsilon, int clustering)
+/* Solve hierarchically with these options (solver set here). */
+static rad_solution *solve_options(const rad_scene *scene, rad_options o)
 {
-    rad_options o = {0};
     o.solver = "hierarchical";
-    o.epsilon = epsilon;
-    o.clustering = clustering;
     rad_solution *s = NULL;
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
     return s;
+}
+
+static rad_solution *solve(const rad_scene *scene, double epsilon, int clustering)
+{
+    return solve_options(scene, (rad_options){.epsilon = epsilon, .clustering = clustering});
 }
 
 static double relative(double got, double want) { return fabs(got - want) / fabs(want); }
@@ -257,15 +260,8 @@ static void test_classic_oracle(void **state)
 {
     (void)state;
     rad_scene *scene = cornell(false);
-    rad_options o = {0};
-    o.solver = "hierarchical";
-    o.epsilon = 3e-5;
-    rad_solution *sources = NULL, *classic = NULL;
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &sources), RAD_OK);
-    assert_int_equal(rad_solution_solve(ctx, sources), RAD_OK);
-    o.classic_oracle = 1;
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &classic), RAD_OK);
-    assert_int_equal(rad_solution_solve(ctx, classic), RAD_OK);
+    rad_solution *sources = solve_options(scene, (rad_options){.epsilon = 3e-5});
+    rad_solution *classic = solve_options(scene, (rad_options){.epsilon = 3e-5, .classic_oracle = 1});
     /* Measured: classic 4,285 leaves, 25k links (5.9 per leaf), 2.2%;
      * sources 3,838 leaves, 68k links, 0.47%. */
     double e_classic = cornell_error(classic), e_sources = cornell_error(sources);
@@ -588,13 +584,7 @@ static void test_office_energy(void **state)
 
     /* With the closure correction each patch sends B / its closure: the
      * building's power balances. */
-    rad_options o = {0};
-    o.solver = "hierarchical";
-    o.epsilon = 1e-3;
-    o.closure_correction = 1;
-    rad_solution *c = NULL;
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &c), RAD_OK);
-    assert_int_equal(rad_solution_solve(ctx, c), RAD_OK);
+    rad_solution *c = solve_options(scene, (rad_options){.epsilon = 1e-3, .closure_correction = 1});
     double emitted_c, absorbed_c;
     rad_solution_power(c, &emitted_c, &absorbed_c);
     /* Measured: 0.79% -> 0.01%, 6,966 of 7,352 leaves scaled. */
