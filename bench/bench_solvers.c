@@ -92,8 +92,8 @@ int main(int argc, char **argv)
         const rad_solver *solver = rad_solvers[k];
         if (!listed(only, solver->name))
             continue;
-        snprintf(sol->solver_name, sizeof sol->solver_name, "%s", solver->name);
-        sol->options.solver = sol->solver_name;
+        snprintf(sol->names.solver, sizeof sol->names.solver, "%s", solver->name);
+        sol->options.solver = sol->names.solver;
         rad_result r = rad_solution_solve(ctx, sol);
         if (r != RAD_OK) {
             printf("%-20s failed: %s\n", solver->name, rad_context_error(ctx));

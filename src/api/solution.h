@@ -5,6 +5,7 @@
 #ifndef RAD_SOLUTION_H
 #define RAD_SOLUTION_H
 
+#include "api/options.h"
 #include "formfactor/formfactor.h"
 #include "hier/hier.h"
 #include "output/output.h"
@@ -14,9 +15,7 @@ struct rad_solution {
     const rad_scene *scene;    /* borrowed: must outlive the solution */
     rad_options options;       /* resolved defaults */
     int threads;               /* the context's, for parallel passes */
-    char form_factor_name[32];
-    char solver_name[32];
-    char visibility_name[32];
+    rad_method_names names;    /* what options' method names point to */
     rad_mesh *mesh;            /* hierarchical: the leaves, after solving */
     rad_mesh *hier_base;       /* hierarchical: the patches (one element each) vis is built on */
     rad_hier_stats hier_stats;

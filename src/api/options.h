@@ -1,0 +1,23 @@
+/*
+ * options.h -- validation and defaults of the public rad_options.
+ */
+#ifndef RAD_API_OPTIONS_H
+#define RAD_API_OPTIONS_H
+
+#include "core/core.h"
+
+/* Copies of the method names, so resolved options do not point into the
+ * caller's strings. */
+typedef struct rad_method_names {
+    char form_factors[32];
+    char solver[32];
+    char visibility[32];
+} rad_method_names;
+
+/* Fill in the defaults of `in` (NULL = all defaults) and check every field;
+ * on success *out holds the resolved options, whose method names point into
+ * *names (which must outlive them).  On failure the context names the field. */
+rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_options *out,
+                               rad_method_names *names);
+
+#endif
