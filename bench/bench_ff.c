@@ -81,7 +81,7 @@ static double case_error(rad_context *ctx, const char *method, const square_case
     o.target_elements = elements;
     rad_solution *sol = NULL;
     double err = NAN;
-    if (rad_solution_create(ctx, scene, &o, &sol) == RAD_OK && sol->F) {
+    if (rad_solution_create(ctx, scene, &o, &sol) == RAD_OK && sol->view.F) {
         size_t S = rad_scene_surface_count(scene);
         double *F = malloc(S * S * sizeof *F);
         if (F) {
@@ -110,8 +110,8 @@ static double cornell_seconds(rad_context *ctx, const rad_scene *cornell, const 
         fprintf(stderr, "%s: Cornell box, %zu elements: %s\n", method, elements, rad_context_error(ctx));
         return NAN;
     }
-    double s = sol->ff_stats.seconds;
-    *actual = sol->mesh->element_count;
+    double s = sol->view.ff->seconds;
+    *actual = sol->view.mesh->element_count;
     rad_solution_destroy(sol);
     return s;
 }

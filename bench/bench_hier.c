@@ -89,19 +89,19 @@ static int offices(rad_context *ctx, const int *rooms, int count, bool per_room,
         rad_solution *s = NULL;
         if (run(ctx, scene, epsilon, 0.02, 0, &s))
             return 1;
-        const rad_hier_stats *h = &s->hier_stats;
+        const rad_hier_stats *h = s->view.hier;
         double emitted, absorbed;
         rad_solution_power(s, &emitted, &absorbed);
         double power = fabs(absorbed - emitted) / emitted;
         printf("%6d %9.0e %8zu %9zu %9zu %8.1f %9.2f %9.1f %7.2f%% %8.4f\n", rooms[i], epsilon,
-               s->hier_base->patch_count, h->leaves, h->links, (double)h->links / (double)h->leaves,
-               s->solve_stats.seconds, h->bytes / 1e6, 100.0 * power, h->closure_power);
+               s->view.hier->patches, h->leaves, h->links, (double)h->links / (double)h->leaves,
+               s->view.solve->seconds, h->bytes / 1e6, 100.0 * power, h->closure_power);
         if (out)
             fprintf(out, "%s%d,%g,%zu,%zu,%.4f,%.0f,,%.5f\n", tag, rooms[i], epsilon, h->leaves, h->links,
-                    s->solve_stats.seconds, h->bytes, power);
+                    s->view.solve->seconds, h->bytes, power);
         lx[runs] = log((double)h->leaves);
         ll[runs] = log((double)h->links);
-        lt[runs] = log(s->solve_stats.seconds);
+        lt[runs] = log(s->view.solve->seconds);
         runs++;
         rad_solution_destroy(s);
         rad_scene_destroy(scene);
@@ -158,11 +158,11 @@ int main(int argc, char **argv)
         rad_solution *s = NULL;
         if (run(ctx, box, eps[i], 0.0, 0, &s))
             return 1;
-        const rad_hier_stats *h = &s->hier_stats;
+        const rad_hier_stats *h = s->view.hier;
         printf("%9.0e %8zu %9zu %8.1f %9.3f %7.2f%%\n", eps[i], h->leaves, h->links,
-               (double)h->links / (double)h->leaves, s->solve_stats.seconds, 100.0 * worst_error(s));
+               (double)h->links / (double)h->leaves, s->view.solve->seconds, 100.0 * worst_error(s));
         if (out)
-            fprintf(out, "cornell,%g,%zu,%zu,%.4f,%.0f,%.5f,\n", eps[i], h->leaves, h->links, s->solve_stats.seconds,
+            fprintf(out, "cornell,%g,%zu,%zu,%.4f,%.0f,%.5f,\n", eps[i], h->leaves, h->links, s->view.solve->seconds,
                     h->bytes, worst_error(s));
         rad_solution_destroy(s);
     }
@@ -179,12 +179,12 @@ int main(int argc, char **argv)
         rad_solution *s = NULL;
         if (run(ctx, box, peer[i].epsilon, 0.0, peer[i].classic, &s))
             return 1;
-        const rad_hier_stats *h = &s->hier_stats;
+        const rad_hier_stats *h = s->view.hier;
         printf("%8s %9.2e %8zu %9zu %8.1f %9.3f %7.2f%%\n", peer[i].name, peer[i].epsilon, h->leaves, h->links,
-               (double)h->links / (double)h->leaves, s->solve_stats.seconds, 100.0 * worst_error(s));
+               (double)h->links / (double)h->leaves, s->view.solve->seconds, 100.0 * worst_error(s));
         if (out)
             fprintf(out, "cornell_%s,%g,%zu,%zu,%.4f,%.0f,%.5f,\n", peer[i].name, peer[i].epsilon, h->leaves,
-                    h->links, s->solve_stats.seconds, h->bytes, worst_error(s));
+                    h->links, s->view.solve->seconds, h->bytes, worst_error(s));
         rad_solution_destroy(s);
     }
     rad_scene_destroy(box);

@@ -150,9 +150,9 @@ int main(int argc, char **argv)
         }
         double total = rad_seconds() - t0;
         printf("%9zu %7.3f %7.4f %9.3f %12llu %8.3f %8.3f %9.3f %12.3g %9.0f\n",
-               sol->mesh->element_count, sol->seconds.mesh, sol->seconds.visibility,
-               sol->seconds.form_factors, (unsigned long long)sol->ff_stats.rays, sol->seconds.solve,
-               sol->seconds.render, total, (double)sol->ff_stats.pairs / sol->seconds.form_factors,
+               sol->view.mesh->element_count, sol->view.seconds.mesh, sol->view.seconds.visibility,
+               sol->view.seconds.form_factors, (unsigned long long)sol->view.ff->rays, sol->view.seconds.solve,
+               sol->view.seconds.render, total, (double)sol->view.ff->pairs / sol->view.seconds.form_factors,
                (double)rad_peak_memory_bytes() / 1048576.0);
         fflush(stdout);
         rad_image_destroy(img);

@@ -84,7 +84,7 @@ int main(int argc, char **argv)
     }
     printf("Cornell box, %zu elements, seed 0, %d threads, analytic form factors (%.1f s), "
            "tolerance %g\n",
-           sol->mesh->element_count, rad_context_threads(ctx), sol->seconds.form_factors, tolerance);
+           sol->view.mesh->element_count, rad_context_threads(ctx), sol->view.seconds.form_factors, tolerance);
     printf("%-20s %10s %10s %12s %12s  %s\n", "solver", "iterations", "seconds", "residual", "unshot",
            "converged");
     int status = 0;
@@ -100,7 +100,7 @@ int main(int argc, char **argv)
             status = 1;
             continue;
         }
-        const rad_solve_stats *st = &sol->solve_stats;
+        const rad_solve_stats *st = sol->view.solve;
         printf("%-20s %10d %10.3f %12.3e %12.3e  %s\n", solver->name, st->iterations, st->seconds,
                st->residual, st->unshot, st->converged ? "yes" : "no");
         fflush(stdout);

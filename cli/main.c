@@ -107,12 +107,14 @@ static void progress_end(progress_state *p)
 
 /* ---- interruption ---- */
 
-static volatile int cancel_flag;
+/* The context whose work a signal cancels (set once, before the handler
+ * can see anything but NULL); rad_context_cancel is an atomic store. */
+static rad_context *volatile cancel_context;
 static volatile sig_atomic_t cancel_signal;
 
 static void on_signal(int sig)
 {
-    cancel_flag = 1;
+    rad_context_cancel(cancel_context, true);
     cancel_signal = sig;
 }
 
@@ -159,35 +161,6 @@ static int fail(rad_context *ctx, rad_result r)
 
 static int interrupted_status(void) { return cancel_signal == SIGTERM ? 143 : 130; }
 
-/* The stats of a run interrupted before there was a solution (docs/stats.md:
- * "partial": true and the phase it stopped in).  Written to a temporary
- * name and renamed, as every output is, so it is whole or absent.  Returns
- * 0 when written. */
-static int write_interrupted_stats(const char *path, const char *phase, const char *scene_name,
-                                   const rad_scene *scene, double seconds)
-{
-    char temp[PATH_MAX];
-    if (snprintf(temp, sizeof temp, "%s.tmp.%ld", path, (long)getpid()) >= (int)sizeof temp)
-        return -1;
-    FILE *f = fopen(temp, "w");
-    if (!f)
-        return -1;
-    fprintf(f, "{\n\t\"version\":\t\"%s\",\n\t\"partial\":\ttrue,\n\t\"interrupted\":\t\"%s\",\n"
-               "\t\"converged\":\tfalse,\n\t\"scene\":\t\"",
-            RAD_VERSION_STRING, phase);
-    for (const unsigned char *c = (const unsigned char *)scene_name; *c; c++) /* JSON string */
-        fprintf(f, *c == '"' || *c == '\\' ? "\\%c" : *c < 0x20 ? "\\u%04x" : "%c", *c);
-    fprintf(f, "\",\n\t\"surfaces\":\t%zu,\n\t\"seconds\":\t{\n\t\t\"total\":\t%.6g\n\t}\n}\n",
-            rad_scene_surface_count(scene), seconds);
-    int failed = ferror(f);
-    failed |= fclose(f) != 0;
-    if (failed || rename(temp, path) != 0) {
-        remove(temp);
-        return -1;
-    }
-    return 0;
-}
-
 /* The absolute path of a file just written, for telling the user where it
  * is; falls back to the name as given. */
 static const char *where(const char *path, char *buf)
@@ -216,7 +189,6 @@ int main(int argc, char **argv)
     progress_state progress = {0};
     rad_context_options co = {0};
     co.threads = s.threads;
-    co.cancel = &cancel_flag;
     if (!s.quiet && isatty(STDERR_FILENO)) {
         co.progress = progress_bar;
         co.progress_user = &progress;
@@ -226,6 +198,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "radiosity: cannot create a context\n");
         return 1;
     }
+    cancel_context = ctx;
     const char *output = s.output ? s.output
                                   : (s.command == CLI_RENDER ? "radiosity.png" : "viewfactors.json");
     rad_camera camera;
@@ -275,9 +248,8 @@ int main(int argc, char **argv)
     progress_end(&progress);
     if (r == RAD_ERROR_INTERRUPTED) {
         /* No radiosity yet, so no image: only the stats say what happened. */
-        int wrote = s.stats && write_interrupted_stats(s.stats, "form factors",
-                                                       s.scene_path ? s.scene_path : "cornell-box",
-                                                       scene, now_seconds() - t0) == 0;
+        int wrote = s.stats && rad_scene_write_interrupted_stats(ctx, scene, "form factors", now_seconds() - t0,
+                                                                 s.stats) == RAD_OK;
         fprintf(stderr, "radiosity: interrupted while computing form factors; %s\n",
                 wrote ? "wrote partial stats only" : "nothing written");
         status = interrupted_status();
@@ -326,7 +298,7 @@ int main(int argc, char **argv)
 
     /* 5. image and stats.  A second signal during output is ignored: the
      * partial results are being saved. */
-    cancel_flag = 0;
+    rad_context_cancel(ctx, false);
     r = rad_solution_render(ctx, sol, &s.render, &image);
     progress_end(&progress);
     if (r == RAD_OK)
@@ -360,6 +332,7 @@ done:
     rad_image_destroy(image);
     rad_solution_destroy(sol);
     rad_scene_destroy(scene);
+    cancel_context = NULL;
     rad_context_destroy(ctx);
     return status;
 }

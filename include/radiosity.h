@@ -31,6 +31,7 @@
 #ifndef RADIOSITY_H
 #define RADIOSITY_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -67,19 +68,32 @@ typedef struct rad_context rad_context;
  * `done` of `total` units finished.  Called from the calling thread only. */
 typedef void (*rad_progress_fn)(void *user, const char *phase, uint64_t done, uint64_t total);
 
+/* Called once per failed call, with its result and the message that
+ * rad_context_error() will return, from the thread that made the call. */
+typedef void (*rad_error_fn)(void *user, rad_result result, const char *message);
+
 typedef struct rad_context_options {
     int threads;                 /* worker threads; 0 = all cores */
     rad_progress_fn progress;    /* optional progress callback */
     void *progress_user;         /* passed to `progress` */
-    /* Optional cancellation flag (set it from a signal handler); long phases
-     * poll it and return RAD_ERROR_INTERRUPTED with partial results. */
-    volatile int *cancel;
+    rad_error_fn on_error;       /* optional: told of every failure */
+    void *error_user;            /* passed to `on_error` */
 } rad_context_options;
 
 rad_result rad_context_create(const rad_context_options *options, rad_context **out);
 void rad_context_destroy(rad_context *ctx);
-/* The message of the most recent failure in this context ("" if none). */
+/* The message of the most recent failed call in this context ("" if none):
+ * its FIRST failure, which names the cause ("box.obj:12: ..."), not what
+ * followed from it.  Owned by the context; valid until its next failure. */
 const char *rad_context_error(const rad_context *ctx);
+
+/* Ask the running and following calls to stop (cancel = true) or let them
+ * run again (false).  Long phases poll the flag and return
+ * RAD_ERROR_INTERRUPTED, keeping partial results.  An atomic store: safe
+ * from a signal handler and from any thread.  NULL is a no-op. */
+void rad_context_cancel(rad_context *ctx, bool cancel);
+/* Whether cancellation was asked for (false for NULL). */
+bool rad_context_cancelled(const rad_context *ctx);
 int rad_context_threads(const rad_context *ctx);
 
 /* ------------------------------------------------------------------------
@@ -258,6 +272,41 @@ void rad_solution_surface_view_factors(const rad_solution *solution, double *F);
 /* Power in watts (summed over RGB / 3): emitted, absorbed by surfaces. */
 void rad_solution_power(const rad_solution *solution, double *emitted, double *absorbed);
 
+/* ---- The solution element by element and vertex by vertex ----
+ *
+ * Elements are numbered 0 .. rad_solution_element_count() - 1 and welded
+ * vertices 0 .. rad_solution_vertex_count() - 1, so a program can read the
+ * whole solution (lit meshes, lightmaps, its own analysis).  Elements are
+ * planar triangles or quads.  The hierarchical solver's elements are the
+ * leaves of its hierarchy: its patches until solved, then the leaves of the
+ * last solve; indices and counts hold until the next rad_solution_solve.
+ * An index out of range returns false (or 0) and writes nothing.  These
+ * calls only read: any number of threads may call them at once on a
+ * solution that is not being solved. */
+
+size_t rad_solution_vertex_count(const rad_solution *solution);
+/* Welded vertex position, m. */
+bool rad_solution_vertex_position(const rad_solution *solution, size_t vertex, double xyz[3]);
+/* Radiosity at every vertex (rgb: 3 per vertex, W/m^2): the values smooth
+ * shading interpolates (area-weighted means of the elements around a
+ * vertex, extrapolated at boundaries, continuous across T-vertices). */
+rad_result rad_solution_vertex_radiosity(rad_context *ctx, const rad_solution *solution, double *rgb);
+
+/* The element's corners (3 or 4 vertex indices, counter-clockwise about
+ * its normal); returns their count, 0 when out of range. */
+int rad_solution_element_vertices(const rad_solution *solution, size_t element, size_t vertex[4]);
+/* Index of the scene surface it belongs to (SIZE_MAX when out of range). */
+size_t rad_solution_element_surface(const rad_solution *solution, size_t element);
+/* Area, m^2 (0 when out of range). */
+double rad_solution_element_area(const rad_solution *solution, size_t element);
+/* Unit normal, and centroid in m. */
+bool rad_solution_element_geometry(const rad_solution *solution, size_t element, double normal[3],
+                                   double centroid[3]);
+/* Reflectance rho (RGB), emission E and radiosity B (RGB, W/m^2); any of
+ * the three may be NULL. */
+bool rad_solution_element_values(const rad_solution *solution, size_t element, double reflectance[3],
+                                 double emission[3], double radiosity[3]);
+
 /* ------------------------------------------------------------------------
  * Output
  * ---------------------------------------------------------------------- */
@@ -298,6 +347,13 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
 /* Stats as JSON (schema in docs/stats.md).  `partial` marks an interrupted run. */
 rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *solution,
                                     const char *path, int partial);
+
+/* The stats of a run interrupted before it had a solution (while meshing or
+ * computing form factors): version, "partial": true, "interrupted": phase,
+ * "converged": false, the scene, its surface count and seconds.total
+ * (docs/stats.md).  Atomic like the other writers. */
+rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *scene, const char *phase,
+                                            double seconds, const char *path);
 
 /* View factors, by extension: .json (surfaces with name, area, row_sum; F),
  * .csv (dense) or .mtx (Matrix Market coordinate, sparse).  `elements`

@@ -109,7 +109,7 @@ static void test_furnace(void **state)
     const double eps[2] = {1e-3, 1e-5};
     for (int i = 0; i < 2; i++) {
         s = solve(scene, eps[i], 0);
-        assert_true(s->hier_stats.leaves > 100);
+        assert_true(s->view.hier->leaves > 100);
         err[i] = 0.0;
         for (size_t k = 0; k < scene->surface_count; k++) {
             double B[3];
@@ -244,9 +244,9 @@ static void test_cornell_converges(void **state)
     assert_true(e_coarse < 0.03);
     assert_true(e_fine < 0.006);
     assert_true(e_fine < 0.6 * e_coarse);
-    assert_true(fine->hier_stats.leaves > 4 * coarse->hier_stats.leaves);
+    assert_true(fine->view.hier->leaves > 4 * coarse->view.hier->leaves);
     /* Links grow about linearly with the leaves. */
-    double per_leaf = (double)fine->hier_stats.links / (double)fine->hier_stats.leaves;
+    double per_leaf = (double)fine->view.hier->links / (double)fine->view.hier->leaves;
     assert_true(per_leaf < 60.0);
     rad_solution_destroy(coarse);
     rad_solution_destroy(fine);
@@ -267,7 +267,7 @@ static void test_classic_oracle(void **state)
     double e_classic = cornell_error(classic), e_sources = cornell_error(sources);
     assert_true(e_classic < 0.035);
     assert_true(e_sources < 0.4 * e_classic);
-    const rad_hier_stats *hc = &classic->hier_stats, *hs = &sources->hier_stats;
+    const rad_hier_stats *hc = classic->view.hier, *hs = sources->view.hier;
     assert_true((double)hc->links / (double)hc->leaves < 8.0);
     assert_true(hc->links < hs->links / 2);
     /* The power absorbed in the (open) box: the same physics either way
@@ -310,7 +310,7 @@ static rad_scene *tetrahedron(void)
 
 static void assert_leaves_locate(const rad_solution *s)
 {
-    const rad_mesh *mesh = s->mesh;
+    const rad_mesh *mesh = s->view.mesh;
     assert_non_null(mesh->tree);
     for (size_t i = 0; i < mesh->element_count; i++) {
         const rad_element *e = &mesh->elements[i];
@@ -332,22 +332,26 @@ static void test_leaves_locate(void **state)
     (void)state;
     rad_scene *tet = tetrahedron();
     rad_solution *ts = solve(tet, 1e-5, 0);
-    assert_true(ts->mesh->element_count > 16);
-    assert_int_equal(ts->mesh->elements[0].vertex_count, 3);
+    assert_true(ts->view.mesh->element_count > 16);
+    assert_int_equal(ts->view.mesh->elements[0].vertex_count, 3);
     assert_leaves_locate(ts);
     rad_solution_destroy(ts);
     rad_scene_destroy(tet);
 
     rad_scene *scene = cornell(false);
     rad_solution *s = solve(scene, 1e-4, 0);
-    const rad_mesh *mesh = s->mesh;
+    const rad_mesh *mesh = s->view.mesh;
     assert_non_null(mesh->tree);
-    assert_int_equal(mesh->element_count, s->hier_stats.leaves);
+    assert_int_equal(mesh->element_count, s->view.hier->leaves);
     assert_true(mesh->tvertex_count > 0); /* neighbours at different levels */
     /* Each leaf's centre locates to that leaf. */
     assert_leaves_locate(s);
     /* Leaves tile their patches: areas add up to the base patch areas. */
-    const rad_mesh *base = s->hier_base;
+    /* The patches as the strategy meshes them: one element each. */
+    rad_mesh *base = NULL;
+    rad_mesh_options mo = {1e30, 0, 0.0};
+    assert_int_equal(rad_mesh_build(ctx, scene, &mo, &base), RAD_OK);
+    assert_int_equal(base->patch_count, mesh->patch_count);
     for (size_t p = 0; p < base->patch_count; p++) {
         double a = 0.0;
         const rad_patch *pa = &mesh->patches[p];
@@ -357,6 +361,7 @@ static void test_leaves_locate(void **state)
          * element is two triangles; the red wall's 3.2 mm bend gives 1e-5) */
         assert_true(relative(a, base->elements[base->patches[p].first_element].area) < 1e-4);
     }
+    rad_mesh_destroy(base);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }
@@ -378,9 +383,9 @@ static void test_thread_count_independent(void **state)
         rad_solution *s = NULL;
         assert_int_equal(rad_solution_create(c, scene, &o, &s), RAD_OK);
         assert_int_equal(rad_solution_solve(c, s), RAD_OK);
-        n[t] = s->mesh->element_count;
+        n[t] = s->view.mesh->element_count;
         B[t] = malloc(3 * n[t] * sizeof *B[t]);
-        memcpy(B[t], s->radiosity, 3 * n[t] * sizeof *B[t]);
+        memcpy(B[t], s->view.radiosity, 3 * n[t] * sizeof *B[t]);
         rad_solution_destroy(s);
         rad_context_destroy(c);
     }
@@ -398,10 +403,10 @@ static void test_clusters_office(void **state)
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_generate_office(ctx, &oo, &scene), RAD_OK);
     rad_solution *with = solve(scene, 1e-3, 1), *without = solve(scene, 1e-3, -1);
-    assert_true(with->hier_stats.clustered);
-    assert_int_equal(with->hier_stats.initial_links, 1);
-    assert_false(without->hier_stats.clustered);
-    assert_true(without->hier_stats.initial_links > 1000);
+    assert_true(with->view.hier->clustered);
+    assert_int_equal(with->view.hier->initial_links, 1);
+    assert_false(without->view.hier->clustered);
+    assert_true(without->view.hier->initial_links > 1000);
     double emitted, absorbed;
     rad_solution_power(with, &emitted, &absorbed);
     assert_true(relative(absorbed, emitted) < 0.015); /* measured 0.44% */
@@ -477,7 +482,7 @@ static void test_furnace_clusters(void **state)
     (void)state;
     rad_scene *scene = furnace_corridor();
     rad_solution *s = solve(scene, 1e-2, 1);
-    assert_true(s->hier_stats.clustered);
+    assert_true(s->view.hier->clustered);
     double err = 0.0;
     for (size_t k = 0; k < scene->surface_count; k++) {
         double B[3];
@@ -488,11 +493,11 @@ static void test_furnace_clusters(void **state)
     rad_solution_power(s, &emitted, &absorbed);
     /* Measured: worst surface 0.9%, power 0.11%, closure 0.9995; cluster
      * links 10% low would put the closure at 0.994. */
-    assert_true(s->hier_stats.links_by_kind[1] > 0 && s->hier_stats.links_by_kind[2] > 0 &&
-                s->hier_stats.links_by_kind[3] > 0);
+    assert_true(s->view.hier->links_by_kind[1] > 0 && s->view.hier->links_by_kind[2] > 0 &&
+                s->view.hier->links_by_kind[3] > 0);
     assert_true(err < 0.02);
     assert_true(relative(absorbed, emitted) < 0.005);
-    assert_true(fabs(s->hier_stats.closure_power - 1.0) < 0.004);
+    assert_true(fabs(s->view.hier->closure_power - 1.0) < 0.004);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }
@@ -574,13 +579,13 @@ static void test_office_energy(void **state)
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_generate_office(ctx, &oo, &scene), RAD_OK);
     rad_solution *s = solve(scene, 1e-3, 0);
-    assert_true(s->hier_stats.clustered);
+    assert_true(s->view.hier->clustered);
     double emitted, absorbed;
     rad_solution_power(s, &emitted, &absorbed);
     /* Measured: 0.79% of the power, closure 0.9964 (the point estimates:
      * 4.9%). */
     assert_true(relative(absorbed, emitted) < 0.015);
-    assert_true(fabs(s->hier_stats.closure_power - 1.0) < 0.01);
+    assert_true(fabs(s->view.hier->closure_power - 1.0) < 0.01);
 
     /* With the closure correction each patch sends B / its closure: the
      * building's power balances. */
@@ -589,7 +594,7 @@ static void test_office_energy(void **state)
     rad_solution_power(c, &emitted_c, &absorbed_c);
     /* Measured: 0.79% -> 0.01%, 6,966 of 7,352 leaves scaled. */
     assert_true(relative(absorbed_c, emitted_c) < 0.001);
-    assert_true(c->hier_stats.closure_corrected > c->hier_stats.leaves / 2);
+    assert_true(c->view.hier->closure_corrected > c->view.hier->leaves / 2);
     rad_solution_destroy(c);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);

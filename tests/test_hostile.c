@@ -191,10 +191,10 @@ static void assert_relative(double got, double want, double tolerance, const cha
 static void assert_physical(const solved *s)
 {
     const rad_solution *sol = s->solution;
-    for (size_t i = 0; i < 3 * sol->mesh->element_count; i++)
-        if (!(isfinite(sol->radiosity[i]) && sol->radiosity[i] >= sol->emission[i]))
-            fail_msg("element %zu: radiosity %g, emission %g", i / 3, sol->radiosity[i],
-                     sol->emission[i]);
+    for (size_t i = 0; i < 3 * sol->view.mesh->element_count; i++)
+        if (!(isfinite(sol->view.radiosity[i]) && sol->view.radiosity[i] >= sol->view.emission[i]))
+            fail_msg("element %zu: radiosity %g, emission %g", i / 3, sol->view.radiosity[i],
+                     sol->view.emission[i]);
 }
 
 /* Power that leaves every element and reaches no surface (channel 0):
@@ -203,16 +203,16 @@ static void assert_physical(const solved *s)
 static double escaped_power(const solved *s, double row_tolerance)
 {
     const rad_solution *sol = s->solution;
-    size_t n = sol->mesh->element_count;
+    size_t n = sol->view.mesh->element_count;
     double escaped = 0.0;
     for (size_t j = 0; j < n; j++) {
         double row = 0.0;
         for (size_t i = 0; i < n; i++)
-            row += (double)sol->F[j * n + i];
+            row += (double)sol->view.F[j * n + i];
         if (!(row <= 1.0 + row_tolerance))
             fail_msg("element %zu (surface %s): row sum %.9f", j,
-                     rad_scene_surface_name(s->scene, sol->mesh->elements[j].surface), row);
-        escaped += sol->area[j] * sol->radiosity[3 * j] * (1.0 - row);
+                     rad_scene_surface_name(s->scene, sol->view.mesh->elements[j].surface), row);
+        escaped += sol->view.area[j] * sol->view.radiosity[3 * j] * (1.0 - row);
     }
     return escaped;
 }
@@ -400,8 +400,8 @@ static void test_thin_sliver(void **state)
         solved s = solve(&t, 0.0625, 0);
         assert_physical(&s);
         double area = 0.0;
-        for (size_t i = 0; i < s.solution->mesh->element_count; i++)
-            area += s.solution->area[i];
+        for (size_t i = 0; i < s.solution->view.mesh->element_count; i++)
+            area += s.solution->view.area[i];
         assert_relative(area, 0.25 + width[k], 1e-12, "element areas (lamp and strip)");
         B[k] = radiosity_of(&s, "strip");
         release(&s);

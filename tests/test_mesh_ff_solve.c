@@ -294,9 +294,7 @@ static void test_solvers_two_patch(void **state)
     const double rho[6] = {0.8, 0.5, 0.2, 0.8, 0.5, 0.2};
     const double E[6] = {1.0, 2.0, 3.0, 0.0, 0.0, 0.0};
     rad_system sys = {.n = 2, .F = F, .area = area, .reflectance = rho, .emission = E, .threads = 2};
-    for (size_t k = 0; rad_solvers[k]; k++) {
-        if (rad_solvers[k]->flags & RAD_SOLVER_MATRIX_FREE)
-            continue; /* needs a mesh and rays: tested through the CLI */
+    for (size_t k = 0; rad_solvers[k]; k++) { /* every one works on F (shooting: through the CLI) */
         double B[6];
         memcpy(B, E, sizeof B);
         rad_solve_params p = {.tolerance = 1e-12};

@@ -5,9 +5,7 @@
  */
 #include "api/options.h"
 
-#include "formfactor/formfactor.h"
-#include "solve/solve.h"
-#include "vis/vis.h"
+#include "strategy/strategy.h"
 
 #include <string.h>
 
@@ -45,17 +43,11 @@ rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_opti
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "unknown form-factor method '%s' (known: %s)",
                         o.form_factors, known);
     }
-    if (!rad_solver_find(o.solver)) {
+    if (!rad_strategy_for_solver(o.solver)) {
         list_methods(RAD_METHOD_SOLVER, known, sizeof known);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "unknown solver '%s' (known: %s)", o.solver,
                         known);
     }
-    unsigned flags = rad_solver_find(o.solver)->flags;
-    if (o.closure_correction && (flags & RAD_SOLVER_MATRIX_FREE) && !(flags & RAD_SOLVER_HIERARCHICAL))
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "closure correction rescales form factors, and solver '%s' computes them afresh for "
-                        "every shot: use a gathering solver or hierarchical",
-                        o.solver);
     if (!rad_vis_find(o.visibility)) {
         list_methods(RAD_METHOD_VISIBILITY, known, sizeof known);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,

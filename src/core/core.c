@@ -54,7 +54,9 @@ rad_result rad_context_create(const rad_context_options *options, rad_context **
     }
     ctx->progress = options->progress;
     ctx->progress_user = options->progress_user;
-    ctx->cancel = options->cancel;
+    ctx->on_error = options->on_error;
+    ctx->error_user = options->error_user;
+    atomic_init(&ctx->cancel, 0);
     *out = ctx;
     return RAD_OK;
 }
@@ -65,9 +67,17 @@ const char *rad_context_error(const rad_context *ctx) { return ctx ? ctx->error 
 
 int rad_context_threads(const rad_context *ctx) { return ctx ? ctx->threads : 1; }
 
+void rad_context_cancel(rad_context *ctx, bool cancel)
+{
+    if (ctx)
+        atomic_store(&ctx->cancel, cancel ? 1 : 0);
+}
+
+bool rad_context_cancelled(const rad_context *ctx) { return rad_cancelled(ctx); }
+
 rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 {
-    if (!ctx)
+    if (!ctx || ctx->error_latched)
         return result;
     va_list ap;
     va_start(ap, fmt);
@@ -78,6 +88,9 @@ rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
         if (*c == '\n' || *c == '\r')
             *c = ' ';
     ctx->last_result = result;
+    ctx->error_latched = true;
+    if (ctx->on_error)
+        ctx->on_error(ctx->error_user, result, ctx->error);
     return result;
 }
 

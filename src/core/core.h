@@ -11,6 +11,7 @@
 
 #include <math.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -52,24 +53,37 @@ struct rad_context {
     int threads;                /* OpenMP and Embree threads */
     rad_progress_fn progress;
     void *progress_user;
-    volatile int *cancel;
+    rad_error_fn on_error;
+    void *error_user;
+    atomic_int cancel;          /* raised by rad_context_cancel, even from a signal handler */
     rad_result last_result;
-    char error[1024];           /* first line of the most recent failure */
+    bool error_latched;         /* this call already recorded its first failure */
+    char error[1024];           /* first line of the first failure of the most recent failed call */
 };
 
 /* Record a failure and return `result`, so callers can write
  * `return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open", path);`.
- * ctx may be NULL (then the message is dropped). */
+ * Only the first failure of a public call is kept (and reported to the
+ * error callback): it names the cause, where later ones would name its
+ * consequences.  ctx may be NULL (then the message is dropped). */
 rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
 
-/* True once the user asked to stop (cancel flag raised). */
+/* Every public function that takes a context calls this first: its first
+ * failure will be the one kept.  NULL is a no-op. */
+static inline void rad_api_enter(rad_context *ctx)
+{
+    if (ctx)
+        ctx->error_latched = false;
+}
+
+/* True once the user asked to stop (rad_context_cancel).  Any thread. */
 static inline bool rad_cancelled(const rad_context *ctx)
 {
-    return ctx && ctx->cancel && *ctx->cancel;
+    return ctx && atomic_load_explicit(&ctx->cancel, memory_order_relaxed) != 0;
 }
 
 /* Report progress (calling thread only); cheap when no callback is set. */

@@ -855,21 +855,3 @@ done:
     free(st.bins_exit);
     return r;
 }
-
-/* The registry entry: rad_solution_solve sees RAD_SOLVER_HIERARCHICAL and
- * calls rad_hier_run, since the element set is the solver's output. */
-static rad_result hierarchical_solve(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
-                                     double *B, rad_solve_stats *stats)
-{
-    (void)sys, (void)p, (void)B, (void)stats;
-    return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                    "the hierarchical solver runs through rad_solution_solve, not on a fixed system");
-}
-
-const rad_solver rad_solver_hierarchical = {
-    "hierarchical",
-    "matrix-free: Hanrahan-Salzman-Aupperle links between element quadtrees, clusters, "
-    "BF refinement; meshes as it solves; ~10 links per element (--epsilon, --min-area)",
-    RAD_SOLVER_MATRIX_FREE | RAD_SOLVER_HIERARCHICAL,
-    hierarchical_solve,
-};

@@ -249,6 +249,7 @@ typedef struct rad_hier_params {
 } rad_hier_params;
 
 typedef struct rad_hier_stats {
+    size_t patches;            /* the roots (set by the caller: strategy/hierarchical.c) */
     size_t nodes, clusters, leaves, links, initial_links;
     size_t links_by_kind[4];   /* surface<-surface, surface<-cluster, cluster<-surface,
                                   cluster<-cluster (receiver<-source) */

@@ -217,6 +217,7 @@ static rad_result write_pfm(rad_context *ctx, const rad_image *image, const char
 rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, const char *path,
                                    double exposure)
 {
+    rad_api_enter(ctx);
     char ext[8];
     rad_path_extension(path, ext, sizeof ext);
     int png = strcmp(ext, "png") == 0, hdr = strcmp(ext, "hdr") == 0,
@@ -252,5 +253,6 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
 
 rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path)
 {
+    rad_api_enter(ctx);
     return rad_image_write_exposed(ctx, image, path, 0.0);
 }

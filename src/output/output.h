@@ -6,7 +6,7 @@
 #define RAD_OUTPUT_H
 
 #include "interp/interp.h"
-#include "vis/vis.h"
+#include "strategy/strategy.h"
 
 struct rad_image {
     int width, height;
@@ -47,5 +47,19 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
 /* Automatic exposure: the multiplier that maps the 95th percentile of
  * luminance among non-saturated pixels to 0.8. */
 double rad_image_auto_exposure(const rad_image *image);
+
+/* ---- results as files (stats.c); every file is written atomically ---- */
+
+/* The stats JSON of a solution (docs/stats.md); `partial` marks an
+ * interrupted run. */
+rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *view, const char *path, int partial);
+
+/* View factors by the path's extension (.json, .csv, .mtx; docs/formats.md),
+ * surface-level or, with `elements`, element-level.  Fails without F. */
+rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *view, const char *path,
+                                  int elements);
+
+/* The convergence history as CSV: iteration, seconds, residual, unshot. */
+rad_result rad_write_history(rad_context *ctx, const rad_solution_view *view, const char *path);
 
 #endif /* RAD_OUTPUT_H */

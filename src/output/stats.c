@@ -3,7 +3,7 @@
  * docs/stats.md) and surface-level view factors (JSON or CSV; docs/formats.md).
  * Both are written atomically (temporary file, then rename).
  */
-#include "api/solution.h"
+#include "output/output.h"
 
 #include <cjson/cJSON.h>
 #include <stdlib.h>
@@ -36,7 +36,7 @@ static rad_result write_json(rad_context *ctx, cJSON *root, const char *path)
  * in one pass over the elements (9 doubles per surface: rho, E, B), so
  * that scenes of 10^5 surfaces and 10^6 elements are not S x n.  NULL when
  * out of memory. */
-static double *surface_means(const rad_solution *s)
+static double *surface_means(const rad_solution_view *s)
 {
     size_t S = s->scene->surface_count;
     double *m = calloc(S ? 9 * S : 1, sizeof *m), *area = calloc(S ? S : 1, sizeof *area);
@@ -45,7 +45,7 @@ static double *surface_means(const rad_solution *s)
         free(area);
         return NULL;
     }
-    for (size_t i = 0; i < s->mesh->element_count; i++) {
+    for (size_t i = 0; i < s->n; i++) {
         size_t k = s->mesh->elements[i].surface;
         double a = s->area[i];
         area[k] += a;
@@ -62,18 +62,40 @@ static double *surface_means(const rad_solution *s)
     return m;
 }
 
-rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, const char *path,
+rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *scene, const char *phase,
+                                            double seconds, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!scene || !phase || !path)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_write_interrupted_stats: NULL argument");
+    cJSON *root = cJSON_CreateObject();
+    if (!root)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+    cJSON_AddStringToObject(root, "version", RAD_VERSION_STRING);
+    cJSON_AddBoolToObject(root, "partial", 1);
+    cJSON_AddStringToObject(root, "interrupted", phase);
+    cJSON_AddBoolToObject(root, "converged", 0);
+    cJSON_AddStringToObject(root, "scene", scene->source);
+    cJSON_AddNumberToObject(root, "surfaces", (double)scene->surface_count);
+    cJSON *sec = cJSON_AddObjectToObject(root, "seconds");
+    cJSON_AddNumberToObject(sec, "total", seconds);
+    rad_result r = write_json(ctx, root, path);
+    cJSON_Delete(root);
+    return r;
+}
+
+rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const char *path,
                                     int partial)
 {
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-    size_t n = s->mesh->element_count;
+    size_t n = s->n;
     cJSON_AddStringToObject(root, "version", RAD_VERSION_STRING);
     cJSON_AddBoolToObject(root, "partial", partial != 0);
     cJSON_AddStringToObject(root, "scene", s->scene->source);
     cJSON_AddNumberToObject(root, "threads", rad_context_threads(ctx));
-    cJSON_AddNumberToObject(root, "seed", (double)s->options.seed);
+    cJSON_AddNumberToObject(root, "seed", (double)s->options->seed);
 
     cJSON *mesh = cJSON_AddObjectToObject(root, "mesh");
     cJSON_AddNumberToObject(mesh, "elements", (double)n);
@@ -84,46 +106,46 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     cJSON_AddNumberToObject(root, "elements", (double)n);
 
     cJSON *ff = cJSON_AddObjectToObject(root, "form_factors");
-    cJSON_AddStringToObject(ff, "method", s->ff_stats.method ? s->ff_stats.method : "");
-    cJSON_AddStringToObject(ff, "visibility", s->options.visibility);
-    cJSON_AddNumberToObject(ff, "shadow_rays", s->options.shadow_rays);
-    cJSON_AddNumberToObject(ff, "rays", (double)s->ff_stats.rays);
-    cJSON_AddNumberToObject(ff, "pairs", (double)s->ff_stats.pairs);
-    cJSON_AddNumberToObject(ff, "row_sum_min", s->ff_stats.row_sum_min);
-    cJSON_AddNumberToObject(ff, "row_sum_max", s->ff_stats.row_sum_max);
-    cJSON_AddNumberToObject(ff, "row_sum_mean", s->ff_stats.row_sum_mean);
-    cJSON_AddNumberToObject(ff, "reciprocity_max", s->ff_stats.reciprocity_max);
-    cJSON_AddNumberToObject(ff, "diagonal_max", s->ff_stats.diagonal_max);
-    cJSON_AddBoolToObject(ff, "closure_corrected", s->ff_stats.closure_corrected);
+    cJSON_AddStringToObject(ff, "method", s->ff->method ? s->ff->method : "");
+    cJSON_AddStringToObject(ff, "visibility", s->options->visibility);
+    cJSON_AddNumberToObject(ff, "shadow_rays", s->options->shadow_rays);
+    cJSON_AddNumberToObject(ff, "rays", (double)s->ff->rays);
+    cJSON_AddNumberToObject(ff, "pairs", (double)s->ff->pairs);
+    cJSON_AddNumberToObject(ff, "row_sum_min", s->ff->row_sum_min);
+    cJSON_AddNumberToObject(ff, "row_sum_max", s->ff->row_sum_max);
+    cJSON_AddNumberToObject(ff, "row_sum_mean", s->ff->row_sum_mean);
+    cJSON_AddNumberToObject(ff, "reciprocity_max", s->ff->reciprocity_max);
+    cJSON_AddNumberToObject(ff, "diagonal_max", s->ff->diagonal_max);
+    cJSON_AddBoolToObject(ff, "closure_corrected", s->ff->closure_corrected);
     if (s->F_variance)
-        cJSON_AddNumberToObject(ff, "std_error_max", s->ff_stats.std_error_max);
-    if (s->ff_stats.near_pairs)
-        cJSON_AddNumberToObject(ff, "near_pairs", (double)s->ff_stats.near_pairs);
-    cJSON_AddNumberToObject(ff, "seconds", s->ff_stats.seconds);
+        cJSON_AddNumberToObject(ff, "std_error_max", s->ff->std_error_max);
+    if (s->ff->near_pairs)
+        cJSON_AddNumberToObject(ff, "near_pairs", (double)s->ff->near_pairs);
+    cJSON_AddNumberToObject(ff, "seconds", s->ff->seconds);
 
     cJSON *so = cJSON_AddObjectToObject(root, "solver");
-    cJSON_AddStringToObject(so, "method", s->options.solver);
+    cJSON_AddStringToObject(so, "method", s->options->solver);
     cJSON_AddBoolToObject(so, "solved", s->solved);
-    cJSON_AddBoolToObject(so, "converged", s->solve_stats.converged);
-    cJSON_AddNumberToObject(so, "iterations", s->solve_stats.iterations);
-    cJSON_AddNumberToObject(so, "residual", s->solve_stats.residual);
-    cJSON_AddNumberToObject(so, "tolerance", s->options.tolerance);
-    cJSON_AddNumberToObject(so, "relaxation", s->options.relaxation);
-    if (!isnan(s->solve_stats.unshot))
-        cJSON_AddNumberToObject(so, "unshot", s->solve_stats.unshot);
-    cJSON_AddNumberToObject(so, "components", (double)s->solve_stats.components);
-    cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve_stats.ambient));
-    cJSON_AddNumberToObject(so, "seconds", s->solve_stats.seconds);
-    if (s->hier_base) {
-        const rad_hier_stats *h = &s->hier_stats;
+    cJSON_AddBoolToObject(so, "converged", s->solve->converged);
+    cJSON_AddNumberToObject(so, "iterations", s->solve->iterations);
+    cJSON_AddNumberToObject(so, "residual", s->solve->residual);
+    cJSON_AddNumberToObject(so, "tolerance", s->options->tolerance);
+    cJSON_AddNumberToObject(so, "relaxation", s->options->relaxation);
+    if (!isnan(s->solve->unshot))
+        cJSON_AddNumberToObject(so, "unshot", s->solve->unshot);
+    cJSON_AddNumberToObject(so, "components", (double)s->solve->components);
+    cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve->ambient));
+    cJSON_AddNumberToObject(so, "seconds", s->solve->seconds);
+    if (s->hier) {
+        const rad_hier_stats *h = s->hier;
         cJSON *hi = cJSON_AddObjectToObject(so, "hierarchical");
-        cJSON_AddNumberToObject(hi, "epsilon", s->options.epsilon > 0.0 ? s->options.epsilon : 1e-4);
+        cJSON_AddNumberToObject(hi, "epsilon", s->options->epsilon > 0.0 ? s->options->epsilon : 1e-4);
         cJSON_AddNumberToObject(hi, "epsilon_W", h->epsilon_abs);
         cJSON_AddNumberToObject(hi, "min_area_m2", h->min_area);
         cJSON_AddBoolToObject(hi, "clustered", h->clustered);
         cJSON_AddStringToObject(hi, "oracle", h->classic_oracle ? "classic" : "sources");
         cJSON_AddNumberToObject(hi, "closure_corrected_leaves", (double)h->closure_corrected);
-        cJSON_AddNumberToObject(hi, "patches", (double)s->hier_base->patch_count);
+        cJSON_AddNumberToObject(hi, "patches", (double)s->hier->patches);
         cJSON_AddNumberToObject(hi, "clusters", (double)h->clusters);
         cJSON_AddNumberToObject(hi, "nodes", (double)h->nodes);
         cJSON_AddNumberToObject(hi, "leaves", (double)h->leaves);
@@ -153,7 +175,7 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     }
 
     double emitted, absorbed;
-    rad_solution_power(s, &emitted, &absorbed);
+    rad_view_power(s, &emitted, &absorbed);
     cJSON *power = cJSON_AddObjectToObject(root, "power_W");
     cJSON_AddNumberToObject(power, "emitted", emitted);
     cJSON_AddNumberToObject(power, "absorbed", absorbed);
@@ -185,14 +207,14 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     cJSON_AddNumberToObject(sec, "render", s->seconds.render);
 
     cJSON *rays = cJSON_AddObjectToObject(root, "rays");
-    cJSON_AddNumberToObject(rays, "form_factors", (double)s->ff_stats.rays);
-    cJSON_AddNumberToObject(rays, "solve", (double)s->solve_stats.rays);
+    cJSON_AddNumberToObject(rays, "form_factors", (double)s->ff->rays);
+    cJSON_AddNumberToObject(rays, "solve", (double)s->solve->rays);
     cJSON_AddNumberToObject(rays, "render", (double)s->render_rays);
 
     cJSON *mem = cJSON_AddObjectToObject(root, "memory_bytes");
     cJSON_AddNumberToObject(mem, "peak_resident", (double)rad_peak_memory_bytes());
     cJSON_AddNumberToObject(mem, "form_factor_matrix", s->F ? (double)n * (double)n * sizeof(float) : 0.0);
-    cJSON_AddNumberToObject(mem, "limit", s->options.max_memory_bytes);
+    cJSON_AddNumberToObject(mem, "limit", s->options->max_memory_bytes);
 
     rad_result r = write_json(ctx, root, path);
     cJSON_Delete(root);
@@ -201,9 +223,9 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
 
 /* Surface-level standard errors from element variances (independent
  * estimates): var F_IJ = sum_{i in I} (A_i / A_I)^2 sum_{j in J} var F_ij. */
-static void surface_std_errors(const rad_solution *s, double *err)
+static void surface_std_errors(const rad_solution_view *s, double *err)
 {
-    size_t S = s->scene->surface_count, n = s->mesh->element_count;
+    size_t S = s->scene->surface_count, n = s->n;
     double *area = calloc(S ? S : 1, sizeof *area);
     memset(err, 0, S * S * sizeof *err);
     if (!area)
@@ -258,19 +280,19 @@ static void vf_rows_free(vf_rows *r)
     free(r->err);
 }
 
-static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, int elements, vf_rows *r)
+static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, int elements, vf_rows *r)
 {
     memset(r, 0, sizeof *r);
-    size_t n = s->mesh->element_count, S = s->scene->surface_count;
+    size_t n = s->n, S = s->scene->surface_count;
     r->count = elements ? n : S;
     bool with_err = s->F_variance != NULL;
     double bytes = (double)r->count * (double)r->count * sizeof *r->F * (with_err ? 2.0 : 1.0);
-    if (bytes > s->options.max_memory_bytes)
+    if (bytes > s->options->max_memory_bytes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "view factors: the %zu x %zu table needs %.2f GiB, above the memory limit "
                         "of %.2f GiB (--max-memory); use --level surface or fewer --elements",
                         r->count, r->count, bytes / 1073741824.0,
-                        s->options.max_memory_bytes / 1073741824.0);
+                        s->options->max_memory_bytes / 1073741824.0);
     r->names = rad_alloc_array(ctx, r->count, sizeof *r->names, "view factors");
     r->area = rad_alloc_array(ctx, r->count, sizeof *r->area, "view factors");
     r->F = rad_alloc_array(ctx, r->count * r->count, sizeof *r->F, "view factors");
@@ -281,7 +303,7 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, int ele
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     if (!elements) {
-        rad_solution_surface_view_factors(s, r->F);
+        rad_view_surface_view_factors(s, r->F);
         if (with_err)
             surface_std_errors(s, r->err);
         for (size_t k = 0; k < S; k++) {
@@ -312,7 +334,7 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, int ele
     return RAD_OK;
 }
 
-rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *s, const char *path,
+rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
                                            int elements)
 {
     char ext[16];
@@ -323,7 +345,7 @@ rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution 
     if (!s->F)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: no view factors: solver '%s' computes no form-factor matrix", path,
-                        s->options.solver);
+                        s->options->solver);
     vf_rows rows;
     rad_result r = vf_rows_build(ctx, s, elements, &rows);
     if (r != RAD_OK)
@@ -332,10 +354,10 @@ rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution 
     if (strcmp(ext, "json") == 0) {
         cJSON *root = cJSON_CreateObject();
         cJSON_AddStringToObject(root, "scene", s->scene->source);
-        cJSON_AddStringToObject(root, "method", s->options.form_factors);
+        cJSON_AddStringToObject(root, "method", s->options->form_factors);
         cJSON_AddStringToObject(root, "level", elements ? "element" : "surface");
-        cJSON_AddNumberToObject(root, "elements", (double)s->mesh->element_count);
-        cJSON_AddBoolToObject(root, "closure_corrected", s->ff_stats.closure_corrected);
+        cJSON_AddNumberToObject(root, "elements", (double)s->n);
+        cJSON_AddBoolToObject(root, "closure_corrected", s->ff->closure_corrected);
         cJSON *list = cJSON_AddArrayToObject(root, elements ? "elements_list" : "surfaces");
         cJSON *F = cJSON_AddArrayToObject(root, "F");
         cJSON *E = rows.err ? cJSON_AddArrayToObject(root, "F_std_error") : NULL;
@@ -399,7 +421,7 @@ rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution 
     return r;
 }
 
-rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, const char *path)
+rad_result rad_write_history(rad_context *ctx, const rad_solution_view *s, const char *path)
 {
     rad_atomic_file f;
     rad_result r = rad_atomic_open(ctx, path, &f);

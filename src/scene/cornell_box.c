@@ -197,6 +197,7 @@ static const char cornell_box_mtl[] =
 
 rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **out)
 {
+    rad_api_enter(ctx);
     if (!out)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "rad_scene_create_cornell_box: out is NULL");

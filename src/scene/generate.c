@@ -585,6 +585,7 @@ static rad_result build_room(office *g, int index)
 rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options *options,
                                      rad_scene **out)
 {
+    rad_api_enter(ctx);
     if (!out)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_generate_office: out is NULL");
     *out = NULL;
@@ -798,6 +799,7 @@ static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE 
 
 rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path)
 {
+    rad_api_enter(ctx);
     if (!scene || !path || !*path)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "rad_scene_write_obj: scene or path is NULL");

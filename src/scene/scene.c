@@ -521,6 +521,7 @@ done:
 
 rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out)
 {
+    rad_api_enter(ctx);
     if (!out)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_file: out is NULL");
     *out = NULL;
@@ -537,6 +538,7 @@ rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void 
                                  size_t size, const void *mtl, size_t mtl_size,
                                  rad_scene **out)
 {
+    rad_api_enter(ctx);
     if (!out)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_memory: out is NULL");
     *out = NULL;

@@ -178,7 +178,7 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
                                    const rad_solve_params *p, double *B, rad_solve_stats *stats)
 {
     size_t n = sys->n;
-    if ((solver->flags & RAD_SOLVER_MATRIX_FREE) || !sys->F || n < 4)
+    if (!sys->F || n < 4)
         return solver->solve(ctx, sys, p, B, stats);
     groups g;
     if (!groups_find(ctx, sys, &g)) {

@@ -11,8 +11,6 @@ extern const rad_solver rad_solver_southwell;
 extern const rad_solver rad_solver_jacobi;
 extern const rad_solver rad_solver_direct;
 extern const rad_solver rad_solver_conjugate_gradient;
-extern const rad_solver rad_solver_shooting;
-extern const rad_solver rad_solver_hierarchical;
 
 const rad_solver *const rad_solvers[] = {
     &rad_solver_gauss_seidel,
@@ -20,8 +18,6 @@ const rad_solver *const rad_solvers[] = {
     &rad_solver_jacobi,
     &rad_solver_direct,
     &rad_solver_conjugate_gradient,
-    &rad_solver_shooting,
-    &rad_solver_hierarchical,
     NULL,
 };
 

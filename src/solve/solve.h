@@ -59,24 +59,24 @@ typedef struct rad_solve_stats {
     size_t components;        /* independent groups of elements solved separately (0 = not split) */
 } rad_solve_stats;
 
-/* Solver flags. */
-enum {
-    RAD_SOLVER_MATRIX_FREE = 1u << 0, /* needs no F: rad_solution_create skips the matrix */
-    RAD_SOLVER_HIERARCHICAL = 1u << 1 /* meshes as it solves (hier/): rad_solution_solve runs
-                                         rad_hier_run instead of `solve` */
-};
-
 typedef struct rad_solver {
     const char *name;
     const char *description;
-    unsigned flags;
     /* B (3n) holds the starting guess (E) and receives the answer. */
     rad_result (*solve)(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
                         double *B, rad_solve_stats *stats);
 } rad_solver;
 
-extern const rad_solver *const rad_solvers[]; /* NULL-terminated */
+/* The linear solvers: each works on a system with its matrix F (the dense
+ * strategy runs them).  NULL-terminated. */
+extern const rad_solver *const rad_solvers[];
 const rad_solver *rad_solver_find(const char *name);
+
+/* Progressive refinement without a matrix (solve_shooting.c): sys->F is
+ * NULL and each shot samples its column with rays against sys->mesh and
+ * sys->vis.  Not in rad_solvers: the matrix-free strategy runs it. */
+extern const rad_solver rad_solver_shooting;
+
 
 /* Irradiance gathered by one row: g[c] = sum_j F_ij B_jc (B interleaved RGB). */
 static inline void rad_gather(const float *F_row, const double *B, size_t n, double g[3])

@@ -284,6 +284,5 @@ const rad_solver rad_solver_conjugate_gradient = {
     "conjugate-gradient",
     "Jacobi-preconditioned CG on the system symmetrised by A/rho, restarted on the true "
     "residual; two parallel O(n^2) passes per iteration",
-    0,
     conjugate_gradient,
 };

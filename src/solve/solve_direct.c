@@ -151,6 +151,5 @@ const rad_solver rad_solver_direct = {
     "direct",
     "LU factorisation (LAPACK dgesv) per colour channel: exact, the reference; O(n^3) time, "
     "8 n^2 bytes (refused above --max-memory)",
-    0,
     direct,
 };

@@ -64,6 +64,5 @@ const rad_solver rad_solver_gauss_seidel = {
     "gauss-seidel",
     "gathering, newest values first, optional SOR (--relaxation); O(n^2) per sweep, "
     "error shrinks ~rho per sweep",
-    0,
     gauss_seidel,
 };

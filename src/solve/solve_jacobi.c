@@ -95,6 +95,5 @@ const rad_solver rad_solver_jacobi = {
     "jacobi",
     "Jacobi iteration: all rows from the last sweep, in parallel, optional weighting "
     "(--relaxation); O(n^2) per sweep, error shrinks ~rho per sweep",
-    0,
     jacobi,
 };

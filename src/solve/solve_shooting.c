@@ -320,6 +320,5 @@ const rad_solver rad_solver_shooting = {
     "shooting",
     "matrix-free progressive refinement: form-factor columns sampled by rays from the "
     "shooter (--ff-samples per shot); O(n) memory, for 10^5-10^6 elements",
-    RAD_SOLVER_MATRIX_FREE,
     shooting,
 };

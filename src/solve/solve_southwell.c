@@ -135,6 +135,5 @@ const rad_solver rad_solver_southwell = {
     "southwell",
     "progressive refinement: shoot the largest unshot power (Cohen et al. 1988), "
     "overshooting with --relaxation > 1, ambient term for display; O(n) per shot",
-    0,
     southwell,
 };

@@ -1,0 +1,133 @@
+/*
+ * dense.c -- the classic method: the full n x n form-factor matrix by one
+ * of the methods in the form-factor table, then the linear system
+ * (I - P F) B = E by one of the solvers in the solver table (Cohen &
+ * Wallace 1993, ch. 4-5).  Memory grows as 4 n^2 bytes, so it is the
+ * strategy for up to some 10^4 elements, and the one that can write view
+ * factors.
+ */
+#include "strategy/strategy.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct dense_state {
+    rad_meshed base;           /* mesh, visibility, elements, stats */
+    float *F;                  /* n x n */
+    float *F_variance;         /* n x n, or NULL */
+} dense_state;
+
+static bool dense_solver_info(size_t index, const char **name, const char **description)
+{
+    size_t count = 0;
+    while (rad_solvers[count])
+        count++;
+    if (index >= count)
+        return false;
+    *name = rad_solvers[index]->name;
+    *description = rad_solvers[index]->description;
+    return true;
+}
+
+/* The sampling methods' per-thread scratch (ray permutations, a hemicube's
+ * depth and item buffers, a row of sums) beside the dense matrix the
+ * form-factor table checks: refused up front, naming the option that
+ * shrinks it.  The dense matrix's own check (formfactor.c) names its way
+ * out. */
+static rad_result check_ff_scratch(rad_context *ctx, const rad_options *o, size_t n, int threads)
+{
+    const char *method = o->form_factors, *option = NULL;
+    double per_thread = 8.0 * (double)n;
+    if (strcmp(method, "hemisphere") == 0 || strcmp(method, "montecarlo") == 0) {
+        per_thread += 4.0 * (double)(o->samples > 0 ? o->samples : 0);
+        option = "--ff-samples";
+    } else if (strcmp(method, "hemicube") == 0) {
+        double R = o->hemicube_resolution > 0 ? o->hemicube_resolution : 256;
+        per_thread += 3.0 * R * R * 8.0; /* depth (float) and item (uint32) per pixel */
+        option = "--hemicube-res";
+    }
+    double matrix = 4.0 * (double)n * (double)n;
+    double scratch = per_thread * (threads > 0 ? threads : 1);
+    if (option && matrix <= o->max_memory_bytes && matrix + scratch > o->max_memory_bytes)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
+                        "form factors: %s needs %.2f GiB of scratch on %d threads beside the "
+                        "%.2f GiB matrix, above the memory limit of %.2f GiB (--max-memory); "
+                        "use a smaller %s or fewer --threads",
+                        method, scratch / 1073741824.0, threads, matrix / 1073741824.0,
+                        o->max_memory_bytes / 1073741824.0, option);
+    return RAD_OK;
+}
+
+static void dense_destroy(void *state)
+{
+    dense_state *st = state;
+    if (!st)
+        return;
+    rad_meshed_free(&st->base);
+    free(st->F);
+    free(st->F_variance);
+    free(st);
+}
+
+static rad_result dense_create(rad_context *ctx, const rad_scene *scene, const rad_options *o, void **out)
+{
+    *out = NULL;
+    dense_state *st = calloc(1, sizeof *st);
+    if (!st)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
+    rad_meshed *m = &st->base;
+    rad_result r = rad_meshed_init(ctx, scene, o, m);
+    if (r != RAD_OK) {
+        free(st);
+        return r;
+    }
+    r = check_ff_scratch(ctx, o, m->mesh->element_count, m->threads);
+    if (r == RAD_OK) {
+        rad_ff_request req = {m->mesh, m->vis, o->seed, o->shadow_rays, o->hemicube_resolution, o->samples,
+                              o->near_field};
+        r = rad_form_factors(ctx, rad_ff_find(o->form_factors), &req, o->max_memory_bytes,
+                             o->closure_correction != 0, &st->F, &st->F_variance, &m->ff_stats);
+        m->seconds.form_factors = m->ff_stats.seconds;
+    }
+    if (r != RAD_OK) {
+        dense_destroy(st);
+        return r;
+    }
+    *out = st;
+    return RAD_OK;
+}
+
+static rad_result dense_solve(rad_context *ctx, void *state, const rad_step_hook *hook)
+{
+    dense_state *st = state;
+    rad_meshed *m = &st->base;
+    const rad_solver *solver = rad_solver_find(m->options->solver);
+    rad_system sys;
+    rad_solve_params p;
+    rad_meshed_begin(m, solver->name, hook, &sys, &p);
+    sys.F = st->F;
+    double t0 = rad_seconds();
+    /* Independent groups of elements (rooms that cannot see each other) are
+     * solved separately; one group is solved as is. */
+    rad_result r = rad_solve_by_components(ctx, solver, &sys, &p, m->elements.radiosity, &m->solve_stats);
+    rad_meshed_end(m, r, t0);
+    return r;
+}
+
+static void dense_view(const void *state, rad_solution_view *v)
+{
+    const dense_state *st = state;
+    rad_meshed_view(&st->base, v);
+    v->F = st->F;
+    v->F_variance = st->F_variance;
+}
+
+const rad_strategy rad_strategy_dense = {
+    "dense",
+    "the n x n form-factor matrix (--form-factors), then a linear solver",
+    dense_solver_info,
+    dense_create,
+    dense_solve,
+    dense_view,
+    dense_destroy,
+};

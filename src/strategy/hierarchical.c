@@ -1,0 +1,163 @@
+/*
+ * hierarchical.c -- hierarchical radiosity as a strategy (hier/: Hanrahan,
+ * Salzman & Aupperle 1991, with clusters).  The patches are the roots of
+ * the hierarchy and its first elements; solving refines the links and
+ * splits nodes, and its leaves become the elements.  The ray structure is
+ * built once, on the patches, and serves every level.
+ */
+#include "strategy/strategy.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct hierarchical_state {
+    const rad_scene *scene;
+    const rad_options *options;
+    rad_mesh *patches;         /* one element per patch: the roots */
+    rad_vis *vis;              /* built on the patches */
+    rad_elements patch_elements;
+    rad_mesh *leaves;          /* the leaves after a solve, else NULL */
+    rad_elements leaf_elements;
+    rad_ff_stats ff_stats;     /* none: names the method "none" */
+    rad_solve_stats solve_stats;
+    rad_hier_stats hier_stats;
+    rad_phase_seconds seconds;
+    bool solved;
+    const rad_step_hook *hook; /* during a solve */
+} hierarchical_state;
+
+static bool hierarchical_solver_info(size_t index, const char **name, const char **description)
+{
+    if (index > 0)
+        return false;
+    *name = "hierarchical";
+    *description = "matrix-free: Hanrahan-Salzman-Aupperle links between element quadtrees, clusters, "
+                   "BF refinement; meshes as it solves; ~10 links per element (--epsilon, --min-area)";
+    return true;
+}
+
+static void hierarchical_destroy(void *state)
+{
+    hierarchical_state *st = state;
+    if (!st)
+        return;
+    rad_vis_destroy(st->vis);
+    rad_mesh_destroy(st->patches);
+    rad_mesh_destroy(st->leaves);
+    rad_elements_free(&st->patch_elements);
+    rad_elements_free(&st->leaf_elements);
+    free(st);
+}
+
+static rad_result hierarchical_create(rad_context *ctx, const rad_scene *scene, const rad_options *o,
+                                      void **out)
+{
+    *out = NULL;
+    hierarchical_state *st = calloc(1, sizeof *st);
+    if (!st)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
+    st->scene = scene;
+    st->options = o;
+    st->ff_stats.method = "none (matrix-free solver)";
+    /* The patches are the roots: one element each; the solver splits them. */
+    rad_mesh_options mo = {1e30, 0, o->crease_angle_degrees};
+    rad_result r = rad_strategy_mesh_and_vis(ctx, scene, o, &mo, &st->patches, &st->vis, &st->seconds);
+    if (r == RAD_OK)
+        r = rad_elements_create(ctx, scene, st->patches, &st->patch_elements);
+    if (r != RAD_OK) {
+        hierarchical_destroy(st);
+        return r;
+    }
+    *out = st;
+    return RAD_OK;
+}
+
+/* Steps reach the hook, marked not displayable: the leaves the view shows
+ * are the last solve's while the hierarchy is refined. */
+static int hierarchical_monitor(void *user, const rad_solve_step *step, const double *B, const double *ambient)
+{
+    (void)B, (void)ambient;
+    hierarchical_state *st = user;
+    return st->hook->fn ? st->hook->fn(st->hook->user, step, false) : 0;
+}
+
+static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_step_hook *hook)
+{
+    hierarchical_state *st = state;
+    const rad_options *o = st->options;
+    rad_hier_params hp = {.scene = st->scene,
+                          .base = st->patches,
+                          .vis = st->vis,
+                          .epsilon = o->epsilon,
+                          .min_area = o->min_area,
+                          .clustering = o->clustering,
+                          .classic_oracle = o->classic_oracle != 0,
+                          .closure_correction = o->closure_correction != 0,
+                          .seed = o->seed,
+                          .shadow_rays = o->shadow_rays,
+                          .tolerance = o->tolerance,
+                          .max_iterations = o->max_iterations,
+                          .max_memory = o->max_memory_bytes,
+                          .crease_angle_degrees = o->crease_angle_degrees,
+                          .monitor = hierarchical_monitor,
+                          .monitor_user = st};
+    st->hook = hook;
+    memset(&st->solve_stats, 0, sizeof st->solve_stats);
+    st->solve_stats.method = "hierarchical";
+    st->solve_stats.unshot = NAN;
+    double t = rad_seconds();
+    rad_mesh *leaves = NULL;
+    double *B = NULL;
+    rad_result r = rad_hier_run(ctx, &hp, &leaves, &B, &st->solve_stats, &st->hier_stats);
+    st->hier_stats.patches = st->patches->patch_count;
+    st->solve_stats.seconds = rad_seconds() - t;
+    st->seconds.solve = st->solve_stats.seconds;
+    st->hook = NULL;
+    if (leaves) {
+        /* The leaves, also of an interrupted solve, become the elements. */
+        rad_elements e;
+        if (rad_elements_create(ctx, st->scene, leaves, &e) != RAD_OK) {
+            free(B);
+            rad_mesh_destroy(leaves);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        free(e.radiosity);
+        e.radiosity = B;
+        rad_mesh_destroy(st->leaves);
+        rad_elements_free(&st->leaf_elements);
+        st->leaves = leaves;
+        st->leaf_elements = e;
+    }
+    st->solved = r == RAD_OK;
+    return r;
+}
+
+static void hierarchical_view(const void *state, rad_solution_view *v)
+{
+    const hierarchical_state *st = state;
+    if (st->leaves)
+        rad_view_elements(v, st->leaves, &st->leaf_elements);
+    else
+        rad_view_elements(v, st->patches, &st->patch_elements);
+    v->vis = st->vis;
+    v->F = NULL;
+    v->F_variance = NULL;
+    v->ff = &st->ff_stats;
+    v->solve = &st->solve_stats;
+    v->hier = st->leaves ? &st->hier_stats : NULL;
+    v->solved = st->solved;
+    v->seconds.mesh = st->seconds.mesh;
+    v->seconds.visibility = st->seconds.visibility;
+    v->seconds.form_factors = 0.0;
+    v->seconds.solve = st->seconds.solve;
+}
+
+const rad_strategy rad_strategy_hierarchical = {
+    "hierarchical",
+    "links between quadtree nodes and clusters, refined as the radiosity converges",
+    hierarchical_solver_info,
+    hierarchical_create,
+    hierarchical_solve,
+    hierarchical_view,
+    hierarchical_destroy,
+};

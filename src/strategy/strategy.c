@@ -1,0 +1,272 @@
+/*
+ * strategy.c -- the strategy table, lookup by solver name, what the
+ * strategies share (element arrays, mesh + ray structure), and the
+ * questions every solution answers from its view: power balance,
+ * per-surface radiosity, surface-to-surface view factors.
+ */
+#include "strategy/strategy.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+extern const rad_strategy rad_strategy_dense;
+extern const rad_strategy rad_strategy_matrix_free;
+extern const rad_strategy rad_strategy_hierarchical;
+
+const rad_strategy *const rad_strategies[] = {
+    &rad_strategy_dense,
+    &rad_strategy_matrix_free,
+    &rad_strategy_hierarchical,
+    NULL,
+};
+
+const rad_strategy *rad_strategy_for_solver(const char *name)
+{
+    const char *solver, *description;
+    for (size_t k = 0; rad_strategies[k]; k++)
+        for (size_t i = 0; rad_strategies[k]->solver_info(i, &solver, &description); i++)
+            if (strcmp(solver, name) == 0)
+                return rad_strategies[k];
+    return NULL;
+}
+
+bool rad_strategy_solver_info(size_t index, const char **name, const char **description)
+{
+    for (size_t k = 0; rad_strategies[k]; k++) {
+        size_t i = 0;
+        while (rad_strategies[k]->solver_info(i, name, description)) {
+            if (index == 0)
+                return true;
+            index--, i++;
+        }
+    }
+    return false;
+}
+
+/* ---- shared parts ---- */
+
+rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
+                               rad_elements *out)
+{
+    memset(out, 0, sizeof *out);
+    size_t n = mesh->element_count;
+    rad_elements e;
+    e.area = rad_alloc_array(ctx, n, sizeof *e.area, "solution: areas");
+    e.reflectance = rad_alloc_array(ctx, 3 * n, sizeof *e.reflectance, "solution: reflectance");
+    e.emission = rad_alloc_array(ctx, 3 * n, sizeof *e.emission, "solution: emission");
+    e.radiosity = rad_alloc_array(ctx, 3 * n, sizeof *e.radiosity, "solution: radiosity");
+    if (!e.area || !e.reflectance || !e.emission || !e.radiosity) {
+        rad_elements_free(&e);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < n; i++) {
+        const rad_element *el = &mesh->elements[i];
+        const rad_material *m = &scene->materials[el->material];
+        e.area[i] = el->area;
+        for (int c = 0; c < 3; c++) {
+            e.reflectance[3 * i + (size_t)c] = m->reflectance[c];
+            e.emission[3 * i + (size_t)c] = m->emission[c];
+        }
+    }
+    memcpy(e.radiosity, e.emission, 3 * n * sizeof *e.radiosity);
+    *out = e;
+    return RAD_OK;
+}
+
+void rad_elements_free(rad_elements *e)
+{
+    free(e->area);
+    free(e->reflectance);
+    free(e->emission);
+    free(e->radiosity);
+    memset(e, 0, sizeof *e);
+}
+
+void rad_view_elements(rad_solution_view *view, const rad_mesh *mesh, const rad_elements *e)
+{
+    view->mesh = mesh;
+    view->n = mesh ? mesh->element_count : 0;
+    view->area = e->area;
+    view->reflectance = e->reflectance;
+    view->emission = e->emission;
+    view->radiosity = e->radiosity;
+}
+
+rad_result rad_strategy_mesh_and_vis(rad_context *ctx, const rad_scene *scene, const rad_options *options,
+                                     const rad_mesh_options *mesh_options, rad_mesh **mesh, rad_vis **vis,
+                                     rad_phase_seconds *seconds)
+{
+    *vis = NULL;
+    double t = rad_seconds();
+    rad_result r = rad_mesh_build_within(ctx, scene, mesh_options, options->max_memory_bytes, mesh);
+    seconds->mesh = rad_seconds() - t;
+    if (r != RAD_OK)
+        return r;
+    r = rad_vis_create(ctx, options->visibility, *mesh, vis);
+    if (r != RAD_OK) {
+        rad_mesh_destroy(*mesh);
+        *mesh = NULL;
+        return r;
+    }
+    seconds->visibility = (*vis)->build_seconds;
+    return RAD_OK;
+}
+
+rad_result rad_meshed_init(rad_context *ctx, const rad_scene *scene, const rad_options *o, rad_meshed *m)
+{
+    memset(m, 0, sizeof *m);
+    m->scene = scene;
+    m->options = o;
+    m->threads = rad_context_threads(ctx);
+    rad_mesh_options mo = {o->mesh_size, o->target_elements, o->crease_angle_degrees};
+    rad_result r = rad_strategy_mesh_and_vis(ctx, scene, o, &mo, &m->mesh, &m->vis, &m->seconds);
+    if (r == RAD_OK)
+        r = rad_elements_create(ctx, scene, m->mesh, &m->elements);
+    if (r != RAD_OK)
+        rad_meshed_free(m);
+    return r;
+}
+
+void rad_meshed_free(rad_meshed *m)
+{
+    rad_vis_destroy(m->vis);
+    rad_mesh_destroy(m->mesh);
+    rad_elements_free(&m->elements);
+    m->vis = NULL;
+    m->mesh = NULL;
+}
+
+static int meshed_monitor(void *user, const rad_solve_step *step, const double *B, const double *ambient)
+{
+    rad_meshed *m = user;
+    (void)B; /* the iterate is m->elements.radiosity, updated in place */
+    if (ambient)
+        memcpy(m->solve_stats.ambient, ambient, sizeof m->solve_stats.ambient);
+    return m->hook->fn(m->hook->user, step, true);
+}
+
+void rad_meshed_begin(rad_meshed *m, const char *method, const rad_step_hook *hook, rad_system *sys,
+                      rad_solve_params *p)
+{
+    const rad_options *o = m->options;
+    size_t n = m->mesh->element_count;
+    *sys = (rad_system){.n = n,
+                        .F = NULL,
+                        .area = m->elements.area,
+                        .reflectance = m->elements.reflectance,
+                        .emission = m->elements.emission,
+                        .threads = m->threads,
+                        .mesh = m->mesh,
+                        .vis = m->vis,
+                        .seed = o->seed,
+                        .samples = o->samples,
+                        .max_memory = o->max_memory_bytes};
+    *p = (rad_solve_params){o->tolerance, o->unshot_tolerance, o->max_iterations, o->relaxation, NULL, m};
+    m->hook = hook;
+    if (hook->fn)
+        p->monitor = meshed_monitor;
+    memcpy(m->elements.radiosity, m->elements.emission, 3 * n * sizeof *m->elements.radiosity);
+    memset(&m->solve_stats, 0, sizeof m->solve_stats);
+    m->solve_stats.method = method;
+    m->solve_stats.unshot = NAN;   /* progressive refinement measures it */
+    m->solve_stats.absorbed = NAN; /* matrix-free solvers count it; else read from F */
+}
+
+void rad_meshed_end(rad_meshed *m, rad_result r, double t0)
+{
+    m->solve_stats.seconds = rad_seconds() - t0;
+    m->seconds.solve = m->solve_stats.seconds;
+    m->solved = r == RAD_OK;
+    m->hook = NULL;
+}
+
+void rad_meshed_view(const rad_meshed *m, rad_solution_view *v)
+{
+    rad_view_elements(v, m->mesh, &m->elements);
+    v->vis = m->vis;
+    v->F = NULL;
+    v->F_variance = NULL;
+    v->ff = &m->ff_stats;
+    v->solve = &m->solve_stats;
+    v->hier = NULL;
+    v->solved = m->solved;
+    v->seconds.mesh = m->seconds.mesh;
+    v->seconds.visibility = m->seconds.visibility;
+    v->seconds.form_factors = m->seconds.form_factors;
+    v->seconds.solve = m->seconds.solve;
+}
+
+/* ---- questions answered from a view ---- */
+
+void rad_view_surface_radiosity(const rad_solution_view *v, size_t surface, double rgb[3])
+{
+    double sum[3] = {0, 0, 0}, area = 0.0;
+    for (size_t i = 0; i < v->n; i++) {
+        if (v->mesh->elements[i].surface != surface)
+            continue;
+        area += v->area[i];
+        for (int c = 0; c < 3; c++)
+            sum[c] += v->area[i] * v->radiosity[3 * i + c];
+    }
+    for (int c = 0; c < 3; c++)
+        rgb[c] = area > 0.0 ? sum[c] / area : 0.0;
+}
+
+void rad_view_surface_view_factors(const rad_solution_view *v, double *F)
+{
+    size_t S = v->scene->surface_count, n = v->n;
+    memset(F, 0, S * S * sizeof *F);
+    if (!v->F) /* no factors were computed */
+        return;
+    double *area = calloc(S ? S : 1, sizeof *area);
+    for (size_t i = 0; i < n; i++) {
+        uint32_t si = v->mesh->elements[i].surface;
+        if (area)
+            area[si] += v->area[i];
+        const float *Fi = v->F + i * n;
+        double *row = F + (size_t)si * S;
+        for (size_t j = 0; j < n; j++)
+            row[v->mesh->elements[j].surface] += v->area[i] * Fi[j];
+    }
+    for (size_t a = 0; a < S; a++)
+        for (size_t b = 0; b < S; b++)
+            F[a * S + b] = area && area[a] > 0.0 ? F[a * S + b] / area[a] : 0.0;
+    free(area);
+}
+
+void rad_view_power(const rad_solution_view *v, double *emitted, double *absorbed)
+{
+    size_t n = v->n;
+    double em = 0.0;
+    if (!v->F) { /* the strategy counted what it deposited */
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++)
+                em += v->area[i] * v->emission[3 * i + c];
+        *emitted = em / 3.0;
+        *absorbed = v->solve->absorbed;
+        return;
+    }
+    /* Per-element absorption in parallel, summed in order (thread-independent). */
+    double *absorbed_by = malloc((n ? n : 1) * sizeof *absorbed_by), ab = 0.0;
+    if (!absorbed_by) {
+        *emitted = *absorbed = NAN;
+        return;
+    }
+#pragma omp parallel for schedule(static) num_threads(v->threads)
+    for (size_t i = 0; i < n; i++) {
+        double h[3];
+        rad_gather(v->F + i * n, v->radiosity, n, h);
+        double a = 0.0;
+        for (int c = 0; c < 3; c++)
+            a += v->area[i] * (1.0 - v->reflectance[3 * i + c]) * h[c];
+        absorbed_by[i] = a;
+    }
+    for (size_t i = 0; i < n; i++) {
+        ab += absorbed_by[i];
+        for (int c = 0; c < 3; c++)
+            em += v->area[i] * v->emission[3 * i + c];
+    }
+    free(absorbed_by);
+    *emitted = em / 3.0;
+    *absorbed = ab / 3.0;
+}

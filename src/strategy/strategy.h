@@ -1,0 +1,171 @@
+/*
+ * strategy.h -- the ways a solution is made, behind one small table.
+ *
+ * A strategy owns everything one run of the method needs, from the start:
+ * its mesh, its ray structure, its unknowns (one B per element) and its
+ * statistics.  The api layer creates one, asks it to solve, and reads the
+ * result through a read-only view; it never looks inside.
+ *
+ *     strategy       couples elements by            solves with
+ *     dense          the n x n form-factor matrix   a linear solver (solve.h table)
+ *     matrix-free    nothing stored: rays per shot  progressive refinement (shooting)
+ *     hierarchical   links between quadtree nodes   Jacobi sweeps + BF refinement
+ *
+ * Each strategy answers to one or more solver names (rad_options.solver):
+ * dense to every linear solver in the solver table, the others to their
+ * own.  Adding a strategy (Galerkin elements, instant radiosity) is one
+ * file and one line in rad_strategies[] (strategy.c).
+ *
+ * The elements of a hierarchical solution are the leaves of its hierarchy:
+ * the patches until it is solved, the refined leaves after; the view is
+ * valid until the next solve.  Dense and matrix-free strategies keep their
+ * elements for life.
+ */
+#ifndef RAD_STRATEGY_H
+#define RAD_STRATEGY_H
+
+#include "hier/hier.h"
+
+/* Wall-clock seconds of each phase of a run. */
+typedef struct rad_phase_seconds {
+    double load, mesh, visibility, form_factors, solve, render;
+} rad_phase_seconds;
+
+/* A solution as downstream code (interpolation, output, the api's
+ * accessors) reads it.  Every pointer is owned by the strategy (or, for
+ * scene, options and history, by the solution) and valid until the next
+ * solve or the solution's end. */
+typedef struct rad_solution_view {
+    const rad_scene *scene;
+    const rad_options *options;     /* resolved: no zero means "default" left */
+    int threads;                    /* for the parallel passes of the questions below */
+    const rad_mesh *mesh;           /* the elements and their welded vertices */
+    const rad_vis *vis;             /* closest-hit and occlusion queries */
+    size_t n;                       /* elements */
+    const double *area;             /* n, m^2 */
+    const double *reflectance;      /* 3n, RGB */
+    const double *emission;         /* 3n, W/m^2 */
+    const double *radiosity;        /* 3n, W/m^2: E before solving, the iterate during */
+    const float *F;                 /* n x n; NULL where the strategy stores none */
+    const float *F_variance;        /* n x n for sampling methods that estimate it, else NULL */
+    const rad_ff_stats *ff;
+    const rad_solve_stats *solve;
+    const rad_hier_stats *hier;     /* hierarchical only, else NULL */
+    bool solved;
+    rad_phase_seconds seconds;
+    const rad_solve_step *history;  /* the last solve's steps */
+    size_t history_count;
+    uint64_t render_rays;
+} rad_solution_view;
+
+/* Called by a strategy after each step; nonzero stops the solve (it then
+ * returns RAD_ERROR_INTERRUPTED).  `displayable` is false where the view
+ * does not show the current iterate (a hierarchy being refined). */
+typedef int (*rad_step_fn)(void *user, const rad_solve_step *step, bool displayable);
+
+typedef struct rad_step_hook {
+    rad_step_fn fn;                 /* NULL: no steps wanted */
+    void *user;
+} rad_step_hook;
+
+typedef struct rad_strategy {
+    const char *name;
+    const char *description;
+    /* The index-th solver name it answers to, and its one-line description;
+     * false past the end. */
+    bool (*solver_info)(size_t index, const char **name, const char **description);
+    /* Mesh, visibility and couplings for `scene` (which must outlive the
+     * state) under resolved options; B = E.  On failure *state is NULL and
+     * nothing leaks; RAD_ERROR_INTERRUPTED when cancelled. */
+    rad_result (*create)(rad_context *ctx, const rad_scene *scene, const rad_options *options,
+                         void **state);
+    /* Solve from B = E; steps go to `hook`.  The iterate is kept when
+     * interrupted. */
+    rad_result (*solve)(rad_context *ctx, void *state, const rad_step_hook *hook);
+    /* Fill the strategy's part of *view: mesh, vis, arrays, stats, seconds
+     * of mesh / visibility / form factors / solve, solved.  Cannot fail. */
+    void (*view)(const void *state, rad_solution_view *view);
+    void (*destroy)(void *state);
+} rad_strategy;
+
+extern const rad_strategy *const rad_strategies[]; /* NULL-terminated */
+
+/* The strategy that answers to solver `name`; NULL if none does. */
+const rad_strategy *rad_strategy_for_solver(const char *name);
+
+/* The index-th solver name over all strategies, in table order; false past
+ * the end (for --list-methods and rad_method_info). */
+bool rad_strategy_solver_info(size_t index, const char **name, const char **description);
+
+/* ---- what the strategies share (strategy.c) ---- */
+
+/* Per-element arrays of a mesh: area, reflectance and emission from the
+ * scene's materials, radiosity = emission. */
+typedef struct rad_elements {
+    double *area;                   /* n */
+    double *reflectance;            /* 3n */
+    double *emission;               /* 3n */
+    double *radiosity;              /* 3n */
+} rad_elements;
+
+/* Fill *out for `mesh`; nothing is allocated on failure (out of memory). */
+rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
+                               rad_elements *out);
+void rad_elements_free(rad_elements *e);
+
+/* Fill the view's element part from a mesh and its arrays. */
+void rad_view_elements(rad_solution_view *view, const rad_mesh *mesh, const rad_elements *e);
+
+/* Mesh and ray structure as every strategy builds them (timed); the mesh
+ * within options->max_memory_bytes.  On failure both are NULL. */
+rad_result rad_strategy_mesh_and_vis(rad_context *ctx, const rad_scene *scene, const rad_options *options,
+                                     const rad_mesh_options *mesh_options, rad_mesh **mesh, rad_vis **vis,
+                                     rad_phase_seconds *seconds);
+
+/* The part of a strategy that meshes once and keeps its elements for life
+ * (dense, matrix-free): a system of n elements solved in place. */
+typedef struct rad_meshed {
+    const rad_scene *scene;
+    const rad_options *options;
+    int threads;
+    rad_mesh *mesh;
+    rad_vis *vis;
+    rad_elements elements;
+    rad_ff_stats ff_stats;
+    rad_solve_stats solve_stats;
+    rad_phase_seconds seconds;
+    bool solved;
+    const rad_step_hook *hook;      /* during a solve */
+} rad_meshed;
+
+/* Mesh (options' mesh size or element count), ray structure and element
+ * arrays.  On failure everything built is freed again. */
+rad_result rad_meshed_init(rad_context *ctx, const rad_scene *scene, const rad_options *options,
+                           rad_meshed *m);
+void rad_meshed_free(rad_meshed *m);
+
+/* Start a solve: B = E, stats cleared and named, *sys and *p filled from
+ * the options (sys->F NULL: the caller sets it).  Steps reach `hook` with
+ * the shooting ambient term kept for display. */
+void rad_meshed_begin(rad_meshed *m, const char *method, const rad_step_hook *hook, rad_system *sys,
+                      rad_solve_params *p);
+/* End it: seconds and solved from the result `r` of a solve begun at `t0`. */
+void rad_meshed_end(rad_meshed *m, rad_result r, double t0);
+
+/* The view of a meshed strategy (F and F_variance left NULL). */
+void rad_meshed_view(const rad_meshed *m, rad_solution_view *v);
+
+/* ---- questions answered from a view (strategy.c) ---- */
+
+/* Power in W (means over RGB): emitted = sum A_i E_i; absorbed = sum A_i
+ * (1 - rho_i) H_i from F where the view has it, else the strategy's own
+ * count.  NAN, NAN when out of memory. */
+void rad_view_power(const rad_solution_view *view, double *emitted, double *absorbed);
+
+/* Area-weighted mean radiosity of one surface. */
+void rad_view_surface_radiosity(const rad_solution_view *view, size_t surface, double rgb[3]);
+
+/* Surface-to-surface factors F[a * S + b] (S surfaces), zero without F. */
+void rad_view_surface_view_factors(const rad_solution_view *view, double *F);
+
+#endif /* RAD_STRATEGY_H */
