@@ -1,7 +1,7 @@
 /*
- * generate.c -- seeded procedural scenes (an office floor of N rooms, for
- * benchmarks and tests that need scenes larger than a Cornell box), and the
- * OBJ + MTL writer that saves any scene.
+ * generate.c -- seeded procedural scenes: an office floor of N rooms, for
+ * benchmarks and tests that need scenes larger than a Cornell box (saved
+ * as OBJ + MTL by write_obj.c).
  *
  * The floor is a grid of ceil(sqrt(N)) columns; column widths and row
  * depths are drawn between 4 and 6 m, and every wall is 10 cm thick,
@@ -42,10 +42,8 @@
  */
 #include "scene/scene.h"
 
-#include <errno.h>
 #include <stdarg.h>
 #include <stdlib.h>
-#include <string.h>
 
 /* ---- parameters ---- */
 
@@ -654,194 +652,5 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
     free(g.z);
     if (r == RAD_OK)
         (*out)->load_seconds = rad_seconds() - start;
-    return r;
-}
-
-/* ---- writing a scene as OBJ + MTL ---- */
-
-/* The shortest of 15 or 17 significant digits that reads back as the same
- * double, so 4.237 is written "4.237" and nothing is lost either way. */
-static void format_double(char *text, size_t size, double value)
-{
-    /* Fast path, 5x quicker than printf: a value that is the double nearest
-     * to k / 10^6 for |k| < 2^53 is written as that decimal, which reads
-     * back (correctly rounded) as the same double. */
-    double scaled = value * 1e6;
-    if (fabs(scaled) < 9007199254740992.0) {
-        long long k = llround(scaled);
-        if ((double)k / 1e6 == value) {
-            unsigned long long magnitude = (unsigned long long)(k < 0 ? -k : k);
-            unsigned long long whole = magnitude / 1000000, fraction = magnitude % 1000000;
-            int n = snprintf(text, size, "%s%llu", k < 0 ? "-" : "", whole);
-            if (fraction && n > 0 && (size_t)n + 8 <= size) {
-                char *p = text + n;
-                *p++ = '.';
-                for (unsigned long long unit = 100000; unit && fraction; unit /= 10) {
-                    *p++ = (char)('0' + fraction / unit);
-                    fraction %= unit;
-                }
-                *p = '\0';
-            }
-            return;
-        }
-    }
-    snprintf(text, size, "%.15g", value);
-    if (strtod(text, NULL) != value)
-        snprintf(text, size, "%.17g", value);
-}
-
-/* An OBJ/MTL name: blanks, control characters and '#' would end or
- * comment out the statement, so they become '_'; empty becomes `fallback`. */
-static void write_name(FILE *file, const char *name, const char *fallback, size_t index)
-{
-    if (!name || !*name) {
-        fprintf(file, "%s_%zu", fallback, index);
-        return;
-    }
-    for (const char *c = name; *c; c++)
-        fputc((unsigned char)*c <= ' ' || *c == '#' || *c == 0x7f ? '_' : *c, file);
-}
-
-/* Material i's name in the MTL, made unique by its index when an earlier
- * material has the same name (the builder does not require unique names).
- * O(materials^2), once per material: scenes have few materials. */
-static void write_material_name(FILE *file, const rad_scene *scene, size_t i)
-{
-    write_name(file, scene->materials[i].name, "material", i);
-    for (size_t j = 0; j < i; j++)
-        if (scene->materials[i].name && scene->materials[j].name &&
-            strcmp(scene->materials[i].name, scene->materials[j].name) == 0) {
-            fprintf(file, "_%zu", i);
-            return;
-        }
-}
-
-static rad_result write_mtl(const rad_scene *scene, FILE *mtl)
-{
-    fprintf(mtl, "# %s: materials (Kd = reflectance, Ke = emitted radiance = exitance / pi)\n",
-            scene->source ? scene->source : "scene");
-    for (size_t i = 0; i < scene->material_count; i++) {
-        const rad_material *m = &scene->materials[i];
-        char v[3][32];
-        fputs("\nnewmtl ", mtl);
-        write_material_name(mtl, scene, i);
-        for (int c = 0; c < 3; c++)
-            format_double(v[c], sizeof v[c], m->reflectance[c]);
-        fprintf(mtl, "\nKd %s %s %s\n", v[0], v[1], v[2]);
-        /* 15 digits: E / pi is not exact anyway, and no reader keeps more. */
-        fprintf(mtl, "Ke %.15g %.15g %.15g\nillum 1\n", m->emission[0] / M_PI,
-                m->emission[1] / M_PI, m->emission[2] / M_PI);
-    }
-    return RAD_OK;
-}
-
-/* Polygons grouped by surface (one `o` per surface), in scene order within
- * each: a counting sort, O(polygons + surfaces). */
-static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE *obj,
-                                 const char *mtl_name)
-{
-    size_t surfaces = scene->surface_count, polygons = scene->polygon_count;
-    size_t *start = rad_alloc_array(ctx, surfaces + 1, sizeof *start, "surface offsets");
-    uint32_t *order = rad_alloc_array(ctx, polygons ? polygons : 1, sizeof *order, "polygon order");
-    if (!start || !order) {
-        free(start);
-        free(order);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    memset(start, 0, (surfaces + 1) * sizeof *start);
-    for (size_t p = 0; p < polygons; p++)
-        start[scene->polygons[p].surface + 1]++;
-    for (size_t s = 0; s < surfaces; s++)
-        start[s + 1] += start[s];
-    for (size_t p = 0; p < polygons; p++)
-        order[start[scene->polygons[p].surface]++] = (uint32_t)p;
-    /* start[s] now ends surface s: shift back to beginnings. */
-    for (size_t s = surfaces; s > 0; s--)
-        start[s] = start[s - 1];
-    start[0] = 0;
-
-    fprintf(obj, "# %s: %zu surfaces, %zu polygons; metres, y up\n",
-            scene->source ? scene->source : "scene", surfaces, polygons);
-    fprintf(obj, "mtllib %s\n", mtl_name);
-    size_t written = 0; /* vertices so far: OBJ indices are 1 + this */
-    for (size_t s = 0; s < surfaces; s++) {
-        fputs("\no ", obj);
-        write_name(obj, scene->surfaces[s].name, "surface", s);
-        fputc('\n', obj);
-        uint32_t material = UINT32_MAX;
-        for (size_t k = start[s]; k < start[s + 1]; k++) {
-            const rad_polygon *p = &scene->polygons[order[k]];
-            if (p->material != material) {
-                material = p->material;
-                fputs("usemtl ", obj);
-                write_material_name(obj, scene, material);
-                fputc('\n', obj);
-            }
-            for (uint32_t i = 0; i < p->vertex_count; i++) {
-                vec3 v = scene->positions[scene->indices[p->first_index + i]];
-                char x[32], y[32], z[32];
-                format_double(x, sizeof x, v.x);
-                format_double(y, sizeof y, v.y);
-                format_double(z, sizeof z, v.z);
-                fprintf(obj, "v %s %s %s\n", x, y, z);
-            }
-            fputc('f', obj);
-            for (uint32_t i = 0; i < p->vertex_count; i++)
-                fprintf(obj, " %zu", written + 1 + i);
-            fputc('\n', obj);
-            written += p->vertex_count;
-        }
-    }
-    free(start);
-    free(order);
-    return RAD_OK;
-}
-
-rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path)
-{
-    rad_api_enter(ctx);
-    if (!scene || !path || !*path)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "rad_scene_write_obj: scene or path is NULL");
-    /* PATH.obj -> PATH.mtl; any other name gets ".mtl" appended. */
-    size_t length = strlen(path);
-    char extension[8];
-    rad_path_extension(path, extension, sizeof extension);
-    size_t stem = strcmp(extension, "obj") == 0 ? length - 4 : length;
-    char *mtl_path = malloc(stem + 5);
-    if (!mtl_path)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
-    memcpy(mtl_path, path, stem);
-    memcpy(mtl_path + stem, ".mtl", 5);
-    const char *slash = strrchr(mtl_path, '/');
-    const char *mtl_name = slash ? slash + 1 : mtl_path;
-
-    rad_atomic_file obj = {0}, mtl = {0};
-    rad_result r = rad_atomic_open(ctx, path, &obj);
-    if (r == RAD_OK)
-        r = rad_atomic_open(ctx, mtl_path, &mtl);
-    if (r == RAD_OK)
-        r = write_mtl(scene, mtl.file);
-    if (r == RAD_OK)
-        r = write_obj_body(ctx, scene, obj.file, mtl_name);
-    /* Both written in full before either is renamed; a write error shows
-     * here (full disk) and leaves neither file behind. */
-    if (r == RAD_OK && (fflush(obj.file) != 0 || ferror(obj.file)))
-        r = rad_fail(ctx, RAD_ERROR_IO, "%s: write failed: %s", path, strerror(errno));
-    if (r == RAD_OK && (fflush(mtl.file) != 0 || ferror(mtl.file)))
-        r = rad_fail(ctx, RAD_ERROR_IO, "%s: write failed: %s", mtl_path, strerror(errno));
-    if (r != RAD_OK) {
-        rad_atomic_abort(&obj);
-        rad_atomic_abort(&mtl);
-        free(mtl_path);
-        return r;
-    }
-    r = rad_atomic_commit(ctx, &mtl);
-    if (r != RAD_OK) {
-        rad_atomic_abort(&obj);
-    } else if ((r = rad_atomic_commit(ctx, &obj)) != RAD_OK) {
-        remove(mtl_path); /* no MTL without its OBJ */
-    }
-    free(mtl_path);
     return r;
 }

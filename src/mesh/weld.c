@@ -1,0 +1,351 @@
+/*
+ * weld.c -- welding grid points into shared vertices, and T-vertices.
+ *
+ * Grid points are merged when they lie within 1e-6 x the scene diagonal of
+ * each other (less for slivers: mesh_weld_tolerance), belong to the same
+ * surface, and their patches' normals differ by less than the crease
+ * angle: shading is then smooth within a surface but keeps the physical
+ * discontinuity at corners.
+ *
+ * A welded vertex lying inside a boundary edge of another element of its
+ * surface is a T-vertex (neighbouring patches with different grids):
+ *
+ *    +-----+-----+
+ *    |     |     |
+ *    a-----v-----+    v lies inside the edge (a, b) of the element below:
+ *    |           |    its value must be lerp(value[a], value[b], t)
+ *    b-----------+
+ *
+ * Both searches hash points into cubic cells by sorting (cell key, item)
+ * pairs, with an open-addressing index from key to first entry.
+ */
+#include "mesh/mesh_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- spatial hashing by sorting: (cell key, item) pairs ---- */
+
+static uint64_t cell_key(int64_t x, int64_t y, int64_t z)
+{
+    return rad_mix64((uint64_t)x * 0x9e3779b97f4a7c15ULL ^ rad_mix64((uint64_t)y) ^
+                     rad_mix64((uint64_t)z * 0xc2b2ae3d27d4eb4fULL));
+}
+
+/* The grid cell of coordinate x for cells 1/inv wide.  Clamped to +-2^62
+ * so that a coordinate far from the cell size (a tiny weld tolerance in a
+ * scene far from the origin) never overflows the conversion. */
+static int64_t cell_of(double x, double inv)
+{
+    double c = floor(x * inv);
+    if (!(c > -4.6e18))
+        return c < 0.0 ? -(INT64_C(1) << 62) : 0; /* -inf, or NaN */
+    return c < 4.6e18 ? (int64_t)c : (INT64_C(1) << 62);
+}
+
+static int cell_entry_cmp(const void *a, const void *b)
+{
+    const cell_entry *x = a, *y = b;
+    if (x->key != y->key)
+        return x->key < y->key ? -1 : 1;
+    return x->item < y->item ? -1 : (x->item > y->item);
+}
+
+/* A hash index over sorted entries: key -> first entry with that key, in
+ * O(1) instead of a binary search (10^6 boundary vertices and 27 cells per
+ * query made the searches the leaf mesh's bottleneck). */
+typedef struct cell_index {
+    uint64_t *key;
+    uint32_t *first;      /* UINT32_MAX: empty slot */
+    size_t mask;
+} cell_index;
+
+static bool cell_index_build(const cell_entry *e, size_t n, cell_index *ix)
+{
+    size_t size = 64;
+    while (size < 2 * n)
+        size *= 2;
+    ix->key = malloc(size * sizeof *ix->key);
+    ix->first = malloc(size * sizeof *ix->first);
+    ix->mask = size - 1;
+    if (!ix->key || !ix->first) {
+        free(ix->key);
+        free(ix->first);
+        return false;
+    }
+    memset(ix->first, 0xff, size * sizeof *ix->first);
+    for (size_t i = 0; i < n; i++) {
+        if (i > 0 && e[i].key == e[i - 1].key)
+            continue;
+        size_t h = rad_mix64(e[i].key) & ix->mask;
+        while (ix->first[h] != UINT32_MAX)
+            h = (h + 1) & ix->mask;
+        ix->key[h] = e[i].key;
+        ix->first[h] = (uint32_t)i;
+    }
+    return true;
+}
+
+/* First index of `key` in the sorted entries, or n when absent. */
+static size_t cell_index_find(const cell_index *ix, size_t n, uint64_t key)
+{
+    for (size_t h = rad_mix64(key) & ix->mask; ix->first[h] != UINT32_MAX; h = (h + 1) & ix->mask)
+        if (ix->key[h] == key)
+            return ix->first[h];
+    return n;
+}
+
+static void cell_index_free(cell_index *ix)
+{
+    free(ix->key);
+    free(ix->first);
+}
+
+/* ---- welding ---- */
+
+
+/* The distance within which grid points are one vertex: 1e-6 x the scene
+ * diagonal (far above the round-off of grid points computed from
+ * different patches), but below 1e-3 x the narrowest element, so that the
+ * corners of a sliver's elements (a 1 km x 1 um strip) never merge into
+ * zero-area elements.  The narrowest element is estimated per patch as
+ * its width (2 x area / longest edge) or its shortest edge, whichever is
+ * less, over its cells along the longest side. */
+double mesh_weld_tolerance(const rad_mesh *mesh, double diag)
+{
+    double narrowest = HUGE_VAL;
+    for (size_t i = 0; i < mesh->patch_count; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        vec3 n = p->corner_count == 4
+                     ? v3_cross(v3_sub(p->corner[2], p->corner[0]), v3_sub(p->corner[3], p->corner[1]))
+                     : v3_cross(v3_sub(p->corner[1], p->corner[0]), v3_sub(p->corner[2], p->corner[0]));
+        double area = 0.5 * v3_length(n), longest = 0.0, shortest = HUGE_VAL;
+        for (uint32_t k = 0; k < p->corner_count; k++) {
+            double edge = v3_length(v3_sub(p->corner[(k + 1) % p->corner_count], p->corner[k]));
+            longest = fmax(longest, edge);
+            shortest = fmin(shortest, edge);
+        }
+        uint32_t cells = p->nu > p->nv ? p->nu : p->nv;
+        if (longest > 0.0)
+            narrowest = fmin(narrowest, fmin(shortest, 2.0 * area / longest) / (double)cells);
+    }
+    double tol = 1e-6 * diag;
+    if (narrowest > 0.0 && 1e-3 * narrowest < tol)
+        tol = 1e-3 * narrowest;
+    return tol;
+}
+
+/* Weld raw grid points; fills weld[raw] = welded index and the positions. */
+rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *raw, size_t nraw,
+                     double tol, double cos_crease, uint32_t *weld_of, vec3 **positions,
+                     size_t *count)
+{
+    cell_entry *cells = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *cells, "mesh: weld table");
+    vec3 *pos = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *pos, "mesh: vertices");
+    if (!cells || !pos) {
+        free(cells);
+        free(pos);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    double inv = 1.0 / tol;
+    for (size_t r = 0; r < nraw; r++) {
+        vec3 p = raw[r].position;
+        cells[r].key = cell_key(cell_of(p.x, inv), cell_of(p.y, inv), cell_of(p.z, inv));
+        cells[r].item = (uint32_t)r;
+    }
+    qsort(cells, nraw, sizeof *cells, cell_entry_cmp);
+    cell_index cix;
+    if (!cell_index_build(cells, nraw, &cix)) {
+        free(cells);
+        free(pos);
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory for the weld index");
+    }
+    size_t nw = 0;
+    for (size_t r = 0; r < nraw; r++) {
+        vec3 p = raw[r].position;
+        const rad_patch *pr = &mesh->patches[raw[r].patch];
+        int64_t cx = cell_of(p.x, inv), cy = cell_of(p.y, inv), cz = cell_of(p.z, inv);
+        uint32_t best = UINT32_MAX;
+        for (int dz = -1; dz <= 1; dz++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    uint64_t key = cell_key(cx + dx, cy + dy, cz + dz);
+                    for (size_t k = cell_index_find(&cix, nraw, key); k < nraw && cells[k].key == key; k++) {
+                        uint32_t c = cells[k].item;
+                        if (c >= r || c >= best)
+                            continue;
+                        const rad_patch *pc = &mesh->patches[raw[c].patch];
+                        if (pc->surface != pr->surface || v3_dot(pc->normal, pr->normal) < cos_crease)
+                            continue;
+                        if (v3_length(v3_sub(raw[c].position, p)) <= tol)
+                            best = c;
+                    }
+                }
+        if (best != UINT32_MAX) {
+            weld_of[r] = weld_of[best];
+        } else {
+            weld_of[r] = (uint32_t)nw;
+            pos[nw++] = p;
+        }
+    }
+    free(cells);
+    cell_index_free(&cix);
+    *positions = pos;
+    *count = nw;
+    return RAD_OK;
+}
+
+/* ---- T-vertices ---- */
+
+/* Find welded vertices lying inside boundary edges of elements of the same
+ * surface (T-vertices).  Only vertices on boundary edges can be T-vertices,
+ * so both sets are small; they are matched through a grid of cell size h. */
+rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, double h)
+{
+    typedef struct edge_rec {
+        uint32_t a, b, element;
+    } edge_rec;
+    size_t ne = 0;
+    for (size_t i = 0; i < mesh->element_count; i++)
+        ne += mesh->elements[i].vertex_count;
+    edge_rec *edges = rad_alloc_array(ctx, ne ? ne : 1, sizeof *edges, "mesh: edges");
+    if (!edges)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    size_t k = 0;
+    for (size_t i = 0; i < mesh->element_count; i++) {
+        const rad_element *e = &mesh->elements[i];
+        for (uint32_t c = 0; c < e->vertex_count; c++) {
+            uint32_t a = e->vertex[c], b = e->vertex[(c + 1) % e->vertex_count];
+            edges[k].a = a < b ? a : b;
+            edges[k].b = a < b ? b : a;
+            edges[k].element = (uint32_t)i;
+            k++;
+        }
+    }
+    /* Sort edges by (a, b) to find those used once (boundary edges). */
+    cell_entry *order = rad_alloc_array(ctx, ne ? ne : 1, sizeof *order, "mesh: edges");
+    if (!order) {
+        free(edges);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < ne; i++) {
+        order[i].key = ((uint64_t)edges[i].a << 32) | edges[i].b;
+        order[i].item = (uint32_t)i;
+    }
+    qsort(order, ne, sizeof *order, cell_entry_cmp);
+    size_t nb = 0;
+    uint8_t *on_boundary = rad_alloc_array(ctx, mesh->vertex_count ? mesh->vertex_count : 1, 1,
+                                           "mesh: boundary flags");
+    if (!on_boundary) {
+        free(edges);
+        free(order);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < ne;) {
+        size_t j = i;
+        while (j < ne && order[j].key == order[i].key)
+            j++;
+        if (j - i == 1) {
+            order[nb++] = order[i]; /* compact: boundary edges first */
+            on_boundary[edges[order[i].item].a] = on_boundary[edges[order[i].item].b] = 1;
+        }
+        i = j;
+    }
+    /* Vertex -> a surface and normal, from any element that uses it. */
+    uint32_t *vsurf = rad_alloc_array(ctx, mesh->vertex_count ? mesh->vertex_count : 1,
+                                      sizeof *vsurf, "mesh: vertex surfaces");
+    size_t nbv = 0;
+    for (size_t v = 0; v < mesh->vertex_count; v++)
+        nbv += on_boundary[v];
+    cell_entry *grid = rad_alloc_array(ctx, nbv ? nbv : 1, sizeof *grid, "mesh: vertex grid");
+    if (!vsurf || !grid) {
+        free(edges);
+        free(order);
+        free(on_boundary);
+        free(vsurf);
+        free(grid);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < mesh->element_count; i++)
+        for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++)
+            vsurf[mesh->elements[i].vertex[c]] = mesh->elements[i].surface;
+    /* Cells as wide as the longest boundary edge, so that an edge spans at
+     * most 2 cells a side: that is h, except where a patch reached the cap
+     * on cells per side (cells_for, grid.c) and its elements are longer. */
+    double cell = h;
+    for (size_t bi = 0; bi < nb; bi++) {
+        const edge_rec *ed = &edges[order[bi].item];
+        cell = fmax(cell, v3_length(v3_sub(mesh->vertices[ed->b], mesh->vertices[ed->a])));
+    }
+    double inv = 1.0 / cell;
+    size_t g = 0;
+    for (size_t v = 0; v < mesh->vertex_count; v++) {
+        if (!on_boundary[v])
+            continue;
+        vec3 p = mesh->vertices[v];
+        grid[g].key = cell_key(cell_of(p.x, inv), cell_of(p.y, inv), cell_of(p.z, inv));
+        grid[g].item = (uint32_t)v;
+        g++;
+    }
+    qsort(grid, g, sizeof *grid, cell_entry_cmp);
+    cell_index gix;
+    if (!cell_index_build(grid, g, &gix)) {
+        free(edges);
+        free(order);
+        free(on_boundary);
+        free(vsurf);
+        free(grid);
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory for the T-vertex index");
+    }
+
+    size_t cap = 0;
+    rad_result result = RAD_OK;
+    for (size_t bi = 0; bi < nb && result == RAD_OK; bi++) {
+        const edge_rec *ed = &edges[order[bi].item];
+        const rad_element *el = &mesh->elements[ed->element];
+        vec3 a = mesh->vertices[ed->a], b = mesh->vertices[ed->b];
+        vec3 ab = v3_sub(b, a);
+        double len2 = v3_dot(ab, ab);
+        if (!(len2 > 0.0))
+            continue;
+        vec3 lo = v3_min(a, b), hi = v3_max(a, b);
+        int64_t x0 = cell_of(lo.x - tol, inv), x1 = cell_of(hi.x + tol, inv);
+        int64_t y0 = cell_of(lo.y - tol, inv), y1 = cell_of(hi.y + tol, inv);
+        int64_t z0 = cell_of(lo.z - tol, inv), z1 = cell_of(hi.z + tol, inv);
+        for (int64_t z = z0; z <= z1; z++)
+            for (int64_t y = y0; y <= y1; y++)
+                for (int64_t x = x0; x <= x1; x++) {
+                    uint64_t key = cell_key(x, y, z);
+                    for (size_t q = cell_index_find(&gix, g, key); q < g && grid[q].key == key; q++) {
+                        uint32_t v = grid[q].item;
+                        if (v == ed->a || v == ed->b || vsurf[v] != el->surface)
+                            continue;
+                        vec3 d = v3_sub(mesh->vertices[v], a);
+                        double t = v3_dot(d, ab) / len2;
+                        if (t <= 1e-9 || t >= 1.0 - 1e-9)
+                            continue;
+                        if (v3_length(v3_sub(d, v3_scale(ab, t))) > tol)
+                            continue;
+                        if (mesh->tvertex_count == cap) {
+                            size_t nc = cap ? 2 * cap : 64;
+                            rad_tvertex *nt = realloc(mesh->tvertices, nc * sizeof *nt);
+                            if (!nt) {
+                                result = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+                                break;
+                            }
+                            mesh->tvertices = nt;
+                            cap = nc;
+                        }
+                        rad_tvertex tv = {v, ed->a, ed->b, t};
+                        mesh->tvertices[mesh->tvertex_count++] = tv;
+                    }
+                }
+    }
+    free(edges);
+    free(order);
+    free(on_boundary);
+    free(vsurf);
+    free(grid);
+    cell_index_free(&gix);
+    return result;
+}

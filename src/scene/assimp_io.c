@@ -1,0 +1,127 @@
+/*
+ * assimp_io.c -- a read-only, one-file (plus MTL) file system for assimp,
+ * so that scenes load from memory (the Cornell box, the fuzzers, the API's
+ * rad_scene_load_memory).
+ *
+ *    aiImportFileEx(name, io)
+ *       open(name)        -> the buffer            (matched by base name)
+ *       open("any.mtl")   -> the MTL text, if any  (an OBJ's mtllib)
+ *       open(other)       -> NULL: not found
+ *
+ * Reads, seeks and sizes behave like assimp's own MemoryIOStream.
+ */
+#include "scene/import_internal.h"
+
+#include <assimp/cfileio.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct memory_file {
+    struct aiFile file;
+    const char *data;
+    size_t size, position;
+} memory_file;
+
+static memory_file *memory_file_of(struct aiFile *file)
+{
+    return (memory_file *)(void *)file->UserData;
+}
+
+static size_t memory_read(struct aiFile *file, char *buffer, size_t size, size_t count)
+{
+    memory_file *m = memory_file_of(file);
+    if (size == 0 || m->position >= m->size)
+        return 0;
+    size_t whole = (m->size - m->position) / size;
+    if (count > whole)
+        count = whole;
+    memcpy(buffer, m->data + m->position, count * size);
+    m->position += count * size;
+    return count;
+}
+
+static size_t memory_write(struct aiFile *file, const char *buffer, size_t size, size_t count)
+{
+    (void)file;
+    (void)buffer;
+    (void)size;
+    (void)count;
+    return 0; /* read-only */
+}
+
+static size_t memory_tell(struct aiFile *file) { return memory_file_of(file)->position; }
+
+static size_t memory_size(struct aiFile *file) { return memory_file_of(file)->size; }
+
+/* Offsets wrap like assimp's own MemoryIOStream: aiOrigin_END counts back
+ * from the end, and a "negative" aiOrigin_CUR offset arrives as a huge
+ * size_t that wraps around. */
+static enum aiReturn memory_seek(struct aiFile *file, size_t offset, enum aiOrigin origin)
+{
+    memory_file *m = memory_file_of(file);
+    size_t target = origin == aiOrigin_END   ? m->size - offset
+                    : origin == aiOrigin_CUR ? m->position + offset
+                                             : offset;
+    if ((origin == aiOrigin_END && offset > m->size) || target > m->size)
+        return aiReturn_FAILURE;
+    m->position = target;
+    return aiReturn_SUCCESS;
+}
+
+static void memory_flush(struct aiFile *file) { (void)file; }
+
+static const char *base_name(const char *path)
+{
+    const char *slash = strrchr(path, '/'), *backslash = strrchr(path, '\\');
+    if (backslash && (!slash || backslash > slash))
+        slash = backslash;
+    return slash ? slash + 1 : path;
+}
+
+static struct aiFile *memory_open(struct aiFileIO *io, const char *path, const char *mode)
+{
+    const import_memory_fs *fs = (const import_memory_fs *)(void *)io->UserData;
+    if (!path || !mode || strpbrk(mode, "wa+"))
+        return NULL;
+    char extension[16];
+    rad_path_extension(path, extension, sizeof extension);
+    const char *data;
+    size_t size;
+    if (strcmp(base_name(path), base_name(fs->name)) == 0) {
+        data = fs->data;
+        size = fs->size;
+    } else if (fs->mtl && strcmp(extension, "mtl") == 0) {
+        data = fs->mtl;
+        size = fs->mtl_size;
+    } else {
+        return NULL;
+    }
+    memory_file *m = calloc(1, sizeof *m);
+    if (!m)
+        return NULL;
+    m->data = data;
+    m->size = size;
+    m->file.ReadProc = memory_read;
+    m->file.WriteProc = memory_write;
+    m->file.TellProc = memory_tell;
+    m->file.FileSizeProc = memory_size;
+    m->file.SeekProc = memory_seek;
+    m->file.FlushProc = memory_flush;
+    m->file.UserData = (aiUserData)(void *)m;
+    return &m->file;
+}
+
+static void memory_close(struct aiFileIO *io, struct aiFile *file)
+{
+    (void)io;
+    if (file)
+        free(memory_file_of(file));
+}
+
+void import_memory_io(struct aiFileIO *io, import_memory_fs *fs)
+{
+    io->OpenProc = memory_open;
+    io->CloseProc = memory_close;
+    io->UserData = (aiUserData)(void *)fs;
+}

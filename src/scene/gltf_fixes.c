@@ -1,0 +1,106 @@
+/*
+ * gltf_fixes.c -- what the glTF path needs besides assimp 5.2.
+ *
+ * Before assimp: the framing of a GLB file is checked, because assimp
+ * allocates what the header and chunk headers claim before comparing it
+ * with the file's size.  After assimp: it ignores
+ * KHR_materials_emissive_strength and turns the camera's yfov into an
+ * approximate horizontal angle, so the glTF JSON (all of a .gltf, the
+ * first chunk of a .glb) is read with cJSON for both.
+ *
+ *    GLB:  "glTF" version length | chunk length "JSON" text | chunk length "BIN\0" data
+ *
+ * (Khronos, glTF 2.0 specification, section "Binary glTF Layout".)
+ */
+#include "scene/import_internal.h"
+
+#include <cjson/cJSON.h>
+
+#include <string.h>
+
+/* A little-endian 32-bit number, as GLB headers store them. */
+static size_t le32(const unsigned char *p)
+{
+    return (size_t)p[0] | (size_t)p[1] << 8 | (size_t)p[2] << 16 | (size_t)p[3] << 24;
+}
+
+/* The JSON of a .gltf (all of it) or a .glb (its first chunk), parsed;
+ * NULL if it is not JSON (assimp then reports the problem). */
+cJSON *import_gltf_json(const char *data, size_t size, bool binary)
+{
+    if (!binary)
+        return cJSON_ParseWithLength(data, size);
+    /* GLB: magic "glTF", version, length; then chunk length, "JSON", text. */
+    const unsigned char *bytes = (const unsigned char *)data;
+    if (size < 20 || memcmp(bytes, "glTF", 4) != 0 || memcmp(bytes + 16, "JSON", 4) != 0)
+        return NULL;
+    size_t length = le32(bytes + 12);
+    if (length > size - 20)
+        return NULL;
+    return cJSON_ParseWithLength(data + 20, length);
+}
+
+/* Check the framing of a GLB file before assimp reads it: assimp 5.2
+ * allocates what the header and chunk headers claim before comparing it
+ * with the file's size, so a 40-byte file claiming a 4 GiB chunk costs
+ * 4 GiB.  Header: magic "glTF", version, total length; then chunks of
+ * (length, type, data), each within the file. */
+rad_result import_glb_check_framing(rad_context *ctx, const char *name, const char *data,
+                                     size_t size)
+{
+    const unsigned char *bytes = (const unsigned char *)data;
+    if (size < 12 || memcmp(bytes, "glTF", 4) != 0)
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s: not a binary glTF file (no 'glTF' header)",
+                        name);
+    size_t declared = le32(bytes + 8);
+    if (declared > size)
+        return rad_fail(ctx, RAD_ERROR_PARSE,
+                        "%s: GLB header claims %zu bytes, the file has %zu", name, declared, size);
+    size_t offset = 12;
+    for (int chunk = 0; offset < declared; chunk++) {
+        if (declared - offset < 8)
+            return rad_fail(ctx, RAD_ERROR_PARSE, "%s: GLB chunk %d is cut short at byte %zu",
+                            name, chunk, offset);
+        size_t length = le32(bytes + offset);
+        if (length > declared - offset - 8)
+            return rad_fail(ctx, RAD_ERROR_PARSE,
+                            "%s: GLB chunk %d claims %zu bytes, %zu are left in the file", name,
+                            chunk, length, declared - offset - 8);
+        offset += 8 + length;
+    }
+    return RAD_OK;
+}
+
+/* KHR_materials_emissive_strength of the glTF material assimp imported as
+ * material `index` named `name`: assimp keeps the glTF order (and appends a
+ * default material), so match by index, by name when the names differ. */
+double import_gltf_emissive_strength(const cJSON *materials, unsigned index, const char *name)
+{
+    const cJSON *match = NULL, *item;
+    unsigned i = 0;
+    cJSON_ArrayForEach(item, materials) {
+        const cJSON *item_name = cJSON_GetObjectItemCaseSensitive(item, "name");
+        bool same_name = !cJSON_IsString(item_name) || strcmp(item_name->valuestring, name) == 0;
+        if (i++ == index && same_name) {
+            match = item;
+            break;
+        }
+        if (!match && cJSON_IsString(item_name) && strcmp(item_name->valuestring, name) == 0)
+            match = item;
+    }
+    const cJSON *extensions = cJSON_GetObjectItemCaseSensitive(match, "extensions");
+    const cJSON *extension =
+        cJSON_GetObjectItemCaseSensitive(extensions, "KHR_materials_emissive_strength");
+    const cJSON *strength = cJSON_GetObjectItemCaseSensitive(extension, "emissiveStrength");
+    return cJSON_IsNumber(strength) ? strength->valuedouble : 1.0;
+}
+
+/* The full vertical field of view (radians) of the first glTF camera, or 0. */
+double import_gltf_camera_yfov(const cJSON *root)
+{
+    const cJSON *cameras = cJSON_GetObjectItemCaseSensitive(root, "cameras");
+    const cJSON *perspective =
+        cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(cameras, 0), "perspective");
+    const cJSON *yfov = cJSON_GetObjectItemCaseSensitive(perspective, "yfov");
+    return cJSON_IsNumber(yfov) ? yfov->valuedouble : 0.0;
+}

@@ -1,0 +1,64 @@
+/*
+ * import_internal.h -- what the files of the assimp importer share, and
+ * nothing outside scene/ uses:
+ *
+ *    obj_prescan.c   OBJ/MTL text checked, with line numbers, before assimp
+ *    gltf_fixes.c    GLB framing checked before assimp; glTF JSON read after
+ *    assimp_io.c     a memory file system for assimp
+ *    import_assimp.c aiScene -> rad_scene_builder, and the two entry points
+ */
+#ifndef RAD_SCENE_IMPORT_INTERNAL_H
+#define RAD_SCENE_IMPORT_INTERNAL_H
+
+#include "scene/scene.h"
+
+struct aiFileIO;
+struct cJSON;
+
+/* ---- obj_prescan.c ---- */
+
+/* Check the OBJ text [text, text + size) (`path` names it in messages);
+ * writes the first `mtllib` name (or "", cut to mtllib_size - 1
+ * characters) and its line.  Fails with a line-numbered RAD_ERROR_PARSE
+ * or RAD_ERROR_INVALID_SCENE. */
+rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
+                              char *mtllib, size_t mtllib_size, int *mtllib_line);
+
+/* Check the MTL text [text, text + size), as import_obj_prescan. */
+rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *text, size_t size);
+
+/* ---- gltf_fixes.c ---- */
+
+/* The parsed JSON of a .gltf (binary false) or a .glb (its JSON chunk),
+ * owned by the caller (cJSON_Delete); NULL if there is none. */
+struct cJSON *import_gltf_json(const char *data, size_t size, bool binary);
+
+/* Check that a GLB's header and chunks lie within its `size` bytes;
+ * RAD_ERROR_PARSE naming `name` if not. */
+rad_result import_glb_check_framing(rad_context *ctx, const char *name, const char *data,
+                                    size_t size);
+
+/* The emissive strength (1 when absent) of assimp material `index` named
+ * `name`, from the glTF "materials" array. */
+double import_gltf_emissive_strength(const struct cJSON *materials, unsigned index,
+                                     const char *name);
+
+/* The first camera's full vertical field of view (radians), or 0. */
+double import_gltf_camera_yfov(const struct cJSON *root);
+
+/* ---- assimp_io.c ---- */
+
+/* The files a memory import serves; the buffers are the caller's. */
+typedef struct import_memory_fs {
+    const char *name; /* the main buffer's file name */
+    const char *data;
+    size_t size;
+    const char *mtl; /* served under any *.mtl name; NULL if none */
+    size_t mtl_size;
+} import_memory_fs;
+
+/* Fill `io` so that assimp reads `fs` (which must outlive the import).
+ * Cannot fail. */
+void import_memory_io(struct aiFileIO *io, import_memory_fs *fs);
+
+#endif /* RAD_SCENE_IMPORT_INTERNAL_H */
