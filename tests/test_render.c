@@ -125,7 +125,7 @@ static void add_quad_patch(test_mesh *m, vec3 c0, vec3 c1, vec3 c2, vec3 c3, uin
     m->mesh.patch_count++;
 }
 
-/* A triangle patch meshed k^2, in mesh.c's order (mesh.h's sketch). */
+/* A triangle patch meshed k^2, in mesh/grid.c's order (mesh.h's sketch). */
 static void add_triangle_patch(test_mesh *m, vec3 c0, vec3 c1, vec3 c2, uint32_t k)
 {
     rad_patch *p = &m->patches[m->mesh.patch_count];

@@ -14,7 +14,7 @@
  *                                      m01                   3 (m01 m12 m20)
  *
  * (rad_ff_split4, the quadratures' refinement step), so a child's
- * parameters follow from its parent's (mesh.c locates leaves the same way).  Children are created on demand, four consecutive nodes,
+ * parameters follow from its parent's (mesh/grid.c locates leaves the same way).  Children are created on demand, four consecutive nodes,
  * always after their parent: index order is a topological order.
  *
  * Clusters.  With clustering, a binary bounding-volume hierarchy is built
