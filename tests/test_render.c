@@ -643,6 +643,7 @@ static void test_camera_parse(void **unused)
                                  ",1,2,3,4,5,6", "1;2;3;4;5;6", "1,2,3,4,5,6x"};
     for (size_t k = 0; k < sizeof wrong_count / sizeof wrong_count[0]; k++) {
         c.position[0] = 99;
+        rad_api_enter(ctx); /* a new call: its first failure is kept */
         assert_int_equal(rad_camera_parse(ctx, wrong_count[k], &c), RAD_ERROR_INVALID_ARGUMENT);
         char expected[200];
         snprintf(expected, sizeof expected,
@@ -662,6 +663,7 @@ static void test_camera_parse(void **unused)
         "0,0,5,0,0,0,0,1,0,-30",
     };
     for (size_t k = 0; k < sizeof rejected / sizeof rejected[0]; k++) {
+        rad_api_enter(ctx); /* a new call: its first failure is kept */
         if (rad_camera_parse(ctx, rejected[k], &c) != RAD_ERROR_INVALID_ARGUMENT)
             fail_msg("accepted '%s'", rejected[k]);
         assert_non_null(strstr(rad_context_error(ctx), "--camera: "));

@@ -389,43 +389,53 @@ static void test_builder_errors(void **state)
     vec3 triangle[] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
     const vec3 bowtie[] = {{0, 0, 0}, {2, 1, 0}, {2, 0, 0}, {0, 2, 0}};
     rad_scene_builder *b = rad_scene_builder_create(ctx, "box.obj");
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_material(b, "white", bright, black), -1);
     assert_int_equal(ctx->last_result, RAD_ERROR_INVALID_SCENE);
     assert_string_equal(rad_context_error(ctx),
                         "box.obj: material 'white': reflectance 1.2 is outside [0, 1)");
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_material(b, "lamp", grey, negative), -1);
     assert_contains(rad_context_error(ctx), "material 'lamp': emission -1");
     int material = rad_scene_builder_material(b, "grey", grey, black);
     int surface = rad_scene_builder_surface(b, "wall");
 
     triangle[1].y = NAN;
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 3, 7),
                      RAD_ERROR_INVALID_SCENE);
     assert_string_equal(rad_context_error(ctx),
                         "box.obj:7: polygon in surface 'wall' has a non-finite coordinate");
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 3, 0),
                      RAD_ERROR_INVALID_SCENE);
     assert_string_equal(rad_context_error(ctx),
                         "box.obj: polygon in surface 'wall' has a non-finite coordinate");
     triangle[1] = v3(1e-7, 1e-7, 0.0); /* on the line through the others, nearly */
     triangle[2] = v3(1.0, 1.0 + 1e-13, 0.0);
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 3, 0),
                      RAD_ERROR_INVALID_SCENE);
     assert_contains(rad_context_error(ctx), "has zero area");
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, triangle, 2, 0),
                      RAD_ERROR_INVALID_SCENE);
     assert_contains(rad_context_error(ctx), "has 2 distinct vertices");
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, NULL, 0, 0),
                      RAD_ERROR_INVALID_SCENE);
     assert_contains(rad_context_error(ctx), "has 0 distinct vertices");
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_polygon(b, surface, material, bowtie, 4, 9),
                      RAD_ERROR_INVALID_SCENE);
     assert_string_equal(rad_context_error(ctx),
                         "box.obj:9: polygon in surface 'wall' intersects itself");
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_polygon(b, surface + 5, material, bowtie, 4, 9),
                      RAD_ERROR_INVALID_ARGUMENT);
 
     rad_scene sentinel, *scene = &sentinel; /* must come back NULL */
+    rad_api_enter(ctx); /* a new call: its first failure is kept */
     assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_ERROR_INVALID_SCENE);
     assert_null(scene);
     assert_string_equal(rad_context_error(ctx), "box.obj: scene is empty (no polygons)");
