@@ -71,9 +71,10 @@ static rad_result element_arrays(rad_context *ctx, const rad_scene *scene, const
 rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const rad_options *options,
                                rad_solution **out)
 {
-    *out = NULL;
-    if (!ctx || !scene)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_solution_create: NULL argument");
+    if (out)
+        *out = NULL;
+    if (!ctx || !scene || !out)
+        return rad_null_argument(ctx, __func__);
     rad_solution *s = calloc(1, sizeof *s);
     if (!s)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
@@ -172,6 +173,11 @@ static int solve_monitor(void *user, const rad_solve_step *step, const double *B
 
 const rad_solve_step *rad_solution_history(const rad_solution *s, size_t *count)
 {
+    if (!s || !count) {
+        if (count)
+            *count = 0;
+        return NULL;
+    }
     *count = s->history_count;
     return s->history;
 }
@@ -248,6 +254,8 @@ static rad_result solve_hierarchical(rad_context *ctx, rad_solution *s)
 
 rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
 {
+    if (!ctx || !s)
+        return rad_null_argument(ctx, __func__);
     if (!rad_scene_has_emitter(s->scene))
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
@@ -322,14 +330,16 @@ void rad_solution_destroy(rad_solution *s)
     free(s);
 }
 
-size_t rad_solution_element_count(const rad_solution *s) { return s->mesh->element_count; }
-double rad_solution_residual(const rad_solution *s) { return s->solve_stats.residual; }
-int rad_solution_iterations(const rad_solution *s) { return s->solve_stats.iterations; }
+size_t rad_solution_element_count(const rad_solution *s) { return s ? s->mesh->element_count : 0; }
+double rad_solution_residual(const rad_solution *s) { return s ? s->solve_stats.residual : NAN; }
+int rad_solution_iterations(const rad_solution *s) { return s ? s->solve_stats.iterations : 0; }
 
 void rad_solution_surface_radiosity(const rad_solution *s, size_t surface, double rgb[3])
 {
     double sum[3] = {0, 0, 0}, area = 0.0;
-    for (size_t i = 0; i < s->mesh->element_count; i++) {
+    if (!rgb)
+        return;
+    for (size_t i = 0; s && i < s->mesh->element_count; i++) {
         if (s->mesh->elements[i].surface != surface)
             continue;
         area += s->area[i];
@@ -342,6 +352,8 @@ void rad_solution_surface_radiosity(const rad_solution *s, size_t surface, doubl
 
 void rad_solution_surface_view_factors(const rad_solution *s, double *F)
 {
+    if (!s || !F)
+        return;
     size_t S = s->scene->surface_count, n = s->mesh->element_count;
     if (!s->F) { /* matrix-free: no factors were computed */
         memset(F, 0, S * S * sizeof *F);
@@ -366,6 +378,13 @@ void rad_solution_surface_view_factors(const rad_solution *s, double *F)
 
 void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed)
 {
+    double unused_emitted, unused_absorbed;
+    emitted = emitted ? emitted : &unused_emitted;
+    absorbed = absorbed ? absorbed : &unused_absorbed;
+    if (!s) {
+        *emitted = *absorbed = NAN;
+        return;
+    }
     /* Per-element absorption in parallel, summed in order (thread-independent). */
     size_t n = s->mesh->element_count;
     if (!s->F) { /* matrix-free: the solver measured what it deposited */
@@ -405,7 +424,10 @@ void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed
 rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_render_options *options,
                                rad_image **out)
 {
-    *out = NULL;
+    if (out)
+        *out = NULL;
+    if (!ctx || !s || !out)
+        return rad_null_argument(ctx, __func__);
     rad_render_options o = options ? *options : (rad_render_options){0};
     size_t n = s->mesh->element_count;
     /* Display values: a partial shooting solution gets the ambient term. */
@@ -458,37 +480,46 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
 
 rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera)
 {
+    if (!ctx || !text || !camera)
+        return rad_null_argument(ctx, __func__);
     return rad_camera_parse(ctx, text, camera);
 }
 
-int rad_method_info(rad_method_kind kind, size_t index, const char **name, const char **description)
+bool rad_method_info(rad_method_kind kind, size_t index, const char **name, const char **description)
 {
     size_t count = 0;
+    const char *method_name = NULL, *method_description = NULL;
     switch (kind) {
     case RAD_METHOD_FORM_FACTOR:
         while (rad_ff_methods[count])
             count++;
         if (index >= count)
-            return 0;
-        *name = rad_ff_methods[index]->name;
-        *description = rad_ff_methods[index]->description;
-        return 1;
+            return false;
+        method_name = rad_ff_methods[index]->name;
+        method_description = rad_ff_methods[index]->description;
+        break;
     case RAD_METHOD_SOLVER:
         while (rad_solvers[count])
             count++;
         if (index >= count)
-            return 0;
-        *name = rad_solvers[index]->name;
-        *description = rad_solvers[index]->description;
-        return 1;
+            return false;
+        method_name = rad_solvers[index]->name;
+        method_description = rad_solvers[index]->description;
+        break;
     case RAD_METHOD_VISIBILITY:
         while (rad_vis_backends[count])
             count++;
         if (index >= count)
-            return 0;
-        *name = rad_vis_backends[index]->name;
-        *description = rad_vis_backends[index]->description;
-        return 1;
+            return false;
+        method_name = rad_vis_backends[index]->name;
+        method_description = rad_vis_backends[index]->description;
+        break;
+    default:
+        return false;
     }
-    return 0;
+    if (name)
+        *name = method_name;
+    if (description)
+        *description = method_description;
+    return true;
 }

@@ -66,6 +66,14 @@ rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 #endif
     ;
 
+/* The public functions' answer to a NULL context, object, path or out
+ * pointer (radiosity.h, "NULL"): "FUNCTION: NULL argument" in the context
+ * when there is one, and RAD_ERROR_INVALID_ARGUMENT. */
+static inline rad_result rad_null_argument(rad_context *ctx, const char *function)
+{
+    return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: NULL argument", function);
+}
+
 /* True once the user asked to stop (cancel flag raised). */
 static inline bool rad_cancelled(const rad_context *ctx)
 {

@@ -63,14 +63,16 @@ static double *surface_means(const rad_solution *s)
 }
 
 rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, const char *path,
-                                    int partial)
+                                    bool partial)
 {
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
     size_t n = s->mesh->element_count;
     cJSON_AddStringToObject(root, "version", RAD_VERSION_STRING);
-    cJSON_AddBoolToObject(root, "partial", partial != 0);
+    cJSON_AddBoolToObject(root, "partial", partial);
     cJSON_AddStringToObject(root, "scene", s->scene->source);
     cJSON_AddNumberToObject(root, "threads", rad_context_threads(ctx));
     cJSON_AddNumberToObject(root, "seed", (double)s->options.seed);
@@ -258,7 +260,7 @@ static void vf_rows_free(vf_rows *r)
     free(r->err);
 }
 
-static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, int elements, vf_rows *r)
+static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, bool elements, vf_rows *r)
 {
     memset(r, 0, sizeof *r);
     size_t n = s->mesh->element_count, S = s->scene->surface_count;
@@ -313,8 +315,10 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution *s, int ele
 }
 
 rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *s, const char *path,
-                                           int elements)
+                                           bool elements)
 {
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);
     if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0)
@@ -401,6 +405,8 @@ rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution 
 
 rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, const char *path)
 {
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
     rad_atomic_file f;
     rad_result r = rad_atomic_open(ctx, path, &f);
     if (r != RAD_OK)

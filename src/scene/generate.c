@@ -585,9 +585,10 @@ static rad_result build_room(office *g, int index)
 rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options *options,
                                      rad_scene **out)
 {
-    if (!out)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_generate_office: out is NULL");
-    *out = NULL;
+    if (out)
+        *out = NULL;
+    if (!ctx || !out)
+        return rad_null_argument(ctx, __func__);
     rad_office_options o = options ? *options : (rad_office_options){0};
     if (o.rooms == 0)
         o.rooms = OFFICE_DEFAULT_ROOMS;
@@ -798,9 +799,10 @@ static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE 
 
 rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path)
 {
-    if (!scene || !path || !*path)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "rad_scene_write_obj: scene or path is NULL");
+    if (!ctx || !scene || !path)
+        return rad_null_argument(ctx, __func__);
+    if (!*path)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_write_obj: the path is empty");
     /* PATH.obj -> PATH.mtl; any other name gets ".mtl" appended. */
     size_t length = strlen(path);
     char extension[8];
