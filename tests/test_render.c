@@ -540,7 +540,9 @@ static void test_hdr(void **unused)
     rad_image *image = rad_image_create(NULL, 4, 3);
     for (int i = 0; i < 36; i++)
         image->pixels[i] = (float)(0.01 + 13.0 * (i % 7) + (i % 3));
-    assert_int_equal(rad_image_write(NULL, image, path), RAD_OK);
+    rad_context *ctx = make_context(1);
+    assert_int_equal(rad_image_write(ctx, image, path), RAD_OK);
+    rad_context_destroy(ctx);
     int w, h, n;
     float *pixels = stbi_loadf(path, &w, &h, &n, 3);
     assert_non_null(pixels);

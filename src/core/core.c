@@ -16,6 +16,10 @@
 #include <omp.h>
 #endif
 
+const char *rad_version(void) { return RAD_VERSION_STRING; }
+
+int rad_version_number(void) { return RAD_VERSION_NUMBER; }
+
 const char *rad_result_string(rad_result result)
 {
     switch (result) {
@@ -33,6 +37,8 @@ const char *rad_result_string(rad_result result)
 
 rad_result rad_context_create(const rad_context_options *options, rad_context **out)
 {
+    if (!out)
+        return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     rad_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
@@ -170,8 +176,10 @@ rad_result rad_atomic_open(rad_context *ctx, const char *path, rad_atomic_file *
     size_t n = strlen(path) + 32;
     out->final_path = rad_strdup(path);
     out->temp_path = malloc(n);
-    if (!out->final_path || !out->temp_path) {
-        rad_atomic_abort(out);
+    if (!out->final_path || !out->temp_path) { /* no temporary file to remove yet */
+        free(out->final_path);
+        free(out->temp_path);
+        memset(out, 0, sizeof *out);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     snprintf(out->temp_path, n, "%s.tmp.%ld", path, (long)getpid());

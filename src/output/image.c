@@ -112,6 +112,8 @@ static float select_kth(float *a, size_t n, size_t k)
  * background would otherwise be exposed for the background. */
 double rad_image_auto_exposure(const rad_image *image)
 {
+    if (!image)
+        return 1.0;
     size_t n = (size_t)image->width * (size_t)image->height, lit = 0;
     float *y = malloc((n ? n : 1) * sizeof *y);
     double sum = 0.0;
@@ -218,6 +220,8 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
                                    double exposure)
 {
     rad_api_enter(ctx);
+    if (!ctx || !image || !path)
+        return rad_null_argument(ctx, __func__);
     char ext[8];
     rad_path_extension(path, ext, sizeof ext);
     int png = strcmp(ext, "png") == 0, hdr = strcmp(ext, "hdr") == 0,

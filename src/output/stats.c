@@ -66,8 +66,8 @@ rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *
                                             double seconds, const char *path)
 {
     rad_api_enter(ctx);
-    if (!scene || !phase || !path)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_write_interrupted_stats: NULL argument");
+    if (!ctx || !scene || !phase || !path)
+        return rad_null_argument(ctx, __func__);
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
@@ -84,15 +84,14 @@ rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *
     return r;
 }
 
-rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const char *path,
-                                    int partial)
+rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const char *path, bool partial)
 {
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
     size_t n = s->n;
     cJSON_AddStringToObject(root, "version", RAD_VERSION_STRING);
-    cJSON_AddBoolToObject(root, "partial", partial != 0);
+    cJSON_AddBoolToObject(root, "partial", partial);
     cJSON_AddStringToObject(root, "scene", s->scene->source);
     cJSON_AddNumberToObject(root, "threads", rad_context_threads(ctx));
     cJSON_AddNumberToObject(root, "seed", (double)s->options->seed);
@@ -280,7 +279,7 @@ static void vf_rows_free(vf_rows *r)
     free(r->err);
 }
 
-static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, int elements, vf_rows *r)
+static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bool elements, vf_rows *r)
 {
     memset(r, 0, sizeof *r);
     size_t n = s->n, S = s->scene->surface_count;
@@ -335,7 +334,7 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, in
 }
 
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
-                                           int elements)
+                                  bool elements)
 {
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);

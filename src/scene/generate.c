@@ -584,9 +584,10 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
                                      rad_scene **out)
 {
     rad_api_enter(ctx);
-    if (!out)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_generate_office: out is NULL");
-    *out = NULL;
+    if (out)
+        *out = NULL;
+    if (!ctx || !out)
+        return rad_null_argument(ctx, __func__);
     rad_office_options o = options ? *options : (rad_office_options){0};
     if (o.rooms == 0)
         o.rooms = OFFICE_DEFAULT_ROOMS;
