@@ -514,6 +514,79 @@ typedef enum rad_method_kind {
 RAD_API bool rad_method_info(rad_method_kind kind, size_t index, const char **name,
                              const char **description);
 
+/* ------------------------------------------------------------------------
+ * Option table: every field of rad_options, rad_render_options and
+ * rad_office_options that a user sets, with its type, range, default and
+ * one line of help.  The library checks the fields against these rows and
+ * names the field when it refuses one ("rad_options.tolerance must be in
+ * (0, 1), got 2"); a program builds its flags, help and manual from them.
+ * ---------------------------------------------------------------------- */
+
+typedef enum rad_option_set {
+    RAD_OPTION_SET_SOLUTION = 0, /* rad_options */
+    RAD_OPTION_SET_RENDER = 1,   /* rad_render_options */
+    RAD_OPTION_SET_OFFICE = 2    /* rad_office_options */
+} rad_option_set;
+
+typedef enum rad_option_type {
+    RAD_OPTION_INT = 0, /* int */
+    RAD_OPTION_SIZE,    /* size_t */
+    RAD_OPTION_UINT64,  /* uint64_t, any value */
+    RAD_OPTION_DOUBLE,  /* double, finite */
+    RAD_OPTION_BYTES,   /* double, finite: a byte count */
+    RAD_OPTION_FLAG,    /* int: 0 or nonzero; `words` may name the two */
+    RAD_OPTION_ENUM,    /* int: one of the values in `words` */
+    RAD_OPTION_METHOD,  /* const char *: a name from the registry `methods` */
+    RAD_OPTION_STRING   /* const char *, any text (no library field has it; for
+                           programs that describe their own options alike) */
+} rad_option_type;
+
+/* A named value of a FLAG or ENUM field ("on" = 1). */
+typedef struct rad_option_word {
+    const char *word;
+    int value;
+} rad_option_word;
+
+typedef struct rad_option_info {
+    const char *name;              /* the field as in its struct: "tolerance" */
+    rad_option_type type;
+    size_t offset;                 /* offsetof(struct, field) */
+    /* Accepted values of INT, SIZE, DOUBLE and BYTES fields, besides 0 (the
+     * default): min to max, each bound excluded when its _open is nonzero;
+     * max may be INFINITY. */
+    double min, max;
+    int min_open, max_open;
+    double default_value;          /* what 0 stands for; NAN where that is not a constant */
+    const char *default_text;      /* the default in words: "1e-06", "80% of physical memory" */
+    const rad_option_word *words;  /* FLAG (optional) and ENUM; ends with {NULL, 0} */
+    rad_method_kind methods;       /* METHOD: the registry of its names */
+    const char *help;              /* one line, lower case, no final full stop */
+} rad_option_info;
+
+/* The index-th row of a set, in header order; NULL past the end.  Rows are
+ * static and never change. */
+const rad_option_info *rad_option_info_get(rad_option_set set, size_t index);
+/* The row of field `name` in a set; NULL when there is none. */
+const rad_option_info *rad_option_find(rad_option_set set, const char *name);
+/* The struct a set describes: "rad_options", "rad_render_options", ... */
+const char *rad_option_set_name(rad_option_set set);
+
+/* Nonzero when `value` is within the row's range (INT, SIZE, DOUBLE, BYTES:
+ * finite and between the bounds; ENUM: one of the words' values); always
+ * nonzero for the other types.  0, the default, is not special here. */
+int rad_option_in_range(const rad_option_info *option, double value);
+
+/* Nonzero when `text` is one of the row's words (FLAG, ENUM: *value, if
+ * not NULL, is set to the word's value) or a name in its registry
+ * (METHOD); 0 otherwise, and for the other types. */
+int rad_option_lookup_word(const rad_option_info *option, const char *text, int *value);
+
+/* The accepted values in words, as the library's messages give them:
+ * "(0, 1)", "[1, 48]", "(0, inf)", "auto, on or off", "analytic, contour,
+ * ... or montecarlo"; "" for a FLAG without words and a STRING.  Writes at
+ * most `size` bytes, NUL included; returns the length it wanted. */
+size_t rad_option_range_text(const rad_option_info *option, char *text, size_t size);
+
 #ifdef __cplusplus
 }
 #endif

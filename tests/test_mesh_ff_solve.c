@@ -277,8 +277,8 @@ static void test_analytic_cube(void **state)
     assert_int_equal(rad_form_factors(ctx, rad_ff_find("analytic"), &req, 100.0, false, &F, NULL, &st),
                      RAD_ERROR_OUT_OF_MEMORY);
     assert_null(F);
-    assert_non_null(strstr(rad_context_error(ctx), "--max-memory"));
-    assert_non_null(strstr(rad_context_error(ctx), "--solver shooting"));
+    assert_non_null(strstr(rad_context_error(ctx), "rad_options.max_memory_bytes"));
+    assert_non_null(strstr(rad_context_error(ctx), "'shooting' (rad_options.solver"));
     rad_mesh_destroy(mesh);
     rad_scene_destroy(scene);
 }

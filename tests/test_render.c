@@ -649,7 +649,7 @@ static void test_camera_parse(void **unused)
         assert_int_equal(rad_camera_parse(ctx, wrong_count[k], &c), RAD_ERROR_INVALID_ARGUMENT);
         char expected[200];
         snprintf(expected, sizeof expected,
-                 "--camera: expected 6, 9 or 10 comma-separated numbers, got '%s'", wrong_count[k]);
+                 "camera: expected 6, 9 or 10 comma-separated numbers, got '%s'", wrong_count[k]);
         assert_string_equal(rad_context_error(ctx), expected);
         assert_true(c.position[0] == 99); /* untouched */
     }
@@ -668,7 +668,7 @@ static void test_camera_parse(void **unused)
         rad_api_enter(ctx); /* a new call: its first failure is kept */
         if (rad_camera_parse(ctx, rejected[k], &c) != RAD_ERROR_INVALID_ARGUMENT)
             fail_msg("accepted '%s'", rejected[k]);
-        assert_non_null(strstr(rad_context_error(ctx), "--camera: "));
+        assert_non_null(strstr(rad_context_error(ctx), "camera: "));
         assert_null(strchr(rad_context_error(ctx), '\n'));
     }
     rad_context_destroy(ctx);

@@ -287,7 +287,8 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
         free(display);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "render: a %dx%d image needs %.2f GiB, above the memory limit of %.2f GiB "
-                        "(--max-memory); use a smaller --width / --height",
+                        "(rad_options.max_memory_bytes); use a smaller rad_render_options.width / "
+                        "rad_render_options.height",
                         w, h, image_bytes / 1073741824.0, s->options.max_memory_bytes / 1073741824.0);
     }
     if (o.camera)

@@ -120,7 +120,7 @@ static rad_result hybrid_compute(rad_context *ctx, const rad_ff_request *req, fl
 
 const rad_ff_method rad_ff_hybrid = {
     "hybrid",
-    "one-point (centroid) factor x shadow-ray visibility beyond --near-field element sizes "
+    "one-point (centroid) factor x shadow-ray visibility beyond rad_options.near_field element sizes "
     "(default 3), the contour integral closer in; ~1e-4 on the reference cases, O(n^2)",
     0,
     hybrid_compute,

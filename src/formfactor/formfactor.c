@@ -142,8 +142,9 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     if (bytes > max_memory)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "form factors: the dense matrix for %zu elements needs %.2f GiB, above "
-                        "the memory limit of %.2f GiB (--max-memory); use the matrix-free "
-                        "solver (--solver shooting, O(n) memory) or fewer elements (--elements)",
+                        "the memory limit of %.2f GiB (rad_options.max_memory_bytes); use the matrix-free "
+                        "solver 'shooting' (rad_options.solver, O(n) memory) or fewer elements "
+                        "(rad_options.target_elements)",
                         n, bytes / 1073741824.0, max_memory / 1073741824.0);
     float *F = rad_alloc_array(ctx, n * n, sizeof *F, "form factors: dense matrix");
     float *var = want_variance ? rad_alloc_array(ctx, n * n, sizeof *var, "form factors: variances")

@@ -106,7 +106,8 @@ static rad_result ensure_values(hr_state *st)
         st->Bsend = st->B;
     if (!B || !H || !Ht || !sp || !op || !se || !Bs || (correct && !co))
         return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: out of memory for %zu nodes; use a larger --epsilon or --min-area", n);
+                        "hierarchical: out of memory for %zu nodes; use a larger rad_options.epsilon or "
+                        "rad_options.min_area", n);
     for (size_t k = st->values; k < n; k++) {
         const hr_node *nd = &st->tree.nodes[k];
         for (int c = 0; c < 3; c++) {
@@ -765,7 +766,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         if (r == RAD_OK && bytes_in_use(&st) > p->max_memory)
             r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                          "hierarchical: %zu links and %zu nodes need %.3g GB, over the limit of %.3g GB "
-                         "(--max-memory); use a larger --epsilon or --min-area",
+                         "(rad_options.max_memory_bytes); use a larger rad_options.epsilon or rad_options.min_area",
                          st.links.count, st.tree.count, bytes_in_use(&st) / 1e9, p->max_memory / 1e9);
         hs->seconds_refine += rad_seconds() - t1;
         if (r != RAD_OK)

@@ -428,7 +428,8 @@ static rad_result links_reserve(rad_context *ctx, hr_links *l, size_t count)
     hr_link *items = hr_grow(l->items, &l->capacity, count, sizeof *items);
     if (!items)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: out of memory for %zu links; use a larger --epsilon or --min-area",
+                        "hierarchical: out of memory for %zu links; use a larger rad_options.epsilon or "
+                        "rad_options.min_area",
                         count);
     l->items = items;
     return RAD_OK;
@@ -450,7 +451,8 @@ rad_result hr_links_initial(rad_context *ctx, hr_tree *t, const hr_refine_params
     size_t P = t->base->patch_count;
     if ((double)P * (double)P * sizeof(hr_link) > 0.5 * 1e12)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: %zu patches make too many initial links; use --clustering on", P);
+                        "hierarchical: %zu patches make too many initial links; turn clustering on "
+                        "(rad_options.clustering)", P);
     hr_link *all = rad_alloc_array(ctx, P * P, sizeof *all, "hierarchical: initial links");
     uint8_t *keep = rad_alloc_array(ctx, P * P, 1, "hierarchical: initial links");
     rad_result r = !all || !keep ? RAD_ERROR_OUT_OF_MEMORY : RAD_OK;
@@ -574,8 +576,9 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
             (r = links_reserve(ctx, &next, total)) != RAD_OK) {
             if (r == RAD_OK)
                 r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                             "hierarchical: %zu links need %.3g GB, over the limit of %.3g GB (--max-memory); "
-                             "use a larger --epsilon or --min-area",
+                             "hierarchical: %zu links need %.3g GB, over the limit of %.3g GB "
+                             "(rad_options.max_memory_bytes); use a larger rad_options.epsilon or "
+                             "rad_options.min_area",
                              total + done.count, (double)(total + done.count) * sizeof(hr_link) / 1e9,
                              p->max_memory / 1e9);
             break;

@@ -75,7 +75,8 @@ static rad_result reserve(rad_context *ctx, hr_tree *t, size_t extra)
     hr_node *nodes = hr_grow(t->nodes, &t->capacity, t->count + extra, sizeof *nodes);
     if (!nodes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: out of memory for %zu nodes; use a larger --min-area or --epsilon",
+                        "hierarchical: out of memory for %zu nodes; use a larger rad_options.min_area or "
+                        "rad_options.epsilon",
                         t->count + extra);
     t->nodes = nodes;
     return RAD_OK;
@@ -298,7 +299,8 @@ rad_result hr_subdivide(rad_context *ctx, hr_tree *t, uint32_t k)
         return RAD_OK;
     if (t->count + 4 > (size_t)UINT32_MAX - 1)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: more than %u nodes; use a larger --min-area or --epsilon",
+                        "hierarchical: more than %u nodes; use a larger rad_options.min_area or "
+                        "rad_options.epsilon",
                         UINT32_MAX - 1);
     rad_result r = reserve(ctx, t, 4);
     if (r != RAD_OK)

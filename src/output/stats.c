@@ -289,7 +289,8 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
     if (bytes > s->options->max_memory_bytes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "view factors: the %zu x %zu table needs %.2f GiB, above the memory limit "
-                        "of %.2f GiB (--max-memory); use --level surface or fewer --elements",
+                        "of %.2f GiB (rad_options.max_memory_bytes); use surface-level view factors or fewer "
+                        "rad_options.target_elements",
                         r->count, r->count, bytes / 1073741824.0,
                         s->options->max_memory_bytes / 1073741824.0);
     r->names = rad_alloc_array(ctx, r->count, sizeof *r->names, "view factors");
