@@ -76,9 +76,7 @@ typedef struct elem_geom {
     vec3 normal;
     vec3 centroid;
     double area;
-    double diameter; /* longest diagonal or edge, m */
     double radius;   /* max centroid-to-corner distance, m */
-    double offset;   /* plane offset n . c0 */
 } elem_geom;
 
 static void geom_init(elem_geom *g, const rad_mesh *mesh, const rad_element *e)
@@ -89,23 +87,9 @@ static void geom_init(elem_geom *g, const rad_mesh *mesh, const rad_element *e)
     g->normal = e->normal;
     g->centroid = e->centroid;
     g->area = e->area;
-    g->diameter = 0.0;
     g->radius = 0.0;
-    for (uint32_t a = 0; a < g->corners; a++) {
+    for (uint32_t a = 0; a < g->corners; a++)
         g->radius = fmax(g->radius, v3_length(v3_sub(g->corner[a], g->centroid)));
-        for (uint32_t b = a + 1; b < g->corners; b++)
-            g->diameter = fmax(g->diameter, v3_length(v3_sub(g->corner[a], g->corner[b])));
-    }
-    g->offset = v3_dot(g->normal, g->corner[0]);
-}
-
-/* Is every corner of `g` on or behind the plane of `p`? */
-static bool behind(const elem_geom *g, const elem_geom *p, double eps)
-{
-    for (uint32_t k = 0; k < g->corners; k++)
-        if (v3_dot(p->normal, g->corner[k]) - p->offset > eps)
-            return false;
-    return true;
 }
 
 /* int over the region (3 or 4 corners, a piece of the receiver) of
@@ -223,14 +207,7 @@ static rad_result analytic_compute(rad_context *ctx, const rad_ff_request *req, 
     for (size_t i = 0; i < n; i++)
         geom_init(&geom[i], mesh, &mesh->elements[i]);
     double eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
-    /* Plane test tolerance: 1e-9 x the mesh's extent, so coplanar elements
-     * (whose factors vanish exactly) are culled despite rounding. */
-    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        lo = v3_min(lo, mesh->vertices[v]);
-        hi = v3_max(hi, mesh->vertices[v]);
-    }
-    double plane_eps = 1e-9 * v3_length(v3_sub(hi, lo));
+    double plane_tol = rad_ff_plane_tolerance(mesh);
 
     uint64_t rays = 0, pairs = 0, rows_done = 0;
     volatile int stop = 0;
@@ -243,7 +220,7 @@ static rad_result analytic_compute(rad_context *ctx, const rad_ff_request *req, 
             const elem_geom *gi = &geom[i];
             for (size_t j = i + 1; j < n; j++) {
                 const elem_geom *gj = &geom[j];
-                if (behind(gj, gi, plane_eps) || behind(gi, gj, plane_eps))
+                if (!rad_ff_facing(mesh, (uint32_t)i, (uint32_t)j, plane_tol))
                     continue;
                 pairs++;
                 /* Integrate over the smaller element, the source is the larger. */

@@ -331,31 +331,6 @@ double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const
     return coupling > 0.0 ? coupling : 0.0;
 }
 
-bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol)
-{
-    const rad_element *e[2] = {&mesh->elements[i], &mesh->elements[j]};
-    for (int a = 0; a < 2; a++) {
-        const rad_element *p = e[a], *o = e[1 - a];
-        double offset = v3_dot(p->normal, p->centroid);
-        bool in_front = false;
-        for (uint32_t k = 0; k < o->vertex_count && !in_front; k++)
-            in_front = v3_dot(p->normal, mesh->vertices[o->vertex[k]]) - offset > plane_tol;
-        if (!in_front)
-            return false;
-    }
-    return true;
-}
-
-double rad_ff_plane_tolerance(const rad_mesh *mesh)
-{
-    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        lo = v3_min(lo, mesh->vertices[v]);
-        hi = v3_max(hi, mesh->vertices[v]);
-    }
-    return 1e-9 * v3_length(v3_sub(hi, lo));
-}
-
 double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol)
 {
     const rad_element *ei = &mesh->elements[i], *ej = &mesh->elements[j];

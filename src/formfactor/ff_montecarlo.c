@@ -17,7 +17,7 @@
  *
  * Each unordered pair is sampled once (F_ji = F_ij A_i / A_j, so the matrix
  * is reciprocal by construction); pairs with one element wholly behind the
- * other's plane are skipped, as in ff_analytic.c.  The N point pairs are
+ * other's plane are skipped (rad_ff_facing).  The N point pairs are
  * stratified on both ends (sqrt(N) x sqrt(N) jittered strata on each,
  * matched by a random permutation; samples beyond the largest square are
  * unstratified), and each end carries rad_element_sample's density
@@ -92,7 +92,6 @@ static void flush_chunk(const rad_ff_request *req, mc_scratch *s, uint64_t *rays
 
 /* What the pair loop needs of each element. */
 typedef struct mc_elem {
-    double offset;     /* plane offset n . c0, m */
     double radius;     /* largest centroid-to-corner distance, m */
 } mc_elem;
 
@@ -152,16 +151,6 @@ static bool target_contains(const mc_target *t, vec3 y)
         if (v3_dot(t->normal, v3_cross(v3_sub(b, a), v3_sub(y, a))) < 0.0)
             return false;
     }
-    return true;
-}
-
-/* Is every corner of element g on or behind the plane of element p? */
-static bool behind(const rad_mesh *mesh, const rad_element *g, const rad_element *p, double p_offset,
-                   double eps)
-{
-    for (uint32_t k = 0; k < g->vertex_count; k++)
-        if (v3_dot(p->normal, mesh->vertices[g->vertex[k]]) - p_offset > eps)
-            return false;
     return true;
 }
 
@@ -296,19 +285,11 @@ static rad_result montecarlo_compute(rad_context *ctx, const rad_ff_request *req
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n; i++) {
         const rad_element *e = &mesh->elements[i];
-        table[i].offset = v3_dot(e->normal, mesh->vertices[e->vertex[0]]);
         table[i].radius = 0.0;
         for (uint32_t k = 0; k < e->vertex_count; k++)
             table[i].radius = fmax(table[i].radius, v3_length(v3_sub(mesh->vertices[e->vertex[k]], e->centroid)));
     }
-    /* Plane test tolerance: 1e-9 x the mesh's extent, as in ff_analytic.c,
-     * so coplanar elements (whose factors vanish exactly) are culled. */
-    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        lo = v3_min(lo, mesh->vertices[v]);
-        hi = v3_max(hi, mesh->vertices[v]);
-    }
-    double plane_eps = 1e-9 * v3_length(v3_sub(hi, lo));
+    double plane_tol = rad_ff_plane_tolerance(mesh);
 
     uint64_t rays = 0, pairs = 0, rows_done = 0;
     volatile int stop = 0, failed = 0;
@@ -327,8 +308,7 @@ static rad_result montecarlo_compute(rad_context *ctx, const rad_ff_request *req
             const rad_element *ei = &mesh->elements[i];
             for (size_t j = i + 1; j < n; j++) {
                 const rad_element *ej = &mesh->elements[j];
-                if (behind(mesh, ej, ei, table[i].offset, plane_eps) ||
-                    behind(mesh, ei, ej, table[j].offset, plane_eps))
+                if (!rad_ff_facing(mesh, (uint32_t)i, (uint32_t)j, plane_tol))
                     continue;
                 pairs++;
                 /* Near: closer than twice their summed radii, where the

@@ -71,6 +71,29 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
  * from inside the OpenMP region.  Cannot fail. */
 void rad_ff_row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatile int *stop);
 
+/* ---- the plane tolerance and the facing test (formfactor.c): every
+ * method, and the hierarchical links ---- */
+
+/* Plane distances within this fraction of the scene's size count as 0:
+ * far above the rounding that leaves coplanar elements, or an edge shared
+ * with a plane, a few 1e-16 off it, far below any gap the mesh resolves
+ * (the shadow-ray offset is 1e-5 of the scene). */
+#define RAD_FF_PLANE_TOLERANCE 1e-9
+
+/* RAD_FF_PLANE_TOLERANCE x the extent of the mesh's vertices, m.  Cannot
+ * fail. */
+double rad_ff_plane_tolerance(const rad_mesh *mesh);
+
+/* True when one of the points lies in front of the plane through `origin`
+ * with unit `normal` by more than `tol`: what lies wholly on or behind a
+ * surface's plane exchanges no light with it.  Cannot fail. */
+bool rad_ff_in_front(const vec3 *point, size_t count, vec3 origin, vec3 normal, double tol);
+
+/* Elements i and j face each other: each reaches in front of the other's
+ * plane (through its centroid) by more than plane_tol (rad_ff_in_front);
+ * else their factors vanish.  Cannot fail. */
+bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
+
 /* Reciprocity-preserving closure correction for closed scenes: find x > 0
  * with sum_j x_i x_j A_i F_ij = A_i (symmetric Sinkhorn scaling of the
  * power-coupling matrix G = A F), then F_ij <- x_i x_j F_ij.  Keeps zeros,
@@ -168,12 +191,5 @@ double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const
 
 /* rad_polygon_coupling of elements i and j of the mesh.  Cannot fail. */
 double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
-
-/* False when either element lies wholly on or behind the other's plane
- * (their factors vanish).  Cannot fail. */
-bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
-
-/* 1e-9 x the mesh's extent: coplanar elements are culled despite rounding. */
-double rad_ff_plane_tolerance(const rad_mesh *mesh);
 
 #endif /* RAD_FORMFACTOR_H */
