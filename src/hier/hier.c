@@ -735,7 +735,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                            .shadow_rays = p->shadow_rays > 0 ? (4 * p->shadow_rays < 64 ? 4 * p->shadow_rays : 64) : 16,
                            .epsilon = epsilon_abs,
                            .source_weight = p->classic_oracle ? 0.0 : HR_SOURCE_WEIGHT,
-                           .tol = 1e-9 * rad_scene_diagonal(scene),
+                           .tol = rad_ff_plane_tolerance(base),
                            .max_memory = p->max_memory,
                            .threads = rad_context_threads(ctx)};
     hr_refine_stats rs = {0};

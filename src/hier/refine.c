@@ -208,21 +208,16 @@ static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t 
     return all > 0.0 ? pass / all : 1.0;
 }
 
-/* Largest signed distance of a node's points from the plane (point o,
- * normal n). */
-static double front_extent(const hr_node *x, vec3 o, vec3 n)
+/* Does node x (a polygon, or a cluster's box) reach in front of surface
+ * node p's plane?  The facing test of the form factors, rad_ff_in_front. */
+static bool reaches_front(const hr_node *x, const hr_node *p, double tol)
 {
-    double best = -INFINITY;
-    if (x->kind == HR_SURFACE) {
-        for (int c = 0; c < x->corners; c++)
-            best = fmax(best, v3_dot(n, v3_sub(x->corner[c], o)));
-        return best;
-    }
-    for (int c = 0; c < 8; c++) {
-        vec3 p = v3(c & 1 ? x->hi.x : x->lo.x, c & 2 ? x->hi.y : x->lo.y, c & 4 ? x->hi.z : x->lo.z);
-        best = fmax(best, v3_dot(n, v3_sub(p, o)));
-    }
-    return best;
+    if (x->kind == HR_SURFACE)
+        return rad_ff_in_front(x->corner, x->corners, p->center, p->normal, tol);
+    vec3 box[8];
+    for (int c = 0; c < 8; c++)
+        box[c] = v3(c & 1 ? x->hi.x : x->lo.x, c & 2 ? x->hi.y : x->lo.y, c & 4 ? x->hi.z : x->lo.z);
+    return rad_ff_in_front(box, 8, p->center, p->normal, tol);
 }
 
 /* The mean over a receiver polygon of the exact point-to-polygon factor to
@@ -271,9 +266,9 @@ static bool make_link(const link_ctx *lc, uint32_t r, uint32_t s, uint32_t paren
     if (r == s && nr->kind == HR_SURFACE)
         return false; /* a flat surface does not see itself */
     /* Each end must reach in front of the other's plane. */
-    if (nr->kind == HR_SURFACE && front_extent(ns, nr->center, nr->normal) <= p->tol)
+    if (nr->kind == HR_SURFACE && !reaches_front(ns, nr, p->tol))
         return false;
-    if (ns->kind == HR_SURFACE && front_extent(nr, ns->center, ns->normal) <= p->tol)
+    if (ns->kind == HR_SURFACE && !reaches_front(nr, ns, p->tol))
         return false;
     double k;
     double spread = 0.0;
