@@ -555,7 +555,7 @@ typedef struct rad_option_info {
      * default): min to max, each bound excluded when its _open is nonzero;
      * max may be INFINITY. */
     double min, max;
-    int min_open, max_open;
+    bool min_open, max_open;
     double default_value;          /* what 0 stands for; NAN where that is not a constant */
     const char *default_text;      /* the default in words: "1e-06", "80% of physical memory" */
     const rad_option_word *words;  /* FLAG (optional) and ENUM; ends with {NULL, 0} */
@@ -563,29 +563,34 @@ typedef struct rad_option_info {
     const char *help;              /* one line, lower case, no final full stop */
 } rad_option_info;
 
-/* The index-th row of a set, in header order; NULL past the end.  Rows are
- * static and never change. */
-const rad_option_info *rad_option_info_get(rad_option_set set, size_t index);
-/* The row of field `name` in a set; NULL when there is none. */
-const rad_option_info *rad_option_find(rad_option_set set, const char *name);
-/* The struct a set describes: "rad_options", "rad_render_options", ... */
-const char *rad_option_set_name(rad_option_set set);
+/* These functions only read static tables: any thread, any time. */
 
-/* Nonzero when `value` is within the row's range (INT, SIZE, DOUBLE, BYTES:
+/* The index-th row of a set, in header order; NULL past the end or for an
+ * unknown set.  Rows are static and never change. */
+RAD_API const rad_option_info *rad_option_info_get(rad_option_set set, size_t index);
+/* The row of field `name` in a set; NULL when there is none (or name is NULL). */
+RAD_API const rad_option_info *rad_option_find(rad_option_set set, const char *name);
+/* The struct a set describes: "rad_options", "rad_render_options", ...;
+ * "" for an unknown set.  A static string. */
+RAD_API const char *rad_option_set_name(rad_option_set set);
+
+/* Whether `value` is within the row's range (INT, SIZE, DOUBLE, BYTES:
  * finite and between the bounds; ENUM: one of the words' values); always
- * nonzero for the other types.  0, the default, is not special here. */
-int rad_option_in_range(const rad_option_info *option, double value);
+ * true for the other types, false for a NULL row.  0, the default, is not
+ * special here. */
+RAD_API bool rad_option_in_range(const rad_option_info *option, double value);
 
-/* Nonzero when `text` is one of the row's words (FLAG, ENUM: *value, if
- * not NULL, is set to the word's value) or a name in its registry
- * (METHOD); 0 otherwise, and for the other types. */
-int rad_option_lookup_word(const rad_option_info *option, const char *text, int *value);
+/* Whether `text` is one of the row's words (FLAG, ENUM: *value, if not
+ * NULL, is set to the word's value) or a name in its registry (METHOD);
+ * false otherwise, for the other types and for a NULL row or text. */
+RAD_API bool rad_option_lookup_word(const rad_option_info *option, const char *text, int *value);
 
 /* The accepted values in words, as the library's messages give them:
  * "(0, 1)", "[1, 48]", "(0, inf)", "auto, on or off", "analytic, contour,
  * ... or montecarlo"; "" for a FLAG without words and a STRING.  Writes at
- * most `size` bytes, NUL included; returns the length it wanted. */
-size_t rad_option_range_text(const rad_option_info *option, char *text, size_t size);
+ * most `size` bytes, NUL included (nothing when text is NULL); returns the
+ * length it wanted (0 for a NULL row). */
+RAD_API size_t rad_option_range_text(const rad_option_info *option, char *text, size_t size);
 
 #ifdef __cplusplus
 }

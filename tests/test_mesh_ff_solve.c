@@ -286,15 +286,15 @@ static void test_analytic_cube(void **state)
 
 /* ---- the form-factor loop (formfactor.c): threads, reciprocity, cancellation ---- */
 
-static rad_result form_factors_with(int threads, volatile int *cancel, const rad_ff_method *method,
+static rad_result form_factors_with(int threads, bool cancel, const rad_ff_method *method,
                                     const rad_ff_request *req, float **F, float **variance,
                                     rad_ff_stats *st)
 {
     rad_context_options o = {0};
     o.threads = threads;
-    o.cancel = cancel;
     rad_context *c = NULL;
     assert_int_equal(rad_context_create(&o, &c), RAD_OK);
+    rad_context_cancel(c, cancel);
     rad_result r = rad_form_factors(c, method, req, 1e9, false, F, variance, st);
     rad_context_destroy(c);
     return r;
@@ -321,8 +321,8 @@ static void test_ff_loop(void **state)
         const rad_ff_method *m = rad_ff_methods[k];
         float *F1 = NULL, *F3 = NULL, *V1 = NULL, *V3 = NULL;
         rad_ff_stats s1, s3;
-        assert_int_equal(form_factors_with(1, NULL, m, &req, &F1, &V1, &s1), RAD_OK);
-        assert_int_equal(form_factors_with(3, NULL, m, &req, &F3, &V3, &s3), RAD_OK);
+        assert_int_equal(form_factors_with(1, false, m, &req, &F1, &V1, &s1), RAD_OK);
+        assert_int_equal(form_factors_with(3, false, m, &req, &F3, &V3, &s3), RAD_OK);
         assert_memory_equal(F1, F3, n * n * sizeof *F1);
         if (m->flags & RAD_FF_VARIANCE)
             assert_memory_equal(V1, V3, n * n * sizeof *V1);
@@ -346,9 +346,8 @@ static void test_ff_loop(void **state)
         free(V1);
         free(V3);
 
-        volatile int cancel = 1;
         float *F = NULL;
-        assert_int_equal(form_factors_with(2, &cancel, m, &req, &F, NULL, &s1), RAD_ERROR_INTERRUPTED);
+        assert_int_equal(form_factors_with(2, true, m, &req, &F, NULL, &s1), RAD_ERROR_INTERRUPTED);
         assert_true(s1.pairs < s3.pairs);
         free(F);
     }

@@ -37,12 +37,12 @@ static const rad_option_word shading_words[] = {
 #define UINT64_RANGE .min = 0.0, .max = 18446744073709551616.0
 
 static const rad_option_info solution_rows[] = {
-    {SOLUTION(mesh_size), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = INFINITY,
+    {SOLUTION(mesh_size), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = NAN, .default_text = "from the element count",
      .help = "longest element edge, metres"},
     {SOLUTION(target_elements), .type = RAD_OPTION_SIZE, .min = 1.0, .max = 1e8, .default_value = 2000.0,
      .default_text = "2000", .help = "about this many elements in all, unless a mesh size is given"},
-    {SOLUTION(crease_angle_degrees), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = 180.0,
+    {SOLUTION(crease_angle_degrees), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 180.0,
      .default_value = 30.0, .default_text = "30",
      .help = "vertices of a surface are shared across polygons meeting at less than this angle, degrees"},
     {SOLUTION(form_factors), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_FORM_FACTOR,
@@ -57,7 +57,7 @@ static const rad_option_info solution_rows[] = {
      .default_text = "the method's",
      .help = "hemisphere: rays per element; montecarlo: point pairs per element pair; "
              "shooting: rays per shot"},
-    {SOLUTION(near_field), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = INFINITY,
+    {SOLUTION(near_field), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = 3.0, .default_text = "3",
      .help = "hybrid: pairs closer than this many element sizes use the exact method"},
     {SOLUTION(closure_correction), .type = RAD_OPTION_FLAG, .default_value = 0.0,
@@ -65,25 +65,25 @@ static const rad_option_info solution_rows[] = {
              "sending by its link closure (closed scenes only; refused by shooting)"},
     {SOLUTION(solver), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_SOLVER, .default_value = NAN,
      .default_text = "gauss-seidel", .help = "solver"},
-    {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = 1.0, .max_open = 1,
+    {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0, .max_open = true,
      .default_value = 1e-6, .default_text = "1e-6",
      .help = "stop when the residual (unaccounted power / emitted power) falls below this"},
-    {SOLUTION(unshot_tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = 1.0,
-     .max_open = 1, .default_value = NAN, .default_text = "not used",
+    {SOLUTION(unshot_tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0,
+     .max_open = true, .default_value = NAN, .default_text = "not used",
      .help = "shooting: also stop when unshot power / emitted power falls below this"},
     {SOLUTION(max_iterations), .type = RAD_OPTION_INT, .min = 0.0, .max = INT_MAX, .default_value = NAN,
      .default_text = "0 (automatic)", .help = "cap on sweeps (gathering) or shots (shooting)"},
-    {SOLUTION(relaxation), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = 2.0, .max_open = 1,
+    {SOLUTION(relaxation), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 2.0, .max_open = true,
      .default_value = 1.0, .default_text = "1",
      .help = "over-relaxation: SOR for jacobi and gauss-seidel, overshooting for southwell"},
     {SOLUTION(record_history), .type = RAD_OPTION_FLAG, .default_value = 0.0,
      .help = "keep every step's residual in the history (gathering then measures it every sweep)"},
-    {SOLUTION(epsilon), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = 1e6, .max_open = 1,
+    {SOLUTION(epsilon), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1e6, .max_open = true,
      .default_value = 1e-4, .default_text = "1e-4",
      .help = "hierarchical: refine a link while its error (power its receiver reflects) exceeds this "
              "times the scene's emitted power (N rooms need about 1/N of one room's value for the "
              "same accuracy per room)"},
-    {SOLUTION(min_area), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = INFINITY,
+    {SOLUTION(min_area), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = NAN, .default_text = "1e-4 x the total area x min(1, 100 / patches)",
      .help = "hierarchical: smallest element area, m^2"},
     {SOLUTION(clustering), .type = RAD_OPTION_ENUM, .words = clustering_words, .default_value = 0.0,
@@ -95,7 +95,7 @@ static const rad_option_info solution_rows[] = {
              "(sources), or on the first two only (classic: fewer links, ~3x the per-surface error)"},
     {SOLUTION(seed), .type = RAD_OPTION_UINT64, UINT64_RANGE, .default_value = 0.0, .default_text = "0",
      .help = "seed of all sampling; results do not depend on the thread count"},
-    {SOLUTION(max_memory_bytes), .type = RAD_OPTION_BYTES, .min = 0.0, .min_open = 1, .max = INFINITY,
+    {SOLUTION(max_memory_bytes), .type = RAD_OPTION_BYTES, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = NAN, .default_text = "80% of physical memory",
      .help = "refuse to allocate more memory than this"},
 };
@@ -109,7 +109,7 @@ static const rad_option_info render_rows[] = {
      .default_text = "4", .help = "anti-aliasing: samples per pixel along each axis (their square in all)"},
     {RENDER(shading), .type = RAD_OPTION_ENUM, .words = shading_words, .default_value = 0.0,
      .default_text = "smooth", .help = "smooth (vertex values interpolated) or flat (one colour per element)"},
-    {RENDER(exposure), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = 1, .max = INFINITY,
+    {RENDER(exposure), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = NAN, .default_text = "automatic", .help = "multiplier on radiance before sRGB"},
 };
 
@@ -159,38 +159,42 @@ static int is_number(rad_option_type type)
            type == RAD_OPTION_BYTES;
 }
 
-int rad_option_in_range(const rad_option_info *o, double value)
+bool rad_option_in_range(const rad_option_info *o, double value)
 {
+    if (!o)
+        return false;
     if (o->type == RAD_OPTION_ENUM) {
         for (const rad_option_word *w = o->words; w->word; w++)
             if (value == w->value)
-                return 1;
-        return 0;
+                return true;
+        return false;
     }
     if (!is_number(o->type))
-        return 1;
+        return true;
     return isfinite(value) && (o->min_open ? value > o->min : value >= o->min) &&
            (o->max_open ? value < o->max : value <= o->max);
 }
 
-int rad_option_lookup_word(const rad_option_info *o, const char *text, int *value)
+bool rad_option_lookup_word(const rad_option_info *o, const char *text, int *value)
 {
+    if (!o || !text)
+        return false;
     if (o->type == RAD_OPTION_METHOD) {
         const char *name, *description;
         for (size_t i = 0; rad_method_info(o->methods, i, &name, &description); i++)
             if (strcmp(name, text) == 0)
-                return 1;
-        return 0;
+                return true;
+        return false;
     }
     if (o->type != RAD_OPTION_FLAG && o->type != RAD_OPTION_ENUM)
-        return 0;
+        return false;
     for (const rad_option_word *w = o->words; w && w->word; w++)
         if (strcmp(w->word, text) == 0) {
             if (value)
                 *value = w->value;
-            return 1;
+            return true;
         }
-    return 0;
+    return false;
 }
 
 /* Appends to a bounded buffer; `length` counts what was wanted. */
@@ -220,9 +224,13 @@ static void put_listed(text_out *t, size_t i, size_t n, const char *item)
 
 size_t rad_option_range_text(const rad_option_info *o, char *text, size_t size)
 {
+    if (!text)
+        size = 0;
     text_out t = {text, size, 0};
     if (size)
         text[0] = '\0';
+    if (!o)
+        return 0;
     char number[64];
     if (is_number(o->type) || o->type == RAD_OPTION_UINT64) {
         put(&t, o->min_open ? "(" : "[");
