@@ -78,9 +78,21 @@ typedef struct rad_context_options {
     void *progress_user;         /* passed to `progress` */
     rad_error_fn on_error;       /* optional: told of every failure */
     void *error_user;            /* passed to `on_error` */
+    double max_memory_bytes;     /* the memory limit: everything the engine allocates in
+                                    this context (scenes while loading included) stays
+                                    below it, else RAD_ERROR_OUT_OF_MEMORY with the limit
+                                    named; 0 = 80% of physical memory.  Memory that
+                                    assimp, Embree, LAPACK and cJSON allocate themselves
+                                    is not counted (loading refuses files that assimp
+                                    would need more than the limit for: docs/robustness.md) */
 } rad_context_options;
 
+/* Fails with RAD_ERROR_INVALID_ARGUMENT for negative threads or memory. */
 rad_result rad_context_create(const rad_context_options *options, rad_context **out);
+/* Destroy the context.  The scenes, solutions and images made with it
+ * keep their memory accounted to it: destroyed before them, it lives on
+ * (for no further calls) until the last of them is destroyed.  NULL is a
+ * no-op. */
 void rad_context_destroy(rad_context *ctx);
 /* The message of the most recent failed call in this context ("" if none):
  * its FIRST failure, which names the cause ("box.obj:12: ..."), not what
@@ -233,7 +245,9 @@ typedef struct rad_options {
 
     uint64_t seed;                /* all sampling is seeded per element pair: results do
                                      not depend on the thread count */
-    double max_memory_bytes;      /* refuse to allocate more; 0 = 80% of physical memory */
+    double max_memory_bytes;      /* 0 = the context's limit (rad_context_options); else a
+                                     lower limit for this solution's calls (create, solve,
+                                     render, the writers); never above the context's */
 } rad_options;
 
 /* Mesh the scene, build visibility and compute form factors.  The returned
@@ -336,7 +350,8 @@ const float *rad_image_pixels(const rad_image *image); /* RGB, row 0 at the top 
  * so a failure never leaves a partial file. */
 rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
 /* The automatic exposure of an image: the multiplier that maps the 95th
- * percentile of its luminance to 0.8 (1 if it is black). */
+ * percentile of its luminance to 0.8 (1 if it is black, or when its
+ * context has no memory for a float per pixel). */
 double rad_image_auto_exposure(const rad_image *image);
 
 /* As rad_image_write, with the PNG exposure given (0 = automatic; ignored

@@ -584,7 +584,7 @@ static void test_write_failures(void **unused)
     FILE *f = fopen(path, "wb");
     fputs("old", f);
     fclose(f);
-    rad_image empty = {0, 0, NULL};
+    rad_image empty = {NULL, 0, 0, NULL};
     assert_int_equal(rad_image_write(ctx, &empty, path), RAD_ERROR_INVALID_ARGUMENT);
     size_t size;
     unsigned char *data = read_file(path, &size);

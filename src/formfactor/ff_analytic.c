@@ -217,7 +217,7 @@ static rad_result analytic_compute(rad_context *ctx, const rad_ff_request *req, 
     int base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;
     if (base_rays > 48)
         base_rays = 48;
-    elem_geom *geom = rad_alloc_array(ctx, n, sizeof *geom, "form factors: element table");
+    elem_geom *geom = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n, sizeof *geom, "form factors: element table");
     if (!geom)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n; i++)
@@ -274,7 +274,7 @@ static rad_result analytic_compute(rad_context *ctx, const rad_ff_request *req, 
             rad_ff_row_done(ctx, &rows_done, n, &stop);
         }
     }
-    free(geom);
+    rad_free(geom);
     stats->rays = rays;
     stats->pairs = pairs;
     if (stop)

@@ -385,7 +385,7 @@ static rad_result hemicube_compute(rad_context *ctx, const rad_ff_request *req, 
     hs.R += hs.R & 1; /* side faces are R/2 high */
     hs.H = hs.R / 2;
     hs.pixels = 3 * (size_t)hs.R * (size_t)hs.R;
-    double *delta = rad_alloc_array(ctx, hs.pixels, sizeof *delta, "hemicube: delta form factors");
+    double *delta = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, hs.pixels, sizeof *delta, "hemicube: delta form factors");
     if (!delta)
         return RAD_ERROR_OUT_OF_MEMORY;
     rad_hemicube_deltas(hs.R, delta);
@@ -396,36 +396,46 @@ static rad_result hemicube_compute(rad_context *ctx, const rad_ff_request *req, 
     hs.near = 1e-2 * eps;
     hs.edge_on = 1e-3 * eps;
 
+    /* Per-thread buffers, one slice per thread, allocated before the region. */
+    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1), nv = mesh->vertex_count;
+    vec3 *local = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * nv, sizeof *local, "hemicube: vertices");
+    float *depth = local ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * hs.pixels, sizeof *depth,
+                                     "hemicube: depth buffers")
+                         : NULL;
+    uint32_t *item = depth ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * hs.pixels, sizeof *item,
+                                       "hemicube: item buffers")
+                           : NULL;
+    double *sum = item ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (n + 2), sizeof *sum, "hemicube: row sums")
+                       : NULL;
+    double *row = sum ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (n + 1), sizeof *row, "hemicube: rows")
+                      : NULL;
+    rad_result r = row ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
     uint64_t pairs = 0, rows_done = 0;
-    volatile int stop = 0, failed = 0;
+    volatile int stop = 0;
+    if (r == RAD_OK) {
 #pragma omp parallel num_threads(ctx->threads) reduction(+ : pairs)
-    {
-        hc_scratch s;
-        s.local = malloc((mesh->vertex_count ? mesh->vertex_count : 1) * sizeof *s.local);
-        s.depth = malloc(hs.pixels * sizeof *s.depth);
-        s.item = malloc(hs.pixels * sizeof *s.item);
-        s.sum = malloc((n + 2) * sizeof *s.sum);
-        s.row = malloc((n + 1) * sizeof *s.row);
-        if (!s.local || !s.depth || !s.item || !s.sum || !s.row)
-            failed = 1;
+        {
+            size_t t = (size_t)omp_get_thread_num();
+            hc_scratch s = {local + t * nv, depth + t * hs.pixels, item + t * hs.pixels, sum + t * (n + 2),
+                            row + t * (n + 1)};
 #pragma omp for schedule(dynamic, 4)
-        for (size_t i = 0; i < n; i++) {
-            if (stop || failed)
-                continue;
-            pairs += hemicube_row(&hs, &s, mesh, i, eps, F);
-            rad_ff_row_done(ctx, &rows_done, n, &stop);
+            for (size_t i = 0; i < n; i++) {
+                if (stop)
+                    continue;
+                pairs += hemicube_row(&hs, &s, mesh, i, eps, F);
+                rad_ff_row_done(ctx, &rows_done, n, &stop);
+            }
         }
-        free(s.local);
-        free(s.depth);
-        free(s.item);
-        free(s.sum);
-        free(s.row);
     }
-    free(delta);
+    rad_free(local);
+    rad_free(depth);
+    rad_free(item);
+    rad_free(sum);
+    rad_free(row);
+    rad_free(delta);
     stats->pairs = pairs;
-    if (failed)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hemicube: out of memory for %d x %d buffers",
-                        hs.R, hs.R);
+    if (r != RAD_OK)
+        return r;
     if (stop)
         return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
     rad_progress(ctx, "form factors", n, n);

@@ -183,34 +183,42 @@ static rad_result hemisphere_compute(rad_context *ctx, const rad_ff_request *req
     int N = req->samples > 0 ? req->samples : 1024;
     double eps = rad_vis_epsilon(mesh);
 
+    /* Per-thread scratch, one slice per thread, allocated before the region. */
+    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1);
+    hs_scratch *scratch = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads, sizeof *scratch, "hemisphere: scratch");
+    uint32_t *perm = scratch ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (size_t)N, sizeof *perm,
+                                         "hemisphere: ray strata")
+                             : NULL;
+    double *sum = perm ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * n, sizeof *sum, "hemisphere: row sums")
+                       : NULL;
+    if (!sum) {
+        rad_free(scratch);
+        rad_free(perm);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t t = 0; t < threads; t++) {
+        scratch[t].perm = perm + t * (size_t)N;
+        scratch[t].sum = sum + t * n;
+    }
+
     uint64_t rows_done = 0, pairs = 0;
-    volatile int stop = 0, failed = 0;
+    volatile int stop = 0;
 #pragma omp parallel num_threads(ctx->threads) reduction(+ : pairs)
     {
-        hs_scratch *s = malloc(sizeof *s);
-        uint32_t *perm = malloc((size_t)N * sizeof *perm);
-        double *sum = malloc((n ? n : 1) * sizeof *sum);
-        if (!s || !perm || !sum)
-            failed = 1;
-        else {
-            s->perm = perm;
-            s->sum = sum;
-        }
+        hs_scratch *s = &scratch[omp_get_thread_num()];
 #pragma omp for schedule(dynamic, 4)
         for (size_t i = 0; i < n; i++) {
-            if (stop || failed)
+            if (stop)
                 continue;
             pairs += hemisphere_row(req, s, i, N, eps, F, variance);
             rad_ff_row_done(ctx, &rows_done, n, &stop);
         }
-        free(perm);
-        free(sum);
-        free(s);
     }
+    rad_free(scratch);
+    rad_free(perm);
+    rad_free(sum);
     stats->rays = (uint64_t)rows_done * (uint64_t)N;
     stats->pairs = pairs; /* pairs that received a ray */
-    if (failed)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hemisphere: out of memory for %d rays", N);
     if (stop)
         return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
     rad_progress(ctx, "form factors", n, n);

@@ -56,7 +56,7 @@ static rad_result hybrid_compute(rad_context *ctx, const rad_ff_request *req, fl
     double near_field = req->near_field > 0.0 ? req->near_field : 3.0;
     double eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
     double plane_tol = rad_ff_plane_tolerance(mesh);
-    double *diameter = rad_alloc_array(ctx, n ? n : 1, sizeof *diameter, "form factors: sizes");
+    double *diameter = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n ? n : 1, sizeof *diameter, "form factors: sizes");
     if (!diameter)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n; i++) {
@@ -108,7 +108,7 @@ static rad_result hybrid_compute(rad_context *ctx, const rad_ff_request *req, fl
             rad_ff_row_done(ctx, &rows_done, n, &stop);
         }
     }
-    free(diameter);
+    rad_free(diameter);
     stats->rays = rays;
     stats->pairs = pairs;
     stats->near_pairs = near_pairs;

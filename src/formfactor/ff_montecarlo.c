@@ -291,7 +291,7 @@ static rad_result montecarlo_compute(rad_context *ctx, const rad_ff_request *req
     if (N < 2)
         N = 2;
     double eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
-    mc_elem *table = rad_alloc_array(ctx, n ? n : 1, sizeof *table, "form factors: element table");
+    mc_elem *table = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n ? n : 1, sizeof *table, "form factors: element table");
     if (!table)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n; i++) {
@@ -310,19 +310,28 @@ static rad_result montecarlo_compute(rad_context *ctx, const rad_ff_request *req
     }
     double plane_eps = 1e-9 * v3_length(v3_sub(hi, lo));
 
+    /* Per-thread scratch, one slice per thread, allocated before the region. */
+    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1);
+    mc_scratch *scratch = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads, sizeof *scratch, "montecarlo: scratch");
+    uint32_t *perm = scratch ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (size_t)N, sizeof *perm,
+                                         "montecarlo: sample strata")
+                             : NULL;
+    if (!perm) {
+        rad_free(scratch);
+        rad_free(table);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t t = 0; t < threads; t++)
+        scratch[t].perm = perm + t * (size_t)N;
+
     uint64_t rays = 0, pairs = 0, rows_done = 0;
-    volatile int stop = 0, failed = 0;
+    volatile int stop = 0;
 #pragma omp parallel num_threads(ctx->threads) reduction(+ : rays, pairs)
     {
-        mc_scratch *s = malloc(sizeof *s);
-        uint32_t *perm = malloc((size_t)N * sizeof *perm);
-        if (!s || !perm)
-            failed = 1;
-        else
-            s->perm = perm;
+        mc_scratch *s = &scratch[omp_get_thread_num()];
 #pragma omp for schedule(dynamic, 4)
         for (size_t i = 0; i < n; i++) {
-            if (stop || failed)
+            if (stop)
                 continue;
             const rad_element *ei = &mesh->elements[i];
             for (size_t j = i + 1; j < n; j++) {
@@ -348,14 +357,12 @@ static rad_result montecarlo_compute(rad_context *ctx, const rad_ff_request *req
             }
             rad_ff_row_done(ctx, &rows_done, n, &stop);
         }
-        free(perm);
-        free(s);
     }
-    free(table);
+    rad_free(scratch);
+    rad_free(perm);
+    rad_free(table);
     stats->rays = rays;
     stats->pairs = pairs;
-    if (failed)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "montecarlo: out of memory for %d samples", N);
     if (stop)
         return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
     rad_progress(ctx, "form factors", n, n);

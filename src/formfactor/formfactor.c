@@ -87,15 +87,13 @@ void rad_ff_row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatil
         *stop = 1;
 }
 
-void rad_ff_close(const rad_mesh *mesh, float *F)
+rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F)
 {
     size_t n = mesh->element_count;
-    double *x = malloc((n ? n : 1) * sizeof *x), *row = malloc((n ? n : 1) * sizeof *row);
-    if (!x || !row) {
-        free(x);
-        free(row);
-        return;
-    }
+    double *x = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 2 * n, sizeof *x, "form factors: closure correction");
+    if (!x)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    double *row = x + n;
     for (size_t i = 0; i < n; i++)
         x[i] = 1.0;
     /* Symmetric Sinkhorn iteration on G_ij = A_i F_ij: with s_i = sum_j G_ij x_j,
@@ -123,8 +121,8 @@ void rad_ff_close(const rad_mesh *mesh, float *F)
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++)
             F[i * n + j] = (float)((double)F[i * n + j] * x[i] * x[j]);
-    free(x);
-    free(row);
+    rad_free(x);
+    return RAD_OK;
 }
 
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
@@ -145,24 +143,25 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
                         "the memory limit of %.2f GiB (--max-memory); use the matrix-free "
                         "solver (--solver shooting, O(n) memory) or fewer elements (--elements)",
                         n, bytes / 1073741824.0, max_memory / 1073741824.0);
-    float *F = rad_alloc_array(ctx, n * n, sizeof *F, "form factors: dense matrix");
-    float *var = want_variance ? rad_alloc_array(ctx, n * n, sizeof *var, "form factors: variances")
-                               : NULL;
+    float *F = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *F, "form factors: dense matrix");
+    float *var = F && want_variance
+                     ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *var, "form factors: variances")
+                     : NULL;
     if (!F || (want_variance && !var)) {
-        free(F);
-        free(var);
+        rad_free(F);
+        rad_free(var);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double t0 = rad_seconds();
     rad_result r = method->compute(ctx, req, F, var, stats);
     if (r == RAD_OK && close) {
-        rad_ff_close(req->mesh, F);
-        stats->closure_corrected = true;
+        r = rad_ff_close(ctx, req->mesh, F);
+        stats->closure_corrected = r == RAD_OK;
     }
     stats->seconds = rad_seconds() - t0;
     if (r != RAD_OK && r != RAD_ERROR_INTERRUPTED) {
-        free(F);
-        free(var);
+        rad_free(F);
+        rad_free(var);
         return r;
     }
     diagnostics(req->mesh, F, stats);

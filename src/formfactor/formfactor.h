@@ -74,8 +74,9 @@ void rad_ff_row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatil
 /* Reciprocity-preserving closure correction for closed scenes: find x > 0
  * with sum_j x_i x_j A_i F_ij = A_i (symmetric Sinkhorn scaling of the
  * power-coupling matrix G = A F), then F_ij <- x_i x_j F_ij.  Keeps zeros,
- * positivity and A_i F_ij = A_j F_ji; rows that see nothing stay 0. */
-void rad_ff_close(const rad_mesh *mesh, float *F);
+ * positivity and A_i F_ij = A_j F_ji; rows that see nothing stay 0.
+ * Fails only for memory (2n doubles), F then unchanged. */
+rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F);
 
 /* ---- shared kernels (polygon.c) ---- */
 
