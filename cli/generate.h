@@ -5,10 +5,13 @@
 #ifndef RAD_CLI_GENERATE_H
 #define RAD_CLI_GENERATE_H
 
-/* Run the generate command.  argv[0] is "generate", argv[1] the scene kind
- * ("office"), then its options.  Prints one line on stderr on failure.
- * Returns the exit status: 0 ok, 1 failure (the scene could not be built
- * or written; no file is left), 2 usage error. */
-int rad_cli_generate(int argc, char **argv);
+#include "options.h"
+
+/* Run the generate command on parsed settings (cli_parse_args: the scene
+ * kind, s->office, s->output, s->quiet).  Prints one line on stderr on
+ * failure.  Returns the exit status: 0 ok, 1 failure (the scene could not
+ * be built or written; no file is left), 2 when the library refuses an
+ * option. */
+int cli_generate(const cli_settings *s);
 
 #endif

@@ -7,8 +7,9 @@
  *   4. solve     B = E + rho F B                   rad_solution_solve
  *   5. output    image / view factors / stats      rad_solution_render, ..._write_*
  *
- * Options live in one table (options.c) from which --help is printed, so
- * the two cannot drift; the parser there has no side effects.  Exit
+ * Flags live in one table (options.c), shared by every command, which
+ * takes each flag's range, default and help from the library's option
+ * table; --help and the man page are printed from it, so none can drift.  Exit
  * status: 0 ok, 1 failure, 2 usage error, 130 / 143 when interrupted by
  * SIGINT / SIGTERM (partial outputs are written and marked as such).
  */
@@ -38,25 +39,29 @@ static void list_methods(void)
     for (int k = 0; k < 3; k++) {
         printf("%s:\n", titles[k]);
         const char *name, *desc;
+        char text[1024];
         for (size_t i = 0; rad_method_info((rad_method_kind)k, i, &name, &desc); i++)
-            printf("  %-14s %s\n", name, desc);
+            printf("  %-14s %s\n", name, cli_rewrite_message(desc, text, sizeof text));
     }
 }
 
 /* Parse the command line (options.c) and carry out --help, --version,
- * --list-methods and usage errors.  Returns -1 to go on, else an exit status. */
+ * --list-methods, --man and usage errors.  Returns -1 to go on, else an
+ * exit status. */
 static int parse_args(int argc, char **argv, settings *s)
 {
-    char err[512];
+    char err[1024];
     switch (cli_parse_args(argc, argv, s, err, sizeof err)) {
     case CLI_RUN: return -1;
-    case CLI_HELP: cli_print_help(stdout); return 0;
+    case CLI_HELP: cli_print_help(stdout, s->command); return 0;
     case CLI_VERSION: printf("radiosity %s\n", RAD_VERSION_STRING); return 0;
     case CLI_LIST_METHODS: list_methods(); return 0;
-    case CLI_NO_ARGUMENTS: cli_print_help(stderr); return EXIT_USAGE;
+    case CLI_MAN: cli_print_man(stdout); return 0;
+    case CLI_NO_ARGUMENTS: cli_print_help(stderr, 0); return EXIT_USAGE;
     case CLI_USAGE_ERROR: break;
     }
-    fprintf(stderr, "radiosity: %s (see radiosity --help)\n", err);
+    const char *command = cli_command_name(s->command);
+    fprintf(stderr, "radiosity: %s (see radiosity %s%s--help)\n", err, command, command[0] ? " " : "");
     return EXIT_USAGE;
 }
 
@@ -123,7 +128,7 @@ static void on_signal(int sig)
 typedef struct progressive {
     rad_context *ctx;
     const char *dir;
-    long every;
+    int every;
     const rad_render_options *render;
     double exposure;
     int failed;
@@ -152,9 +157,12 @@ static int on_step(void *user, rad_solution *solution, const rad_solve_step *ste
 
 /* ---- the commands ---- */
 
+/* The library's message, with its field names written as our flags
+ * ("rad_options.max_memory_bytes" -> "--max-memory"). */
 static int fail(rad_context *ctx, rad_result r)
 {
-    const char *msg = rad_context_error(ctx);
+    char msg[1024];
+    cli_rewrite_message(rad_context_error(ctx), msg, sizeof msg);
     fprintf(stderr, "radiosity: %s\n", msg[0] ? msg : rad_result_string(r));
     return 1;
 }
@@ -170,15 +178,15 @@ static const char *where(const char *path, char *buf)
 
 int main(int argc, char **argv)
 {
-    /* Command dispatch: generate has its own options (generate.c); render
-     * and viewfactors (below) share the option table in options.c. */
-    if (argc > 1 && strcmp(argv[1], "generate") == 0)
-        return rad_cli_generate(argc - 1, argv + 1);
+    /* Every command's flags come from the one table in options.c;
+     * generate runs in generate.c, render and viewfactors below. */
     settings s;
     memset(&s, 0, sizeof s);
     int status = parse_args(argc, argv, &s);
     if (status >= 0)
         return status;
+    if (s.command == CLI_GENERATE)
+        return cli_generate(&s);
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -201,8 +209,7 @@ int main(int argc, char **argv)
         return 1;
     }
     cancel_context = ctx;
-    const char *output = s.output ? s.output
-                                  : (s.command == CLI_RENDER ? "radiosity.png" : "viewfactors.json");
+    const char *output = s.output; /* the parser gives the command's default */
     rad_camera camera;
     rad_scene *scene = NULL;
     rad_solution *sol = NULL;
@@ -219,10 +226,11 @@ int main(int argc, char **argv)
         goto done;
     }
     if (s.camera) {
-        /* The library owns the camera syntax (docs/cli.md). */
+        /* The library owns the camera syntax (docs/cli.md).  Its messages
+         * begin "camera: "; with "--" before them they name our flag. */
         r = rad_camera_from_string(ctx, s.camera, &camera);
         if (r != RAD_OK) {
-            fprintf(stderr, "radiosity: %s (see radiosity --help)\n", rad_context_error(ctx));
+            fprintf(stderr, "radiosity: --%s (see radiosity render --help)\n", rad_context_error(ctx));
             status = EXIT_USAGE;
             goto done;
         }

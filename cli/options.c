@@ -1,12 +1,21 @@
 /*
- * options.c -- the `radiosity` command's option table, --help printed from
- * it, and the parser (see options.h).  The parser has no side effects:
- * errors go into the caller's buffer, and --help / --version /
- * --list-methods are returned as actions for main.c to carry out.
+ * options.c -- the `radiosity` command's flags (see options.h): the table,
+ * the parser every command shares, --help and the man page printed from
+ * the table, and the library's field names rewritten into flags.
+ *
+ * A flag that sets a library field takes the field's type, range, default
+ * and help from the library's option table (radiosity.h), so the program
+ * accepts exactly what the library accepts and documents what the library
+ * does.  The parser has no side effects: errors go into the caller's
+ * buffer, and --help / --version / --list-methods / --man are returned as
+ * actions for main.c to carry out.
  */
 #include "options.h"
 
+#include <ctype.h>
 #include <errno.h>
+#include <inttypes.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -14,112 +23,144 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- the option table ---- */
+/* ---- the commands ---- */
 
-enum option_id {
-    OPT_OUTPUT, OPT_MESH_SIZE, OPT_ELEMENTS, OPT_FORM_FACTORS, OPT_SOLVER, OPT_VISIBILITY,
-    OPT_SHADOW_RAYS, OPT_TOLERANCE, OPT_MAX_ITERATIONS, OPT_WIDTH, OPT_HEIGHT, OPT_SAMPLES,
-    OPT_CAMERA, OPT_EXPOSURE, OPT_FLAT, OPT_THREADS, OPT_SEED, OPT_STATS, OPT_MAX_MEMORY,
-    OPT_QUIET, OPT_HELP, OPT_VERSION, OPT_LIST_METHODS, OPT_HEMICUBE_RES, OPT_SAMPLES_FF,
-    OPT_NEAR_FIELD, OPT_CLOSURE, OPT_RELAXATION, OPT_UNSHOT_TOLERANCE, OPT_HISTORY,
-    OPT_PROGRESS_IMAGES, OPT_EVERY, OPT_LEVEL, OPT_EPSILON, OPT_MIN_AREA, OPT_CLUSTERING, OPT_ORACLE
-};
-
-typedef struct option_def {
-    enum option_id id;
-    char short_name;
+typedef struct command_def {
+    int bit;
     const char *name;
-    const char *arg;       /* NULL for flags */
-    int commands;          /* which commands take it */
-    const char *help;
-} option_def;
+    const char *synopsis;  /* after "radiosity " */
+    const char *summary;
+} command_def;
 
-static const option_def OPTIONS[] = {
-    {OPT_OUTPUT, 'o', "output", "FILE", CLI_ALL,
-     "output file: image (.png .hdr .pfm; default radiosity.png) or view factors "
-     "(.json .csv; default viewfactors.json)"},
-    {OPT_MESH_SIZE, 0, "mesh-size", "L", CLI_ALL, "longest element edge, metres"},
-    {OPT_ELEMENTS, 0, "elements", "N", CLI_ALL, "about N elements in all (default 2000)"},
-    {OPT_FORM_FACTORS, 0, "form-factors", "NAME", CLI_ALL, "form-factor method (default analytic)"},
-    {OPT_SOLVER, 0, "solver", "NAME", CLI_RENDER, "solver (default gauss-seidel)"},
-    {OPT_VISIBILITY, 0, "visibility", "NAME", CLI_ALL, "ray backend: embree (default) or brute"},
-    {OPT_SHADOW_RAYS, 0, "shadow-rays", "N", CLI_ALL,
-     "visibility rays per element pair, 4x more where partial (default 4)"},
-    {OPT_HEMICUBE_RES, 0, "hemicube-res", "N", CLI_ALL, "hemicube: pixels along a full face (default 256)"},
-    {OPT_SAMPLES_FF, 0, "ff-samples", "N", CLI_ALL,
-     "hemisphere: rays per element; montecarlo: point pairs per element pair; matrix-free "
-     "shooting: rays per shot (default: the method's)"},
-    {OPT_NEAR_FIELD, 0, "near-field", "X", CLI_ALL,
-     "hybrid: pairs closer than X element sizes use the exact method (default 3)"},
-    {OPT_CLOSURE, 0, "closure-correction", NULL, CLI_ALL,
-     "rescale F so rows sum to 1 keeping reciprocity; hierarchical: scale each patch's sending by its link closure (closed scenes only; docs/methods.md)"},
-    {OPT_LEVEL, 0, "level", "WHICH", CLI_VIEWFACTORS,
-     "view factors between 'surface's (default) or 'element's"},
-    {OPT_EPSILON, 0, "epsilon", "X", CLI_RENDER,
-     "hierarchical: refine a link while its error (power its receiver reflects) exceeds X x the whole scene's emitted power (default 1e-4; a building of N rooms needs about 1/N of a room's X for the same accuracy per room)"},
-    {OPT_MIN_AREA, 0, "min-area", "A", CLI_RENDER,
-     "hierarchical: smallest element area, m^2 (default 1e-4 x the total area x min(1, 100 / patches))"},
-    {OPT_CLUSTERING, 0, "clustering", "WHEN", CLI_RENDER,
-     "hierarchical: start from a cluster hierarchy 'on', 'off' or 'auto' (> 64 patches; default)"},
-    {OPT_ORACLE, 0, "oracle", "WHICH", CLI_RENDER,
-     "hierarchical: split links on the receiver, visibility and the source's radiosity 'sources' (default), "
-     "or on the first two only, 'classic' (fewer links, ~3x the per-surface error)"},
-    {OPT_TOLERANCE, 0, "tolerance", "X", CLI_RENDER,
-     "stop when the residual (unaccounted power / emitted power) < X (default 1e-6)"},
-    {OPT_MAX_ITERATIONS, 0, "max-iterations", "N", CLI_RENDER,
-     "cap on sweeps (gathering) or shots (shooting); 0 = automatic"},
-    {OPT_UNSHOT_TOLERANCE, 0, "unshot-tolerance", "X", CLI_RENDER,
-     "shooting: stop when unshot power / emitted power < X (default: --tolerance)"},
-    {OPT_RELAXATION, 0, "relaxation", "W", CLI_RENDER,
-     "over-relaxation in (0, 2): SOR for jacobi / gauss-seidel, overshooting for southwell (default 1)"},
-    {OPT_HISTORY, 0, "history", "FILE.csv", CLI_RENDER,
-     "write the convergence history: iteration, seconds, residual, unshot power"},
-    {OPT_PROGRESS_IMAGES, 0, "progress-images", "DIR", CLI_RENDER,
-     "write the image every --every iterations while solving (progressive display)"},
-    {OPT_EVERY, 0, "every", "K", CLI_RENDER, "with --progress-images: every K iterations (default 1)"},
-    {OPT_WIDTH, 0, "width", "W", CLI_RENDER, "image width in pixels (default 512)"},
-    {OPT_HEIGHT, 0, "height", "H", CLI_RENDER, "image height in pixels (default 512)"},
-    {OPT_SAMPLES, 0, "samples", "N", CLI_RENDER, "N x N anti-aliasing samples per pixel (default 2)"},
-    {OPT_CAMERA, 0, "camera", "P,L[,U[,FOV]]", CLI_RENDER,
-     "camera: position px,py,pz, look-at lx,ly,lz, up ux,uy,uz, vertical FOV in degrees "
-     "(default: the scene's camera, else framed automatically)"},
-    {OPT_EXPOSURE, 0, "exposure", "X", CLI_RENDER, "multiply radiance by X before sRGB (default automatic)"},
-    {OPT_FLAT, 0, "flat", NULL, CLI_RENDER, "flat shading: one colour per element"},
-    {OPT_THREADS, 0, "threads", "N", CLI_ALL, "worker threads (default: all cores)"},
-    {OPT_SEED, 0, "seed", "N", CLI_ALL, "seed of all sampling (default 0); results do not depend on --threads"},
-    {OPT_STATS, 0, "stats", "FILE.json", CLI_ALL, "write run statistics as JSON (docs/stats.md)"},
-    {OPT_MAX_MEMORY, 0, "max-memory", "SIZE", CLI_ALL,
-     "refuse to use more memory than SIZE (e.g. 4G, 512M; default 80% of RAM)"},
-    {OPT_QUIET, 'q', "quiet", NULL, CLI_ALL, "print nothing but errors"},
-    {OPT_LIST_METHODS, 0, "list-methods", NULL, 0, "list form-factor methods, solvers and ray backends"},
-    {OPT_VERSION, 0, "version", NULL, 0, "print the version"},
-    {OPT_HELP, 'h', "help", NULL, 0, "print this help"},
+static const command_def COMMANDS[] = {
+    {CLI_RENDER, "render", "render [SCENE] [options]", "solve the scene and write an image"},
+    {CLI_VIEWFACTORS, "viewfactors", "viewfactors [SCENE] [options]",
+     "write the view factors between the scene's named surfaces"},
+    {CLI_GENERATE, "generate", "generate office [options]",
+     "write a procedural office floor as OBJ + MTL (docs/scenes.md)"},
 };
-#define OPTION_COUNT (sizeof OPTIONS / sizeof OPTIONS[0])
+#define COMMAND_COUNT (sizeof COMMANDS / sizeof COMMANDS[0])
 
-void cli_print_help(FILE *out)
+const char *cli_command_name(int command)
 {
-    fprintf(out,
-            "radiosity %s -- diffuse global illumination by the radiosity method\n\n"
-            "usage:\n"
-            "  radiosity render [SCENE] [options]        solve and write an image\n"
-            "  radiosity generate office [--rooms N] [--seed S] [-o F.obj]   write a procedural scene\n"
-            "  radiosity viewfactors [SCENE] [options]   write view factors between named surfaces\n"
-            "  radiosity --list-methods | --version | --help\n\n"
-            "SCENE is an OBJ (+MTL) or glTF 2.0 file; without one, the built-in Cornell box.\n"
-            "Units: metres; emission and radiosity in W/m^2; OBJ Ke is emitted radiance (E = pi Ke).\n\n"
-            "options:\n",
-            RAD_VERSION_STRING);
-    for (size_t i = 0; i < OPTION_COUNT; i++) {
-        const option_def *o = &OPTIONS[i];
-        char left[64];
-        snprintf(left, sizeof left, "%s%c%s--%s%s%s", o->short_name ? "-" : "",
-                 o->short_name ? o->short_name : ' ', o->short_name ? ", " : "  ", o->name,
-                 o->arg ? " " : "", o->arg ? o->arg : "");
-        const char *which = o->commands == CLI_RENDER ? " [render]" : "";
-        fprintf(out, "  %-28s %s%s\n", left, o->help, which);
+    for (size_t k = 0; k < COMMAND_COUNT; k++)
+        if (COMMANDS[k].bit == command)
+            return COMMANDS[k].name;
+    return "";
+}
+
+/* ---- the flags ---- */
+
+#define RV (CLI_RENDER | CLI_VIEWFACTORS)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_GENERATE)
+#define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
+#define RENDER(field_) .target = CLI_TO_RENDER, .field = #field_
+#define OFFICE(field_) .target = CLI_TO_OFFICE, .field = #field_
+#define OWN(field_, type_) .target = CLI_TO_SETTINGS, .own.name = #field_, \
+    .own.offset = offsetof(cli_settings, field_), .own.type = type_
+#define ACTION(action_) .target = CLI_TO_ACTION, .action = action_
+
+static const rad_option_word level_words[] = {{"surface", 0}, {"element", 1}, {NULL, 0}};
+
+static const cli_flag FLAGS[] = {
+    {"output", 'o', "FILE", CLI_RENDER, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output image: .png (exposed, sRGB), .hdr or .pfm (linear)",
+     .own.default_text = "radiosity.png"},
+    {"output", 'o', "FILE", CLI_VIEWFACTORS, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output view factors: .json, .csv or .mtx (docs/formats.md)",
+     .own.default_text = "viewfactors.json"},
+    {"output", 'o', "FILE", CLI_GENERATE, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output OBJ; the MTL is written beside it", .own.default_text = "office.obj"},
+    {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
+    {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
+    {"mesh-size", 0, "L", RV, SOLVE(mesh_size)},
+    {"elements", 0, "N", RV, SOLVE(target_elements)},
+    {"form-factors", 0, "NAME", RV, SOLVE(form_factors)},
+    {"solver", 0, "NAME", CLI_RENDER, SOLVE(solver)},
+    {"visibility", 0, "NAME", RV, SOLVE(visibility)},
+    {"shadow-rays", 0, "N", RV, SOLVE(shadow_rays)},
+    {"hemicube-res", 0, "N", RV, SOLVE(hemicube_resolution)},
+    {"ff-samples", 0, "N", RV, SOLVE(samples)},
+    {"near-field", 0, "X", RV, SOLVE(near_field)},
+    {"closure-correction", 0, NULL, RV, SOLVE(closure_correction)},
+    {"level", 0, "WHICH", CLI_VIEWFACTORS, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
+     .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
+    {"epsilon", 0, "X", CLI_RENDER, SOLVE(epsilon)},
+    {"min-area", 0, "A", CLI_RENDER, SOLVE(min_area)},
+    {"clustering", 0, "WHEN", CLI_RENDER, SOLVE(clustering)},
+    {"oracle", 0, "WHICH", CLI_RENDER, SOLVE(classic_oracle)},
+    {"tolerance", 0, "X", CLI_RENDER, SOLVE(tolerance)},
+    {"max-iterations", 0, "N", CLI_RENDER, SOLVE(max_iterations)},
+    {"unshot-tolerance", 0, "X", CLI_RENDER, SOLVE(unshot_tolerance)},
+    {"relaxation", 0, "W", CLI_RENDER, SOLVE(relaxation)},
+    {"history", 0, "FILE.csv", CLI_RENDER, OWN(history, RAD_OPTION_STRING),
+     .own.help = "write the convergence history: iteration, seconds, residual, unshot power"},
+    {"progress-images", 0, "DIR", CLI_RENDER, OWN(progress_dir, RAD_OPTION_STRING),
+     .own.help = "write the image every --every iterations while solving (progressive display)"},
+    {"every", 0, "K", CLI_RENDER, OWN(every, RAD_OPTION_INT), .own.min = 1.0, .own.max = INT_MAX,
+     .own.default_text = "1", .own.help = "with --progress-images: every K iterations"},
+    {"width", 0, "W", CLI_RENDER, RENDER(width)},
+    {"height", 0, "H", CLI_RENDER, RENDER(height)},
+    {"samples", 0, "N", CLI_RENDER, RENDER(samples)},
+    {"camera", 0, "P,L[,U[,FOV]]", CLI_RENDER, OWN(camera, RAD_OPTION_STRING),
+     .own.help = "camera: position px,py,pz, look-at point lx,ly,lz, up ux,uy,uz (0,1,0), "
+                 "vertical field of view in degrees (40)",
+     .own.default_text = "the scene's camera, else framed automatically"},
+    {"exposure", 0, "X", CLI_RENDER, RENDER(exposure)},
+    {"flat", 0, NULL, CLI_RENDER, RENDER(shading), .word = "flat",
+     .help = "flat shading: one colour per element"},
+    {"seed", 0, "S", RV, SOLVE(seed)},
+    {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
+     .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},
+    {"stats", 0, "FILE.json", RV, OWN(stats, RAD_OPTION_STRING),
+     .own.help = "write run statistics as JSON (docs/stats.md)"},
+    {"max-memory", 0, "SIZE", RV, SOLVE(max_memory_bytes)},
+    {"quiet", 'q', NULL, ALL, OWN(quiet, RAD_OPTION_FLAG), .own.help = "print nothing but errors"},
+    {"list-methods", 0, NULL, 0, ACTION(CLI_LIST_METHODS),
+     .help = "list form-factor methods, solvers and ray backends"},
+    {"version", 0, NULL, 0, ACTION(CLI_VERSION), .help = "print the version"},
+    {"man", 0, NULL, 0, ACTION(CLI_MAN), .help = "print the manual page as roff (man -l)"},
+    {"help", 'h', NULL, 0, ACTION(CLI_HELP), .help = "print this help; after a command, that command's"},
+};
+#define FLAG_COUNT (sizeof FLAGS / sizeof FLAGS[0])
+
+const cli_flag *cli_flag_get(size_t index)
+{
+    return index < FLAG_COUNT ? &FLAGS[index] : NULL;
+}
+
+/* The library's set of a flag's field; -1 for the program's own flags. */
+static int flag_set(const cli_flag *f)
+{
+    switch (f->target) {
+    case CLI_TO_SOLVE: return RAD_OPTION_SET_SOLUTION;
+    case CLI_TO_RENDER: return RAD_OPTION_SET_RENDER;
+    case CLI_TO_OFFICE: return RAD_OPTION_SET_OFFICE;
+    case CLI_TO_SETTINGS:
+    case CLI_TO_ACTION: break;
     }
-    fprintf(out, "\nexit status: 0 ok, 1 failure, 2 usage error, 130/143 interrupted\n");
+    return -1;
+}
+
+const rad_option_info *cli_flag_info(const cli_flag *f)
+{
+    int set = flag_set(f);
+    return set < 0 ? &f->own : rad_option_find((rad_option_set)set, f->field);
+}
+
+static const char *flag_help(const cli_flag *f)
+{
+    return f->help ? f->help : cli_flag_info(f)->help;
+}
+
+/* Where a flag's value is stored in the settings. */
+static void *flag_field(const cli_flag *f, cli_settings *s)
+{
+    char *base = f->target == CLI_TO_SOLVE    ? (char *)&s->solve
+                 : f->target == CLI_TO_RENDER ? (char *)&s->render
+                 : f->target == CLI_TO_OFFICE ? (char *)&s->office
+                                              : (char *)s;
+    return base + cli_flag_info(f)->offset;
 }
 
 /* ---- the parser ---- */
@@ -143,45 +184,137 @@ static int usage_error(error_sink *e, const char *fmt, ...)
     return 1;
 }
 
-static int parse_double(error_sink *e, const char *opt, const char *text, double lo, double hi,
-                        double *out)
+/* What a value must look like, for messages: "a number in (0, 1)". */
+static void expectation(const rad_option_info *o, char *text, size_t size)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v) || v < lo || v > hi)
-        return usage_error(e, "--%s: expected a number in [%g, %g], got '%s'", opt, lo, hi, text);
-    *out = v;
-    return 0;
+    char range[512];
+    rad_option_range_text(o, range, sizeof range);
+    switch (o->type) {
+    case RAD_OPTION_INT:
+    case RAD_OPTION_SIZE:
+    case RAD_OPTION_UINT64: snprintf(text, size, "an integer in %s", range); break;
+    case RAD_OPTION_DOUBLE: snprintf(text, size, "a number in %s", range); break;
+    case RAD_OPTION_BYTES: snprintf(text, size, "a size such as 4G or 512M, in %s bytes", range); break;
+    case RAD_OPTION_METHOD: snprintf(text, size, "one of %s", range); break;
+    case RAD_OPTION_FLAG:
+    case RAD_OPTION_ENUM: snprintf(text, size, "%s", range); break;
+    case RAD_OPTION_STRING: snprintf(text, size, "a value"); break;
+    }
 }
 
-static int parse_int(error_sink *e, const char *opt, const char *text, long lo, long hi, long *out)
+/* Parse `text` as the value of a row into `field` (of the row's C type).
+ * Returns 0, or 1 with nothing stored. */
+static int parse_value(const rad_option_info *o, const char *text, void *field)
 {
-    char *end;
+    char *end = NULL;
     errno = 0;
-    long v = strtol(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi)
-        return usage_error(e, "--%s: expected an integer in [%ld, %ld], got '%s'", opt, lo, hi, text);
-    *out = v;
-    return 0;
+    switch (o->type) {
+    case RAD_OPTION_INT:
+    case RAD_OPTION_SIZE: {
+        long long v = strtoll(text, &end, 10);
+        if (end == text || *end != '\0' || errno == ERANGE || !rad_option_in_range(o, (double)v))
+            return 1;
+        if (o->type == RAD_OPTION_INT)
+            *(int *)field = (int)v; /* the range is within int */
+        else
+            *(size_t *)field = (size_t)v;
+        return 0;
+    }
+    case RAD_OPTION_UINT64: {
+        /* Digits only: strtoull would take "-1" as 2^64 - 1.  No double on
+         * the way, so every value is exact. */
+        if (text[0] < '0' || text[0] > '9')
+            return 1;
+        unsigned long long v = strtoull(text, &end, 10);
+        if (*end != '\0' || errno == ERANGE)
+            return 1;
+        *(uint64_t *)field = (uint64_t)v;
+        return 0;
+    }
+    case RAD_OPTION_DOUBLE:
+    case RAD_OPTION_BYTES: {
+        double v = strtod(text, &end);
+        if (end != text && o->type == RAD_OPTION_BYTES) {
+            double unit = 1.0;
+            switch (*end) {
+            case 'K': case 'k': unit = 1024.0; break;
+            case 'M': case 'm': unit = 1048576.0; break;
+            case 'G': case 'g': unit = 1073741824.0; break;
+            }
+            if (unit > 1.0)
+                v *= unit, end++;
+        }
+        /* Overflow gives infinity, which no range holds; underflow gives
+         * what is nearest, which the range judges. */
+        if (end == text || *end != '\0' || !rad_option_in_range(o, v))
+            return 1;
+        *(double *)field = v;
+        return 0;
+    }
+    case RAD_OPTION_FLAG:
+    case RAD_OPTION_ENUM: {
+        int v;
+        if (!rad_option_lookup_word(o, text, &v))
+            return 1;
+        *(int *)field = v;
+        return 0;
+    }
+    case RAD_OPTION_METHOD:
+        if (!rad_option_lookup_word(o, text, NULL))
+            return 1;
+        *(const char **)field = text;
+        return 0;
+    case RAD_OPTION_STRING: *(const char **)field = text; return 0;
+    }
+    return 1;
 }
 
-static int parse_size(error_sink *e, const char *opt, const char *text, double *bytes)
+/* A switch: 1, or the value of its word. */
+static void set_switch(const cli_flag *f, cli_settings *s)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    double unit = 1.0;
-    if (*end == 'K' || *end == 'k')
-        unit = 1024.0, end++;
-    else if (*end == 'M' || *end == 'm')
-        unit = 1048576.0, end++;
-    else if (*end == 'G' || *end == 'g')
-        unit = 1073741824.0, end++;
-    if (end == text || *end != '\0' || !isfinite(v) || v <= 0.0 || !isfinite(v * unit))
-        return usage_error(e, "--%s: expected a size such as 4G or 512M, got '%s'", opt, text);
-    *bytes = v * unit;
-    return 0;
+    int value = 1;
+    if (f->word)
+        rad_option_lookup_word(cli_flag_info(f), f->word, &value);
+    *(int *)flag_field(f, s) = value;
+}
+
+/* The flag `arg` names ("--name", "--name=...", "-x") for the command, or
+ * NULL; *known tells whether some command has it. */
+static const cli_flag *find_flag(const char *arg, int command, int *known, const char **value)
+{
+    const char *name = NULL;
+    size_t len = 0;
+    *value = NULL;
+    *known = 0;
+    if (arg[1] == '-') {
+        name = arg + 2;
+        const char *eq = strchr(name, '=');
+        len = eq ? (size_t)(eq - name) : strlen(name);
+        if (eq)
+            *value = eq + 1;
+    } else if (arg[2] != '\0') {
+        return NULL;
+    }
+    for (size_t k = 0; k < FLAG_COUNT; k++) {
+        const cli_flag *f = &FLAGS[k];
+        int match = name ? strlen(f->name) == len && strncmp(f->name, name, len) == 0
+                         : f->short_name && f->short_name == arg[1];
+        if (!match)
+            continue;
+        *known = 1;
+        if (!f->commands || (f->commands & command))
+            return f;
+    }
+    return NULL;
+}
+
+/* The default of the command's --output (its row's default). */
+static const char *default_output(int command)
+{
+    for (size_t k = 0; k < FLAG_COUNT; k++)
+        if (strcmp(FLAGS[k].name, "output") == 0 && (FLAGS[k].commands & command))
+            return FLAGS[k].own.default_text;
+    return NULL;
 }
 
 cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *err, size_t err_size)
@@ -193,177 +326,71 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         err[0] = '\0';
     if (argc < 2)
         return CLI_NO_ARGUMENTS;
-    if (strcmp(argv[1], "render") == 0)
-        s->command = CLI_RENDER, i = 2;
-    else if (strcmp(argv[1], "viewfactors") == 0)
-        s->command = CLI_VIEWFACTORS, i = 2;
+    for (size_t k = 0; k < COMMAND_COUNT; k++)
+        if (strcmp(argv[1], COMMANDS[k].name) == 0)
+            s->command = COMMANDS[k].bit, i = 2;
     for (; i < argc; i++) {
         const char *arg = argv[i];
         if (arg[0] != '-' || arg[1] == '\0') {
+            /* A scene: a file for render and viewfactors, a kind for generate. */
             if (!s->command) {
                 usage_error(e, "unknown command '%s'", arg);
                 return CLI_USAGE_ERROR;
             }
-            if (s->scene_path) {
-                usage_error(e, "more than one scene given ('%s' and '%s')", s->scene_path, arg);
+            const char **scene = s->command == CLI_GENERATE ? &s->scene_kind : &s->scene_path;
+            if (*scene) {
+                usage_error(e, "more than one scene given ('%s' and '%s')", *scene, arg);
                 return CLI_USAGE_ERROR;
             }
-            s->scene_path = arg;
+            if (s->command == CLI_GENERATE && strcmp(arg, "office") != 0) {
+                usage_error(e, "unknown scene kind '%s' (known: office)", arg);
+                return CLI_USAGE_ERROR;
+            }
+            *scene = arg;
             continue;
         }
-        const option_def *o = NULL;
-        const char *value = NULL;
-        if (arg[1] == '-') {
-            const char *name = arg + 2;
-            const char *eq = strchr(name, '=');
-            size_t len = eq ? (size_t)(eq - name) : strlen(name);
-            for (size_t k = 0; k < OPTION_COUNT; k++)
-                if (strlen(OPTIONS[k].name) == len && strncmp(OPTIONS[k].name, name, len) == 0)
-                    o = &OPTIONS[k];
-            if (eq)
-                value = eq + 1;
-        } else if (arg[2] == '\0') {
-            for (size_t k = 0; k < OPTION_COUNT; k++)
-                if (OPTIONS[k].short_name == arg[1])
-                    o = &OPTIONS[k];
-        }
+        int known;
+        const char *value;
+        const cli_flag *f = find_flag(arg, s->command, &known, &value);
         int bad = 0;
-        if (!o)
+        if (!f && !known)
             bad = usage_error(e, "unknown option '%s'", arg);
-        else if (o->arg && !value && i + 1 >= argc)
-            bad = usage_error(e, "%s needs a value (%s)", arg, o->arg);
-        else if (!o->arg && value)
+        else if (!f && !s->command)
+            bad = usage_error(e, "%s needs a command: render, viewfactors or generate", arg);
+        else if (!f)
+            bad = usage_error(e, "%s does not apply to %s", arg, cli_command_name(s->command));
+        else if (f->metavar && !value && i + 1 >= argc)
+            bad = usage_error(e, "%s needs a value (%s)", arg, f->metavar);
+        else if (!f->metavar && value)
             bad = usage_error(e, "%s takes no value", arg);
-        else if (o->commands && !s->command)
-            bad = usage_error(e, "%s needs a command: render or viewfactors", arg);
-        else if (o->commands && !(o->commands & s->command))
-            bad = usage_error(e, "%s does not apply to this command", arg);
         if (bad)
             return CLI_USAGE_ERROR;
-        if (o->arg && !value)
-            value = argv[++i];
-        long l = 0;
-        double d = 0.0;
-        switch (o->id) {
-        case OPT_HELP: return CLI_HELP;
-        case OPT_VERSION: return CLI_VERSION;
-        case OPT_LIST_METHODS: return CLI_LIST_METHODS;
-        case OPT_OUTPUT: s->output = value; break;
-        case OPT_STATS: s->stats = value; break;
-        case OPT_CAMERA: s->camera = value; break;
-        case OPT_FORM_FACTORS: s->solve.form_factors = value; break;
-        case OPT_SOLVER: s->solve.solver = value; break;
-        case OPT_VISIBILITY: s->solve.visibility = value; break;
-        case OPT_FLAT: s->render.shading = RAD_SHADING_FLAT; break;
-        case OPT_QUIET: s->quiet = 1; break;
-        case OPT_MESH_SIZE:
-            bad = parse_double(e, o->name, value, 1e-9, 1e9, &s->solve.mesh_size);
-            break;
-        case OPT_ELEMENTS:
-            bad = parse_int(e, o->name, value, 1, 100000000, &l);
-            s->solve.target_elements = (size_t)l;
-            break;
-        case OPT_SHADOW_RAYS:
-            bad = parse_int(e, o->name, value, 1, 48, &l);
-            s->solve.shadow_rays = (int)l;
-            break;
-        case OPT_TOLERANCE:
-            bad = parse_double(e, o->name, value, 1e-15, 0.5, &s->solve.tolerance);
-            break;
-        case OPT_EPSILON:
-            bad = parse_double(e, o->name, value, 1e-12, 1e3, &s->solve.epsilon);
-            break;
-        case OPT_MIN_AREA:
-            bad = parse_double(e, o->name, value, 1e-18, 1e18, &s->solve.min_area);
-            break;
-        case OPT_CLUSTERING:
-            if (strcmp(value, "on") == 0)
-                s->solve.clustering = 1;
-            else if (strcmp(value, "off") == 0)
-                s->solve.clustering = -1;
-            else if (strcmp(value, "auto") == 0)
-                s->solve.clustering = 0;
-            else
-                bad = usage_error(e, "--clustering takes on, off or auto, got '%s'", value);
-            break;
-        case OPT_ORACLE:
-            if (strcmp(value, "sources") == 0)
-                s->solve.classic_oracle = 0;
-            else if (strcmp(value, "classic") == 0)
-                s->solve.classic_oracle = 1;
-            else
-                bad = usage_error(e, "--oracle takes sources or classic, got '%s'", value);
-            break;
-        case OPT_MAX_ITERATIONS:
-            bad = parse_int(e, o->name, value, 0, 2000000000, &l);
-            s->solve.max_iterations = (int)l;
-            break;
-        case OPT_WIDTH:
-            bad = parse_int(e, o->name, value, 1, 16384, &l);
-            s->render.width = (int)l;
-            break;
-        case OPT_HEIGHT:
-            bad = parse_int(e, o->name, value, 1, 16384, &l);
-            s->render.height = (int)l;
-            break;
-        case OPT_SAMPLES:
-            bad = parse_int(e, o->name, value, 1, 16, &l);
-            s->render.samples = (int)l;
-            break;
-        case OPT_EXPOSURE:
-            bad = parse_double(e, o->name, value, 1e-12, 1e12, &s->render.exposure);
-            break;
-        case OPT_THREADS:
-            bad = parse_int(e, o->name, value, 1, 1024, &l);
-            s->threads = (int)l;
-            break;
-        case OPT_SEED:
-            bad = parse_double(e, o->name, value, 0, 9007199254740992.0, &d);
-            if (!bad && d != floor(d))
-                bad = usage_error(e, "--%s: expected a non-negative integer, got '%s'", o->name, value);
-            s->solve.seed = (uint64_t)d;
-            break;
-        case OPT_MAX_MEMORY:
-            bad = parse_size(e, o->name, value, &s->solve.max_memory_bytes);
-            break;
-        case OPT_HEMICUBE_RES:
-            bad = parse_int(e, o->name, value, 2, 8192, &l);
-            s->solve.hemicube_resolution = (int)l;
-            break;
-        case OPT_SAMPLES_FF:
-            bad = parse_int(e, o->name, value, 1, 100000000, &l);
-            s->solve.samples = (int)l;
-            break;
-        case OPT_NEAR_FIELD:
-            bad = parse_double(e, o->name, value, 1e-6, 1e6, &s->solve.near_field);
-            break;
-        case OPT_CLOSURE: s->solve.closure_correction = 1; break;
-        case OPT_RELAXATION:
-            bad = parse_double(e, o->name, value, 1e-3, 1.999, &s->solve.relaxation);
-            break;
-        case OPT_UNSHOT_TOLERANCE:
-            bad = parse_double(e, o->name, value, 1e-15, 0.5, &s->solve.unshot_tolerance);
-            break;
-        case OPT_HISTORY:
-            s->history = value;
-            s->solve.record_history = 1;
-            break;
-        case OPT_PROGRESS_IMAGES: s->progress_dir = value; break;
-        case OPT_EVERY: bad = parse_int(e, o->name, value, 1, 2000000000, &s->every); break;
-        case OPT_LEVEL:
-            if (strcmp(value, "surface") == 0)
-                s->element_level = 0;
-            else if (strcmp(value, "element") == 0)
-                s->element_level = 1;
-            else
-                bad = usage_error(e, "--level: expected 'surface' or 'element', got '%s'", value);
-            break;
+        if (f->target == CLI_TO_ACTION)
+            return f->action;
+        if (!f->metavar) {
+            set_switch(f, s);
+            continue;
         }
-        if (bad)
+        if (!value)
+            value = argv[++i];
+        const rad_option_info *o = cli_flag_info(f);
+        if (value[0] == '\0') {
+            usage_error(e, "--%s needs a value (%s)", f->name, f->metavar);
             return CLI_USAGE_ERROR;
+        }
+        if (parse_value(o, value, flag_field(f, s)) != 0) {
+            char expected[600];
+            expectation(o, expected, sizeof expected);
+            usage_error(e, "--%s: expected %s, got '%s'", f->name, expected, value);
+            return CLI_USAGE_ERROR;
+        }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render or viewfactors");
+        usage_error(e, "no command given: use render, viewfactors or generate");
+        return CLI_USAGE_ERROR;
+    }
+    if (s->command == CLI_GENERATE && !s->scene_kind) {
+        usage_error(e, "no scene kind given (known: office)");
         return CLI_USAGE_ERROR;
     }
     if (s->every && !s->progress_dir) {
@@ -375,5 +402,242 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
                        "(its elements change while it solves; use --history)");
         return CLI_USAGE_ERROR;
     }
+    if (!s->output)
+        s->output = default_output(s->command);
+    if (s->history)
+        s->solve.record_history = 1;
     return CLI_RUN;
+}
+
+/* ---- the library's messages, in flags ---- */
+
+/* The length of "rad_options.field" at p when it names the field of flag
+ * f, and not a longer identifier; 0 otherwise. */
+static size_t names_field(const char *p, const cli_flag *f)
+{
+    int set = flag_set(f);
+    if (set < 0)
+        return 0;
+    const char *struct_name = rad_option_set_name((rad_option_set)set);
+    size_t sl = strlen(struct_name), fl = strlen(f->field);
+    if (strncmp(p, struct_name, sl) != 0 || p[sl] != '.' || strncmp(p + sl + 1, f->field, fl) != 0)
+        return 0;
+    char next = p[sl + 1 + fl];
+    return next == '_' || isalnum((unsigned char)next) ? 0 : sl + 1 + fl;
+}
+
+char *cli_rewrite_message(const char *message, char *out, size_t size)
+{
+    /* The context's memory limit is the one --max-memory sets too (main.c). */
+    static const char context_limit[] = "rad_context_options.max_memory_bytes";
+    size_t n = 0;
+    if (!size)
+        return out;
+    for (const char *p = message; *p && n + 1 < size;) {
+        size_t skip = 0, k = 0;
+        while (k < FLAG_COUNT && !(skip = names_field(p, &FLAGS[k])))
+            k++;
+        if (!skip && strncmp(p, context_limit, sizeof context_limit - 1) == 0) {
+            skip = sizeof context_limit - 1;
+            k = 0;
+            while (k < FLAG_COUNT && strcmp(FLAGS[k].name, "max-memory") != 0)
+                k++;
+        }
+        if (skip && k < FLAG_COUNT) {
+            size_t wrote = (size_t)snprintf(out + n, size - n, "--%s", FLAGS[k].name);
+            n += wrote < size - n ? wrote : size - n - 1;
+            p += skip;
+        } else {
+            out[n++] = *p++;
+        }
+    }
+    out[n] = '\0';
+    return out;
+}
+
+/* ---- --help and the man page ---- */
+
+/* The flag as the user writes it: "-o, --output FILE". */
+static void flag_usage(const cli_flag *f, char *text, size_t size)
+{
+    char shortcut[8] = "";
+    if (f->short_name)
+        snprintf(shortcut, sizeof shortcut, "-%c, ", f->short_name);
+    snprintf(text, size, "%s--%s%s%s", shortcut, f->name, f->metavar ? " " : "", f->metavar ? f->metavar : "");
+}
+
+/* "help; X in (0, 1), default 1e-6": the help with the accepted values and
+ * the default, from the flag's row. */
+static void flag_description(const cli_flag *f, char *text, size_t size)
+{
+    const rad_option_info *o = cli_flag_info(f);
+    char range[512] = "", values[600] = "", deflt[300] = "";
+    if (f->metavar)
+        rad_option_range_text(o, range, sizeof range);
+    if (range[0] && (o->type == RAD_OPTION_METHOD || o->type == RAD_OPTION_ENUM || o->type == RAD_OPTION_FLAG))
+        snprintf(values, sizeof values, "%s: %s", f->metavar, range);
+    else if (range[0])
+        snprintf(values, sizeof values, "%s in %s%s", f->metavar, range,
+                 o->type == RAD_OPTION_BYTES ? " bytes, with K, M or G for 2^10, 2^20, 2^30" : "");
+    if (f->metavar && o->default_text)
+        snprintf(deflt, sizeof deflt, "%sdefault %s", values[0] ? ", " : "", o->default_text);
+    snprintf(text, size, "%s%s%s%s", flag_help(f), values[0] || deflt[0] ? "; " : "", values, deflt);
+}
+
+/* " [render, viewfactors]": the commands of a flag that not all take. */
+static void flag_commands(const cli_flag *f, char *text, size_t size)
+{
+    text[0] = '\0';
+    if (!f->commands || f->commands == ALL)
+        return;
+    size_t n = 0;
+    for (size_t k = 0; k < COMMAND_COUNT; k++)
+        if (f->commands & COMMANDS[k].bit) {
+            int wrote = snprintf(text + n, size - n, "%s%s", n ? ", " : " [", COMMANDS[k].name);
+            n += wrote > 0 && (size_t)wrote < size - n ? (size_t)wrote : 0;
+        }
+    snprintf(text + n, size - n, "]");
+}
+
+static const char *const DESCRIPTION =
+    "SCENE is an OBJ (+MTL) or glTF 2.0 file; without one, the built-in Cornell box.\n"
+    "Units: metres; emission and radiosity in W/m^2; OBJ Ke is emitted radiance (E = pi Ke).\n";
+
+static const char *const EXIT_STATUS = "exit status: 0 ok, 1 failure, 2 usage error, 130/143 interrupted\n";
+
+void cli_print_help(FILE *out, int command)
+{
+    const command_def *c = NULL;
+    for (size_t k = 0; k < COMMAND_COUNT; k++)
+        if (COMMANDS[k].bit == command)
+            c = &COMMANDS[k];
+    if (c) {
+        fprintf(out, "usage: radiosity %s\n%s.\n\n%s%soptions:\n", c->synopsis, c->summary,
+                command == CLI_GENERATE ? "" : DESCRIPTION, command == CLI_GENERATE ? "" : "\n");
+    } else {
+        fprintf(out, "radiosity %s -- diffuse global illumination by the radiosity method\n\nusage:\n",
+                RAD_VERSION_STRING);
+        for (size_t k = 0; k < COMMAND_COUNT; k++)
+            fprintf(out, "  radiosity %-32s %s\n", COMMANDS[k].synopsis, COMMANDS[k].summary);
+        fprintf(out, "  radiosity %-32s %s\n", "COMMAND --help", "the options of one command");
+        fprintf(out, "  radiosity --list-methods | --version | --man | --help\n\n%s\n"
+                     "options ([...]: the commands that take it, where not all do):\n",
+                DESCRIPTION);
+    }
+    for (size_t k = 0; k < FLAG_COUNT; k++) {
+        const cli_flag *f = &FLAGS[k];
+        if (c && !(f->commands & command) && f->target != CLI_TO_ACTION)
+            continue;
+        if (c && f->target == CLI_TO_ACTION && f->action != CLI_HELP)
+            continue;
+        char usage[64], description[1200], commands[64] = "";
+        flag_usage(f, usage, sizeof usage);
+        flag_description(f, description, sizeof description);
+        if (!c)
+            flag_commands(f, commands, sizeof commands);
+        fprintf(out, "  %-28s %s%s\n", usage, description, commands);
+    }
+    fprintf(out, "\n%s", EXIT_STATUS);
+}
+
+/* Text for roff: backslashes and hyphens escaped, no line starting with a
+ * control character. */
+static void roff(FILE *out, const char *text)
+{
+    if (text[0] == '.' || text[0] == '\'')
+        fputs("\\&", out);
+    for (const char *p = text; *p; p++) {
+        if (*p == '\\')
+            fputs("\\e", out);
+        else if (*p == '-')
+            fputs("\\-", out);
+        else
+            fputc(*p, out);
+        if (*p == '\n' && (p[1] == '.' || p[1] == '\''))
+            fputs("\\&", out);
+    }
+}
+
+static void man_flag(FILE *out, const cli_flag *f)
+{
+    fputs(".TP\n", out);
+    if (f->short_name)
+        fprintf(out, "\\fB\\-%c\\fR, ", f->short_name);
+    fputs("\\fB\\-\\-", out);
+    roff(out, f->name);
+    fputs("\\fR", out);
+    if (f->metavar) {
+        fputs(" \\fI", out);
+        roff(out, f->metavar);
+        fputs("\\fR", out);
+    }
+    char description[1200];
+    flag_description(f, description, sizeof description);
+    fputc('\n', out);
+    roff(out, description);
+    fputc('\n', out);
+}
+
+void cli_print_man(FILE *out)
+{
+    /* Left-aligned and unhyphenated: flags and numbers must not break. */
+    fprintf(out, ".TH RADIOSITY 1 \"\" \"radiosity %s\" \"User Commands\"\n.nh\n.ad l\n", RAD_VERSION_STRING);
+    fputs(".SH NAME\nradiosity \\- diffuse global illumination by the radiosity method\n"
+          ".SH SYNOPSIS\n",
+          out);
+    for (size_t k = 0; k < COMMAND_COUNT; k++) {
+        fputs(k ? ".br\n" : "", out);
+        fprintf(out, "\\fBradiosity %s\\fR ", COMMANDS[k].name);
+        roff(out, strchr(COMMANDS[k].synopsis, ' ') + 1);
+        fputc('\n', out);
+    }
+    fputs(".br\n\\fBradiosity\\fR \\-\\-list\\-methods | \\-\\-version | \\-\\-man | \\-\\-help\n"
+          ".SH DESCRIPTION\n"
+          "\\fBradiosity\\fR solves the radiosity equation B = E + rho F B for diffuse (Lambertian)\n"
+          "scenes: it meshes the surfaces into elements, computes the form factors F between them\n"
+          "with one of several methods, solves for the radiosity B of every element and writes an\n"
+          "image, the view factors between named surfaces, or statistics.  The library behind it\n"
+          "is declared in radiosity.h; its option structs have the ranges and defaults given here.\n"
+          ".PP\n",
+          out);
+    roff(out, DESCRIPTION);
+    fputs(".SH COMMANDS\n", out);
+    for (size_t k = 0; k < COMMAND_COUNT; k++) {
+        fprintf(out, ".TP\n\\fB%s\\fR\n", COMMANDS[k].name);
+        roff(out, COMMANDS[k].summary);
+        fputs(".\n", out);
+    }
+    fputs(".SH OPTIONS\n"
+          "Ranges are intervals: a parenthesis excludes its bound, a bracket includes it.\n"
+          "A value may follow its flag as the next argument or after '='.\n",
+          out);
+    for (size_t k = 0; k < COMMAND_COUNT; k++) {
+        fprintf(out, ".SS %s\n", COMMANDS[k].name);
+        for (size_t i = 0; i < FLAG_COUNT; i++)
+            if (FLAGS[i].commands & COMMANDS[k].bit)
+                man_flag(out, &FLAGS[i]);
+    }
+    fputs(".SS \"any command, or none\"\n", out);
+    for (size_t i = 0; i < FLAG_COUNT; i++)
+        if (!FLAGS[i].commands)
+            man_flag(out, &FLAGS[i]);
+    fputs(".SH EXIT STATUS\n"
+          ".TP\n.B 0\nsuccess\n"
+          ".TP\n.B 1\nfailure: a scene that cannot be read or solved, an output that cannot be\n"
+          "written, a memory limit; nothing partial is left behind\n"
+          ".TP\n.B 2\nusage error: an unknown flag, a value out of range\n"
+          ".TP\n.B 130, 143\ninterrupted by SIGINT or SIGTERM; the partial solution is written and marked\n"
+          "so in the statistics\n"
+          ".SH FILES\n"
+          "Scenes are OBJ with MTL (Kd: reflectance, Ke: emitted radiance) or glTF 2.0 (.gltf, .glb).\n"
+          "Images are PNG (exposed, sRGB), Radiance HDR or PFM (linear radiance).  View factors are\n"
+          "JSON, CSV or Matrix Market; statistics are JSON.  Every output is written to a temporary\n"
+          "name and renamed, so it is whole or absent.\n"
+          ".SH UNITS\n"
+          "Lengths in metres, areas in m^2; radiosity B and emission E in W/m^2 (exitance);\n"
+          "radiance L = B / pi in W/(m^2 sr).  OBJ Ke and glTF emission are radiance: E = pi Ke.\n"
+          ".SH SEE ALSO\n"
+          "In the source tree: docs/units.md, docs/methods.md, docs/hierarchical.md,\n"
+          "docs/scenes.md, docs/stats.md, docs/formats.md; the library's header radiosity.h.\n",
+          out);
 }

@@ -1,10 +1,18 @@
 /*
- * options.h -- the `radiosity` command's option table and its parser.
+ * options.h -- the `radiosity` command's flags and their parser, shared by
+ * every command (render, viewfactors, generate).
  *
- * cli_parse_args() turns argv into a cli_settings without side effects: it
- * prints nothing, exits nothing and allocates nothing (the settings point
- * into argv), so a fuzz target can call it on any input
- * (fuzz/fuzz_cli_options.c).  main.c acts on what it returns.
+ * One table of flags (options.c): each maps to a field of the library's
+ * option structs, whose row in the library's option table (radiosity.h,
+ * "Option table") gives its type, range, default and help, or is the
+ * program's own (--output, --stats, --camera, ...) with a row of the same
+ * kind.  The parser, --help, the man page and the rewriting of the
+ * library's messages into flag names all read that table.
+ *
+ * cli_parse_args() has no side effects: it prints nothing, exits nothing
+ * and allocates nothing (the settings point into argv), so a fuzz target
+ * can call it on any input (fuzz/fuzz_cli_options.c).  main.c acts on what
+ * it returns.
  */
 #ifndef RAD_CLI_OPTIONS_H
 #define RAD_CLI_OPTIONS_H
@@ -14,42 +22,88 @@
 #include <stddef.h>
 #include <stdio.h>
 
-enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_ALL = 3 };
+/* The commands, as bits: a flag lists those that take it. */
+enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
-    CLI_RUN,          /* run s->command (CLI_RENDER or CLI_VIEWFACTORS) */
-    CLI_HELP,         /* --help: print cli_print_help(stdout), exit 0 */
+    CLI_RUN,          /* run s->command */
+    CLI_HELP,         /* --help: cli_print_help(stdout, s->command), exit 0 */
     CLI_VERSION,      /* --version */
     CLI_LIST_METHODS, /* --list-methods */
+    CLI_MAN,          /* --man: cli_print_man(stdout) */
     CLI_NO_ARGUMENTS, /* nothing given: help on stderr, exit 2 */
     CLI_USAGE_ERROR   /* the message is in err: exit 2 */
 } cli_action;
 
 /* The parsed command line; zero-initialised, 0 means the default. */
 typedef struct cli_settings {
-    int command;              /* CLI_RENDER or CLI_VIEWFACTORS */
-    const char *scene_path;   /* NULL: the built-in Cornell box */
-    const char *output;
+    int command;              /* CLI_RENDER, CLI_VIEWFACTORS or CLI_GENERATE */
+    const char *scene_path;   /* render, viewfactors: NULL = the built-in Cornell box */
+    const char *scene_kind;   /* generate: "office" */
+    const char *output;       /* the command's default when not given */
     const char *stats;
     const char *camera;       /* parsed later by rad_camera_from_string */
     const char *history;
     const char *progress_dir;
-    long every;
-    int element_level;
+    int every;
+    int element_level;        /* viewfactors: 0 surfaces, 1 elements */
     rad_options solve;
     rad_render_options render;
+    rad_office_options office;
     int threads;
     int quiet;
 } cli_settings;
 
+/* Where a flag's value goes. */
+typedef enum cli_target {
+    CLI_TO_SOLVE,    /* a field of rad_options (settings.solve) */
+    CLI_TO_RENDER,   /* a field of rad_render_options (settings.render) */
+    CLI_TO_OFFICE,   /* a field of rad_office_options (settings.office) */
+    CLI_TO_SETTINGS, /* the program's own: `own` describes it, offset in cli_settings */
+    CLI_TO_ACTION    /* --help, --version, ...: returns `action` */
+} cli_target;
+
+typedef struct cli_flag {
+    const char *name;         /* "max-memory" for --max-memory */
+    char short_name;          /* 'o' for -o; 0 for none */
+    const char *metavar;      /* "SIZE"; NULL: a switch, which takes no value */
+    unsigned commands;        /* the commands that take it; 0: any, and none needed */
+    cli_target target;
+    const char *field;        /* CLI_TO_SOLVE / _RENDER / _OFFICE: the library field */
+    const char *word;         /* a switch on an ENUM or FLAG field: the word it sets
+                                 (NULL: 1) */
+    const char *help;         /* NULL: the field's help */
+    rad_option_info own;      /* CLI_TO_SETTINGS: type, offset, range, default, help */
+    cli_action action;        /* CLI_TO_ACTION */
+} cli_flag;
+
+/* The index-th flag of the table; NULL past the end. */
+const cli_flag *cli_flag_get(size_t index);
+
+/* The row that describes a flag's value: the library's row of its field,
+ * or the flag's own.  Never NULL for a flag of the table. */
+const rad_option_info *cli_flag_info(const cli_flag *flag);
+
 /* Parse argv[1..argc-1] into *s (which the caller zeroes).  Returns what to
  * do; on CLI_USAGE_ERROR, err holds one line without the program name or
- * newline, e.g. "--width: expected an integer in [1, 16384], got 'x'".
+ * newline, e.g. "--tolerance: expected a number in (0, 1), got '2'".
  * Strings in *s point into argv.  Cannot fail otherwise. */
 cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *err, size_t err_size);
 
-/* Print --help (generated from the option table) to out. */
-void cli_print_help(FILE *out);
+/* --help, from the table: the overall help for command 0, else that
+ * command's (CLI_RENDER, ...). */
+void cli_print_help(FILE *out, int command);
+
+/* The manual page radiosity(1) as roff, from the same table. */
+void cli_print_man(FILE *out);
+
+/* Copy a library message into out (at most `size` bytes, NUL included),
+ * with every field the table maps to a flag written as the flag:
+ * "rad_options.max_memory_bytes" -> "--max-memory".  Returns out. */
+char *cli_rewrite_message(const char *message, char *out, size_t size);
+
+/* The name of a command bit ("render"); "" for anything else. */
+const char *cli_command_name(int command);
 
 #endif

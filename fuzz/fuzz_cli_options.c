@@ -2,12 +2,11 @@
  * fuzz_cli_options.c -- the command line (cli_parse_args in cli/options.c).
  * The input is argv[1..] separated by NUL bytes.  The parser must not
  * print, exit or read past argv; a usage error leaves one line of text;
- * accepted settings are in range.
+ * accepted settings are within the ranges of the option table.
  */
 #include "fuzz.h"
 #include "options.h"
 
-#include <math.h>
 #include <string.h>
 
 enum { MAX_ARGS = 64, MAX_TEXT = 4096 };
@@ -38,16 +37,34 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     switch (a) {
     case CLI_USAGE_ERROR: FUZZ_CHECK(err[0] != '\0'); break;
     case CLI_RUN:
-        FUZZ_CHECK(s.command == CLI_RENDER || s.command == CLI_VIEWFACTORS);
-        FUZZ_CHECK(s.solve.mesh_size == 0.0 || (s.solve.mesh_size >= 1e-9 && s.solve.mesh_size <= 1e9));
-        FUZZ_CHECK(s.render.width >= 0 && s.render.width <= 16384);
-        FUZZ_CHECK(s.render.height >= 0 && s.render.height <= 16384);
-        FUZZ_CHECK(s.threads >= 0 && s.threads <= 1024);
-        FUZZ_CHECK(s.solve.max_memory_bytes == 0.0 ||
-                   (isfinite(s.solve.max_memory_bytes) && s.solve.max_memory_bytes > 0.0));
+        FUZZ_CHECK(s.command == CLI_RENDER || s.command == CLI_VIEWFACTORS || s.command == CLI_GENERATE);
+        FUZZ_CHECK(s.output != NULL);
+        FUZZ_CHECK(s.command != CLI_GENERATE || (s.scene_kind && strcmp(s.scene_kind, "office") == 0));
+        /* Every number set is 0 (the default) or within its field's range
+         * in the library's option table. */
+        for (size_t k = 0; cli_flag_get(k); k++) {
+            const cli_flag *f = cli_flag_get(k);
+            const rad_option_info *o = cli_flag_info(f);
+            const char *base = f->target == CLI_TO_SOLVE    ? (const char *)&s.solve
+                               : f->target == CLI_TO_RENDER ? (const char *)&s.render
+                               : f->target == CLI_TO_OFFICE ? (const char *)&s.office
+                                                            : (const char *)&s;
+            double v;
+            if (f->target == CLI_TO_ACTION || !f->metavar)
+                continue;
+            if (o->type == RAD_OPTION_INT || o->type == RAD_OPTION_ENUM)
+                v = *(const int *)(const void *)(base + o->offset);
+            else if (o->type == RAD_OPTION_SIZE)
+                v = (double)*(const size_t *)(const void *)(base + o->offset);
+            else if (o->type == RAD_OPTION_DOUBLE || o->type == RAD_OPTION_BYTES)
+                v = *(const double *)(const void *)(base + o->offset);
+            else
+                continue;
+            FUZZ_CHECK(v == 0.0 || rad_option_in_range(o, v));
+        }
         FUZZ_CHECK(s.every == 0 || s.progress_dir != NULL);
         break;
-    case CLI_HELP: case CLI_VERSION: case CLI_LIST_METHODS: break;
+    case CLI_HELP: case CLI_VERSION: case CLI_LIST_METHODS: case CLI_MAN: break;
     case CLI_NO_ARGUMENTS: FUZZ_CHECK(0); break; /* argc >= 2 here */
     }
     return 0;

@@ -27,6 +27,34 @@
  * one human-readable line (e.g. "box.obj:12: face has 2 vertices").
  * Destroying NULL is a no-op.  Option structs are zero-initialisable: a zero
  * field means "the documented default".
+ *
+ * NULL: a fallible call given a NULL context, object, path or out pointer
+ * returns RAD_ERROR_INVALID_ARGUMENT (the message goes to the context when
+ * there is one; *out is set to NULL when `out` is not NULL) and does nothing
+ * else.  An options pointer may be NULL: all defaults.  Accessors given a
+ * NULL object return the neutral value stated at each (0, NULL, NaN, "").
+ *
+ * Ownership and lifetime: whoever creates an object owns it and destroys it
+ * with the matching rad_*_destroy.  Objects do not keep the context they
+ * were made with: a context need only outlive each call it is passed to,
+ * and any context may be passed with any object.  A solution borrows its
+ * scene, which must outlive it.  Strings and arrays returned by accessors
+ * are owned by the object they came from and stay valid until it is
+ * destroyed (or until the event stated at the accessor); never free them.
+ *
+ * Threads: the library has no mutable global state, so calls on different
+ * objects may run at the same time on different threads.  A context is used
+ * by one thread at a time (it holds the error text and calls the progress
+ * callback): give each thread its own.  A scene is immutable once made: any
+ * number of threads may read it and create solutions from it at once.  A
+ * solution or image may be read (calls taking it `const`) from several
+ * threads at once, but not while a call that modifies it (solve, render)
+ * runs.  Long calls use the context's worker threads (OpenMP) internally.
+ *
+ * Linking: pkg-config --cflags --libs radiosity, or in CMake
+ * find_package(radiosity) and radiosity::radiosity (shared) or
+ * radiosity::radiosity_static.  The shared library exports exactly the
+ * functions declared here (RAD_API).
  */
 #ifndef RADIOSITY_H
 #define RADIOSITY_H
@@ -35,14 +63,32 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* What the shared library exports: every function below, nothing else (the
+ * library is compiled with -fvisibility=hidden). */
+#if defined(__GNUC__) || defined(__clang__)
+#define RAD_API __attribute__((visibility("default")))
+#else
+#define RAD_API
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
 
+/* The version of this header; CMakeLists.txt checks it against the project's. */
 #define RAD_VERSION_MAJOR 0
 #define RAD_VERSION_MINOR 1
 #define RAD_VERSION_PATCH 0
 #define RAD_VERSION_STRING "0.1.0"
+/* MAJOR * 1000000 + MINOR * 1000 + PATCH, for comparisons in #if */
+#define RAD_VERSION_NUMBER 1000
+
+/* The version of the library linked at run time, which may differ from the
+ * header's when the shared library was replaced: rad_version() is its
+ * RAD_VERSION_STRING (a static string), rad_version_number() its
+ * RAD_VERSION_NUMBER.  Cannot fail; any thread. */
+RAD_API const char *rad_version(void);
+RAD_API int rad_version_number(void);
 
 typedef enum rad_result {
     RAD_OK = 0,
@@ -55,8 +101,9 @@ typedef enum rad_result {
     RAD_ERROR_INTERNAL          /* a library (Embree, LAPACK) failed unexpectedly */
 } rad_result;
 
-/* A short name for a result code ("RAD_ERROR_IO"); never NULL. */
-const char *rad_result_string(rad_result result);
+/* A short name for a result code ("RAD_ERROR_IO"), a static string;
+ * "RAD_ERROR_UNKNOWN" for a value outside the enum.  Never NULL; any thread. */
+RAD_API const char *rad_result_string(rad_result result);
 
 /* ------------------------------------------------------------------------
  * Context: threads, progress, cancellation and the last error message.
@@ -64,8 +111,9 @@ const char *rad_result_string(rad_result result);
 
 typedef struct rad_context rad_context;
 
-/* Progress of a long phase: `phase` is a short name ("form factors"),
- * `done` of `total` units finished.  Called from the calling thread only. */
+/* Progress of a long phase: `phase` is a short name ("form factors"), valid
+ * during the callback only; `done` of `total` units finished.  Called from
+ * the thread that made the library call, never from a worker thread. */
 typedef void (*rad_progress_fn)(void *user, const char *phase, uint64_t done, uint64_t total);
 
 /* Called once per failed call, with its result and the message that
@@ -87,26 +135,34 @@ typedef struct rad_context_options {
                                     would need more than the limit for: docs/robustness.md) */
 } rad_context_options;
 
-/* Fails with RAD_ERROR_INVALID_ARGUMENT for negative threads or memory. */
-rad_result rad_context_create(const rad_context_options *options, rad_context **out);
-/* Destroy the context.  The scenes, solutions and images made with it
- * keep their memory accounted to it: destroyed before them, it lives on
- * (for no further calls) until the last of them is destroyed.  NULL is a
- * no-op. */
-void rad_context_destroy(rad_context *ctx);
+/* Create a context.  `options` may be NULL (all defaults); it is copied, but
+ * the pointers in it (progress_user, error_user) are kept and must stay
+ * valid until the context is destroyed.  Fails with
+ * RAD_ERROR_INVALID_ARGUMENT when `out` is NULL, threads < 0 or
+ * max_memory_bytes < 0, RAD_ERROR_OUT_OF_MEMORY when the allocation fails
+ * (no context then holds a message). */
+RAD_API rad_result rad_context_create(const rad_context_options *options, rad_context **out);
+/* Destroy the context.  NULL: no-op.  Objects made with it are not
+ * affected: their memory stays accounted to it, and a context destroyed
+ * before them lives on (for no further calls) until the last of them is
+ * destroyed. */
+RAD_API void rad_context_destroy(rad_context *ctx);
 /* The message of the most recent failed call in this context ("" if none):
  * its FIRST failure, which names the cause ("box.obj:12: ..."), not what
- * followed from it.  Owned by the context; valid until its next failure. */
-const char *rad_context_error(const rad_context *ctx);
+ * followed from it.  Owned by the context: valid until its next failing
+ * call or its destroy.  NULL context: "". */
+RAD_API const char *rad_context_error(const rad_context *ctx);
 
 /* Ask the running and following calls to stop (cancel = true) or let them
  * run again (false).  Long phases poll the flag and return
  * RAD_ERROR_INTERRUPTED, keeping partial results.  An atomic store: safe
- * from a signal handler and from any thread.  NULL is a no-op. */
-void rad_context_cancel(rad_context *ctx, bool cancel);
-/* Whether cancellation was asked for (false for NULL). */
-bool rad_context_cancelled(const rad_context *ctx);
-int rad_context_threads(const rad_context *ctx);
+ * from a signal handler and from any thread.  NULL: no-op. */
+RAD_API void rad_context_cancel(rad_context *ctx, bool cancel);
+/* Whether cancellation was asked for (false for NULL).  Any thread. */
+RAD_API bool rad_context_cancelled(const rad_context *ctx);
+/* The worker threads this context's calls use (threads option; 0 there =
+ * the number of cores).  NULL context: 1. */
+RAD_API int rad_context_threads(const rad_context *ctx);
 
 /* ------------------------------------------------------------------------
  * Scene: named surfaces made of planar polygons with Lambertian materials.
@@ -114,21 +170,30 @@ int rad_context_threads(const rad_context *ctx);
 
 typedef struct rad_scene rad_scene;
 
-/* Load OBJ(+MTL) or glTF 2.0 (.gltf/.glb) through assimp.  The scene is
- * validated: finite coordinates, polygons of non-zero area, reflectance in
- * [0, 1).  A scene without an emitter loads; solving it is an error. */
-rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out);
+/* Load OBJ(+MTL) or glTF 2.0 (.gltf/.glb) through assimp, coordinates in
+ * metres.  The scene is validated: finite coordinates, polygons of non-zero
+ * area, reflectance in [0, 1).  A scene without an emitter loads; solving
+ * it is an error.  On success *out is a new scene the caller destroys with
+ * rad_scene_destroy; it does not refer to `path` or the file afterwards.
+ * Fails with RAD_ERROR_IO (unreadable), RAD_ERROR_PARSE (malformed, with
+ * file:line), RAD_ERROR_INVALID_SCENE, RAD_ERROR_OUT_OF_MEMORY; NULL ctx,
+ * path or out: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out);
 
-/* Load from memory.  `name` is used in messages and to guess the format
- * from its extension (".obj", ".gltf", ".glb").  `mtl`, if not NULL, is the
- * text of the material library an OBJ names in `mtllib`. */
-rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void *data,
-                                 size_t size, const void *mtl, size_t mtl_size,
-                                 rad_scene **out);
+/* Load from memory, as rad_scene_load_file.  `name` is used in messages and
+ * to guess the format from its extension (".obj", ".gltf", ".glb").  `mtl`,
+ * if not NULL, is the text of the material library an OBJ names in
+ * `mtllib`.  The buffers are read during the call only (the scene copies
+ * what it needs).  NULL ctx, name or out, or NULL data (mtl) with a
+ * non-zero size: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void *data,
+                                         size_t size, const void *mtl, size_t mtl_size,
+                                         rad_scene **out);
 
 /* The measured Cornell box (Cornell University Program of Computer
- * Graphics), in metres, with its published camera. */
-rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **out);
+ * Graphics), in metres, with its published camera; "cornell-box" in
+ * messages.  NULL ctx or out: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **out);
 
 /* A procedural office floor (docs/scenes.md): `rooms` rooms of about
  * 4-6 x 4-6 x 3 m on a grid, with doors between neighbours, daylight
@@ -141,9 +206,10 @@ typedef struct rad_office_options {
 } rad_office_options;
 
 /* `options` may be NULL (the defaults).  Fails with
- * RAD_ERROR_INVALID_ARGUMENT when rooms is out of range. */
-rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options *options,
-                                     rad_scene **out);
+ * RAD_ERROR_INVALID_ARGUMENT when rooms is out of range or ctx or out is
+ * NULL, RAD_ERROR_OUT_OF_MEMORY when the scene does not fit. */
+RAD_API rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options *options,
+                                             rad_scene **out);
 
 /* Write a scene as OBJ + MTL: PATH (PATH.obj -> PATH.mtl beside it, named
  * in `mtllib`), one `o` per surface (its name, blanks replaced by '_'),
@@ -151,31 +217,46 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
  * in the shortest decimal that parses back to the same double (the loader
  * reads them through assimp's float); the camera is not written.  Both
  * files go to temporary names first and are renamed only when both are
- * complete, so a failure leaves neither. */
-rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path);
+ * complete, so a failure leaves neither.  Fails with RAD_ERROR_IO; NULL
+ * ctx, scene or path, or an empty path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path);
 
-void rad_scene_destroy(rad_scene *scene);
+/* Free the scene.  Every solution made from it must be destroyed first.
+ * NULL: no-op. */
+RAD_API void rad_scene_destroy(rad_scene *scene);
 
-size_t rad_scene_surface_count(const rad_scene *scene);
-const char *rad_scene_surface_name(const rad_scene *scene, size_t surface);
-double rad_scene_surface_area(const rad_scene *scene, size_t surface); /* m^2 */
-size_t rad_scene_polygon_count(const rad_scene *scene);
+/* Surfaces are numbered 0 .. rad_scene_surface_count() - 1, in the order the
+ * file names them; the same numbers index solutions' per-surface results.
+ * NULL scene: 0. */
+RAD_API size_t rad_scene_surface_count(const rad_scene *scene);
+/* A surface's name (OBJ `o`/`g`, glTF node), owned by the scene: valid
+ * until rad_scene_destroy.  NULL scene or surface out of range: NULL. */
+RAD_API const char *rad_scene_surface_name(const rad_scene *scene, size_t surface);
+/* A surface's area, m^2.  NULL scene or surface out of range: 0. */
+RAD_API double rad_scene_surface_area(const rad_scene *scene, size_t surface);
+/* Planar polygons in the scene (a non-planar face of the file counts as
+ * its triangles).  NULL scene: 0. */
+RAD_API size_t rad_scene_polygon_count(const rad_scene *scene);
 
 /* A pinhole camera.  vfov_degrees is the full vertical field of view. */
 typedef struct rad_camera {
-    double position[3];
-    double look_at[3];
+    double position[3];           /* m */
+    double look_at[3];            /* m */
     double up[3];
     double vfov_degrees;
 } rad_camera;
 
 /* Parse "px,py,pz,lx,ly,lz[,ux,uy,uz[,vfov]]": position, look-at point,
- * up vector (default 0,1,0) and vertical field of view (default 40). */
-rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera);
+ * up vector (default 0,1,0) and vertical field of view (default 40).
+ * *camera is written on success only.  Fails with
+ * RAD_ERROR_INVALID_ARGUMENT on malformed text or a NULL ctx, text or
+ * camera. */
+RAD_API rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera);
 
 /* The scene's own camera (from the file, or the Cornell box's published
- * one).  Returns 0 and leaves *camera untouched when there is none. */
-int rad_scene_camera(const rad_scene *scene, rad_camera *camera);
+ * one).  Returns false and leaves *camera untouched when there is none or
+ * scene or camera is NULL. */
+RAD_API bool rad_scene_camera(const rad_scene *scene, rad_camera *camera);
 
 /* ------------------------------------------------------------------------
  * Solution: mesh, form factors and radiosity for one scene.
@@ -250,41 +331,67 @@ typedef struct rad_options {
                                      render, the writers); never above the context's */
 } rad_options;
 
-/* Mesh the scene, build visibility and compute form factors.  The returned
- * solution holds B = E (not yet solved). */
-rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene,
-                               const rad_options *options, rad_solution **out);
+/* Mesh the scene, build visibility and compute form factors, on the
+ * context's threads.  The returned solution holds B = E (not yet solved);
+ * the caller destroys it with rad_solution_destroy.  It borrows `scene`,
+ * which must outlive it; `options` (NULL = all defaults) is copied, method
+ * names included, so it need not outlive the call, except on_step_user,
+ * which is kept.  The thread count is the context's at this call.  Fails
+ * with RAD_ERROR_INVALID_ARGUMENT (an option out of range, an unknown
+ * method, NULL ctx, scene or out), RAD_ERROR_OUT_OF_MEMORY (above
+ * max_memory_bytes: the message names the option that shrinks it),
+ * RAD_ERROR_INTERRUPTED, RAD_ERROR_INTERNAL. */
+RAD_API rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene,
+                                       const rad_options *options, rad_solution **out);
 
-/* Solve for B with the solver named in the options.  The scene must have
- * an emitter.  Returns RAD_ERROR_INTERRUPTED with the current iterate kept
- * (marked partial in the stats) if the cancel flag was raised. */
-rad_result rad_solution_solve(rad_context *ctx, rad_solution *solution);
+/* Solve for B with the solver named in the options; solving again starts
+ * over from B = E.  The scene must have an emitter (else
+ * RAD_ERROR_INVALID_SCENE).  Returns RAD_ERROR_INTERRUPTED with the current
+ * iterate kept (marked partial in the stats) if the cancel flag was raised
+ * or on_step asked to stop.  NULL ctx or solution:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_solve(rad_context *ctx, rad_solution *solution);
 
-void rad_solution_destroy(rad_solution *solution);
+/* Free the solution and everything it owns (history included); the scene
+ * and images rendered from it are not affected.  NULL: no-op. */
+RAD_API void rad_solution_destroy(rad_solution *solution);
 
-size_t rad_solution_element_count(const rad_solution *solution);
+/* Elements of the mesh (the hierarchical solver's leaves once it has
+ * solved).  NULL solution: 0. */
+RAD_API size_t rad_solution_element_count(const rad_solution *solution);
 /* Residual measure after solving: sum_i A_i |r_i| / sum_i A_i E_i summed over
- * the channels, with r = B - E - rho F B (the notes' residual). */
-double rad_solution_residual(const rad_solution *solution);
-int rad_solution_iterations(const rad_solution *solution);
+ * the channels, with r = B - E - rho F B (the notes' residual); 0 before
+ * the first solve.  NULL solution: NaN. */
+RAD_API double rad_solution_residual(const rad_solution *solution);
+/* Iterations (sweeps or shots) the last solve took; 0 before the first.
+ * NULL solution: 0. */
+RAD_API int rad_solution_iterations(const rad_solution *solution);
 
 /* The convergence history of the last solve: *count steps, owned by the
- * solution. */
-const rad_solve_step *rad_solution_history(const rad_solution *solution, size_t *count);
-/* Write it as CSV (iteration,seconds,residual,unshot), atomically. */
-rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *solution,
-                                      const char *path);
+ * solution and valid until its next solve or destroy.  NULL solution or
+ * count: NULL (and *count = 0 when count is not NULL). */
+RAD_API const rad_solve_step *rad_solution_history(const rad_solution *solution, size_t *count);
+/* Write it as CSV (iteration,seconds,residual,unshot), atomically.  Fails
+ * with RAD_ERROR_IO; NULL ctx, solution or path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *solution,
+                                              const char *path);
 
-/* Area-weighted mean radiosity of a surface, RGB, W/m^2. */
-void rad_solution_surface_radiosity(const rad_solution *solution, size_t surface,
-                                    double rgb[3]);
+/* Area-weighted mean radiosity of a surface, RGB, W/m^2, written to rgb.
+ * A surface out of range, or a NULL solution: 0, 0, 0.  NULL rgb: nothing
+ * is written. */
+RAD_API void rad_solution_surface_radiosity(const rad_solution *solution, size_t surface,
+                                            double rgb[3]);
 
 /* Surface-to-surface view factors: F[i * S + j] for S surfaces, the
- * area-weighted sum over their elements.  `F` holds S*S doubles. */
-void rad_solution_surface_view_factors(const rad_solution *solution, double *F);
+ * area-weighted sum over their elements.  `F` holds S*S doubles
+ * (S = rad_scene_surface_count).  Matrix-free solvers compute no factors:
+ * all 0.  NULL solution or F: nothing is written. */
+RAD_API void rad_solution_surface_view_factors(const rad_solution *solution, double *F);
 
-/* Power in watts (summed over RGB / 3): emitted, absorbed by surfaces. */
-void rad_solution_power(const rad_solution *solution, double *emitted, double *absorbed);
+/* Power in watts (summed over RGB / 3): emitted, absorbed by surfaces.
+ * NaN where it cannot be had (NULL solution, out of memory).  A NULL
+ * emitted or absorbed is not written. */
+RAD_API void rad_solution_power(const rad_solution *solution, double *emitted, double *absorbed);
 
 /* ---- The solution element by element and vertex by vertex ----
  *
@@ -294,32 +401,37 @@ void rad_solution_power(const rad_solution *solution, double *emitted, double *a
  * planar triangles or quads.  The hierarchical solver's elements are the
  * leaves of its hierarchy: its patches until solved, then the leaves of the
  * last solve; indices and counts hold until the next rad_solution_solve.
- * An index out of range returns false (or 0) and writes nothing.  These
- * calls only read: any number of threads may call them at once on a
- * solution that is not being solved. */
+ * An index out of range, a NULL solution or a NULL output array returns
+ * false (or 0, SIZE_MAX as said) and writes nothing.  These calls only
+ * read: any number of threads may call them at once on a solution that is
+ * not being solved. */
 
-size_t rad_solution_vertex_count(const rad_solution *solution);
+RAD_API size_t rad_solution_vertex_count(const rad_solution *solution);
 /* Welded vertex position, m. */
-bool rad_solution_vertex_position(const rad_solution *solution, size_t vertex, double xyz[3]);
-/* Radiosity at every vertex (rgb: 3 per vertex, W/m^2): the values smooth
- * shading interpolates (area-weighted means of the elements around a
- * vertex, extrapolated at boundaries, continuous across T-vertices). */
-rad_result rad_solution_vertex_radiosity(rad_context *ctx, const rad_solution *solution, double *rgb);
+RAD_API bool rad_solution_vertex_position(const rad_solution *solution, size_t vertex, double xyz[3]);
+/* Radiosity at every vertex (rgb: 3 per vertex, W/m^2, written in full):
+ * the values smooth shading interpolates (area-weighted means of the
+ * elements around a vertex, extrapolated at boundaries, continuous across
+ * T-vertices).  Fails with RAD_ERROR_OUT_OF_MEMORY; NULL ctx, solution or
+ * rgb: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_vertex_radiosity(rad_context *ctx, const rad_solution *solution,
+                                                 double *rgb);
 
 /* The element's corners (3 or 4 vertex indices, counter-clockwise about
  * its normal); returns their count, 0 when out of range. */
-int rad_solution_element_vertices(const rad_solution *solution, size_t element, size_t vertex[4]);
+RAD_API int rad_solution_element_vertices(const rad_solution *solution, size_t element,
+                                          size_t vertex[4]);
 /* Index of the scene surface it belongs to (SIZE_MAX when out of range). */
-size_t rad_solution_element_surface(const rad_solution *solution, size_t element);
+RAD_API size_t rad_solution_element_surface(const rad_solution *solution, size_t element);
 /* Area, m^2 (0 when out of range). */
-double rad_solution_element_area(const rad_solution *solution, size_t element);
-/* Unit normal, and centroid in m. */
-bool rad_solution_element_geometry(const rad_solution *solution, size_t element, double normal[3],
-                                   double centroid[3]);
+RAD_API double rad_solution_element_area(const rad_solution *solution, size_t element);
+/* Unit normal, and centroid in m; either may be NULL. */
+RAD_API bool rad_solution_element_geometry(const rad_solution *solution, size_t element,
+                                          double normal[3], double centroid[3]);
 /* Reflectance rho (RGB), emission E and radiosity B (RGB, W/m^2); any of
  * the three may be NULL. */
-bool rad_solution_element_values(const rad_solution *solution, size_t element, double reflectance[3],
-                                 double emission[3], double radiosity[3]);
+RAD_API bool rad_solution_element_values(const rad_solution *solution, size_t element,
+                                        double reflectance[3], double emission[3], double radiosity[3]);
 
 /* ------------------------------------------------------------------------
  * Output
@@ -338,44 +450,66 @@ typedef struct rad_render_options {
 /* A linear-radiance RGB image, W/(m^2 sr). */
 typedef struct rad_image rad_image;
 
-rad_result rad_solution_render(rad_context *ctx, rad_solution *solution,
-                               const rad_render_options *options, rad_image **out);
-void rad_image_destroy(rad_image *image);
-int rad_image_width(const rad_image *image);
-int rad_image_height(const rad_image *image);
-const float *rad_image_pixels(const rad_image *image); /* RGB, row 0 at the top */
+/* Ray-cast an image of the solution's radiance L = B / pi (solved or not:
+ * progressive display from on_step works), on the context's threads.
+ * `options` may be NULL (512 x 512, the scene's camera); its camera is read
+ * during the call only.  The image is the caller's, independent of the
+ * solution (it may outlive it); destroy it with rad_image_destroy.  The
+ * solution is modified (it caches vertex values).  Fails with
+ * RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INTERRUPTED; NULL ctx, solution or
+ * out: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_render(rad_context *ctx, rad_solution *solution,
+                                       const rad_render_options *options, rad_image **out);
+/* Free the image.  NULL: no-op. */
+RAD_API void rad_image_destroy(rad_image *image);
+/* Pixels across and down.  NULL image: 0. */
+RAD_API int rad_image_width(const rad_image *image);
+RAD_API int rad_image_height(const rad_image *image);
+/* width * height RGB triples, row 0 at the top, W/(m^2 sr); owned by the
+ * image, valid until rad_image_destroy.  NULL image: NULL. */
+RAD_API const float *rad_image_pixels(const rad_image *image);
 
 /* Write by extension: .png (exposed, sRGB, 8 bit), .hdr (Radiance RGBE) or
  * .pfm (32-bit float).  The file is written to a temporary name and renamed,
- * so a failure never leaves a partial file. */
-rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
+ * so a failure never leaves a partial file.  Fails with RAD_ERROR_IO;
+ * an unknown extension, an empty image or a NULL ctx, image or path:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
 /* The automatic exposure of an image: the multiplier that maps the 95th
- * percentile of its luminance to 0.8 (1 if it is black, or when its
- * context has no memory for a float per pixel). */
-double rad_image_auto_exposure(const rad_image *image);
+ * percentile of its luminance to 0.8 (1 if it is black, or NULL, or when
+ * its context has no memory for a float per pixel). */
+RAD_API double rad_image_auto_exposure(const rad_image *image);
 
 /* As rad_image_write, with the PNG exposure given (0 = automatic; ignored
- * by the linear formats). */
-rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, const char *path,
-                                   double exposure);
+ * by the linear formats; negative or not finite:
+ * RAD_ERROR_INVALID_ARGUMENT). */
+RAD_API rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image,
+                                           const char *path, double exposure);
 
-/* Stats as JSON (schema in docs/stats.md).  `partial` marks an interrupted run. */
-rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *solution,
-                                    const char *path, int partial);
+/* Stats as JSON (schema in docs/stats.md), atomically.  `partial` marks an
+ * interrupted run.  Fails with RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY; NULL
+ * ctx, solution or path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *solution,
+                                            const char *path, bool partial);
 
 /* The stats of a run interrupted before it had a solution (while meshing or
  * computing form factors): version, "partial": true, "interrupted": phase,
  * "converged": false, the scene, its surface count and seconds.total
- * (docs/stats.md).  Atomic like the other writers. */
-rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *scene, const char *phase,
-                                            double seconds, const char *path);
+ * (docs/stats.md).  Atomic like the other writers.  Fails with
+ * RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY; NULL ctx, scene, phase or path:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *scene,
+                                                     const char *phase, double seconds, const char *path);
 
 /* View factors, by extension: .json (surfaces with name, area, row_sum; F),
  * .csv (dense) or .mtx (Matrix Market coordinate, sparse).  `elements`
- * nonzero writes element-to-element factors instead of surface-level ones.
- * Atomic like the image writer.  Formats: docs/formats.md. */
-rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *solution,
-                                           const char *path, int elements);
+ * true writes element-to-element factors instead of surface-level ones.
+ * Atomic like the image writer.  Formats: docs/formats.md.  Fails with
+ * RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY; an unknown extension, a
+ * matrix-free solver (no factors) or a NULL ctx, solution or path:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *solution,
+                                                   const char *path, bool elements);
 
 /* ------------------------------------------------------------------------
  * Method registries
@@ -387,10 +521,89 @@ typedef enum rad_method_kind {
     RAD_METHOD_VISIBILITY = 2
 } rad_method_kind;
 
-/* Enumerate methods: returns 0 past the end.  *name and *description are
- * static strings. */
-int rad_method_info(rad_method_kind kind, size_t index, const char **name,
-                    const char **description);
+/* Enumerate methods: index 0, 1, ... of `kind`; returns false past the end
+ * (or for an unknown kind) and writes nothing.  *name and *description are
+ * static strings; a NULL name or description is not written.  Any thread. */
+RAD_API bool rad_method_info(rad_method_kind kind, size_t index, const char **name,
+                             const char **description);
+
+/* ------------------------------------------------------------------------
+ * Option table: every field of rad_options, rad_render_options and
+ * rad_office_options that a user sets, with its type, range, default and
+ * one line of help.  The library checks the fields against these rows and
+ * names the field when it refuses one ("rad_options.tolerance must be in
+ * (0, 1), got 2"); a program builds its flags, help and manual from them.
+ * ---------------------------------------------------------------------- */
+
+typedef enum rad_option_set {
+    RAD_OPTION_SET_SOLUTION = 0, /* rad_options */
+    RAD_OPTION_SET_RENDER = 1,   /* rad_render_options */
+    RAD_OPTION_SET_OFFICE = 2    /* rad_office_options */
+} rad_option_set;
+
+typedef enum rad_option_type {
+    RAD_OPTION_INT = 0, /* int */
+    RAD_OPTION_SIZE,    /* size_t */
+    RAD_OPTION_UINT64,  /* uint64_t, any value */
+    RAD_OPTION_DOUBLE,  /* double, finite */
+    RAD_OPTION_BYTES,   /* double, finite: a byte count */
+    RAD_OPTION_FLAG,    /* int: 0 or nonzero; `words` may name the two */
+    RAD_OPTION_ENUM,    /* int: one of the values in `words` */
+    RAD_OPTION_METHOD,  /* const char *: a name from the registry `methods` */
+    RAD_OPTION_STRING   /* const char *, any text (no library field has it; for
+                           programs that describe their own options alike) */
+} rad_option_type;
+
+/* A named value of a FLAG or ENUM field ("on" = 1). */
+typedef struct rad_option_word {
+    const char *word;
+    int value;
+} rad_option_word;
+
+typedef struct rad_option_info {
+    const char *name;              /* the field as in its struct: "tolerance" */
+    rad_option_type type;
+    size_t offset;                 /* offsetof(struct, field) */
+    /* Accepted values of INT, SIZE, DOUBLE and BYTES fields, besides 0 (the
+     * default): min to max, each bound excluded when its _open is nonzero;
+     * max may be INFINITY. */
+    double min, max;
+    bool min_open, max_open;
+    double default_value;          /* what 0 stands for; NAN where that is not a constant */
+    const char *default_text;      /* the default in words: "1e-06", "80% of physical memory" */
+    const rad_option_word *words;  /* FLAG (optional) and ENUM; ends with {NULL, 0} */
+    rad_method_kind methods;       /* METHOD: the registry of its names */
+    const char *help;              /* one line, lower case, no final full stop */
+} rad_option_info;
+
+/* These functions only read static tables: any thread, any time. */
+
+/* The index-th row of a set, in header order; NULL past the end or for an
+ * unknown set.  Rows are static and never change. */
+RAD_API const rad_option_info *rad_option_info_get(rad_option_set set, size_t index);
+/* The row of field `name` in a set; NULL when there is none (or name is NULL). */
+RAD_API const rad_option_info *rad_option_find(rad_option_set set, const char *name);
+/* The struct a set describes: "rad_options", "rad_render_options", ...;
+ * "" for an unknown set.  A static string. */
+RAD_API const char *rad_option_set_name(rad_option_set set);
+
+/* Whether `value` is within the row's range (INT, SIZE, DOUBLE, BYTES:
+ * finite and between the bounds; ENUM: one of the words' values); always
+ * true for the other types, false for a NULL row.  0, the default, is not
+ * special here. */
+RAD_API bool rad_option_in_range(const rad_option_info *option, double value);
+
+/* Whether `text` is one of the row's words (FLAG, ENUM: *value, if not
+ * NULL, is set to the word's value) or a name in its registry (METHOD);
+ * false otherwise, for the other types and for a NULL row or text. */
+RAD_API bool rad_option_lookup_word(const rad_option_info *option, const char *text, int *value);
+
+/* The accepted values in words, as the library's messages give them:
+ * "(0, 1)", "[1, 48]", "(0, inf)", "auto, on or off", "analytic, contour,
+ * ... or montecarlo"; "" for a FLAG without words and a STRING.  Writes at
+ * most `size` bytes, NUL included (nothing when text is NULL); returns the
+ * length it wanted (0 for a NULL row). */
+RAD_API size_t rad_option_range_text(const rad_option_info *option, char *text, size_t size);
 
 #ifdef __cplusplus
 }

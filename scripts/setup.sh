@@ -10,7 +10,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(build-essential cmake pkg-config libembree-dev libassimp-dev libstb-dev
+packages=(build-essential g++ cmake pkg-config libembree-dev libassimp-dev libstb-dev
           libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev)
 if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
   packages+=(clang-14 libclang-rt-14-dev libomp-14-dev)

@@ -342,7 +342,7 @@ static void test_limit(void **state)
     rad_api_enter(ctx);
     assert_null(rad_alloc(ctx, RAD_MEM_SOLVER, 2, 1048576, "a big table"));
     assert_contains(rad_context_error(ctx), "a big table: 2.0 MiB more would pass the memory limit of 1.0 MiB");
-    assert_contains(rad_context_error(ctx), "--max-memory");
+    assert_contains(rad_context_error(ctx), "max_memory_bytes");
     assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
 
     /* Blocks are counted in their category until freed, peaks kept. */
@@ -377,7 +377,7 @@ static void test_limit(void **state)
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_OUT_OF_MEMORY);
     assert_null(s);
     assert_contains(rad_context_error(ctx), "memory limit of");
-    assert_contains(rad_context_error(ctx), "--max-memory");
+    assert_contains(rad_context_error(ctx), "max_memory_bytes");
     /* A solution's own limit is never above the context's. */
     o.target_elements = 48;
     o.max_memory_bytes = 1e12;

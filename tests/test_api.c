@@ -1,18 +1,12 @@
 /*
- * test_api.c -- the public contract, through include/radiosity.h only:
- *
- *   strategies    every solver name resolves; one solver of each strategy
- *                 (dense, matrix-free, hierarchical) on the closed furnace
- *                 box gives B = E / (1 - rho) and conserves power
- *   accessors     per-element and per-vertex values add up to the
- *                 per-surface answers (areas to the surface areas, area-
- *                 weighted B to the surface means); the hierarchical
- *                 solution's elements are its leaves after solving
- *   errors        the first failure of a call is the one kept and the one
- *                 the error callback hears, once; a later call's failure
- *                 replaces it
- *   cancellation  an atomic flag: a cancelled context interrupts, with
- *                 nothing returned, and runs again once cleared
+ * test_api.c -- the public header as a contract, used as a program outside
+ * the library would (it includes radiosity.h and nothing internal): the
+ * run-time version agrees with the header's macros, and every public
+ * function given a NULL pointer does what radiosity.h says, "NULL":
+ * fallible calls return RAD_ERROR_INVALID_ARGUMENT, name themselves in the
+ * context's message, set *out to NULL and write no file; accessors return
+ * their neutral value; destroying NULL does nothing.  Under the sanitizer
+ * build a crash or a leak on any of these paths fails the suite.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -20,283 +14,358 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <radiosity.h>
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
-#include "radiosity.h"
+static char temp_dir[] = "/tmp/rad_test_api_XXXXXX";
 
-static rad_context *ctx;
-
-typedef struct error_log {
-    int calls;
-    rad_result last;
-    char message[512];
-} error_log;
-
-static void on_error(void *user, rad_result result, const char *message)
+/* A path in the temporary folder (static, overwritten by the next call). */
+static const char *temp_path(const char *name)
 {
-    error_log *log = user;
-    log->calls++;
-    log->last = result;
-    snprintf(log->message, sizeof log->message, "%s", message);
+    static char path[512];
+    snprintf(path, sizeof path, "%s/%s", temp_dir, name);
+    return path;
 }
 
-static error_log errors;
+static bool file_exists(const char *path) { return access(path, F_OK) == 0; }
 
-static int setup(void **state)
+/* A non-NULL pointer the calls must overwrite with NULL on failure. */
+static char sentinel;
+#define NOT_NULL(type) ((type *)(void *)&sentinel)
+
+/* `result` is RAD_ERROR_INVALID_ARGUMENT and, where there is a context, its
+ * message names the function. */
+static void check_invalid(rad_result result, const rad_context *ctx, const char *function,
+                          const char *file, int line)
 {
-    (void)state;
-    rad_context_options co = {0};
-    co.threads = 2;
-    co.on_error = on_error;
-    co.error_user = &errors;
-    return rad_context_create(&co, &ctx) == RAD_OK ? 0 : -1;
+    if (result != RAD_ERROR_INVALID_ARGUMENT) {
+        print_error("%s returned %s, expected RAD_ERROR_INVALID_ARGUMENT\n", function,
+                    rad_result_string(result));
+        _fail(file, line);
+    }
+    if (ctx && !strstr(rad_context_error(ctx), function)) {
+        print_error("message \"%s\" does not name %s\n", rad_context_error(ctx), function);
+        _fail(file, line);
+    }
 }
+#define assert_invalid(result, ctx, function) \
+    check_invalid((result), (ctx), (function), __FILE__, __LINE__)
 
-static int teardown(void **state)
+/* One small solved scene the NULL tests need real objects from. */
+typedef struct api_fixture {
+    rad_context *ctx;
+    rad_scene *scene;
+    rad_solution *solution;
+    rad_image *image;
+} api_fixture;
+
+static int fixture_setup(void **state)
 {
-    (void)state;
-    rad_context_destroy(ctx);
+    api_fixture *f = calloc(1, sizeof *f);
+    if (!f || rad_context_create(NULL, &f->ctx) != RAD_OK ||
+        rad_scene_create_cornell_box(f->ctx, &f->scene) != RAD_OK)
+        return -1;
+    rad_options options = {0};
+    options.target_elements = 60; /* enough to have every surface meshed; fast */
+    rad_render_options render = {0};
+    render.width = render.height = 8;
+    render.samples = 1;
+    if (rad_solution_create(f->ctx, f->scene, &options, &f->solution) != RAD_OK ||
+        rad_solution_solve(f->ctx, f->solution) != RAD_OK ||
+        rad_solution_render(f->ctx, f->solution, &render, &f->image) != RAD_OK)
+        return -1;
+    *state = f;
     return 0;
 }
 
-/* A closed unit cube, normals inward, rho 0.5 and E 1 on every face, as
- * OBJ: the furnace, B = E / (1 - rho) = 2 everywhere. */
-static rad_scene *furnace(void)
+static int fixture_teardown(void **state)
 {
-    static const char obj[] = "mtllib f.mtl\nusemtl m\n"
-                              "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
-                              "o bottom\nf 1 2 3 4\no top\nf 5 8 7 6\no front\nf 1 5 6 2\n"
-                              "o back\nf 4 3 7 8\no left\nf 1 4 8 5\no right\nf 2 6 7 3\n";
-    static const char mtl[] = "newmtl m\nKd 0.5 0.5 0.5\nKe 0.318309886 0.318309886 0.318309886\n";
-    rad_scene *scene = NULL;
-    assert_int_equal(rad_scene_load_memory(ctx, "furnace.obj", obj, strlen(obj), mtl, strlen(mtl), &scene),
-                     RAD_OK);
-    return scene;
+    api_fixture *f = *state;
+    rad_image_destroy(f->image);
+    rad_solution_destroy(f->solution);
+    rad_scene_destroy(f->scene);
+    rad_context_destroy(f->ctx);
+    free(f);
+    return 0;
 }
 
-static rad_solution *solved(const rad_scene *scene, const char *solver)
+/* ---- version ---- */
+
+static void test_version(void **unused)
 {
-    rad_options o = {0};
-    o.solver = solver;
-    o.target_elements = 600;
-    o.epsilon = 1e-5;
-    o.tolerance = 1e-7;
-    rad_solution *s = NULL;
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
-    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
-    return s;
+    (void)unused;
+    assert_string_equal(rad_version(), RAD_VERSION_STRING);
+    assert_int_equal(rad_version_number(), RAD_VERSION_NUMBER);
+    assert_int_equal(RAD_VERSION_NUMBER,
+                     RAD_VERSION_MAJOR * 1000000 + RAD_VERSION_MINOR * 1000 + RAD_VERSION_PATCH);
+    char text[32];
+    snprintf(text, sizeof text, "%d.%d.%d", RAD_VERSION_MAJOR, RAD_VERSION_MINOR,
+             RAD_VERSION_PATCH);
+    assert_string_equal(text, RAD_VERSION_STRING);
 }
 
-static void test_every_solver_name_resolves(void **state)
+/* ---- context and results ---- */
+
+static void test_null_context(void **unused)
 {
-    (void)state;
-    const char *name, *description;
-    size_t count = 0;
-    for (size_t i = 0; rad_method_info(RAD_METHOD_SOLVER, i, &name, &description); i++, count++) {
-        assert_true(strlen(description) > 10);
-        rad_options o = {0};
-        o.solver = name;
-        o.max_memory_bytes = 1.0; /* fails after the name is resolved, before any work */
-        rad_solution *s = (rad_solution *)&o;
-        rad_scene *scene = furnace();
-        rad_result r = rad_solution_create(ctx, scene, &o, &s);
-        assert_int_equal(r, RAD_ERROR_OUT_OF_MEMORY);
-        assert_null(s);
-        assert_null(strstr(rad_context_error(ctx), "unknown solver"));
-        rad_scene_destroy(scene);
-    }
-    assert_int_equal(count, 7); /* five linear solvers, shooting, hierarchical */
-    rad_options o = {0};
-    o.solver = "no-such-solver";
-    rad_solution *s = NULL;
-    rad_scene *scene = furnace();
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rad_context_error(ctx), "hierarchical")); /* the known ones are listed */
-    rad_scene_destroy(scene);
-}
-
-/* One solver of each strategy: the furnace's exact answer, power conserved,
- * and the accessors adding up to the per-surface figures. */
-static void test_strategies_furnace_and_accessors(void **state)
-{
-    (void)state;
-    const char *solvers[] = {"gauss-seidel", "direct", "shooting", "hierarchical"};
-    rad_scene *scene = furnace();
-    size_t S = rad_scene_surface_count(scene);
-    for (size_t k = 0; k < sizeof solvers / sizeof solvers[0]; k++) {
-        rad_solution *s = solved(scene, solvers[k]);
-        /* Relative error allowed in the power balance and per element:
-         * the dense solvers are exact to the factors' 1e-8 and the
-         * tolerance; shooting samples its factors with rays (measured
-         * 1.0e-3 and 6.0e-2); hierarchical stops where epsilon allows
-         * (measured 8.6e-5 and 2.3e-2 at 1e-5). */
-        double tol = 2e-5, element_tol = 2e-5;
-        if (strcmp(solvers[k], "shooting") == 0)
-            tol = 5e-3, element_tol = 0.12;
-        else if (strcmp(solvers[k], "hierarchical") == 0)
-            tol = 5e-4, element_tol = 5e-2;
-        double emitted, absorbed;
-        rad_solution_power(s, &emitted, &absorbed);
-        assert_true(fabs(emitted - 6.0) < 1e-6);
-        assert_true(fabs(absorbed - emitted) < tol * emitted);
-
-        double worst = 0.0;
-        size_t n = rad_solution_element_count(s), V = rad_solution_vertex_count(s);
-        assert_true(n >= 6 && V >= 8);
-        double *area = calloc(S, sizeof *area), *sum = calloc(3 * S, sizeof *sum);
-        for (size_t i = 0; i < n; i++) {
-            size_t surface = rad_solution_element_surface(s, i);
-            assert_true(surface < S);
-            double a = rad_solution_element_area(s, i), rho[3], E[3], B[3], normal[3], centroid[3];
-            assert_true(a > 0.0);
-            assert_true(rad_solution_element_values(s, i, rho, E, B));
-            assert_true(rad_solution_element_geometry(s, i, normal, centroid));
-            assert_true(fabs(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2] - 1.0) < 1e-9);
-            for (int c = 0; c < 3; c++) {
-                assert_true(rho[c] == 0.5);
-                assert_true(fabs(E[c] - 1.0) < 1e-6);
-                worst = fmax(worst, fabs(B[c] - 2.0) / 2.0);
-                assert_true(centroid[c] >= -1e-12 && centroid[c] <= 1.0 + 1e-12);
-                sum[3 * surface + (size_t)c] += a * B[c];
-            }
-            area[surface] += a;
-            size_t vertex[4];
-            int corners = rad_solution_element_vertices(s, i, vertex);
-            assert_true(corners == 3 || corners == 4);
-            for (int q = 0; q < corners; q++)
-                assert_true(vertex[q] < V);
-        }
-        assert_true(worst < element_tol);
-        for (size_t j = 0; j < S; j++) {
-            assert_true(fabs(area[j] - rad_scene_surface_area(scene, j)) < 1e-9);
-            double mean[3];
-            rad_solution_surface_radiosity(s, j, mean);
-            for (int c = 0; c < 3; c++)
-                assert_true(fabs(sum[3 * j + (size_t)c] / area[j] - mean[c]) < 1e-9 * mean[c]);
-        }
-        double *vb = malloc(3 * V * sizeof *vb), xyz[3];
-        assert_int_equal(rad_solution_vertex_radiosity(ctx, s, vb), RAD_OK);
-        for (size_t v = 0; v < V; v++) {
-            assert_true(rad_solution_vertex_position(s, v, xyz));
-            assert_true(fabs(vb[3 * v] - 2.0) < 2.0 * element_tol * 2.0); /* extrapolated at edges */
-        }
-        /* Out of range: nothing written, nothing read. */
-        assert_false(rad_solution_vertex_position(s, V, xyz));
-        assert_false(rad_solution_element_values(s, n, NULL, NULL, NULL));
-        assert_int_equal(rad_solution_element_surface(s, n), SIZE_MAX);
-        assert_true(rad_solution_element_area(s, n) == 0.0);
-        size_t vertex[4];
-        assert_int_equal(rad_solution_element_vertices(s, n, vertex), 0);
-        free(vb);
-        free(area);
-        free(sum);
-        rad_solution_destroy(s);
-    }
-    rad_scene_destroy(scene);
-}
-
-/* The hierarchical solution's elements are its patches until solved, then
- * its leaves. */
-static void test_hierarchical_elements_are_leaves(void **state)
-{
-    (void)state;
-    rad_scene *scene = NULL;
-    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
-    rad_options o = {0};
-    o.solver = "hierarchical";
-    rad_solution *s = NULL;
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
-    size_t patches = rad_solution_element_count(s);
-    /* One element per patch (coplanar triangle pairs are merged into quads). */
-    assert_true(patches >= rad_scene_surface_count(scene) && patches <= rad_scene_polygon_count(scene));
-    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
-    size_t leaves = rad_solution_element_count(s);
-    assert_true(leaves > 10 * patches);
-    double total = 0.0, want = 0.0;
-    for (size_t i = 0; i < leaves; i++)
-        total += rad_solution_element_area(s, i);
-    for (size_t j = 0; j < rad_scene_surface_count(scene); j++)
-        want += rad_scene_surface_area(scene, j);
-    assert_true(fabs(total - want) < 1e-6 * want);
-    rad_solution_destroy(s);
-    rad_scene_destroy(scene);
-}
-
-static void test_first_error_kept_and_reported_once(void **state)
-{
-    (void)state;
-    memset(&errors, 0, sizeof errors);
-    rad_scene *scene = (rad_scene *)&errors;
-    assert_int_equal(rad_scene_load_file(ctx, "/nonexistent/room.obj", &scene), RAD_ERROR_IO);
-    assert_null(scene);
-    assert_int_equal(errors.calls, 1);
-    assert_int_equal(errors.last, RAD_ERROR_IO);
-    assert_string_equal(errors.message, rad_context_error(ctx));
-    assert_non_null(strstr(rad_context_error(ctx), "/nonexistent/room.obj"));
-
-    /* A malformed file: the message names the file and the line, and the
-     * callback hears exactly that one message. */
-    static const char bad[] = "v 0 0 0\nv 1 0 0\nf 1 2\n";
-    memset(&errors, 0, sizeof errors);
-    rad_result r = rad_scene_load_memory(ctx, "bad.obj", bad, strlen(bad), NULL, 0, &scene);
-    assert_int_not_equal(r, RAD_OK);
-    assert_null(scene);
-    assert_int_equal(errors.calls, 1);
-    assert_string_equal(errors.message, rad_context_error(ctx));
-    assert_non_null(strstr(rad_context_error(ctx), "bad.obj"));
-
-    /* Success leaves the last failure's message and calls nothing. */
-    memset(&errors, 0, sizeof errors);
-    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
-    assert_int_equal(errors.calls, 0);
-    assert_non_null(strstr(rad_context_error(ctx), "bad.obj"));
-    /* An option out of range: the next failure replaces it. */
-    rad_options o = {0};
-    o.tolerance = 2.0;
-    rad_solution *s = NULL;
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(errors.calls, 1);
-    assert_non_null(strstr(rad_context_error(ctx), "tolerance"));
-    rad_scene_destroy(scene);
-}
-
-static void test_cancellation_flag(void **state)
-{
-    (void)state;
-    rad_scene *scene = NULL;
-    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
-    rad_options o = {0};
-    o.target_elements = 400;
-    assert_false(rad_context_cancelled(ctx));
-    rad_context_cancel(ctx, true);
-    assert_true(rad_context_cancelled(ctx));
-    rad_solution *s = (rad_solution *)&o;
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_INTERRUPTED);
-    assert_null(s);
-    rad_context_cancel(ctx, false);
-    assert_false(rad_context_cancelled(ctx));
-    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
-    rad_context_cancel(ctx, true);
-    assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_INTERRUPTED);
-    rad_context_cancel(ctx, false);
-    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
-    rad_solution_destroy(s);
-    rad_scene_destroy(scene);
-    rad_context_cancel(NULL, true); /* no-op */
+    (void)unused;
+    assert_int_equal(rad_context_create(NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    rad_context_options negative = {0};
+    negative.threads = -1;
+    rad_context *ctx = NOT_NULL(rad_context);
+    assert_int_equal(rad_context_create(&negative, &ctx), RAD_ERROR_INVALID_ARGUMENT);
+    assert_null(ctx);
+    rad_context_destroy(NULL);
+    assert_string_equal(rad_context_error(NULL), "");
+    assert_int_equal(rad_context_threads(NULL), 1);
+    rad_context_cancel(NULL, true);
     assert_false(rad_context_cancelled(NULL));
+
+    assert_string_equal(rad_result_string(RAD_ERROR_INVALID_ARGUMENT), "RAD_ERROR_INVALID_ARGUMENT");
+    assert_string_equal(rad_result_string((rad_result)99), "RAD_ERROR_UNKNOWN");
+}
+
+/* ---- scenes ---- */
+
+static void test_null_scene(void **state)
+{
+    api_fixture *f = *state;
+    rad_context *ctx = f->ctx;
+    const char *obj = temp_path("scene.obj");
+    const char text[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+    rad_scene *scene = NOT_NULL(rad_scene);
+    assert_invalid(rad_scene_load_file(NULL, obj, &scene), NULL, "rad_scene_load_file");
+    assert_null(scene);
+    assert_invalid(rad_scene_load_file(ctx, NULL, &scene), ctx, "rad_scene_load_file");
+    assert_invalid(rad_scene_load_file(ctx, obj, NULL), ctx, "rad_scene_load_file");
+
+    scene = NOT_NULL(rad_scene);
+    assert_invalid(rad_scene_load_memory(NULL, "x.obj", text, sizeof text - 1, NULL, 0, &scene),
+                   NULL, "rad_scene_load_memory");
+    assert_null(scene);
+    assert_invalid(rad_scene_load_memory(ctx, NULL, text, sizeof text - 1, NULL, 0, &scene), ctx,
+                   "rad_scene_load_memory");
+    assert_invalid(rad_scene_load_memory(ctx, "x.obj", NULL, 5, NULL, 0, &scene), ctx,
+                   "rad_scene_load_memory");
+    assert_invalid(rad_scene_load_memory(ctx, "x.obj", text, sizeof text - 1, NULL, 5, &scene),
+                   ctx, "rad_scene_load_memory");
+    assert_invalid(rad_scene_load_memory(ctx, "x.obj", text, sizeof text - 1, NULL, 0, NULL), ctx,
+                   "rad_scene_load_memory");
+
+    scene = NOT_NULL(rad_scene);
+    assert_invalid(rad_scene_create_cornell_box(NULL, &scene), NULL, "rad_scene_create_cornell_box");
+    assert_null(scene);
+    assert_invalid(rad_scene_create_cornell_box(ctx, NULL), ctx, "rad_scene_create_cornell_box");
+
+    scene = NOT_NULL(rad_scene);
+    assert_invalid(rad_scene_generate_office(NULL, NULL, &scene), NULL, "rad_scene_generate_office");
+    assert_null(scene);
+    assert_invalid(rad_scene_generate_office(ctx, NULL, NULL), ctx, "rad_scene_generate_office");
+
+    assert_invalid(rad_scene_write_obj(NULL, f->scene, obj), NULL, "rad_scene_write_obj");
+    assert_invalid(rad_scene_write_obj(ctx, NULL, obj), ctx, "rad_scene_write_obj");
+    assert_invalid(rad_scene_write_obj(ctx, f->scene, NULL), ctx, "rad_scene_write_obj");
+    assert_invalid(rad_scene_write_obj(ctx, f->scene, ""), ctx, "rad_scene_write_obj");
+    assert_false(file_exists(obj));
+
+    rad_scene_destroy(NULL);
+    assert_int_equal(rad_scene_surface_count(NULL), 0);
+    assert_null(rad_scene_surface_name(NULL, 0));
+    assert_null(rad_scene_surface_name(f->scene, rad_scene_surface_count(f->scene)));
+    assert_true(rad_scene_surface_area(NULL, 0) == 0.0);
+    assert_true(rad_scene_surface_area(f->scene, rad_scene_surface_count(f->scene)) == 0.0);
+    assert_int_equal(rad_scene_polygon_count(NULL), 0);
+
+    rad_camera camera = {{1, 2, 3}, {4, 5, 6}, {0, 1, 0}, 40};
+    assert_false(rad_scene_camera(NULL, &camera));
+    assert_true(camera.position[0] == 1.0); /* untouched */
+    assert_false(rad_scene_camera(f->scene, NULL));
+    assert_invalid(rad_camera_from_string(NULL, "0,0,0,0,0,1", &camera), NULL,
+                   "rad_camera_from_string");
+    assert_invalid(rad_camera_from_string(ctx, NULL, &camera), ctx, "rad_camera_from_string");
+    assert_invalid(rad_camera_from_string(ctx, "0,0,0,0,0,1", NULL), ctx, "rad_camera_from_string");
+    assert_true(camera.position[0] == 1.0);
+}
+
+/* ---- solutions ---- */
+
+static void test_null_solution(void **state)
+{
+    api_fixture *f = *state;
+    rad_context *ctx = f->ctx;
+    const rad_solution *s = f->solution;
+
+    rad_solution *solution = NOT_NULL(rad_solution);
+    assert_invalid(rad_solution_create(NULL, f->scene, NULL, &solution), NULL, "rad_solution_create");
+    assert_null(solution);
+    solution = NOT_NULL(rad_solution);
+    assert_invalid(rad_solution_create(ctx, NULL, NULL, &solution), ctx, "rad_solution_create");
+    assert_null(solution);
+    assert_invalid(rad_solution_create(ctx, f->scene, NULL, NULL), ctx, "rad_solution_create");
+    assert_invalid(rad_solution_solve(NULL, f->solution), NULL, "rad_solution_solve");
+    assert_invalid(rad_solution_solve(ctx, NULL), ctx, "rad_solution_solve");
+    rad_solution_destroy(NULL);
+
+    assert_int_equal(rad_solution_element_count(NULL), 0);
+    assert_true(isnan(rad_solution_residual(NULL)));
+    assert_int_equal(rad_solution_iterations(NULL), 0);
+    size_t count = 7;
+    assert_null(rad_solution_history(NULL, &count));
+    assert_int_equal(count, 0);
+    assert_null(rad_solution_history(s, NULL));
+    assert_non_null(rad_solution_history(s, &count));
+    assert_true(count > 0);
+
+    double rgb[3] = {7, 7, 7};
+    rad_solution_surface_radiosity(NULL, 0, rgb);
+    assert_true(rgb[0] == 0.0 && rgb[1] == 0.0 && rgb[2] == 0.0);
+    rgb[0] = rgb[1] = rgb[2] = 7;
+    rad_solution_surface_radiosity(s, rad_scene_surface_count(f->scene), rgb);
+    assert_true(rgb[0] == 0.0 && rgb[1] == 0.0 && rgb[2] == 0.0);
+    rad_solution_surface_radiosity(s, 0, NULL);
+
+    double F[1] = {7};
+    rad_solution_surface_view_factors(NULL, F);
+    assert_true(F[0] == 7.0); /* untouched: the surface count is unknown */
+    rad_solution_surface_view_factors(s, NULL);
+
+    double emitted = 7, absorbed = 7;
+    rad_solution_power(NULL, &emitted, &absorbed);
+    assert_true(isnan(emitted) && isnan(absorbed));
+    rad_solution_power(s, NULL, &absorbed);
+    assert_true(absorbed > 0.0);
+    rad_solution_power(s, &emitted, NULL);
+    assert_true(emitted > 0.0);
+    rad_solution_power(s, NULL, NULL);
+
+    const char *history = temp_path("history.csv");
+    assert_invalid(rad_solution_write_history(NULL, s, history), NULL, "rad_solution_write_history");
+    assert_invalid(rad_solution_write_history(ctx, NULL, history), ctx, "rad_solution_write_history");
+    assert_invalid(rad_solution_write_history(ctx, s, NULL), ctx, "rad_solution_write_history");
+    assert_false(file_exists(history));
+
+    const char *stats = temp_path("stats.json");
+    assert_invalid(rad_solution_write_stats(NULL, s, stats, false), NULL, "rad_solution_write_stats");
+    assert_invalid(rad_solution_write_stats(ctx, NULL, stats, false), ctx, "rad_solution_write_stats");
+    assert_invalid(rad_solution_write_stats(ctx, s, NULL, true), ctx, "rad_solution_write_stats");
+    assert_false(file_exists(stats));
+
+    const char *vf = temp_path("vf.json");
+    assert_invalid(rad_solution_write_view_factors(NULL, s, vf, false), NULL,
+                   "rad_solution_write_view_factors");
+    assert_invalid(rad_solution_write_view_factors(ctx, NULL, vf, false), ctx,
+                   "rad_solution_write_view_factors");
+    assert_invalid(rad_solution_write_view_factors(ctx, s, NULL, true), ctx,
+                   "rad_solution_write_view_factors");
+    assert_false(file_exists(vf));
+
+    /* Element and vertex accessors: NULL solution or output writes nothing. */
+    double xyz[3] = {7, 7, 7}, rgb3[3] = {7, 7, 7};
+    size_t corners[4] = {7, 7, 7, 7};
+    assert_int_equal(rad_solution_vertex_count(NULL), 0);
+    assert_false(rad_solution_vertex_position(NULL, 0, xyz));
+    assert_false(rad_solution_vertex_position(s, 0, NULL));
+    assert_int_equal(rad_solution_element_vertices(NULL, 0, corners), 0);
+    assert_int_equal(rad_solution_element_vertices(s, 0, NULL), 0);
+    assert_int_equal(rad_solution_element_surface(NULL, 0), SIZE_MAX);
+    assert_true(rad_solution_element_area(NULL, 0) == 0.0);
+    assert_false(rad_solution_element_geometry(NULL, 0, xyz, xyz));
+    assert_true(rad_solution_element_geometry(s, 0, NULL, NULL));
+    assert_false(rad_solution_element_values(NULL, 0, rgb3, rgb3, rgb3));
+    assert_true(rad_solution_element_values(s, 0, NULL, NULL, NULL));
+    assert_true(xyz[0] == 7.0 && rgb3[0] == 7.0 && corners[0] == 7);
+    double *vertex_rgb = calloc(3 * rad_solution_vertex_count(s), sizeof *vertex_rgb);
+    assert_invalid(rad_solution_vertex_radiosity(NULL, s, vertex_rgb), NULL, "rad_solution_vertex_radiosity");
+    assert_invalid(rad_solution_vertex_radiosity(ctx, NULL, vertex_rgb), ctx, "rad_solution_vertex_radiosity");
+    assert_invalid(rad_solution_vertex_radiosity(ctx, s, NULL), ctx, "rad_solution_vertex_radiosity");
+    free(vertex_rgb);
+
+    const char *partial = temp_path("partial.json");
+    assert_invalid(rad_scene_write_interrupted_stats(NULL, f->scene, "mesh", 1.0, partial), NULL,
+                   "rad_scene_write_interrupted_stats");
+    assert_invalid(rad_scene_write_interrupted_stats(ctx, NULL, "mesh", 1.0, partial), ctx,
+                   "rad_scene_write_interrupted_stats");
+    assert_invalid(rad_scene_write_interrupted_stats(ctx, f->scene, NULL, 1.0, partial), ctx,
+                   "rad_scene_write_interrupted_stats");
+    assert_invalid(rad_scene_write_interrupted_stats(ctx, f->scene, "mesh", 1.0, NULL), ctx,
+                   "rad_scene_write_interrupted_stats");
+    assert_false(file_exists(partial));
+}
+
+/* ---- images ---- */
+
+static void test_null_image(void **state)
+{
+    api_fixture *f = *state;
+    rad_context *ctx = f->ctx;
+
+    rad_image *image = NOT_NULL(rad_image);
+    assert_invalid(rad_solution_render(NULL, f->solution, NULL, &image), NULL, "rad_solution_render");
+    assert_null(image);
+    image = NOT_NULL(rad_image);
+    assert_invalid(rad_solution_render(ctx, NULL, NULL, &image), ctx, "rad_solution_render");
+    assert_null(image);
+    assert_invalid(rad_solution_render(ctx, f->solution, NULL, NULL), ctx, "rad_solution_render");
+
+    rad_image_destroy(NULL);
+    assert_int_equal(rad_image_width(NULL), 0);
+    assert_int_equal(rad_image_height(NULL), 0);
+    assert_null(rad_image_pixels(NULL));
+    assert_true(rad_image_auto_exposure(NULL) == 1.0);
+
+    const char *png = temp_path("image.png");
+    assert_invalid(rad_image_write(NULL, f->image, png), NULL, "rad_image_write");
+    assert_invalid(rad_image_write(ctx, NULL, png), ctx, "rad_image_write");
+    assert_invalid(rad_image_write(ctx, f->image, NULL), ctx, "rad_image_write");
+    assert_invalid(rad_image_write_exposed(NULL, f->image, png, 1.0), NULL, "rad_image_write_exposed");
+    assert_invalid(rad_image_write_exposed(ctx, NULL, png, 1.0), ctx, "rad_image_write_exposed");
+    assert_invalid(rad_image_write_exposed(ctx, f->image, NULL, 1.0), ctx, "rad_image_write_exposed");
+    assert_false(file_exists(png));
+    /* The real objects work: the NULL checks turn nothing valid away. */
+    assert_int_equal(rad_image_write(ctx, f->image, png), RAD_OK);
+    assert_true(file_exists(png));
+    remove(png);
+}
+
+/* ---- method registries ---- */
+
+static void test_null_methods(void **unused)
+{
+    (void)unused;
+    const char *name = NULL, *description = NULL;
+    assert_true(rad_method_info(RAD_METHOD_SOLVER, 0, NULL, NULL));
+    assert_true(rad_method_info(RAD_METHOD_SOLVER, 0, &name, NULL));
+    assert_non_null(name);
+    assert_true(rad_method_info(RAD_METHOD_FORM_FACTOR, 0, NULL, &description));
+    assert_non_null(description);
+    name = description = NULL;
+    assert_false(rad_method_info(RAD_METHOD_VISIBILITY, 1000, &name, &description));
+    assert_false(rad_method_info((rad_method_kind)99, 0, &name, &description));
+    assert_null(name);
+    assert_null(description);
 }
 
 int main(void)
 {
+    if (!mkdtemp(temp_dir)) {
+        perror("mkdtemp");
+        return 1;
+    }
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_every_solver_name_resolves),
-        cmocka_unit_test(test_strategies_furnace_and_accessors),
-        cmocka_unit_test(test_hierarchical_elements_are_leaves),
-        cmocka_unit_test(test_first_error_kept_and_reported_once),
-        cmocka_unit_test(test_cancellation_flag),
+        cmocka_unit_test(test_version),
+        cmocka_unit_test(test_null_context),
+        cmocka_unit_test(test_null_scene),
+        cmocka_unit_test(test_null_solution),
+        cmocka_unit_test(test_null_image),
+        cmocka_unit_test(test_null_methods),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    int failed = cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
+    rmdir(temp_dir);
+    return failed;
 }

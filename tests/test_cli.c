@@ -197,14 +197,16 @@ static void test_malformed_gltf(void **state)
 
 /* ---- bad input: the command line ---- */
 
+/* A method name is checked against the library's registry while parsing:
+ * a usage error that lists the known names. */
 static void test_unknown_method_names(void **state)
 {
     (void)state;
-    assert_int_equal(run("render -o bad_out.png --solver nosuch"), 1);
-    assert_one_line_error("nosuch", "gauss-seidel");
-    assert_int_equal(run("render -o bad_out.png --form-factors nosuch"), 1);
+    assert_int_equal(run("render -o bad_out.png --solver nosuch"), 2);
+    assert_one_line_error("--solver: expected one of", "gauss-seidel");
+    assert_int_equal(run("render -o bad_out.png --form-factors nosuch"), 2);
     assert_one_line_error("nosuch", "analytic");
-    assert_int_equal(run("viewfactors -o bad_out.json --visibility nosuch"), 1);
+    assert_int_equal(run("viewfactors -o bad_out.json --visibility nosuch"), 2);
     assert_one_line_error("nosuch", "embree");
     assert_no_output("bad_out");
 }
@@ -230,8 +232,15 @@ static void test_usage_errors(void **state)
     assert_one_line_error("--solver", NULL);
     assert_int_equal(run("render --oracle nosuch"), 2);
     assert_one_line_error("--oracle", "nosuch");
+    assert_int_equal(run("render --tolerance 2"), 2);
+    assert_one_line_error("--tolerance: expected a number in (0, 1), got '2'", NULL);
+    assert_int_equal(run("render --rooms 3"), 2);
+    assert_one_line_error("--rooms does not apply to render", NULL);
+    assert_int_equal(run("render -o ''"), 2);
+    assert_one_line_error("--output needs a value", NULL);
+    /* The library's refusal, its field written as our flag. */
     assert_int_equal(run("render --solver shooting --closure-correction -o cc.png"), 1);
-    assert_one_line_error("closure correction", "shooting");
+    assert_one_line_error("--closure-correction rescales", "shooting");
     assert_no_output("cc.png");
     assert_int_equal(run(""), 2);
     assert_no_output("radiosity.png");
@@ -272,12 +281,26 @@ static void test_help_version_methods(void **state)
     assert_int_equal(run("--help"), 0);
     assert_non_null(strstr(out_text, "--mesh-size"));
     assert_non_null(strstr(out_text, "viewfactors"));
+    assert_non_null(strstr(out_text, "--rooms"));
+    /* A command's help has its flags only. */
+    assert_int_equal(run("render --help"), 0);
+    assert_non_null(strstr(out_text, "usage: radiosity render"));
+    assert_non_null(strstr(out_text, "--samples N"));
+    assert_null(strstr(out_text, "--rooms"));
+    assert_int_equal(run("generate --help"), 0);
+    assert_non_null(strstr(out_text, "--rooms N"));
+    assert_null(strstr(out_text, "--solver"));
+    assert_int_equal(run("--man"), 0);
+    assert_true(strncmp(out_text, ".TH RADIOSITY 1", 15) == 0);
     assert_int_equal(run("--version"), 0);
     assert_non_null(strstr(out_text, "radiosity 0."));
     assert_int_equal(run("--list-methods"), 0);
     assert_non_null(strstr(out_text, "analytic"));
     assert_non_null(strstr(out_text, "southwell"));
     assert_non_null(strstr(out_text, "brute"));
+    /* The registry's descriptions name fields; the listing names flags. */
+    assert_non_null(strstr(out_text, "(--relaxation)"));
+    assert_null(strstr(out_text, "rad_options."));
 }
 
 static void test_viewfactors_csv(void **state)
@@ -388,7 +411,7 @@ static void test_limits(void **state)
      * allocation. */
     too_big("--mesh-size 1e-9", "exceed the limit", "--mesh-size");
     /* The dense matrix of the default 2000 elements (16 MB) in 1 MB. */
-    too_big("--max-memory 1M", "--max-memory", "--solver shooting");
+    too_big("--max-memory 1M", "(--max-memory)", "'shooting' (--solver");
     /* A matrix-free run whose mesh alone is over the limit. */
     too_big("--solver shooting --elements 300000 --max-memory 20M", "mesh:", "--elements");
     /* Hit records of 10^8 rays a shot. */
@@ -401,7 +424,7 @@ static void test_limits(void **state)
     too_big("--elements 200 --width 16384 --height 16384 --max-memory 1G", "render:", "--width");
     /* Element-to-element view factors: 3000^2 doubles. */
     assert_int_equal(run("viewfactors --elements 3000 --level element --max-memory 60M -o big.csv"), 1);
-    assert_one_line_error("view factors:", "--level surface");
+    assert_one_line_error("view factors:", "surface-level view factors or fewer --elements");
     assert_no_output("big");
 }
 

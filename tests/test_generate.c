@@ -142,7 +142,7 @@ static void test_same_seed_same_scene(void **state)
                             sizeof a->materials[i].reflectance);
     assert_string_equal(a->source, "office:7:12345");
     rad_camera c;
-    assert_int_equal(rad_scene_camera(a, &c), 1);
+    assert_true(rad_scene_camera(a, &c));
     rad_scene_destroy(a);
     rad_scene_destroy(b);
 }

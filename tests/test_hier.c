@@ -619,7 +619,7 @@ static void test_bad_options(void **state)
     o.max_memory_bytes = (double)rad_memory_in_use(ctx, RAD_MEM_CATEGORIES) + 65536.0;
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_OUT_OF_MEMORY);
-    assert_non_null(strstr(rad_context_error(ctx), "--max-memory"));
+    assert_non_null(strstr(rad_context_error(ctx), "rad_options.max_memory_bytes"));
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }

@@ -575,7 +575,7 @@ static void test_million_tiny_triangles(void **state)
     dense.target_elements = 2000;
     assert_int_equal(rad_solution_create(ctx, scene, &dense, &sol), RAD_ERROR_OUT_OF_MEMORY);
     assert_null(sol);
-    assert_non_null(strstr(rad_context_error(ctx), "--solver shooting"));
+    assert_non_null(strstr(rad_context_error(ctx), "solver 'shooting' (rad_options.solver"));
     rad_scene_destroy(scene);
 }
 

@@ -2,8 +2,9 @@
  * test_mesh_ff_solve.c -- unit tests of the numerical core: meshing
  * (element counts, area conservation, point location, welding,
  * T-vertices), the point-to-polygon kernel against exact values, the
- * analytic element method (reciprocity, closure, culling) and the solvers
- * on systems with known solutions.
+ * analytic element method (reciprocity, closure, culling), the
+ * form-factor loop every method runs in (thread count, reciprocity,
+ * cancellation) and the solvers on systems with known solutions.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -277,8 +278,80 @@ static void test_analytic_cube(void **state)
     assert_int_equal(rad_form_factors(ctx, rad_ff_find("analytic"), &req, 100.0, false, &F, NULL, &st),
                      RAD_ERROR_OUT_OF_MEMORY);
     assert_null(F);
-    assert_non_null(strstr(rad_context_error(ctx), "--max-memory"));
-    assert_non_null(strstr(rad_context_error(ctx), "--solver shooting"));
+    assert_non_null(strstr(rad_context_error(ctx), "rad_options.max_memory_bytes"));
+    assert_non_null(strstr(rad_context_error(ctx), "'shooting' (rad_options.solver"));
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
+}
+
+/* ---- the form-factor loop (formfactor.c): threads, reciprocity, cancellation ---- */
+
+static rad_result form_factors_with(int threads, bool cancel, const rad_ff_method *method,
+                                    const rad_ff_request *req, float **F, float **variance,
+                                    rad_ff_stats *st)
+{
+    rad_context_options o = {0};
+    o.threads = threads;
+    rad_context *c = NULL;
+    assert_int_equal(rad_context_create(&o, &c), RAD_OK);
+    rad_context_cancel(c, cancel);
+    rad_result r = rad_form_factors(c, method, req, 1e9, false, F, variance, st);
+    rad_context_destroy(c);
+    return r;
+}
+
+/* Every method on the Cornell box (occluding blocks, elements of many
+ * sizes): F, its variances and the counts are the same with 1 thread and
+ * with 3 (the dynamic schedule hands rows out differently); the pair
+ * methods' factors are reciprocal, A_i F_ij = A_j F_ji, to float rounding;
+ * a raised cancel flag interrupts every method. */
+static void test_ff_loop(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    rad_mesh_options mo = {0, 150, 0};
+    rad_mesh *mesh = NULL;
+    assert_int_equal(rad_mesh_build(ctx, scene, &mo, &mesh), RAD_OK);
+    rad_vis *vis = NULL;
+    assert_int_equal(rad_vis_create(ctx, "embree", mesh, &vis), RAD_OK);
+    rad_ff_request req = {.mesh = mesh, .vis = vis, .seed = 11, .hemicube_resolution = 64, .samples = 16};
+    size_t n = mesh->element_count;
+    for (size_t k = 0; rad_ff_methods[k]; k++) {
+        const rad_ff_method *m = rad_ff_methods[k];
+        float *F1 = NULL, *F3 = NULL, *V1 = NULL, *V3 = NULL;
+        rad_ff_stats s1, s3;
+        assert_int_equal(form_factors_with(1, false, m, &req, &F1, &V1, &s1), RAD_OK);
+        assert_int_equal(form_factors_with(3, false, m, &req, &F3, &V3, &s3), RAD_OK);
+        assert_memory_equal(F1, F3, n * n * sizeof *F1);
+        if (m->flags & RAD_FF_VARIANCE)
+            assert_memory_equal(V1, V3, n * n * sizeof *V1);
+        assert_true(s1.rays == s3.rays && s1.pairs == s3.pairs && s1.near_pairs == s3.near_pairs);
+        assert_true(s1.pairs > 0);
+        if (m->pair) {
+            size_t coupled = 0;
+            for (size_t i = 0; i < n; i++) {
+                assert_true(F1[i * n + i] == 0.0f);
+                for (size_t j = i + 1; j < n; j++) {
+                    double gij = mesh->elements[i].area * F1[i * n + j];
+                    double gji = mesh->elements[j].area * F1[j * n + i];
+                    assert_true(fabs(gij - gji) <= 1e-6 * fmax(gij, gji));
+                    coupled += gij > 0.0 && mesh->elements[i].area != mesh->elements[j].area;
+                }
+            }
+            assert_true(coupled > n); /* the check above saw unequal areas */
+        }
+        rad_free(F1);
+        rad_free(F3);
+        rad_free(V1);
+        rad_free(V3);
+
+        float *F = NULL;
+        assert_int_equal(form_factors_with(2, true, m, &req, &F, NULL, &s1), RAD_ERROR_INTERRUPTED);
+        assert_true(s1.pairs < s3.pairs);
+        rad_free(F);
+    }
+    rad_vis_destroy(vis);
     rad_mesh_destroy(mesh);
     rad_scene_destroy(scene);
 }
@@ -355,6 +428,7 @@ int main(void)
         cmocka_unit_test(test_point_polygon_exact),
         cmocka_unit_test(test_point_polygon_clipping),
         cmocka_unit_test(test_analytic_cube),
+        cmocka_unit_test(test_ff_loop),
         cmocka_unit_test(test_solvers_two_patch),
         cmocka_unit_test(test_residual_definition),
     };

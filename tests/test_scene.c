@@ -145,7 +145,7 @@ static void test_cornell_box(void **state)
     assert_string_equal(scene->source, "cornell-box");
 
     rad_camera camera;
-    assert_int_equal(rad_scene_camera(scene, &camera), 1);
+    assert_true(rad_scene_camera(scene, &camera));
     assert_close(camera.vfov_degrees, 39.3076, 1e-3);
     assert_close(camera.position[0], 0.278, 0.0);
     assert_close(camera.position[1], 0.273, 0.0);
@@ -286,7 +286,7 @@ static void check_quad_gltf(const rad_scene *scene)
     assert_close(glow->reflectance[2], 0.3, 1e-12);
 
     rad_camera camera;
-    assert_int_equal(rad_scene_camera(scene, &camera), 1);
+    assert_true(rad_scene_camera(scene, &camera));
     assert_close(camera.position[2], 5.0, 1e-12); /* the node's translation, counted once */
     assert_close(camera.look_at[2], 4.0, 1e-12);  /* glTF cameras look down -z */
     assert_close(camera.up[1], 1.0, 1e-12);

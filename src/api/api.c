@@ -11,14 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A public call on solution s begins: the first error will be kept, and
- * the memory limit is the solution's (rad_options.max_memory_bytes). */
-static void enter(rad_context *ctx, const rad_solution *s)
-{
-    rad_api_enter(ctx);
-    rad_memory_limit_call(ctx, s->options.max_memory_bytes);
-}
-
 /* The view downstream code reads, after the strategy changed its state. */
 static void refresh_view(rad_solution *s)
 {
@@ -34,9 +26,10 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
                                rad_solution **out)
 {
     rad_api_enter(ctx);
-    *out = NULL;
-    if (!ctx || !scene)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_solution_create: NULL argument");
+    if (out)
+        *out = NULL;
+    if (!ctx || !scene || !out)
+        return rad_null_argument(ctx, __func__);
     rad_solution *s = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *s, "solution");
     if (!s)
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -94,7 +87,10 @@ static int on_strategy_step(void *user, const rad_solve_step *step, bool display
 
 rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
 {
-    enter(ctx, s);
+    rad_api_enter(ctx);
+    if (!ctx || !s)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     if (!rad_scene_has_emitter(s->scene))
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
@@ -131,6 +127,11 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
 
 const rad_solve_step *rad_solution_history(const rad_solution *s, size_t *count)
 {
+    if (!s || !count) {
+        if (count)
+            *count = 0;
+        return NULL;
+    }
     *count = s->history_count;
     return s->history;
 }
@@ -146,22 +147,36 @@ void rad_solution_destroy(rad_solution *s)
     rad_free(s);
 }
 
-size_t rad_solution_element_count(const rad_solution *s) { return s->view.n; }
-double rad_solution_residual(const rad_solution *s) { return s->view.solve->residual; }
-int rad_solution_iterations(const rad_solution *s) { return s->view.solve->iterations; }
+size_t rad_solution_element_count(const rad_solution *s) { return s ? s->view.n : 0; }
+double rad_solution_residual(const rad_solution *s) { return s ? s->view.solve->residual : NAN; }
+int rad_solution_iterations(const rad_solution *s) { return s ? s->view.solve->iterations : 0; }
 
 void rad_solution_surface_radiosity(const rad_solution *s, size_t surface, double rgb[3])
 {
+    if (!rgb)
+        return;
+    if (!s) {
+        rgb[0] = rgb[1] = rgb[2] = 0.0;
+        return;
+    }
     rad_view_surface_radiosity(&s->view, surface, rgb);
 }
 
 void rad_solution_surface_view_factors(const rad_solution *s, double *F)
 {
-    rad_view_surface_view_factors(s->ctx, &s->view, F);
+    if (s && F)
+        rad_view_surface_view_factors(s->ctx, &s->view, F);
 }
 
 void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed)
 {
+    double unused_emitted, unused_absorbed;
+    emitted = emitted ? emitted : &unused_emitted;
+    absorbed = absorbed ? absorbed : &unused_absorbed;
+    if (!s) {
+        *emitted = *absorbed = NAN;
+        return;
+    }
     rad_view_power(s->ctx, &s->view, emitted, absorbed);
 }
 
@@ -179,9 +194,9 @@ bool rad_solution_vertex_position(const rad_solution *s, size_t vertex, double x
 rad_result rad_solution_vertex_radiosity(rad_context *ctx, const rad_solution *s, double *rgb)
 {
     rad_api_enter(ctx);
-    if (!s || !rgb)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_solution_vertex_radiosity: NULL argument");
-    rad_memory_limit_call(ctx, s->options.max_memory_bytes);
+    if (!ctx || !s || !rgb)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_vertex_values(ctx, s->view.mesh, s->view.radiosity, rgb);
 }
 
@@ -243,8 +258,12 @@ bool rad_solution_element_values(const rad_solution *s, size_t element, double r
 rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_render_options *options,
                                rad_image **out)
 {
-    enter(ctx, s);
-    *out = NULL;
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !s || !out)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     rad_render_options o = options ? *options : (rad_render_options){0};
     size_t n = s->view.mesh->element_count;
     /* Display values: a partial shooting solution gets the ambient term. */
@@ -280,7 +299,8 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
         rad_free(display);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "render: a %dx%d image needs %.2f GiB, above the memory limit of %.2f GiB "
-                        "(--max-memory); use a smaller --width / --height",
+                        "(rad_options.max_memory_bytes); use a smaller rad_render_options.width / "
+                        "rad_render_options.height",
                         w, h, image_bytes / 1073741824.0, s->options.max_memory_bytes / 1073741824.0);
     }
     if (o.camera)
@@ -295,53 +315,73 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     return r;
 }
 
-rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, const char *path, int partial)
+rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, const char *path, bool partial)
 {
-    enter(ctx, s);
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_write_stats(ctx, &s->view, path, partial);
 }
 
 rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *s, const char *path,
-                                           int elements)
+                                           bool elements)
 {
-    enter(ctx, s);
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_write_view_factors(ctx, &s->view, path, elements);
 }
 
 rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, const char *path)
 {
-    enter(ctx, s);
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_write_history(ctx, &s->view, path);
 }
 
 rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera)
 {
     rad_api_enter(ctx);
+    if (!ctx || !text || !camera)
+        return rad_null_argument(ctx, __func__);
     return rad_camera_parse(ctx, text, camera);
 }
 
-int rad_method_info(rad_method_kind kind, size_t index, const char **name, const char **description)
+bool rad_method_info(rad_method_kind kind, size_t index, const char **name, const char **description)
 {
     size_t count = 0;
+    const char *method_name = NULL, *method_description = NULL;
     switch (kind) {
     case RAD_METHOD_FORM_FACTOR:
         while (rad_ff_methods[count])
             count++;
         if (index >= count)
-            return 0;
-        *name = rad_ff_methods[index]->name;
-        *description = rad_ff_methods[index]->description;
-        return 1;
+            return false;
+        method_name = rad_ff_methods[index]->name;
+        method_description = rad_ff_methods[index]->description;
+        break;
     case RAD_METHOD_SOLVER:
-        return rad_strategy_solver_info(index, name, description);
+        if (!rad_strategy_solver_info(index, &method_name, &method_description))
+            return false;
+        break;
     case RAD_METHOD_VISIBILITY:
         while (rad_vis_backends[count])
             count++;
         if (index >= count)
-            return 0;
-        *name = rad_vis_backends[index]->name;
-        *description = rad_vis_backends[index]->description;
-        return 1;
+            return false;
+        method_name = rad_vis_backends[index]->name;
+        method_description = rad_vis_backends[index]->description;
+        break;
+    default:
+        return false;
     }
-    return 0;
+    if (name)
+        *name = method_name;
+    if (description)
+        *description = method_description;
+    return true;
 }

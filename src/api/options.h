@@ -1,5 +1,6 @@
 /*
- * options.h -- validation and defaults of the public rad_options.
+ * options.h -- validation and defaults of the public rad_options, driven by
+ * the option table (options.c; the table's API is in radiosity.h).
  */
 #ifndef RAD_API_OPTIONS_H
 #define RAD_API_OPTIONS_H
@@ -14,9 +15,11 @@ typedef struct rad_method_names {
     char visibility[32];
 } rad_method_names;
 
-/* Fill in the defaults of `in` (NULL = all defaults) and check every field;
- * on success *out holds the resolved options, whose method names point into
- * *names (which must outlive them).  On failure the context names the field. */
+/* Fill in the defaults of `in` (NULL = all defaults) and check every field
+ * against its row of the option table; on success *out holds the resolved
+ * options, whose method names point into *names (which must outlive them).
+ * On failure the context names the field: "rad_options.tolerance must be
+ * in (0, 1), got 2". */
 rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_options *out,
                                rad_method_names *names);
 

@@ -17,6 +17,10 @@
 #include <omp.h>
 #endif
 
+const char *rad_version(void) { return RAD_VERSION_STRING; }
+
+int rad_version_number(void) { return RAD_VERSION_NUMBER; }
+
 const char *rad_result_string(rad_result result)
 {
     switch (result) {
@@ -34,6 +38,8 @@ const char *rad_result_string(rad_result result)
 
 rad_result rad_context_create(const rad_context_options *options, rad_context **out)
 {
+    if (!out)
+        return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
     rad_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
@@ -210,9 +216,10 @@ static bool account(rad_context *ctx, rad_memory_category category, size_t bytes
         rad_format_bytes((double)bytes, amount, sizeof amount);
         rad_format_bytes((double)m->call_limit, limit, sizeof limit);
         rad_format_bytes((double)(now - bytes), used, sizeof used);
-        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                 "%s: %s more would pass the memory limit of %s (%s in use; --max-memory)", what, amount,
-                 limit, used);
+        /* Name the limit in force: a solution's own where it is lower. */
+        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: %s more would pass the memory limit of %s (%s in use; %s)", what,
+                 amount, limit, used,
+                 m->call_limit < m->limit ? "rad_options.max_memory_bytes" : "rad_context_options.max_memory_bytes");
         return false;
     }
     raise_peak(&m->peak, now);
@@ -388,8 +395,10 @@ rad_result rad_atomic_open(rad_context *ctx, const char *path, rad_atomic_file *
     size_t n = strlen(path) + 32;
     out->final_path = rad_strdup(ctx, RAD_MEM_OUTPUT, path, "output file name");
     out->temp_path = rad_alloc(ctx, RAD_MEM_OUTPUT, n, 1, "temporary file name");
-    if (!out->final_path || !out->temp_path) {
-        rad_atomic_abort(out);
+    if (!out->final_path || !out->temp_path) { /* no temporary file to remove yet */
+        rad_free(out->final_path);
+        rad_free(out->temp_path);
+        memset(out, 0, sizeof *out);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     snprintf(out->temp_path, n, "%s.tmp.%ld", path, (long)getpid());

@@ -107,6 +107,14 @@ rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 #endif
     ;
 
+/* The public functions' answer to a NULL context, object, path or out
+ * pointer (radiosity.h, "NULL"): "FUNCTION: NULL argument" in the context
+ * when there is one, and RAD_ERROR_INVALID_ARGUMENT. */
+static inline rad_result rad_null_argument(rad_context *ctx, const char *function)
+{
+    return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: NULL argument", function);
+}
+
 /* Every public function that takes a context calls this first: its first
  * failure will be the one kept.  NULL is a no-op. */
 static inline void rad_api_enter(rad_context *ctx)

@@ -49,10 +49,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 /* Gauss-Legendre nodes and weights on [0, 1], orders 1..4. */
 static const double gauss_x[5][4] = {
     {0},
@@ -76,9 +72,7 @@ typedef struct elem_geom {
     vec3 normal;
     vec3 centroid;
     double area;
-    double diameter; /* longest diagonal or edge, m */
     double radius;   /* max centroid-to-corner distance, m */
-    double offset;   /* plane offset n . c0 */
 } elem_geom;
 
 static void geom_init(elem_geom *g, const rad_mesh *mesh, const rad_element *e)
@@ -89,23 +83,9 @@ static void geom_init(elem_geom *g, const rad_mesh *mesh, const rad_element *e)
     g->normal = e->normal;
     g->centroid = e->centroid;
     g->area = e->area;
-    g->diameter = 0.0;
     g->radius = 0.0;
-    for (uint32_t a = 0; a < g->corners; a++) {
+    for (uint32_t a = 0; a < g->corners; a++)
         g->radius = fmax(g->radius, v3_length(v3_sub(g->corner[a], g->centroid)));
-        for (uint32_t b = a + 1; b < g->corners; b++)
-            g->diameter = fmax(g->diameter, v3_length(v3_sub(g->corner[a], g->corner[b])));
-    }
-    g->offset = v3_dot(g->normal, g->corner[0]);
-}
-
-/* Is every corner of `g` on or behind the plane of `p`? */
-static bool behind(const elem_geom *g, const elem_geom *p, double eps)
-{
-    for (uint32_t k = 0; k < g->corners; k++)
-        if (v3_dot(p->normal, g->corner[k]) - p->offset > eps)
-            return false;
-    return true;
 }
 
 /* int over the region (3 or 4 corners, a piece of the receiver) of
@@ -208,79 +188,57 @@ static double occluded_factor(const rad_ff_request *req, const elem_geom *recv,
     return cast > 0 ? f * pass / cast : f; /* no facing sample: slivers, taken as visible */
 }
 
-static rad_result analytic_compute(rad_context *ctx, const rad_ff_request *req, float *F,
-                                   float *variance, rad_ff_stats *stats)
+/* What every pair reads. */
+typedef struct analytic_shared {
+    int base_rays;       /* shadow rays per pair before the pilot's verdict */
+    double eps;          /* m: the ray-end lift, rad_vis_epsilon (0 without visibility) */
+    elem_geom geom[];    /* per element */
+} analytic_shared;
+
+static rad_result analytic_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
 {
-    (void)variance;
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
-    int base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;
-    if (base_rays > 48)
-        base_rays = 48;
-    elem_geom *geom = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n, sizeof *geom, "form factors: element table");
-    if (!geom)
+    analytic_shared *a = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *a + n * sizeof a->geom[0],
+                                         "form factors: element table");
+    if (!a)
         return RAD_ERROR_OUT_OF_MEMORY;
+    a->base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;
+    if (a->base_rays > RAD_FF_MAX_BASE_RAYS)
+        a->base_rays = RAD_FF_MAX_BASE_RAYS;
+    a->eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
     for (size_t i = 0; i < n; i++)
-        geom_init(&geom[i], mesh, &mesh->elements[i]);
-    double eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
-    /* Plane test tolerance: 1e-9 x the mesh's extent, so coplanar elements
-     * (whose factors vanish exactly) are culled despite rounding. */
-    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        lo = v3_min(lo, mesh->vertices[v]);
-        hi = v3_max(hi, mesh->vertices[v]);
-    }
-    double plane_eps = 1e-9 * v3_length(v3_sub(hi, lo));
-
-    uint64_t rays = 0, pairs = 0, rows_done = 0;
-    volatile int stop = 0;
-#pragma omp parallel num_threads(ctx->threads) reduction(+ : rays, pairs)
-    {
-#pragma omp for schedule(dynamic, 4)
-        for (size_t i = 0; i < n; i++) {
-            if (stop)
-                continue;
-            const elem_geom *gi = &geom[i];
-            for (size_t j = i + 1; j < n; j++) {
-                const elem_geom *gj = &geom[j];
-                if (behind(gj, gi, plane_eps) || behind(gi, gj, plane_eps))
-                    continue;
-                pairs++;
-                /* Integrate over the smaller element, the source is the larger. */
-                const elem_geom *recv = gi, *src = gj;
-                if (gj->area < gi->area) {
-                    recv = gj;
-                    src = gi;
-                }
-                uint32_t ri = recv == gi ? (uint32_t)i : (uint32_t)j, si = recv == gi ? (uint32_t)j : (uint32_t)i;
-                rad_ff_end recv_end, src_end;
-                rad_ff_end_element(mesh, ri, eps, &recv_end);
-                rad_ff_end_element(mesh, si, eps, &src_end);
-                rad_rng rng = rad_rng_keyed(req->seed, i, j);
-                double fr = occluded_factor(req, recv, &recv_end, src->corner, src->corners, &src_end, &rng,
-                                            base_rays, 0, &rays) /
-                            recv->area;
-                if (!(fr > 0.0))
-                    continue;
-                double fs = fr * recv->area / src->area; /* reciprocity */
-                if (recv == gi) {
-                    F[i * n + j] = (float)fr;
-                    F[j * n + i] = (float)fs;
-                } else {
-                    F[j * n + i] = (float)fr;
-                    F[i * n + j] = (float)fs;
-                }
-            }
-            rad_ff_row_done(ctx, &rows_done, n, &stop);
-        }
-    }
-    rad_free(geom);
-    stats->rays = rays;
-    stats->pairs = pairs;
-    if (stop)
-        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
-    rad_progress(ctx, "form factors", n, n);
+        geom_init(&a->geom[i], mesh, &mesh->elements[i]);
+    *shared = a;
     return RAD_OK;
+}
+
+/* Integrate over the smaller element, the source is the larger; the other
+ * direction by reciprocity. */
+static void analytic_pair(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                          uint32_t j, rad_ff_pair *out, rad_ff_tally *tally)
+{
+    (void)scratch;
+    const analytic_shared *a = shared;
+    const elem_geom *gi = &a->geom[i], *gj = &a->geom[j];
+    const elem_geom *recv = gi, *src = gj;
+    if (gj->area < gi->area) {
+        recv = gj;
+        src = gi;
+    }
+    uint32_t ri = recv == gi ? i : j, si = recv == gi ? j : i;
+    rad_ff_end recv_end, src_end;
+    rad_ff_end_element(req->mesh, ri, a->eps, &recv_end);
+    rad_ff_end_element(req->mesh, si, a->eps, &src_end);
+    rad_rng rng = rad_rng_keyed(req->seed, i, j);
+    double fr = occluded_factor(req, recv, &recv_end, src->corner, src->corners, &src_end, &rng,
+                                a->base_rays, 0, &tally->rays) /
+                recv->area;
+    if (!(fr > 0.0))
+        return;
+    double fs = fr * recv->area / src->area; /* reciprocity */
+    out->F_ij = recv == gi ? fr : fs;
+    out->F_ji = recv == gi ? fs : fr;
 }
 
 const rad_ff_method rad_ff_analytic = {
@@ -288,5 +246,8 @@ const rad_ff_method rad_ff_analytic = {
     "exact point-to-polygon factor (Baum et al. 1989), adaptive Gauss over the receiver, "
     "shadow-ray visibility; ~1e-8 unoccluded, ~1e-4 occluded, O(n^2)",
     0,
-    analytic_compute,
+    analytic_prepare,
+    NULL,
+    analytic_pair,
+    NULL,
 };

@@ -76,10 +76,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 /* Gauss-Legendre nodes and weights on [0, 1]; orders 3..8 are used. */
 enum { GAUSS_MAX = 8 };
 static const double gauss_x[GAUSS_MAX + 1][GAUSS_MAX] = {
@@ -331,31 +327,6 @@ double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const
     return coupling > 0.0 ? coupling : 0.0;
 }
 
-bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol)
-{
-    const rad_element *e[2] = {&mesh->elements[i], &mesh->elements[j]};
-    for (int a = 0; a < 2; a++) {
-        const rad_element *p = e[a], *o = e[1 - a];
-        double offset = v3_dot(p->normal, p->centroid);
-        bool in_front = false;
-        for (uint32_t k = 0; k < o->vertex_count && !in_front; k++)
-            in_front = v3_dot(p->normal, mesh->vertices[o->vertex[k]]) - offset > plane_tol;
-        if (!in_front)
-            return false;
-    }
-    return true;
-}
-
-double rad_ff_plane_tolerance(const rad_mesh *mesh)
-{
-    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        lo = v3_min(lo, mesh->vertices[v]);
-        hi = v3_max(hi, mesh->vertices[v]);
-    }
-    return 1e-9 * v3_length(v3_sub(hi, lo));
-}
-
 double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol)
 {
     const rad_element *ei = &mesh->elements[i], *ej = &mesh->elements[j];
@@ -368,45 +339,38 @@ double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double
                                 plane_tol);
 }
 
-static rad_result contour_compute(rad_context *ctx, const rad_ff_request *req, float *F,
-                                  float *variance, rad_ff_stats *stats)
-{
-    (void)variance;
-    const rad_mesh *mesh = req->mesh;
-    size_t n = mesh->element_count;
-    int base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;
-    double eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
-    double plane_tol = rad_ff_plane_tolerance(mesh);
+/* What every pair reads. */
+typedef struct contour_shared {
+    int base_rays;     /* shadow rays per pair before the pilot's verdict */
+    double eps;        /* m: the ray-end lift, rad_vis_epsilon (0 without visibility) */
+    double plane_tol;  /* m: rad_ff_plane_tolerance */
+} contour_shared;
 
-    uint64_t rays = 0, pairs = 0, rows_done = 0;
-    volatile int stop = 0;
-#pragma omp parallel num_threads(ctx->threads) reduction(+ : rays, pairs)
-    {
-#pragma omp for schedule(dynamic, 4)
-        for (size_t i = 0; i < n; i++) {
-            if (stop)
-                continue;
-            double area_i = mesh->elements[i].area;
-            for (size_t j = i + 1; j < n; j++) {
-                if (!rad_ff_facing(mesh, (uint32_t)i, (uint32_t)j, plane_tol))
-                    continue;
-                pairs++;
-                double g = rad_element_coupling(mesh, (uint32_t)i, (uint32_t)j, plane_tol);
-                if (!(g > 0.0))
-                    continue;
-                g *= rad_ff_visibility(req, (uint32_t)i, (uint32_t)j, eps, base_rays, &rays);
-                F[i * n + j] = (float)(g / area_i);
-                F[j * n + i] = (float)(g / mesh->elements[j].area);
-            }
-            rad_ff_row_done(ctx, &rows_done, n, &stop);
-        }
-    }
-    stats->rays = rays;
-    stats->pairs = pairs;
-    if (stop)
-        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
-    rad_progress(ctx, "form factors", n, n);
+static rad_result contour_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
+{
+    contour_shared *c = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *c, "form factors: settings");
+    if (!c)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    c->base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;
+    c->eps = req->vis ? rad_vis_epsilon(req->mesh) : 0.0;
+    c->plane_tol = rad_ff_plane_tolerance(req->mesh);
+    *shared = c;
     return RAD_OK;
+}
+
+/* One evaluation gives both directions: A_i F_ij = A_j F_ji exactly. */
+static void contour_pair(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                         uint32_t j, rad_ff_pair *out, rad_ff_tally *tally)
+{
+    (void)scratch;
+    const contour_shared *c = shared;
+    const rad_mesh *mesh = req->mesh;
+    double g = rad_element_coupling(mesh, i, j, c->plane_tol);
+    if (!(g > 0.0))
+        return;
+    g *= rad_ff_visibility(req, i, j, c->eps, c->base_rays, &tally->rays);
+    out->F_ij = g / mesh->elements[i].area;
+    out->F_ji = g / mesh->elements[j].area;
 }
 
 const rad_ff_method rad_ff_contour = {
@@ -415,5 +379,8 @@ const rad_ff_method rad_ff_contour = {
     "closed-form inner and parallel-edge integrals, adaptive Gauss outer, shadow-ray "
     "visibility; ~1e-8 unoccluded, O(n^2)",
     0,
-    contour_compute,
+    contour_prepare,
+    NULL,
+    contour_pair,
+    NULL,
 };

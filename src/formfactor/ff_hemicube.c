@@ -59,10 +59,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 /* ---- delta form factors ---- */
 
 /* int_0^x int_0^y dA / (pi (u^2+v^2+1)^2): the factor from a point to the
@@ -180,12 +176,14 @@ typedef struct hc_scratch {
     double *row;     /* n: the row being accumulated over the hemicube points */
 } hc_scratch;
 
+/* What every row reads. */
 typedef struct hc_setup {
     int R, H;            /* pixels along a full face; rows of a side face */
     size_t pixels;       /* 3 R^2 */
-    const double *delta; /* per pixel, in rad_hemicube_deltas' layout */
+    double lift;         /* apex above the element, m: rad_vis_epsilon (plus its bend) */
     double near;         /* near plane, m */
     double edge_on;      /* |apex distance from a polygon's plane| below this: edge-on, m */
+    double delta[];      /* per pixel, in rad_hemicube_deltas' layout */
 } hc_setup;
 
 /* Rasterise one polygon (corners in the receiver's frame) onto one face.
@@ -334,15 +332,19 @@ static uint64_t hemicube_point(const hc_setup *hs, hc_scratch *s, const rad_mesh
 
 /* Row i of F: the mean of four hemicubes, one at the centroid of each
  * quarter of element i (rad_ff_split4), weighted by the quarter's area.
- * Returns the element pairs projected (not behind the base). */
-static uint64_t hemicube_row(const hc_setup *hs, hc_scratch *s, const rad_mesh *mesh, size_t i,
-                             double lift, float *F)
+ * Counts the element pairs projected (not behind the base). */
+static void hemicube_row(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                         float *F_row, float *variance_row, rad_ff_tally *tally)
 {
+    (void)variance_row;
+    const hc_setup *hs = shared;
+    hc_scratch *s = scratch;
+    const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
     const rad_element *ei = &mesh->elements[i];
     vec3 ux, uy, corner[4], quarter[4][4];
     tangent_frame(ei->normal, &ux, &uy);
-    lift += rad_element_bend(mesh, ei);
+    double lift = hs->lift + rad_element_bend(mesh, ei);
     for (uint32_t k = 0; k < ei->vertex_count; k++)
         corner[k] = mesh->vertices[ei->vertex[k]];
     rad_ff_split4(corner, ei->vertex_count, quarter);
@@ -368,78 +370,52 @@ static uint64_t hemicube_row(const hc_setup *hs, hc_scratch *s, const rad_mesh *
             s->row[j] += w * s->sum[j + 1];
     }
     for (size_t j = 0; j < n; j++)
-        F[i * n + j] = (float)s->row[j];
-    return pairs / 4;
+        F_row[j] = (float)s->row[j];
+    tally->pairs += pairs / 4;
 }
 
-static rad_result hemicube_compute(rad_context *ctx, const rad_ff_request *req, float *F,
-                                   float *variance, rad_ff_stats *stats)
+static rad_result hemicube_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
 {
-    (void)variance;
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
     if (n >= UINT32_MAX - 1)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "hemicube: too many elements (%zu)", n);
-    hc_setup hs;
-    hs.R = req->hemicube_resolution > 0 ? req->hemicube_resolution : 256;
-    hs.R += hs.R & 1; /* side faces are R/2 high */
-    hs.H = hs.R / 2;
-    hs.pixels = 3 * (size_t)hs.R * (size_t)hs.R;
-    double *delta = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, hs.pixels, sizeof *delta, "hemicube: delta form factors");
-    if (!delta)
+    int R = req->hemicube_resolution > 0 ? req->hemicube_resolution : 256;
+    R += R & 1; /* side faces are R/2 high */
+    size_t pixels = 3 * (size_t)R * (size_t)R;
+    hc_setup *hs = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *hs + pixels * sizeof hs->delta[0],
+                                   "hemicube: delta form factors");
+    if (!hs)
         return RAD_ERROR_OUT_OF_MEMORY;
-    rad_hemicube_deltas(hs.R, delta);
-    hs.delta = delta;
-    double eps = rad_vis_epsilon(mesh);
+    hs->R = R;
+    hs->H = R / 2;
+    hs->pixels = pixels;
+    rad_hemicube_deltas(R, hs->delta);
+    hs->lift = rad_vis_epsilon(mesh);
     /* The apex is lifted by eps: nothing but degenerate geometry lies
      * closer, and 1e-2 eps keeps 1/w finite. */
-    hs.near = 1e-2 * eps;
-    hs.edge_on = 1e-3 * eps;
-
-    /* Per-thread buffers, one slice per thread, allocated before the region. */
-    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1), nv = mesh->vertex_count;
-    vec3 *local = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * nv, sizeof *local, "hemicube: vertices");
-    float *depth = local ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * hs.pixels, sizeof *depth,
-                                     "hemicube: depth buffers")
-                         : NULL;
-    uint32_t *item = depth ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * hs.pixels, sizeof *item,
-                                       "hemicube: item buffers")
-                           : NULL;
-    double *sum = item ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (n + 2), sizeof *sum, "hemicube: row sums")
-                       : NULL;
-    double *row = sum ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (n + 1), sizeof *row, "hemicube: rows")
-                      : NULL;
-    rad_result r = row ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
-    uint64_t pairs = 0, rows_done = 0;
-    volatile int stop = 0;
-    if (r == RAD_OK) {
-#pragma omp parallel num_threads(ctx->threads) reduction(+ : pairs)
-        {
-            size_t t = (size_t)omp_get_thread_num();
-            hc_scratch s = {local + t * nv, depth + t * hs.pixels, item + t * hs.pixels, sum + t * (n + 2),
-                            row + t * (n + 1)};
-#pragma omp for schedule(dynamic, 4)
-            for (size_t i = 0; i < n; i++) {
-                if (stop)
-                    continue;
-                pairs += hemicube_row(&hs, &s, mesh, i, eps, F);
-                rad_ff_row_done(ctx, &rows_done, n, &stop);
-            }
-        }
-    }
-    rad_free(local);
-    rad_free(depth);
-    rad_free(item);
-    rad_free(sum);
-    rad_free(row);
-    rad_free(delta);
-    stats->pairs = pairs;
-    if (r != RAD_OK)
-        return r;
-    if (stop)
-        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
-    rad_progress(ctx, "form factors", n, n);
+    hs->near = 1e-2 * hs->lift;
+    hs->edge_on = 1e-3 * hs->lift;
+    *shared = hs;
     return RAD_OK;
+}
+
+/* One block: the struct, then the vertices in the receiver's frame, the
+ * accumulators, the depths and the items. */
+static size_t hemicube_scratch(const rad_ff_request *req, const void *shared, void *block)
+{
+    const hc_setup *hs = shared;
+    size_t n = req->mesh->element_count, vertices = req->mesh->vertex_count;
+    hc_scratch *s = block;
+    if (s) {
+        s->local = (vec3 *)(s + 1);
+        s->sum = (double *)(s->local + vertices);
+        s->row = s->sum + n + 2;
+        s->depth = (float *)(s->row + n + 1);
+        s->item = (uint32_t *)(s->depth + hs->pixels);
+    }
+    return sizeof *s + vertices * sizeof *s->local + (2 * n + 3) * sizeof *s->sum +
+           hs->pixels * (sizeof *s->depth + sizeof *s->item);
 }
 
 const rad_ff_method rad_ff_hemicube = {
@@ -448,5 +424,8 @@ const rad_ff_method rad_ff_hemicube = {
     "item buffer, exact delta factors, deterministic; 5e-4 to 7e-3 at R=512 on the test cases, "
     "O(n^2 + n R^2)",
     0,
-    hemicube_compute,
+    hemicube_prepare,
+    hemicube_scratch,
+    NULL,
+    hemicube_row,
 };

@@ -41,11 +41,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 enum { BATCH = 64 }; /* rays per intersect call */
+
+/* What every row reads. */
+typedef struct hs_shared {
+    int N;            /* rays per element */
+    double eps;       /* m: the ray-origin lift, rad_vis_epsilon */
+} hs_shared;
 
 /* Per-thread buffers, allocated once per thread. */
 typedef struct hs_scratch {
@@ -104,10 +106,15 @@ static void trace_batch(const rad_ff_request *req, hs_scratch *s, size_t count, 
     }
 }
 
-/* Row i of F (and of the variance).  Returns the elements it hit. */
-static uint64_t hemisphere_row(const rad_ff_request *req, hs_scratch *s, size_t i, int N, double eps,
-                           float *F, float *variance)
+/* Row i of F (and of the variance); counts its rays and the elements it
+ * hit. */
+static void hemisphere_row(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                           float *F_row, float *variance_row, rad_ff_tally *tally)
 {
+    const hs_shared *h = shared;
+    hs_scratch *s = scratch;
+    int N = h->N;
+    double eps = h->eps;
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
     const rad_element *e = &mesh->elements[i];
@@ -159,70 +166,43 @@ static uint64_t hemisphere_row(const rad_ff_request *req, hs_scratch *s, size_t 
     }
     if (batch)
         trace_batch(req, s, batch, i);
-    uint64_t seen = 0;
     for (size_t j = 0; j < n; j++) {
         double f = s->sum[j];
-        seen += f > 0.0;
-        F[i * n + j] = (float)f;
-        if (variance) {
+        tally->pairs += f > 0.0;
+        F_row[j] = (float)f;
+        if (variance_row) {
             double p = fmin(fmax(f, 0.0), 1.0);
-            variance[i * n + j] = (float)(p * (1.0 - p) / N);
+            variance_row[j] = (float)(p * (1.0 - p) / N);
         }
     }
-    return seen;
+    tally->rays += (uint64_t)N;
 }
 
-static rad_result hemisphere_compute(rad_context *ctx, const rad_ff_request *req, float *F,
-                                     float *variance, rad_ff_stats *stats)
+static rad_result hemisphere_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
 {
-    const rad_mesh *mesh = req->mesh;
-    size_t n = mesh->element_count;
     if (!req->vis)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "hemisphere form factors need a ray backend (visibility)");
-    int N = req->samples > 0 ? req->samples : 1024;
-    double eps = rad_vis_epsilon(mesh);
-
-    /* Per-thread scratch, one slice per thread, allocated before the region. */
-    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1);
-    hs_scratch *scratch = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads, sizeof *scratch, "hemisphere: scratch");
-    uint32_t *perm = scratch ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (size_t)N, sizeof *perm,
-                                         "hemisphere: ray strata")
-                             : NULL;
-    double *sum = perm ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * n, sizeof *sum, "hemisphere: row sums")
-                       : NULL;
-    if (!sum) {
-        rad_free(scratch);
-        rad_free(perm);
+    hs_shared *h = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *h, "form factors: settings");
+    if (!h)
         return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    for (size_t t = 0; t < threads; t++) {
-        scratch[t].perm = perm + t * (size_t)N;
-        scratch[t].sum = sum + t * n;
-    }
-
-    uint64_t rows_done = 0, pairs = 0;
-    volatile int stop = 0;
-#pragma omp parallel num_threads(ctx->threads) reduction(+ : pairs)
-    {
-        hs_scratch *s = &scratch[omp_get_thread_num()];
-#pragma omp for schedule(dynamic, 4)
-        for (size_t i = 0; i < n; i++) {
-            if (stop)
-                continue;
-            pairs += hemisphere_row(req, s, i, N, eps, F, variance);
-            rad_ff_row_done(ctx, &rows_done, n, &stop);
-        }
-    }
-    rad_free(scratch);
-    rad_free(perm);
-    rad_free(sum);
-    stats->rays = (uint64_t)rows_done * (uint64_t)N;
-    stats->pairs = pairs; /* pairs that received a ray */
-    if (stop)
-        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
-    rad_progress(ctx, "form factors", n, n);
+    h->N = req->samples > 0 ? req->samples : 1024;
+    h->eps = rad_vis_epsilon(req->mesh);
+    *shared = h;
     return RAD_OK;
+}
+
+/* One block: the struct, then the n accumulators, then the N strata. */
+static size_t hemisphere_scratch(const rad_ff_request *req, const void *shared, void *block)
+{
+    const hs_shared *h = shared;
+    size_t n = req->mesh->element_count;
+    hs_scratch *s = block;
+    if (s) {
+        s->sum = (double *)(s + 1);
+        s->perm = (uint32_t *)(s->sum + n);
+    }
+    return sizeof *s + n * sizeof *s->sum + (size_t)h->N * sizeof *s->perm;
 }
 
 const rad_ff_method rad_ff_hemisphere = {
@@ -230,5 +210,8 @@ const rad_ff_method rad_ff_hemisphere = {
     "cosine-distributed rays from stratified points of each element (Malley's method), "
     "closest hit; unbiased, std error sqrt(F(1-F)/N) per factor, N n rays",
     RAD_FF_VARIANCE,
-    hemisphere_compute,
+    hemisphere_prepare,
+    hemisphere_scratch,
+    NULL,
+    hemisphere_row,
 };

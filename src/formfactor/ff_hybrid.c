@@ -42,86 +42,75 @@
 
 #include <stdlib.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+/* What every pair reads. */
+typedef struct hybrid_shared {
+    int base_rays;       /* shadow rays per pair before the pilot's verdict */
+    double near_field;   /* element sizes: the switch to the exact method */
+    double eps;          /* m: the ray-end lift, rad_vis_epsilon (0 without visibility) */
+    double plane_tol;    /* m: rad_ff_plane_tolerance */
+    double diameter[];   /* per element: its longest edge or diagonal, m */
+} hybrid_shared;
 
-static rad_result hybrid_compute(rad_context *ctx, const rad_ff_request *req, float *F,
-                                 float *variance, rad_ff_stats *stats)
+static rad_result hybrid_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
 {
-    (void)variance;
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
-    int base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;
-    double near_field = req->near_field > 0.0 ? req->near_field : 3.0;
-    double eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
-    double plane_tol = rad_ff_plane_tolerance(mesh);
-    double *diameter = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n ? n : 1, sizeof *diameter, "form factors: sizes");
-    if (!diameter)
+    hybrid_shared *h = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *h + n * sizeof h->diameter[0], "form factors: sizes");
+    if (!h)
         return RAD_ERROR_OUT_OF_MEMORY;
+    h->base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;
+    h->near_field = req->near_field > 0.0 ? req->near_field : 3.0;
+    h->eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
+    h->plane_tol = rad_ff_plane_tolerance(mesh);
     for (size_t i = 0; i < n; i++) {
         const rad_element *e = &mesh->elements[i];
-        diameter[i] = 0.0;
+        h->diameter[i] = 0.0;
         for (uint32_t a = 0; a < e->vertex_count; a++)
             for (uint32_t b = a + 1; b < e->vertex_count; b++)
-                diameter[i] = fmax(diameter[i], v3_length(v3_sub(mesh->vertices[e->vertex[a]],
-                                                                 mesh->vertices[e->vertex[b]])));
+                h->diameter[i] = fmax(h->diameter[i], v3_length(v3_sub(mesh->vertices[e->vertex[a]],
+                                                                       mesh->vertices[e->vertex[b]])));
     }
-
-    uint64_t rays = 0, pairs = 0, near_pairs = 0, rows_done = 0;
-    volatile int stop = 0;
-#pragma omp parallel num_threads(ctx->threads) reduction(+ : rays, pairs, near_pairs)
-    {
-#pragma omp for schedule(dynamic, 4)
-        for (size_t i = 0; i < n; i++) {
-            if (stop)
-                continue;
-            const rad_element *ei = &mesh->elements[i];
-            for (size_t j = i + 1; j < n; j++) {
-                if (!rad_ff_facing(mesh, (uint32_t)i, (uint32_t)j, plane_tol))
-                    continue;
-                pairs++;
-                const rad_element *ej = &mesh->elements[j];
-                double size = fmax(diameter[i], diameter[j]);
-                double g; /* A_i F_ij, unoccluded */
-                if (v3_length(v3_sub(ei->centroid, ej->centroid)) < near_field * size) {
-                    near_pairs++;
-                    g = rad_element_coupling(mesh, (uint32_t)i, (uint32_t)j, plane_tol);
-                } else {
-                    const rad_element *recv = ei, *src = ej;
-                    if (ej->area < ei->area) {
-                        recv = ej;
-                        src = ei;
-                    }
-                    vec3 corner[4];
-                    for (uint32_t k = 0; k < src->vertex_count; k++)
-                        corner[k] = mesh->vertices[src->vertex[k]];
-                    g = recv->area *
-                        rad_point_polygon_ff(recv->centroid, recv->normal, corner, src->vertex_count);
-                }
-                if (!(g > 0.0))
-                    continue;
-                g *= rad_ff_visibility(req, (uint32_t)i, (uint32_t)j, eps, base_rays, &rays);
-                F[i * n + j] = (float)(g / ei->area);
-                F[j * n + i] = (float)(g / ej->area);
-            }
-            rad_ff_row_done(ctx, &rows_done, n, &stop);
-        }
-    }
-    rad_free(diameter);
-    stats->rays = rays;
-    stats->pairs = pairs;
-    stats->near_pairs = near_pairs;
-    if (stop)
-        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
-    rad_progress(ctx, "form factors", n, n);
+    *shared = h;
     return RAD_OK;
+}
+
+static void hybrid_pair(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                        uint32_t j, rad_ff_pair *out, rad_ff_tally *tally)
+{
+    (void)scratch;
+    const hybrid_shared *h = shared;
+    const rad_mesh *mesh = req->mesh;
+    const rad_element *ei = &mesh->elements[i], *ej = &mesh->elements[j];
+    double size = fmax(h->diameter[i], h->diameter[j]);
+    double g; /* A_i F_ij, unoccluded */
+    if (v3_length(v3_sub(ei->centroid, ej->centroid)) < h->near_field * size) {
+        tally->near_pairs++;
+        g = rad_element_coupling(mesh, i, j, h->plane_tol);
+    } else {
+        const rad_element *recv = ei, *src = ej;
+        if (ej->area < ei->area) {
+            recv = ej;
+            src = ei;
+        }
+        vec3 corner[4];
+        for (uint32_t k = 0; k < src->vertex_count; k++)
+            corner[k] = mesh->vertices[src->vertex[k]];
+        g = recv->area * rad_point_polygon_ff(recv->centroid, recv->normal, corner, src->vertex_count);
+    }
+    if (!(g > 0.0))
+        return;
+    g *= rad_ff_visibility(req, i, j, h->eps, h->base_rays, &tally->rays);
+    out->F_ij = g / ei->area;
+    out->F_ji = g / ej->area;
 }
 
 const rad_ff_method rad_ff_hybrid = {
     "hybrid",
-    "one-point (centroid) factor x shadow-ray visibility beyond --near-field element sizes "
+    "one-point (centroid) factor x shadow-ray visibility beyond rad_options.near_field element sizes "
     "(default 3), the contour integral closer in; ~1e-4 on the reference cases, O(n^2)",
     0,
-    hybrid_compute,
+    hybrid_prepare,
+    NULL,
+    hybrid_pair,
+    NULL,
 };

@@ -17,7 +17,7 @@
  *
  * Each unordered pair is sampled once (F_ji = F_ij A_i / A_j, so the matrix
  * is reciprocal by construction); pairs with one element wholly behind the
- * other's plane are skipped, as in ff_analytic.c.  The N point pairs are
+ * other's plane are skipped (rad_ff_facing).  The N point pairs are
  * stratified on both ends (sqrt(N) x sqrt(N) jittered strata on each,
  * matched by a random permutation; samples beyond the largest square are
  * unstratified), and each end carries rad_element_sample's density
@@ -53,15 +53,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 enum { CHUNK = 256 }; /* samples per occlusion batch */
 
 /* Per-thread buffers, allocated once per thread. */
 typedef struct mc_scratch {
-    uint32_t *perm;           /* N: stratum on j of each stratum on i */
     double kernel[CHUNK];     /* per sample of the chunk: the estimate of F_ij it gives */
     uint32_t sample[CHUNK];   /* per ray: the sample it tests */
     rad_ray rays[CHUNK];
@@ -69,6 +64,7 @@ typedef struct mc_scratch {
     int count, rays_count;    /* samples and rays in the chunk */
     double mean, m2;          /* Welford: running mean and sum of squared deviations */
     int seen;                 /* samples folded in */
+    uint32_t perm[];          /* N: stratum on j of each stratum on i */
 } mc_scratch;
 
 /* Cast the chunk's shadow rays, zero what they find blocked, and fold the
@@ -89,12 +85,6 @@ static void flush_chunk(const rad_ff_request *req, mc_scratch *s, uint64_t *rays
     }
     s->count = s->rays_count = 0;
 }
-
-/* What the pair loop needs of each element. */
-typedef struct mc_elem {
-    double offset;     /* plane offset n . c0, m */
-    double radius;     /* largest centroid-to-corner distance, m */
-} mc_elem;
 
 /* Element j as the near-pair sampler sees it: flat, its corners projected
  * onto the plane through its centroid, split into the fan (0,1,2), (0,2,3). */
@@ -155,16 +145,6 @@ static bool target_contains(const mc_target *t, vec3 y)
     return true;
 }
 
-/* Is every corner of element g on or behind the plane of element p? */
-static bool behind(const rad_mesh *mesh, const rad_element *g, const rad_element *p, double p_offset,
-                   double eps)
-{
-    for (uint32_t k = 0; k < g->vertex_count; k++)
-        if (v3_dot(p->normal, mesh->vertices[g->vertex[k]]) - p_offset > eps)
-            return false;
-    return true;
-}
-
 /* Stratified numbers for sample k of m: (u1, v1) on i in stratum k and
  * (u2, v2) on j in stratum perm[k] of a side x side grid; samples past the
  * grid are unstratified. */
@@ -206,8 +186,8 @@ static int shuffle_strata(rad_rng *rng, uint32_t *perm, int m)
 /* One pair: F_ij and the variance of its estimate.  `near`: half the
  * samples of y are drawn by the polar technique (file header), each
  * technique stratified on its own. */
-static void montecarlo_pair(const rad_ff_request *req, mc_scratch *s, uint32_t i, uint32_t j, int N,
-                            bool near, double eps, double *F_ij, double *var_ij, uint64_t *rays_cast)
+static void estimate(const rad_ff_request *req, mc_scratch *s, uint32_t i, uint32_t j, int N, bool near,
+                     double eps, double *F_ij, double *var_ij, uint64_t *rays_cast)
 {
     const rad_mesh *mesh = req->mesh;
     const rad_element *ei = &mesh->elements[i], *ej = &mesh->elements[j];
@@ -282,91 +262,59 @@ static void montecarlo_pair(const rad_ff_request *req, mc_scratch *s, uint32_t i
     *var_ij = s->m2 / ((double)(N - 1) * N);
 }
 
-static rad_result montecarlo_compute(rad_context *ctx, const rad_ff_request *req, float *F,
-                                     float *variance, rad_ff_stats *stats)
+/* What every pair reads. */
+typedef struct mc_shared {
+    int N;              /* point pairs per element pair */
+    double eps;         /* m: the ray-end lift, rad_vis_epsilon (0 without visibility) */
+    double radius[];    /* per element: largest centroid-to-corner distance, m */
+} mc_shared;
+
+static rad_result montecarlo_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
 {
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
-    int N = req->samples > 0 ? req->samples : 16;
-    if (N < 2)
-        N = 2;
-    double eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
-    mc_elem *table = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n ? n : 1, sizeof *table, "form factors: element table");
-    if (!table)
+    mc_shared *m = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *m + n * sizeof m->radius[0], "form factors: element table");
+    if (!m)
         return RAD_ERROR_OUT_OF_MEMORY;
+    m->N = req->samples > 0 ? req->samples : 16;
+    if (m->N < 2)
+        m->N = 2;
+    m->eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
     for (size_t i = 0; i < n; i++) {
         const rad_element *e = &mesh->elements[i];
-        table[i].offset = v3_dot(e->normal, mesh->vertices[e->vertex[0]]);
-        table[i].radius = 0.0;
+        m->radius[i] = 0.0;
         for (uint32_t k = 0; k < e->vertex_count; k++)
-            table[i].radius = fmax(table[i].radius, v3_length(v3_sub(mesh->vertices[e->vertex[k]], e->centroid)));
+            m->radius[i] = fmax(m->radius[i], v3_length(v3_sub(mesh->vertices[e->vertex[k]], e->centroid)));
     }
-    /* Plane test tolerance: 1e-9 x the mesh's extent, as in ff_analytic.c,
-     * so coplanar elements (whose factors vanish exactly) are culled. */
-    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        lo = v3_min(lo, mesh->vertices[v]);
-        hi = v3_max(hi, mesh->vertices[v]);
-    }
-    double plane_eps = 1e-9 * v3_length(v3_sub(hi, lo));
-
-    /* Per-thread scratch, one slice per thread, allocated before the region. */
-    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1);
-    mc_scratch *scratch = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads, sizeof *scratch, "montecarlo: scratch");
-    uint32_t *perm = scratch ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads * (size_t)N, sizeof *perm,
-                                         "montecarlo: sample strata")
-                             : NULL;
-    if (!perm) {
-        rad_free(scratch);
-        rad_free(table);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    for (size_t t = 0; t < threads; t++)
-        scratch[t].perm = perm + t * (size_t)N;
-
-    uint64_t rays = 0, pairs = 0, rows_done = 0;
-    volatile int stop = 0;
-#pragma omp parallel num_threads(ctx->threads) reduction(+ : rays, pairs)
-    {
-        mc_scratch *s = &scratch[omp_get_thread_num()];
-#pragma omp for schedule(dynamic, 4)
-        for (size_t i = 0; i < n; i++) {
-            if (stop)
-                continue;
-            const rad_element *ei = &mesh->elements[i];
-            for (size_t j = i + 1; j < n; j++) {
-                const rad_element *ej = &mesh->elements[j];
-                if (behind(mesh, ej, ei, table[i].offset, plane_eps) ||
-                    behind(mesh, ei, ej, table[j].offset, plane_eps))
-                    continue;
-                pairs++;
-                /* Near: closer than twice their summed radii, where the
-                 * kernel's 1/r^2 makes uniform sampling's variance explode. */
-                double reach = 2.0 * (table[i].radius + table[j].radius);
-                vec3 gap = v3_sub(ej->centroid, ei->centroid);
-                bool near = v3_dot(gap, gap) < reach * reach;
-                double f, var;
-                montecarlo_pair(req, s, (uint32_t)i, (uint32_t)j, N, near, eps, &f, &var, &rays);
-                double ratio = ei->area / ej->area; /* F_ji = F_ij A_i / A_j */
-                F[i * n + j] = (float)f;
-                F[j * n + i] = (float)(f * ratio);
-                if (variance) {
-                    variance[i * n + j] = (float)var;
-                    variance[j * n + i] = (float)(var * ratio * ratio);
-                }
-            }
-            rad_ff_row_done(ctx, &rows_done, n, &stop);
-        }
-    }
-    rad_free(scratch);
-    rad_free(perm);
-    rad_free(table);
-    stats->rays = rays;
-    stats->pairs = pairs;
-    if (stop)
-        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
-    rad_progress(ctx, "form factors", n, n);
+    *shared = m;
     return RAD_OK;
+}
+
+static size_t montecarlo_scratch(const rad_ff_request *req, const void *shared, void *block)
+{
+    (void)req, (void)block; /* nothing to lay out: the strata are the struct's last member */
+    const mc_shared *m = shared;
+    return sizeof(mc_scratch) + (size_t)m->N * sizeof(uint32_t);
+}
+
+/* F_ji = F_ij A_i / A_j: one estimate per pair, reciprocal by construction. */
+static void montecarlo_pair(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                            uint32_t j, rad_ff_pair *out, rad_ff_tally *tally)
+{
+    const mc_shared *m = shared;
+    const rad_element *ei = &req->mesh->elements[i], *ej = &req->mesh->elements[j];
+    /* Near: closer than twice their summed radii, where the kernel's 1/r^2
+     * makes uniform sampling's variance explode. */
+    double reach = 2.0 * (m->radius[i] + m->radius[j]);
+    vec3 gap = v3_sub(ej->centroid, ei->centroid);
+    bool near = v3_dot(gap, gap) < reach * reach;
+    double f, var;
+    estimate(req, scratch, i, j, m->N, near, m->eps, &f, &var, &tally->rays);
+    double ratio = ei->area / ej->area;
+    out->F_ij = f;
+    out->F_ji = f * ratio;
+    out->var_ij = var;
+    out->var_ji = var * ratio * ratio;
 }
 
 const rad_ff_method rad_ff_montecarlo = {
@@ -374,5 +322,8 @@ const rad_ff_method rad_ff_montecarlo = {
     "area-to-area Monte Carlo: stratified point pairs (default 16 per pair), one shadow ray "
     "each, 1/r^2 sampling mixed in where elements touch; unbiased, variance reported; O(n^2 N)",
     RAD_FF_VARIANCE,
-    montecarlo_compute,
+    montecarlo_prepare,
+    montecarlo_scratch,
+    montecarlo_pair,
+    NULL,
 };

@@ -1,7 +1,22 @@
 /*
  * formfactor.c -- the registry of form-factor methods, and what every
  * method gets for free: the memory check before the dense matrix is
- * allocated, timing, and the diagnostics (row sums, reciprocity, F_ii).
+ * allocated, the one parallel loop that calls the method's kernel, timing,
+ * the diagnostics (row sums, reciprocity, F_ii), and the plane tolerance
+ * and facing test that every method culls with.
+ *
+ * The loop runs over rows i, in parallel with a dynamic schedule (rows of
+ * the upper triangle shrink with i); a pair method's kernel sees the pairs
+ * (i, j > i) that face each other, a row method's kernel row i whole:
+ *
+ *          j ->                      pair methods: kernel(i, j) gives
+ *     i  [ . x x x x x ]             F_ij (x) and F_ji (o) at once
+ *     |  [ o . x x x x ]
+ *     v  [ o o . x x x ]             row methods: kernel(i) fills row i
+ *        [ o o o . x x ]
+ *
+ * Each thread gets its scratch once; kernels key their random numbers on
+ * (seed, elements), so F does not depend on the thread count.
  */
 #include "formfactor/formfactor.h"
 
@@ -73,18 +88,130 @@ static void diagnostics(const rad_mesh *mesh, const float *F, rad_ff_stats *s)
     s->diagonal_max = diag;
 }
 
-void rad_ff_row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatile int *stop)
+double rad_ff_plane_tolerance(const rad_mesh *mesh)
+{
+    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
+    for (size_t v = 0; v < mesh->vertex_count; v++) {
+        lo = v3_min(lo, mesh->vertices[v]);
+        hi = v3_max(hi, mesh->vertices[v]);
+    }
+    return RAD_FF_PLANE_TOLERANCE * v3_length(v3_sub(hi, lo));
+}
+
+bool rad_ff_in_front(const vec3 *point, size_t count, vec3 origin, vec3 normal, double tol)
+{
+    for (size_t k = 0; k < count; k++)
+        if (v3_dot(normal, v3_sub(point[k], origin)) > tol)
+            return true;
+    return false;
+}
+
+bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol)
+{
+    const rad_element *e[2] = {&mesh->elements[i], &mesh->elements[j]};
+    for (int a = 0; a < 2; a++) {
+        const rad_element *plane = e[a], *other = e[1 - a];
+        vec3 corner[4];
+        for (uint32_t k = 0; k < other->vertex_count; k++)
+            corner[k] = mesh->vertices[other->vertex[k]];
+        if (!rad_ff_in_front(corner, other->vertex_count, plane->centroid, plane->normal, plane_tol))
+            return false;
+    }
+    return true;
+}
+
+/* Count one finished row; the master thread reports progress, and every
+ * thread polls cancellation, raising *stop (so that a flag raised before
+ * the start stops the loop after one row per thread, whichever threads get
+ * the rows).  Called inside the parallel region. */
+static void row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatile int *stop)
 {
     uint64_t done;
 #pragma omp atomic capture
     done = ++*rows_done;
+    bool master = true;
 #ifdef _OPENMP
-    if (omp_get_thread_num() != 0)
-        return;
+    master = omp_get_thread_num() == 0;
 #endif
-    rad_progress(ctx, "form factors", done, rows);
+    if (master)
+        rad_progress(ctx, "form factors", done, rows);
     if (rad_cancelled(ctx))
         *stop = 1;
+}
+
+/* Row i of a pair method: the facing pairs (i, j > i), both directions. */
+static void pair_row(const rad_ff_method *method, const rad_ff_request *req, const void *shared,
+                     void *scratch, uint32_t i, double plane_tol, float *F, float *variance,
+                     rad_ff_tally *tally)
+{
+    const rad_mesh *mesh = req->mesh;
+    size_t n = mesh->element_count;
+    for (size_t j = (size_t)i + 1; j < n; j++) {
+        if (!rad_ff_facing(mesh, i, (uint32_t)j, plane_tol))
+            continue;
+        tally->pairs++;
+        rad_ff_pair f = {0};
+        method->pair(req, shared, scratch, i, (uint32_t)j, &f, tally);
+        F[i * n + j] = (float)f.F_ij;
+        F[j * n + i] = (float)f.F_ji;
+        if (variance) {
+            variance[i * n + j] = (float)f.var_ij;
+            variance[j * n + i] = (float)f.var_ji;
+        }
+    }
+}
+
+/* The one loop: every row, in parallel; the counts into stats. */
+static rad_result run_method(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
+                             const void *shared, float *F, float *variance, rad_ff_stats *stats)
+{
+    size_t n = req->mesh->element_count;
+    double plane_tol = rad_ff_plane_tolerance(req->mesh);
+    /* Every thread's scratch in one allocation before the region: a slice
+     * each, whole cache lines apart (64 bytes), so no thread allocates. */
+    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1);
+    size_t slice = method->scratch ? (method->scratch(req, shared, NULL) + 63) / 64 * 64 : 0;
+    unsigned char *scratch_blocks = NULL;
+    if (slice) {
+        char what[64];
+        snprintf(what, sizeof what, "form factors (%s): threads' scratch", method->name);
+        scratch_blocks = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads, slice, what);
+        if (!scratch_blocks)
+            return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    uint64_t rays = 0, pairs = 0, near_pairs = 0, rows_done = 0;
+    volatile int stop = 0;
+#pragma omp parallel num_threads(ctx->threads) reduction(+ : rays, pairs, near_pairs)
+    {
+        void *scratch = NULL;
+        if (slice) {
+            scratch = scratch_blocks + (size_t)omp_get_thread_num() * slice;
+            method->scratch(req, shared, scratch);
+        }
+        rad_ff_tally tally = {0, 0, 0};
+#pragma omp for schedule(dynamic, 4)
+        for (size_t i = 0; i < n; i++) {
+            if (stop)
+                continue;
+            if (method->row)
+                method->row(req, shared, scratch, (uint32_t)i, F + i * n, variance ? variance + i * n : NULL,
+                            &tally);
+            else
+                pair_row(method, req, shared, scratch, (uint32_t)i, plane_tol, F, variance, &tally);
+            row_done(ctx, &rows_done, n, &stop);
+        }
+        rays += tally.rays;
+        pairs += tally.pairs;
+        near_pairs += tally.near_pairs;
+    }
+    rad_free(scratch_blocks);
+    stats->rays = rays;
+    stats->pairs = pairs;
+    stats->near_pairs = near_pairs;
+    if (stop)
+        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
+    rad_progress(ctx, "form factors", n, n);
+    return RAD_OK;
 }
 
 rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F)
@@ -140,8 +267,9 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     if (bytes > max_memory)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "form factors: the dense matrix for %zu elements needs %.2f GiB, above "
-                        "the memory limit of %.2f GiB (--max-memory); use the matrix-free "
-                        "solver (--solver shooting, O(n) memory) or fewer elements (--elements)",
+                        "the memory limit of %.2f GiB (rad_options.max_memory_bytes); use the matrix-free "
+                        "solver 'shooting' (rad_options.solver, O(n) memory) or fewer elements "
+                        "(rad_options.target_elements)",
                         n, bytes / 1073741824.0, max_memory / 1073741824.0);
     float *F = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *F, "form factors: dense matrix");
     float *var = F && want_variance
@@ -153,7 +281,11 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double t0 = rad_seconds();
-    rad_result r = method->compute(ctx, req, F, var, stats);
+    void *shared = NULL;
+    rad_result r = method->prepare ? method->prepare(ctx, req, &shared) : RAD_OK;
+    if (r == RAD_OK)
+        r = run_method(ctx, method, req, shared, F, var, stats);
+    rad_free(shared);
     if (r == RAD_OK && close) {
         r = rad_ff_close(ctx, req->mesh, F);
         stats->closure_corrected = r == RAD_OK;

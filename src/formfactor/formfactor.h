@@ -4,10 +4,10 @@
  *     F_ij = 1/A_i  int_{A_i} int_{A_j} cos(theta_i) cos(theta_j) V / (pi r^2) dA_j dA_i
  *
  * the fraction of the power leaving element i that arrives directly at
- * element j.  A method fills the dense n x n matrix (row i = factors FROM i)
- * and counts its rays; the registry wrapper (formfactor.c) checks memory
- * first and computes the diagnostics every method reports: row sums,
- * reciprocity error and F_ii.
+ * element j.  A method supplies a kernel for one pair of elements or one
+ * row (factors FROM element i); formfactor.c owns the rest: the memory
+ * check, the parallel loop that fills the dense n x n matrix, and the
+ * diagnostics every method reports (row sums, reciprocity error, F_ii).
  */
 #ifndef RAD_FORMFACTOR_H
 #define RAD_FORMFACTOR_H
@@ -40,36 +40,89 @@ typedef struct rad_ff_stats {
 
 /* Method flags. */
 enum {
-    RAD_FF_VARIANCE = 1u << 0 /* compute() also estimates the variance of each F_ij */
+    RAD_FF_VARIANCE = 1u << 0 /* the kernel also estimates the variance of each F_ij */
 };
 
+/* What the kernels count while they run: per thread, summed by the loop. */
+typedef struct rad_ff_tally {
+    uint64_t rays;            /* shadow / visibility rays cast */
+    uint64_t pairs;           /* row methods: element pairs evaluated (the pair loop counts its own) */
+    uint64_t near_pairs;      /* hybrid: pairs given to the exact method */
+} rad_ff_tally;
+
+/* One unordered pair's factors as a pair kernel returns them.  Both
+ * directions: each method has its own exact form of A_i F_ij = A_j F_ji. */
+typedef struct rad_ff_pair {
+    double F_ij, F_ji;
+    double var_ij, var_ji;    /* RAD_FF_VARIANCE methods: their estimated variances */
+} rad_ff_pair;
+
+/* A method is physics only: formfactor.c owns the loop over element rows
+ * (OpenMP, dynamic schedule, cancellation, progress, counting) and calls
+ * one of two kernels.  Pair methods see each unordered pair i < j once,
+ * after the loop has culled the pairs that do not face each other
+ * (rad_ff_facing); the loop writes F_ij and F_ji.  Row methods (a hemicube
+ * or rays shot from element i) fill row i themselves.  Kernels cannot fail,
+ * allocate nothing and take their random numbers from keys of (seed,
+ * elements), so F does not depend on the thread count. */
 typedef struct rad_ff_method {
     const char *name;
     const char *description; /* one line: idea, cost, accuracy */
     unsigned flags;
-    /* Fill F (n*n floats, zeroed by the caller), and, for methods with
-     * RAD_FF_VARIANCE, `variance` (n*n floats, zeroed; else NULL) with the
-     * estimated variance of each F_ij.  Parallel (ctx->threads), polling
-     * rad_cancelled(ctx) (then RAD_ERROR_INTERRUPTED), reporting progress
-     * with rad_progress(ctx, "form factors", ...) from one thread. */
-    rad_result (*compute)(rad_context *ctx, const rad_ff_request *req, float *F, float *variance,
-                          rad_ff_stats *stats);
+    /* Optional.  Check the request and build what every kernel call
+     * reads (settings, per-element tables) as one block of the context's
+     * (rad_alloc) in *shared, which the caller frees; fail through
+     * rad_fail. */
+    rad_result (*prepare)(rad_context *ctx, const rad_ff_request *req, void **shared);
+    /* Optional.  The bytes of one thread's scratch memory; with `block`
+     * (that many bytes, zeroed, 16-byte aligned) also lay it out there
+     * (pointers into it).  The loop allocates every thread's block before
+     * its parallel region and hands `block` to the kernels.  Cannot fail. */
+    size_t (*scratch)(const rad_ff_request *req, const void *shared, void *block);
+    /* Exactly one of these.  pair: the factors of elements i < j into
+     * *out (zeroed by the caller).  row: row i of F into F_row (n floats,
+     * zeroed) and, when variance_row is not NULL, of the variances. */
+    void (*pair)(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                 uint32_t j, rad_ff_pair *out, rad_ff_tally *tally);
+    void (*row)(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
+                float *F_row, float *variance_row, rad_ff_tally *tally);
 } rad_ff_method;
 
 extern const rad_ff_method *const rad_ff_methods[]; /* NULL-terminated */
 const rad_ff_method *rad_ff_find(const char *name);
 
 /* Allocate F (and the variance for RAD_FF_VARIANCE methods; *variance_out
- * may be NULL to decline it), checking `max_memory` first; run the method;
- * optionally apply the closure correction; fill the diagnostics. */
+ * may be NULL to decline it), checking `max_memory` first; run the method
+ * over all rows in parallel (ctx->threads), polling rad_cancelled(ctx)
+ * (then RAD_ERROR_INTERRUPTED, with the rows done so far) and reporting
+ * progress with rad_progress(ctx, "form factors", ...); optionally apply
+ * the closure correction; fill the diagnostics. */
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
                             const rad_ff_request *req, double max_memory, bool close,
                             float **F_out, float **variance_out, rad_ff_stats *stats);
 
-/* For a method's parallel row loop: count one finished row; the master
- * thread reports progress and polls cancellation, raising *stop.  Called
- * from inside the OpenMP region.  Cannot fail. */
-void rad_ff_row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatile int *stop);
+/* ---- the plane tolerance and the facing test (formfactor.c): every
+ * method, and the hierarchical links ---- */
+
+/* Plane distances within this fraction of the scene's size count as 0:
+ * far above the rounding that leaves coplanar elements, or an edge shared
+ * with a plane, a few 1e-16 off it, far below any gap the mesh resolves
+ * (the shadow-ray offset is 1e-5 of the scene). */
+#define RAD_FF_PLANE_TOLERANCE 1e-9
+
+/* RAD_FF_PLANE_TOLERANCE x the extent of the mesh's vertices, m.  Cannot
+ * fail. */
+double rad_ff_plane_tolerance(const rad_mesh *mesh);
+
+/* True when one of the points lies in front of the plane through `origin`
+ * with unit `normal` by more than `tol`: what lies wholly on or behind a
+ * surface's plane exchanges no light with it.  Cannot fail. */
+bool rad_ff_in_front(const vec3 *point, size_t count, vec3 origin, vec3 normal, double tol);
+
+/* Elements i and j face each other: each reaches in front of the other's
+ * plane (through its centroid) by more than plane_tol (rad_ff_in_front);
+ * else their factors vanish.  Cannot fail. */
+bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
 
 /* Reciprocity-preserving closure correction for closed scenes: find x > 0
  * with sum_j x_i x_j A_i F_ij = A_i (symmetric Sinkhorn scaling of the
@@ -169,12 +222,5 @@ double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const
 
 /* rad_polygon_coupling of elements i and j of the mesh.  Cannot fail. */
 double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
-
-/* False when either element lies wholly on or behind the other's plane
- * (their factors vanish).  Cannot fail. */
-bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
-
-/* 1e-9 x the mesh's extent: coplanar elements are culled despite rounding. */
-double rad_ff_plane_tolerance(const rad_mesh *mesh);
 
 #endif /* RAD_FORMFACTOR_H */

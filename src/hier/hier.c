@@ -70,7 +70,7 @@ static const double *node_reflectance(const hr_state *st, const hr_node *n)
     return st->tree.scene->materials[pa->material].reflectance;
 }
 
-#define VALUES_WHAT "hierarchical: node values (a larger --epsilon or --min-area makes fewer nodes)"
+#define VALUES_WHAT "hierarchical: node values (a larger rad_options.epsilon or rad_options.min_area makes fewer nodes)"
 
 /* Grow the per-node arrays to the tree; new nodes start from their
  * parent's radiosity. */
@@ -739,7 +739,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                            .shadow_rays = p->shadow_rays > 0 ? (4 * p->shadow_rays < 64 ? 4 * p->shadow_rays : 64) : 16,
                            .epsilon = epsilon_abs,
                            .source_weight = p->classic_oracle ? 0.0 : HR_SOURCE_WEIGHT,
-                           .tol = 1e-9 * rad_scene_diagonal(scene),
+                           .tol = rad_ff_plane_tolerance(base),
                            .max_memory = p->max_memory,
                            .threads = rad_context_threads(ctx)};
     hr_refine_stats rs = {0};
@@ -770,7 +770,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         if (r == RAD_OK && bytes_in_use(&st) > p->max_memory)
             r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                          "hierarchical: %zu links and %zu nodes need %.3g GB, over the limit of %.3g GB "
-                         "(--max-memory); use a larger --epsilon or --min-area",
+                         "(rad_options.max_memory_bytes); use a larger rad_options.epsilon or rad_options.min_area",
                          st.links.count, st.tree.count, bytes_in_use(&st) / 1e9, p->max_memory / 1e9);
         hs->seconds_refine += rad_seconds() - t1;
         if (r != RAD_OK)

@@ -191,7 +191,7 @@ typedef struct hr_refine_params {
     int shadow_rays;      /* per link whose shaft is not empty */
     double epsilon;       /* power error allowed per link, W */
     double source_weight; /* of the oracle's source term (refine.c); 0: classic */
-    double tol;           /* geometric tolerance, m */
+    double tol;           /* m: rad_ff_plane_tolerance, for plane and shaft tests */
     double max_memory;    /* bytes the link lists may take */
     int threads;
 } hr_refine_params;

@@ -208,21 +208,16 @@ static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t 
     return all > 0.0 ? pass / all : 1.0;
 }
 
-/* Largest signed distance of a node's points from the plane (point o,
- * normal n). */
-static double front_extent(const hr_node *x, vec3 o, vec3 n)
+/* Does node x (a polygon, or a cluster's box) reach in front of surface
+ * node p's plane?  The facing test of the form factors, rad_ff_in_front. */
+static bool reaches_front(const hr_node *x, const hr_node *p, double tol)
 {
-    double best = -INFINITY;
-    if (x->kind == HR_SURFACE) {
-        for (int c = 0; c < x->corners; c++)
-            best = fmax(best, v3_dot(n, v3_sub(x->corner[c], o)));
-        return best;
-    }
-    for (int c = 0; c < 8; c++) {
-        vec3 p = v3(c & 1 ? x->hi.x : x->lo.x, c & 2 ? x->hi.y : x->lo.y, c & 4 ? x->hi.z : x->lo.z);
-        best = fmax(best, v3_dot(n, v3_sub(p, o)));
-    }
-    return best;
+    if (x->kind == HR_SURFACE)
+        return rad_ff_in_front(x->corner, x->corners, p->center, p->normal, tol);
+    vec3 box[8];
+    for (int c = 0; c < 8; c++)
+        box[c] = v3(c & 1 ? x->hi.x : x->lo.x, c & 2 ? x->hi.y : x->lo.y, c & 4 ? x->hi.z : x->lo.z);
+    return rad_ff_in_front(box, 8, p->center, p->normal, tol);
 }
 
 /* The mean over a receiver polygon of the exact point-to-polygon factor to
@@ -271,9 +266,9 @@ static bool make_link(const link_ctx *lc, uint32_t r, uint32_t s, uint32_t paren
     if (r == s && nr->kind == HR_SURFACE)
         return false; /* a flat surface does not see itself */
     /* Each end must reach in front of the other's plane. */
-    if (nr->kind == HR_SURFACE && front_extent(ns, nr->center, nr->normal) <= p->tol)
+    if (nr->kind == HR_SURFACE && !reaches_front(ns, nr, p->tol))
         return false;
-    if (ns->kind == HR_SURFACE && front_extent(nr, ns->center, ns->normal) <= p->tol)
+    if (ns->kind == HR_SURFACE && !reaches_front(nr, ns, p->tol))
         return false;
     double k;
     double spread = 0.0;
@@ -426,7 +421,7 @@ static rad_result links_reserve(rad_context *ctx, hr_links *l, size_t count)
     if (count <= l->capacity)
         return RAD_OK;
     hr_link *items = hr_grow(ctx, l->items, &l->capacity, count, sizeof *items,
-                             "hierarchical: links (a larger --epsilon or --min-area makes fewer)");
+                             "hierarchical: links (a larger rad_options.epsilon or rad_options.min_area makes fewer)");
     if (!items)
         return RAD_ERROR_OUT_OF_MEMORY;
     l->items = items;
@@ -449,7 +444,8 @@ rad_result hr_links_initial(rad_context *ctx, hr_tree *t, const hr_refine_params
     size_t P = t->base->patch_count;
     if ((double)P * (double)P * sizeof(hr_link) > 0.5 * 1e12)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: %zu patches make too many initial links; use --clustering on", P);
+                        "hierarchical: %zu patches make too many initial links; turn clustering on "
+                        "(rad_options.clustering)", P);
     hr_link *all = rad_alloc(ctx, RAD_MEM_HIERARCHY, P * P, sizeof *all, "hierarchical: initial links");
     uint8_t *keep = rad_alloc(ctx, RAD_MEM_HIERARCHY, P * P, 1, "hierarchical: initial links");
     rad_result r = !all || !keep ? RAD_ERROR_OUT_OF_MEMORY : RAD_OK;
@@ -573,8 +569,9 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
             (r = links_reserve(ctx, &next, total)) != RAD_OK) {
             if (r == RAD_OK)
                 r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                             "hierarchical: %zu links need %.3g GB, over the limit of %.3g GB (--max-memory); "
-                             "use a larger --epsilon or --min-area",
+                             "hierarchical: %zu links need %.3g GB, over the limit of %.3g GB "
+                             "(rad_options.max_memory_bytes); use a larger rad_options.epsilon or "
+                             "rad_options.min_area",
                              total + done.count, (double)(total + done.count) * sizeof(hr_link) / 1e9,
                              p->max_memory / 1e9);
             break;

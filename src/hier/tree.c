@@ -73,7 +73,7 @@ static rad_result reserve(rad_context *ctx, hr_tree *t, size_t extra)
     if (t->count + extra <= t->capacity)
         return RAD_OK;
     hr_node *nodes = hr_grow(ctx, t->nodes, &t->capacity, t->count + extra, sizeof *nodes,
-                             "hierarchical: nodes (a larger --min-area or --epsilon makes fewer)");
+                             "hierarchical: nodes (a larger rad_options.min_area or rad_options.epsilon makes fewer)");
     if (!nodes)
         return RAD_ERROR_OUT_OF_MEMORY;
     t->nodes = nodes;
@@ -297,7 +297,8 @@ rad_result hr_subdivide(rad_context *ctx, hr_tree *t, uint32_t k)
         return RAD_OK;
     if (t->count + 4 > (size_t)UINT32_MAX - 1)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: more than %u nodes; use a larger --min-area or --epsilon",
+                        "hierarchical: more than %u nodes; use a larger rad_options.min_area or "
+                        "rad_options.epsilon",
                         UINT32_MAX - 1);
     rad_result r = reserve(ctx, t, 4);
     if (r != RAD_OK)

@@ -61,7 +61,7 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
     *out = NULL;
     rad_mesh_options o = opt ? *opt : (rad_mesh_options){0};
     if (!(o.mesh_size >= 0.0) || !isfinite(o.mesh_size))
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "--mesh-size must be a positive length in metres");
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_options.mesh_size must be a positive length in metres");
     if (o.target_elements == 0)
         o.target_elements = 2000;
     if (o.crease_angle_degrees == 0.0)
@@ -88,7 +88,7 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
     if (nelem > (double)UINT32_MAX / 4) {
         rad_mesh_destroy(mesh);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "mesh: %.3g elements exceed the limit of %u; use a larger --mesh-size",
+                        "mesh: %.3g elements exceed the limit of %u; use a larger rad_options.mesh_size",
                         nelem, UINT32_MAX / 4);
     }
     mesh->mesh_size = h;
@@ -107,7 +107,8 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
         rad_mesh_destroy(mesh);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "mesh: %.0f elements need about %.2f GiB, above the memory limit of "
-                        "%.2f GiB (--max-memory); use a larger --mesh-size or fewer --elements",
+                        "%.2f GiB (rad_options.max_memory_bytes); use a larger rad_options.mesh_size or fewer "
+                        "rad_options.target_elements",
                         nelem, bytes / 1073741824.0, max_memory_bytes / 1073741824.0);
     }
     mesh->element_count = (size_t)nelem;

@@ -76,7 +76,7 @@ rad_result rad_camera_parse(rad_context *ctx, const char *text, rad_camera *came
     for (int i = 0; i < count; i++)
         if (!isfinite(value[i]))
             return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                            "--camera: number %d is not finite in '%s'", i + 1, text);
+                            "camera: number %d is not finite in '%s'", i + 1, text);
 
     rad_camera c;
     memcpy(c.position, value, sizeof c.position);
@@ -95,28 +95,28 @@ rad_result rad_camera_parse(rad_context *ctx, const char *text, rad_camera *came
     vec3 up = v3(c.up[0], c.up[1], c.up[2]);
     if (v3_length(forward) == 0.0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "--camera: position and look-at point coincide in '%s'", text);
+                        "camera: position and look-at point coincide in '%s'", text);
     /* Finite numbers can still be too far apart for a finite view
      * direction (1e308 and -1e308), or too large for the cross product
      * below: the renderer would get infinities. */
     if (!isfinite(v3_length(forward)) || !isfinite(v3_length(v3_cross(forward, up))))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "--camera: position, look-at point or up vector too large in '%s'", text);
+                        "camera: position, look-at point or up vector too large in '%s'", text);
     /* Up must leave a sideways direction: |f x u| against |f||u|, with
      * room for round-off in a nearly parallel pair. */
     if (v3_length(v3_cross(forward, up)) <= 1e-9 * v3_length(forward) * v3_length(up))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "--camera: up vector is zero or parallel to the view direction in '%s'",
+                        "camera: up vector is zero or parallel to the view direction in '%s'",
                         text);
     if (!(c.vfov_degrees > 0.0 && c.vfov_degrees < 180.0))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "--camera: vertical field of view must be in (0, 180) degrees, got %g",
+                        "camera: vertical field of view must be in (0, 180) degrees, got %g",
                         c.vfov_degrees);
     *camera = c;
     return RAD_OK;
 
 bad_count:
     return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                    "--camera: expected 6, 9 or 10 comma-separated numbers, got '%s'",
+                    "camera: expected 6, 9 or 10 comma-separated numbers, got '%s'",
                     text ? text : "");
 }

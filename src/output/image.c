@@ -133,6 +133,8 @@ rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *
 double rad_image_auto_exposure(const rad_image *image)
 {
     double exposure;
+    if (!image)
+        return 1.0;
     return rad_image_exposure(image->ctx, image, &exposure) == RAD_OK ? exposure : 1.0;
 }
 
@@ -218,6 +220,8 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
                                    double exposure)
 {
     rad_api_enter(ctx);
+    if (!ctx || !image || !path)
+        return rad_null_argument(ctx, __func__);
     char ext[8];
     rad_path_extension(path, ext, sizeof ext);
     int png = strcmp(ext, "png") == 0, hdr = strcmp(ext, "hdr") == 0,

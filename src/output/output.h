@@ -54,12 +54,12 @@ rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *
 
 /* The stats JSON of a solution (docs/stats.md); `partial` marks an
  * interrupted run. */
-rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *view, const char *path, int partial);
+rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *view, const char *path, bool partial);
 
 /* View factors by the path's extension (.json, .csv, .mtx; docs/formats.md),
  * surface-level or, with `elements`, element-level.  Fails without F. */
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *view, const char *path,
-                                  int elements);
+                                  bool elements);
 
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
 rad_result rad_write_history(rad_context *ctx, const rad_solution_view *view, const char *path);

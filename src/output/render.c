@@ -40,7 +40,7 @@ static rad_result check_size(rad_context *ctx, const char *what, int value)
 {
     if (value < 1 || value > RAD_RENDER_MAX_SIZE)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "render: %s must be in 1..%d (0 = default), got %d", what,
+                        "rad_render_options.%s must be in [1, %d], got %d", what,
                         RAD_RENDER_MAX_SIZE, value);
     return RAD_OK;
 }

@@ -65,8 +65,8 @@ rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *
                                             double seconds, const char *path)
 {
     rad_api_enter(ctx);
-    if (!scene || !phase || !path)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_write_interrupted_stats: NULL argument");
+    if (!ctx || !scene || !phase || !path)
+        return rad_null_argument(ctx, __func__);
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
@@ -83,15 +83,14 @@ rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *
     return r;
 }
 
-rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const char *path,
-                                    int partial)
+rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const char *path, bool partial)
 {
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
     size_t n = s->n;
     cJSON_AddStringToObject(root, "version", RAD_VERSION_STRING);
-    cJSON_AddBoolToObject(root, "partial", partial != 0);
+    cJSON_AddBoolToObject(root, "partial", partial);
     cJSON_AddStringToObject(root, "scene", s->scene->source);
     cJSON_AddNumberToObject(root, "threads", rad_context_threads(ctx));
     cJSON_AddNumberToObject(root, "seed", (double)s->options->seed);
@@ -292,7 +291,7 @@ static void vf_rows_free(vf_rows *r)
     memset(r, 0, sizeof *r);
 }
 
-static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, int elements, vf_rows *r)
+static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bool elements, vf_rows *r)
 {
     memset(r, 0, sizeof *r);
     size_t n = s->n, S = s->scene->surface_count;
@@ -302,7 +301,8 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, in
     if (bytes > s->options->max_memory_bytes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "view factors: the %zu x %zu table needs %.2f GiB, above the memory limit "
-                        "of %.2f GiB (--max-memory); use --level surface or fewer --elements",
+                        "of %.2f GiB (rad_options.max_memory_bytes); use surface-level view factors or fewer "
+                        "rad_options.target_elements",
                         r->count, r->count, bytes / 1073741824.0,
                         s->options->max_memory_bytes / 1073741824.0);
     r->names = rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->names, "view factors: names");
@@ -352,7 +352,7 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, in
 }
 
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
-                                           int elements)
+                                  bool elements)
 {
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);

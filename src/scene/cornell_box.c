@@ -198,10 +198,10 @@ static const char cornell_box_mtl[] =
 rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **out)
 {
     rad_api_enter(ctx);
-    if (!out)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "rad_scene_create_cornell_box: out is NULL");
-    *out = NULL;
+    if (out)
+        *out = NULL;
+    if (!ctx || !out)
+        return rad_null_argument(ctx, __func__);
     double start = rad_seconds();
     rad_scene *scene;
     rad_result r = rad_import_assimp_memory(ctx, "cornell_box.obj", cornell_box_obj,

@@ -584,15 +584,16 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
                                      rad_scene **out)
 {
     rad_api_enter(ctx);
-    if (!out)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_generate_office: out is NULL");
-    *out = NULL;
+    if (out)
+        *out = NULL;
+    if (!ctx || !out)
+        return rad_null_argument(ctx, __func__);
     rad_office_options o = options ? *options : (rad_office_options){0};
     if (o.rooms == 0)
         o.rooms = OFFICE_DEFAULT_ROOMS;
     if (o.rooms < 1 || o.rooms > OFFICE_MAX_ROOMS)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "office: rooms must be in [1, %d], got %d", OFFICE_MAX_ROOMS, o.rooms);
+                        "rad_office_options.rooms must be in [1, %d], got %d", OFFICE_MAX_ROOMS, o.rooms);
     double start = rad_seconds();
 
     office g = {.ctx = ctx, .seed = o.seed, .rooms = o.rooms};

@@ -311,7 +311,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
         rad_format_bytes(limit, limit_text, sizeof limit_text);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "%s: a file of %s may need %s to import (%.0fx its size), above the memory "
-                        "limit of %s (--max-memory)",
+                        "limit of %s (rad_context_options.max_memory_bytes)",
                         name, file_size, need, ASSIMP_PEAK_PER_BYTE, limit_text);
     }
     cJSON *json = gltf && data ? import_gltf_json(data, size, glb) : NULL;
@@ -396,7 +396,7 @@ static rad_result read_file(rad_context *ctx, const char *path, const char *what
             rad_format_bytes((double)st.st_size, file_size, sizeof file_size);
             rad_format_bytes(limit, limit_text, sizeof limit_text);
             return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                            "%s: the file's %s pass the memory limit of %s (--max-memory)", what,
+                            "%s: the file's %s pass the memory limit of %s (rad_context_options.max_memory_bytes)", what,
                             file_size, limit_text);
         }
         capacity = (size_t)st.st_size + 1; /* + 1: the read that finds the end needs no growth */

@@ -526,11 +526,10 @@ done:
 rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out)
 {
     rad_api_enter(ctx);
-    if (!out)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_file: out is NULL");
-    *out = NULL;
-    if (!path)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_file: path is NULL");
+    if (out)
+        *out = NULL;
+    if (!ctx || !path || !out)
+        return rad_null_argument(ctx, __func__);
     double start = rad_seconds();
     rad_result r = rad_import_assimp_file(ctx, path, out);
     if (r == RAD_OK)
@@ -543,12 +542,10 @@ rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void 
                                  rad_scene **out)
 {
     rad_api_enter(ctx);
-    if (!out)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_load_memory: out is NULL");
-    *out = NULL;
-    if (!name || (!data && size > 0) || (!mtl && mtl_size > 0))
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "rad_scene_load_memory: name is NULL, or data is NULL with a size");
+    if (out)
+        *out = NULL;
+    if (!ctx || !name || !out || (!data && size > 0) || (!mtl && mtl_size > 0))
+        return rad_null_argument(ctx, __func__);
     double start = rad_seconds();
     rad_result r = rad_import_assimp_memory(ctx, name, data, size, mtl, mtl_size, out);
     if (r == RAD_OK)
@@ -587,12 +584,12 @@ double rad_scene_surface_area(const rad_scene *scene, size_t surface)
 
 size_t rad_scene_polygon_count(const rad_scene *scene) { return scene ? scene->polygon_count : 0; }
 
-int rad_scene_camera(const rad_scene *scene, rad_camera *camera)
+bool rad_scene_camera(const rad_scene *scene, rad_camera *camera)
 {
     if (!scene || !scene->has_camera || !camera)
-        return 0;
+        return false;
     *camera = scene->camera;
-    return 1;
+    return true;
 }
 
 bool rad_scene_has_emitter(const rad_scene *scene)

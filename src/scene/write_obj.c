@@ -157,9 +157,10 @@ static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE 
 rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path)
 {
     rad_api_enter(ctx);
-    if (!scene || !path || !*path)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "rad_scene_write_obj: scene or path is NULL");
+    if (!ctx || !scene || !path)
+        return rad_null_argument(ctx, __func__);
+    if (!*path)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "rad_scene_write_obj: the path is empty");
     /* PATH.obj -> PATH.mtl; any other name gets ".mtl" appended. */
     size_t length = strlen(path);
     char extension[8];

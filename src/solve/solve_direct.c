@@ -75,8 +75,8 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
         format_bytes(limit, limit_text, sizeof limit_text);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "solve: the direct solver's LU of the %zu x %zu system needs %s (8 n^2 bytes), "
-                        "above the memory limit of %s (--max-memory); use an iterative solver "
-                        "(--solver gauss-seidel, jacobi or conjugate-gradient) or fewer elements",
+                        "above the memory limit of %s (rad_options.max_memory_bytes); use an iterative solver "
+                        "(rad_options.solver: gauss-seidel, jacobi or conjugate-gradient) or fewer elements",
                         n, n, need_text, limit_text);
     }
     if (n == 0) {
@@ -152,6 +152,6 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
 const rad_solver rad_solver_direct = {
     "direct",
     "LU factorisation (LAPACK dgesv) per colour channel: exact, the reference; O(n^3) time, "
-    "8 n^2 bytes (refused above --max-memory)",
+    "8 n^2 bytes (refused above rad_options.max_memory_bytes)",
     direct,
 };

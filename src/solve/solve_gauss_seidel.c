@@ -71,7 +71,7 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
 
 const rad_solver rad_solver_gauss_seidel = {
     "gauss-seidel",
-    "gathering, newest values first, optional SOR (--relaxation); O(n^2) per sweep, "
+    "gathering, newest values first, optional SOR (rad_options.relaxation); O(n^2) per sweep, "
     "error shrinks ~rho per sweep",
     gauss_seidel,
 };

@@ -94,6 +94,6 @@ static rad_result jacobi(rad_context *ctx, const rad_system *sys, const rad_solv
 const rad_solver rad_solver_jacobi = {
     "jacobi",
     "Jacobi iteration: all rows from the last sweep, in parallel, optional weighting "
-    "(--relaxation); O(n^2) per sweep, error shrinks ~rho per sweep",
+    "(rad_options.relaxation); O(n^2) per sweep, error shrinks ~rho per sweep",
     jacobi,
 };

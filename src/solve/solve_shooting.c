@@ -161,7 +161,7 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     if (bytes > limit)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "shooting: %d rays per shot for %zu elements need %.2f GiB, above the "
-                        "memory limit of %.2f GiB (--max-memory); use fewer --ff-samples",
+                        "memory limit of %.2f GiB (rad_options.max_memory_bytes); use fewer rad_options.samples",
                         N, n, bytes / 1073741824.0, limit / 1073741824.0);
     double *dB = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *dB, "shooting: unshot radiosity");
     heap h = {0};
@@ -319,6 +319,6 @@ done:
 const rad_solver rad_solver_shooting = {
     "shooting",
     "matrix-free progressive refinement: form-factor columns sampled by rays from the "
-    "shooter (--ff-samples per shot); O(n) memory, for 10^5-10^6 elements",
+    "shooter (rad_options.samples per shot); O(n) memory, for 10^5-10^6 elements",
     shooting,
 };

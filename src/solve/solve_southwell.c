@@ -136,6 +136,6 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
 const rad_solver rad_solver_southwell = {
     "southwell",
     "progressive refinement: shoot the largest unshot power (Cohen et al. 1988), "
-    "overshooting with --relaxation > 1, ambient term for display; O(n) per shot",
+    "overshooting with rad_options.relaxation > 1, ambient term for display; O(n) per shot",
     southwell,
 };

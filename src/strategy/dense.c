@@ -40,19 +40,19 @@ static rad_result check_ff_scratch(rad_context *ctx, const rad_options *o, size_
     double per_thread = 8.0 * (double)n;
     if (strcmp(method, "hemisphere") == 0 || strcmp(method, "montecarlo") == 0) {
         per_thread += 4.0 * (double)(o->samples > 0 ? o->samples : 0);
-        option = "--ff-samples";
+        option = "rad_options.samples";
     } else if (strcmp(method, "hemicube") == 0) {
         double R = o->hemicube_resolution > 0 ? o->hemicube_resolution : 256;
         per_thread += 3.0 * R * R * 8.0; /* depth (float) and item (uint32) per pixel */
-        option = "--hemicube-res";
+        option = "rad_options.hemicube_resolution";
     }
     double matrix = 4.0 * (double)n * (double)n;
     double scratch = per_thread * (threads > 0 ? threads : 1);
     if (option && matrix <= o->max_memory_bytes && matrix + scratch > o->max_memory_bytes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "form factors: %s needs %.2f GiB of scratch on %d threads beside the "
-                        "%.2f GiB matrix, above the memory limit of %.2f GiB (--max-memory); "
-                        "use a smaller %s or fewer --threads",
+                        "%.2f GiB matrix, above the memory limit of %.2f GiB (rad_options.max_memory_bytes); "
+                        "use a smaller %s or fewer threads",
                         method, scratch / 1073741824.0, threads, matrix / 1073741824.0,
                         o->max_memory_bytes / 1073741824.0, option);
     return RAD_OK;
@@ -124,7 +124,7 @@ static void dense_view(const void *state, rad_solution_view *v)
 
 const rad_strategy rad_strategy_dense = {
     "dense",
-    "the n x n form-factor matrix (--form-factors), then a linear solver",
+    "the n x n form-factor matrix (rad_options.form_factors), then a linear solver",
     dense_solver_info,
     dense_create,
     dense_solve,

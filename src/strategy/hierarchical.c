@@ -32,7 +32,8 @@ static bool hierarchical_solver_info(size_t index, const char **name, const char
         return false;
     *name = "hierarchical";
     *description = "matrix-free: Hanrahan-Salzman-Aupperle links between element quadtrees, clusters, "
-                   "BF refinement; meshes as it solves; ~10 links per element (--epsilon, --min-area)";
+                   "BF refinement; meshes as it solves; ~10 links per element (rad_options.epsilon, "
+                   "rad_options.min_area)";
     return true;
 }
 

@@ -32,8 +32,8 @@ static rad_result matrix_free_create(rad_context *ctx, const rad_scene *scene, c
     *out = NULL;
     if (o->closure_correction)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "closure correction rescales form factors, and solver '%s' computes them afresh for "
-                        "every shot: use a gathering solver or hierarchical",
+                        "rad_options.closure_correction rescales form factors, and solver '%s' computes "
+                        "them afresh for every shot: use a gathering solver or hierarchical",
                         o->solver);
     rad_meshed *m = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *m, "solution: matrix-free state");
     if (!m)
