@@ -454,7 +454,7 @@ static void test_loading_limits(void **state)
     fclose(f);
     assert_int_equal(truncate(path, (off_t)100 << 30), 0); /* 100 GiB, no blocks */
     assert_int_equal(run("render sparse.obj -o zout.png --max-memory 64M"), 1);
-    assert_one_line_error("sparse.obj: the file's 100.00 GiB pass the memory limit of 64.0 MiB", NULL);
+    assert_one_line_error("sparse.obj: a file of 100.00 GiB, larger than the memory limit of 64.0 MiB", NULL);
     assert_no_output("zout");
     remove(path);
 

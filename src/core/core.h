@@ -63,9 +63,10 @@ typedef enum rad_memory_category {
     RAD_MEM_CATEGORIES      /* count; as an argument: all categories together */
 } rad_memory_category;
 
-/* A context's accounting.  Counters are atomic: per-thread scratch is
- * allocated before a parallel region, but solutions in other threads may
- * share a context's counters. */
+/* A context's accounting.  The counters are atomic so that they stay exact
+ * whichever thread frees a block (an object may be destroyed on another
+ * thread than the one that made it); the engine itself allocates on the
+ * calling thread only, never inside a parallel region. */
 typedef struct rad_memory {
     atomic_size_t references;                   /* live blocks, + 1 until rad_context_destroy */
     size_t limit;                               /* bytes: rad_context_options.max_memory_bytes */

@@ -396,8 +396,9 @@ static rad_result read_file(rad_context *ctx, const char *path, const char *what
             rad_format_bytes((double)st.st_size, file_size, sizeof file_size);
             rad_format_bytes(limit, limit_text, sizeof limit_text);
             return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                            "%s: the file's %s pass the memory limit of %s (rad_context_options.max_memory_bytes)", what,
-                            file_size, limit_text);
+                            "%s: a file of %s, larger than the memory limit of %s "
+                            "(rad_context_options.max_memory_bytes)",
+                            what, file_size, limit_text);
         }
         capacity = (size_t)st.st_size + 1; /* + 1: the read that finds the end needs no growth */
     }
