@@ -197,6 +197,8 @@ int main(int argc, char **argv)
     progress_state progress = {0};
     rad_context_options co = {0};
     co.threads = s.threads;
+    /* --max-memory limits everything the engine allocates, loading included. */
+    co.max_memory_bytes = s.solve.max_memory_bytes;
     if (!s.quiet && isatty(STDERR_FILENO)) {
         co.progress = progress_bar;
         co.progress_user = &progress;

@@ -428,6 +428,8 @@ static size_t names_field(const char *p, const cli_flag *f)
 
 char *cli_rewrite_message(const char *message, char *out, size_t size)
 {
+    /* The context's memory limit is the one --max-memory sets too (main.c). */
+    static const char context_limit[] = "rad_context_options.max_memory_bytes";
     size_t n = 0;
     if (!size)
         return out;
@@ -435,7 +437,13 @@ char *cli_rewrite_message(const char *message, char *out, size_t size)
         size_t skip = 0, k = 0;
         while (k < FLAG_COUNT && !(skip = names_field(p, &FLAGS[k])))
             k++;
-        if (skip) {
+        if (!skip && strncmp(p, context_limit, sizeof context_limit - 1) == 0) {
+            skip = sizeof context_limit - 1;
+            k = 0;
+            while (k < FLAG_COUNT && strcmp(FLAGS[k].name, "max-memory") != 0)
+                k++;
+        }
+        if (skip && k < FLAG_COUNT) {
             size_t wrote = (size_t)snprintf(out + n, size - n, "--%s", FLAGS[k].name);
             n += wrote < size - n ? wrote : size - n - 1;
             p += skip;

@@ -126,16 +126,26 @@ typedef struct rad_context_options {
     void *progress_user;         /* passed to `progress` */
     rad_error_fn on_error;       /* optional: told of every failure */
     void *error_user;            /* passed to `on_error` */
+    double max_memory_bytes;     /* the memory limit: everything the engine allocates in
+                                    this context (scenes while loading included) stays
+                                    below it, else RAD_ERROR_OUT_OF_MEMORY with the limit
+                                    named; 0 = 80% of physical memory.  Memory that
+                                    assimp, Embree, LAPACK and cJSON allocate themselves
+                                    is not counted (loading refuses files that assimp
+                                    would need more than the limit for: docs/robustness.md) */
 } rad_context_options;
 
 /* Create a context.  `options` may be NULL (all defaults); it is copied, but
  * the pointers in it (progress_user, error_user) are kept and must stay
  * valid until the context is destroyed.  Fails with
- * RAD_ERROR_INVALID_ARGUMENT when `out` is NULL or threads < 0,
- * RAD_ERROR_OUT_OF_MEMORY when the allocation fails (no context then holds
- * a message). */
+ * RAD_ERROR_INVALID_ARGUMENT when `out` is NULL, threads < 0 or
+ * max_memory_bytes < 0, RAD_ERROR_OUT_OF_MEMORY when the allocation fails
+ * (no context then holds a message). */
 RAD_API rad_result rad_context_create(const rad_context_options *options, rad_context **out);
-/* Free the context.  NULL: no-op.  Objects made with it are not affected. */
+/* Destroy the context.  NULL: no-op.  Objects made with it are not
+ * affected: their memory stays accounted to it, and a context destroyed
+ * before them lives on (for no further calls) until the last of them is
+ * destroyed. */
 RAD_API void rad_context_destroy(rad_context *ctx);
 /* The message of the most recent failed call in this context ("" if none):
  * its FIRST failure, which names the cause ("box.obj:12: ..."), not what
@@ -316,7 +326,9 @@ typedef struct rad_options {
 
     uint64_t seed;                /* all sampling is seeded per element pair: results do
                                      not depend on the thread count */
-    double max_memory_bytes;      /* refuse to allocate more; 0 = 80% of physical memory */
+    double max_memory_bytes;      /* 0 = the context's limit (rad_context_options); else a
+                                     lower limit for this solution's calls (create, solve,
+                                     render, the writers); never above the context's */
 } rad_options;
 
 /* Mesh the scene, build visibility and compute form factors, on the
@@ -464,7 +476,8 @@ RAD_API const float *rad_image_pixels(const rad_image *image);
  * RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
 /* The automatic exposure of an image: the multiplier that maps the 95th
- * percentile of its luminance to 0.8 (1 if it is black, or NULL). */
+ * percentile of its luminance to 0.8 (1 if it is black, or NULL, or when
+ * its context has no memory for a float per pixel). */
 RAD_API double rad_image_auto_exposure(const rad_image *image);
 
 /* As rad_image_write, with the PNG exposure given (0 = automatic; ignored

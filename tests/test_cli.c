@@ -19,6 +19,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 static const char *radiosity_bin;
@@ -427,6 +428,41 @@ static void test_limits(void **state)
     assert_no_output("big");
 }
 
+/* --max-memory limits loading too: endless input (/dev/zero under an OBJ
+ * name) is read only up to the limit, a file larger than the limit is
+ * refused by its size without being read, and /dev/zero itself is no
+ * scene; each fails at once with one line and exit status 1. */
+static void test_loading_limits(void **state)
+{
+    (void)state;
+    char path[600];
+    snprintf(path, sizeof path, "%s/zero.obj", workdir);
+    remove(path);
+    assert_int_equal(symlink("/dev/zero", path), 0);
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    assert_int_equal(run("render zero.obj -o zout.png --max-memory 64M"), 1);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    assert_one_line_error("zero.obj: ", "memory limit of 64.0 MiB");
+    assert_true((double)(t1.tv_sec - t0.tv_sec) < 20.0);
+    assert_no_output("zout");
+    remove(path);
+
+    snprintf(path, sizeof path, "%s/sparse.obj", workdir);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fclose(f);
+    assert_int_equal(truncate(path, (off_t)100 << 30), 0); /* 100 GiB, no blocks */
+    assert_int_equal(run("render sparse.obj -o zout.png --max-memory 64M"), 1);
+    assert_one_line_error("sparse.obj: a file of 100.00 GiB, larger than the memory limit of 64.0 MiB", NULL);
+    assert_no_output("zout");
+    remove(path);
+
+    assert_int_equal(run("render /dev/zero -o zout.png --max-memory 64M"), 1);
+    assert_one_line_error("/dev/zero", NULL);
+    assert_no_output("zout");
+}
+
 /* SIGTERM while the form factors are computed (the dense analytic matrix
  * for 12,000 elements takes far longer than the 2 s we wait): exit 143,
  * the stats say "partial" and name the phase, no image (there is no
@@ -503,6 +539,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_interrupt_writes_partial),
         cmocka_unit_test(test_interrupt_during_form_factors),
         cmocka_unit_test(test_limits),
+        cmocka_unit_test(test_loading_limits),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -614,7 +614,9 @@ static void test_bad_options(void **state)
     o.min_area = NAN;
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_INVALID_ARGUMENT);
     o.min_area = 0.0;
-    o.max_memory_bytes = 1e4; /* far too little: a clear error, no crash */
+    /* Room for the patches beside what the context holds (the scene), far
+     * too little for the hierarchy: a clear error, no crash. */
+    o.max_memory_bytes = (double)rad_memory_in_use(ctx, RAD_MEM_CATEGORIES) + 65536.0;
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_OUT_OF_MEMORY);
     assert_non_null(strstr(rad_context_error(ctx), "rad_options.max_memory_bytes"));

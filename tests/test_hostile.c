@@ -585,15 +585,15 @@ static void test_allocation_overflow(void **state)
 {
     (void)state;
     rad_api_enter(ctx); /* a new call: its first failure is kept */
-    assert_null(rad_alloc_array(ctx, SIZE_MAX / 2 + 1, 2, "huge table"));
+    assert_null(rad_alloc(ctx, RAD_MEM_SOLVER, SIZE_MAX / 2 + 1, 2, "huge table"));
     assert_non_null(strstr(rad_context_error(ctx), "huge table"));
     assert_non_null(strstr(rad_context_error(ctx), "overflows"));
     rad_api_enter(ctx); /* a new call: its first failure is kept */
-    assert_null(rad_alloc_array(ctx, (size_t)1 << 40, (size_t)1 << 30, "n^2 matrix"));
+    assert_null(rad_alloc(ctx, RAD_MEM_SOLVER, (size_t)1 << 40, (size_t)1 << 30, "n^2 matrix"));
     assert_non_null(strstr(rad_context_error(ctx), "n^2 matrix"));
-    void *one = rad_alloc_array(ctx, SIZE_MAX, 0, "nothing"); /* 0 bytes: a valid block */
+    void *one = rad_alloc(ctx, RAD_MEM_SOLVER, SIZE_MAX, 0, "nothing"); /* 0 bytes: a valid block */
     assert_non_null(one);
-    free(one);
+    rad_free(one);
 }
 
 static int setup(void **state)

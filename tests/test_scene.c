@@ -462,20 +462,21 @@ static void test_triangulate_l_shape(void **state)
     /* An L: the 2 x 2 square without its top-right unit square; area 3. */
     const vec3 l_shape[] = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
     uint32_t t[12];
-    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, 1), t), 4);
+    double scratch[32]; /* RAD_TRIANGULATE_SCRATCH(8) bytes and more */
+    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, 1), scratch, t), 4);
     assert_close(triangles_area(l_shape, t, 4, v3(0, 0, 1)), 3.0, 1e-15);
     assert_close(0.5 * v3_length(rad_polygon_newell(l_shape, 6)), 3.0, 1e-15);
 
     /* Seen from the other side (clockwise about the normal) the triangles
      * keep the polygon's own winding. */
-    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, -1), t), 4);
+    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, -1), scratch, t), 4);
     assert_close(triangles_area(l_shape, t, 4, v3(0, 0, 1)), 3.0, 1e-15);
 
     /* The same L standing in the x = 5 plane, tilted normal. */
     vec3 standing[6];
     for (int i = 0; i < 6; i++)
         standing[i] = v3(5.0, l_shape[i].x, l_shape[i].y);
-    assert_int_equal(rad_triangulate_polygon(standing, 6, v3(1, 0.01, 0), t), 4);
+    assert_int_equal(rad_triangulate_polygon(standing, 6, v3(1, 0.01, 0), scratch, t), 4);
     assert_close(triangles_area(standing, t, 4, v3(1, 0, 0)), 3.0, 1e-15);
 }
 
@@ -486,7 +487,8 @@ static void test_triangulate_collinear(void **state)
     const vec3 square[] = {{0, 0, 0},   {0.5, 0, 0}, {1, 0, 0},   {1, 0.5, 0},
                            {1, 1, 0},   {0.5, 1, 0}, {0, 1, 0},   {0, 0.5, 0}};
     uint32_t t[18];
-    assert_int_equal(rad_triangulate_polygon(square, 8, v3(0, 0, 1), t), 6);
+    double scratch[32]; /* RAD_TRIANGULATE_SCRATCH(8) bytes and more */
+    assert_int_equal(rad_triangulate_polygon(square, 8, v3(0, 0, 1), scratch, t), 6);
     assert_close(triangles_area(square, t, 6, v3(0, 0, 1)), 1.0, 1e-15);
 }
 
@@ -494,16 +496,17 @@ static void test_triangulate_rejects(void **state)
 {
     (void)state;
     uint32_t t[12];
+    double scratch[32]; /* RAD_TRIANGULATE_SCRATCH(8) bytes and more */
     /* A symmetric bowtie (area 0) and a lopsided one (area != 0). */
     const vec3 bowtie[] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 1, 0}};
     const vec3 lopsided[] = {{0, 0, 0}, {2, 1, 0}, {2, 0, 0}, {0, 2, 0}};
     const vec3 line[] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
     const vec3 spike[] = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {2, 3, 0}, {2, 1, 0}, {0, 1, 0}};
-    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 1), t), 0);
-    assert_int_equal(rad_triangulate_polygon(lopsided, 4, v3(0, 0, 1), t), 0);
-    assert_int_equal(rad_triangulate_polygon(line, 3, v3(0, 0, 1), t), 0);
-    assert_int_equal(rad_triangulate_polygon(spike, 6, v3(0, 0, 1), t), 0);
-    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 0), t), 0);
+    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(lopsided, 4, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(line, 3, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(spike, 6, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 0), scratch, t), 0);
 }
 
 /* ---- bad input: the code, and a message naming the file (and line) ---- */

@@ -30,21 +30,25 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
         *out = NULL;
     if (!ctx || !scene || !out)
         return rad_null_argument(ctx, __func__);
-    rad_solution *s = calloc(1, sizeof *s);
+    rad_solution *s = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *s, "solution");
     if (!s)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
+    s->ctx = ctx;
     s->scene = scene;
     s->threads = rad_context_threads(ctx);
     rad_result r = rad_options_resolve(ctx, options, &s->options, &s->names);
     if (r != RAD_OK) {
-        free(s);
+        rad_free(s);
         return r;
     }
+    /* One limit: the context's, or the solution's own where lower. */
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes);
+    s->options.max_memory_bytes = rad_memory_limit(ctx);
     /* mesh -> visibility -> couplings, as the strategy does them */
     s->strategy = rad_strategy_for_solver(s->options.solver);
     r = s->strategy->create(ctx, scene, &s->options, &s->state);
     if (r != RAD_OK) {
-        free(s);
+        rad_free(s);
         return r;
     }
     s->view.seconds.load = scene->load_seconds;
@@ -57,9 +61,11 @@ static bool history_push(rad_solution *s, const rad_solve_step *step)
 {
     if (s->history_count == s->history_capacity) {
         size_t cap = s->history_capacity ? 2 * s->history_capacity : 256;
-        rad_solve_step *h = realloc(s->history, cap * sizeof *h);
-        if (!h)
+        rad_solve_step *h = rad_realloc(s->ctx, RAD_MEM_SOLVER, s->history, cap, sizeof *h, "solve: history");
+        if (!h) {
+            s->history_failed = true;
             return false;
+        }
         s->history = h;
         s->history_capacity = cap;
     }
@@ -84,6 +90,7 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     rad_api_enter(ctx);
     if (!ctx || !s)
         return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     if (!rad_scene_has_emitter(s->scene))
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
@@ -92,7 +99,8 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     if (s->options.record_history || s->options.on_step)
         hook.fn = on_strategy_step;
     s->history_count = 0;
-    free(s->vertex_radiosity);
+    s->history_failed = false;
+    rad_free(s->vertex_radiosity);
     s->vertex_radiosity = NULL;
     rad_result r = s->strategy->solve(ctx, s->state, &hook);
     refresh_view(s);
@@ -112,7 +120,9 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
             tail->unshot = last.unshot;
     }
     refresh_view(s);
-    return r;
+    /* A history that could not grow stopped the solve (or lost its last row):
+     * out of memory, as the allocator's message says, not an interruption. */
+    return s->history_failed ? RAD_ERROR_OUT_OF_MEMORY : r;
 }
 
 const rad_solve_step *rad_solution_history(const rad_solution *s, size_t *count)
@@ -132,9 +142,9 @@ void rad_solution_destroy(rad_solution *s)
         return;
     if (s->strategy)
         s->strategy->destroy(s->state);
-    free(s->history);
-    free(s->vertex_radiosity);
-    free(s);
+    rad_free(s->history);
+    rad_free(s->vertex_radiosity);
+    rad_free(s);
 }
 
 size_t rad_solution_element_count(const rad_solution *s) { return s ? s->view.n : 0; }
@@ -155,7 +165,7 @@ void rad_solution_surface_radiosity(const rad_solution *s, size_t surface, doubl
 void rad_solution_surface_view_factors(const rad_solution *s, double *F)
 {
     if (s && F)
-        rad_view_surface_view_factors(&s->view, F);
+        rad_view_surface_view_factors(s->ctx, &s->view, F);
 }
 
 void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed)
@@ -167,7 +177,7 @@ void rad_solution_power(const rad_solution *s, double *emitted, double *absorbed
         *emitted = *absorbed = NAN;
         return;
     }
-    rad_view_power(&s->view, emitted, absorbed);
+    rad_view_power(s->ctx, &s->view, emitted, absorbed);
 }
 
 size_t rad_solution_vertex_count(const rad_solution *s) { return s && s->view.mesh ? s->view.mesh->vertex_count : 0; }
@@ -186,6 +196,7 @@ rad_result rad_solution_vertex_radiosity(rad_context *ctx, const rad_solution *s
     rad_api_enter(ctx);
     if (!ctx || !s || !rgb)
         return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_vertex_values(ctx, s->view.mesh, s->view.radiosity, rgb);
 }
 
@@ -252,27 +263,28 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
         *out = NULL;
     if (!ctx || !s || !out)
         return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     rad_render_options o = options ? *options : (rad_render_options){0};
     size_t n = s->view.mesh->element_count;
     /* Display values: a partial shooting solution gets the ambient term. */
-    double *display = rad_alloc_array(ctx, 3 * n, sizeof *display, "render: element values");
+    double *display = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *display, "render: element values");
     if (!display)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++)
             display[3 * i + c] = s->view.radiosity[3 * i + c] +
                                  s->view.reflectance[3 * i + c] * s->view.solve->ambient[c];
-    free(s->vertex_radiosity);
-    s->vertex_radiosity = rad_alloc_array(ctx, 3 * s->view.mesh->vertex_count, sizeof *s->vertex_radiosity,
-                                          "render: vertex values");
+    rad_free(s->vertex_radiosity);
+    s->vertex_radiosity = rad_alloc(ctx, RAD_MEM_RENDER, 3 * s->view.mesh->vertex_count, sizeof *s->vertex_radiosity,
+                                    "render: vertex values");
     if (!s->vertex_radiosity) {
-        free(display);
+        rad_free(display);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double t = rad_seconds();
     rad_result r = rad_vertex_values(ctx, s->view.mesh, display, s->vertex_radiosity);
     if (r != RAD_OK) {
-        free(display);
+        rad_free(display);
         return r;
     }
     rad_render_input in;
@@ -284,7 +296,7 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     /* The image (3 floats a pixel) and its 8-bit copy for PNG. */
     double image_bytes = 15.0 * (double)w * (double)h;
     if (w <= 16384 && h <= 16384 && image_bytes > s->options.max_memory_bytes) {
-        free(display);
+        rad_free(display);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "render: a %dx%d image needs %.2f GiB, above the memory limit of %.2f GiB "
                         "(rad_options.max_memory_bytes); use a smaller rad_render_options.width / "
@@ -299,7 +311,7 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     s->view.seconds.render = rad_seconds() - t;
     int spp = o.samples > 0 ? o.samples : 4;
     s->view.render_rays = (uint64_t)w * (uint64_t)h * (uint64_t)spp * (uint64_t)spp;
-    free(display);
+    rad_free(display);
     return r;
 }
 
@@ -308,6 +320,7 @@ rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, con
     rad_api_enter(ctx);
     if (!ctx || !s || !path)
         return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_write_stats(ctx, &s->view, path, partial);
 }
 
@@ -317,6 +330,7 @@ rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution 
     rad_api_enter(ctx);
     if (!ctx || !s || !path)
         return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_write_view_factors(ctx, &s->view, path, elements);
 }
 
@@ -325,6 +339,7 @@ rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, c
     rad_api_enter(ctx);
     if (!ctx || !s || !path)
         return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_write_history(ctx, &s->view, path);
 }
 

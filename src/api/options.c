@@ -343,9 +343,11 @@ rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_opti
         if (r != RAD_OK)
             return r;
     }
-    /* The one default that is not a constant. */
+    /* The one default that is not a constant: the context's memory limit
+     * (rad_context_options.max_memory_bytes), which a solution's own only
+     * lowers (api.c). */
     if (o.max_memory_bytes == 0.0)
-        o.max_memory_bytes = 0.8 * (double)rad_physical_memory_bytes();
+        o.max_memory_bytes = rad_memory_limit(ctx);
     if (!(o.max_memory_bytes > 0.0))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "rad_options.max_memory_bytes: the physical memory is unknown, give a limit");

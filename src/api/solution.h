@@ -12,6 +12,7 @@
 #include "strategy/strategy.h"
 
 struct rad_solution {
+    rad_context *ctx;              /* made in: its memory is accounted there (must outlive it) */
     const rad_scene *scene;        /* borrowed: must outlive the solution */
     rad_options options;           /* resolved defaults */
     rad_method_names names;        /* what options' method names point to */
@@ -21,6 +22,7 @@ struct rad_solution {
     rad_solution_view view;        /* read-only view, refreshed after create and every solve */
     rad_solve_step *history;       /* the last solve's steps */
     size_t history_count, history_capacity;
+    bool history_failed;           /* the history could not grow (out of memory) */
     double *vertex_radiosity;      /* 3 per vertex of view.mesh, computed on demand */
 };
 

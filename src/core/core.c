@@ -1,11 +1,12 @@
 /*
- * core.c -- context, errors, progress, clocks, memory figures, checked
- * allocation and atomic file output.
+ * core.c -- context, errors, progress, clocks, memory figures, the
+ * accounting allocator and atomic file output.
  */
 #include "core/core.h"
 
 #include <ctype.h>
 #include <errno.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
@@ -58,6 +59,15 @@ rad_result rad_context_create(const rad_context_options *options, rad_context **
         ctx->threads = 1;
 #endif
     }
+    if (!(options->max_memory_bytes >= 0.0)) {
+        free(ctx);
+        return RAD_ERROR_INVALID_ARGUMENT;
+    }
+    double limit = options->max_memory_bytes > 0.0 ? options->max_memory_bytes
+                                                   : 0.8 * (double)rad_physical_memory_bytes();
+    ctx->memory.limit = limit >= (double)SIZE_MAX ? SIZE_MAX : (size_t)limit;
+    atomic_init(&ctx->memory.references, 1);
+    ctx->memory.call_limit = ctx->memory.limit;
     ctx->progress = options->progress;
     ctx->progress_user = options->progress_user;
     ctx->on_error = options->on_error;
@@ -67,7 +77,19 @@ rad_result rad_context_create(const rad_context_options *options, rad_context **
     return RAD_OK;
 }
 
-void rad_context_destroy(rad_context *ctx) { free(ctx); }
+/* Drop one reference: the owner's (rad_context_destroy) or a block's.  The
+ * last one frees the context. */
+static void context_release(rad_context *ctx)
+{
+    if (atomic_fetch_sub_explicit(&ctx->memory.references, 1, memory_order_acq_rel) == 1)
+        free(ctx);
+}
+
+void rad_context_destroy(rad_context *ctx)
+{
+    if (ctx)
+        context_release(ctx);
+}
 
 const char *rad_context_error(const rad_context *ctx) { return ctx ? ctx->error : ""; }
 
@@ -83,8 +105,10 @@ bool rad_context_cancelled(const rad_context *ctx) { return rad_cancelled(ctx); 
 
 rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 {
-    if (!ctx || ctx->error_latched)
+    if (!ctx)
         return result;
+    if (ctx->error_latched)
+        return ctx->last_result; /* the code that goes with the message kept */
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(ctx->error, sizeof ctx->error, fmt, ap);
@@ -129,30 +153,225 @@ size_t rad_physical_memory_bytes(void)
     return (size_t)pages * (size_t)page;
 }
 
-void *rad_alloc_array(rad_context *ctx, size_t count, size_t size, const char *what)
+/* ---- the allocator ---- */
+
+/* The header before every block: 16 bytes, so the caller's bytes keep
+ * malloc's 16-byte alignment.  Sizes fit in 60 bits on every machine
+ * this runs on; the low 4 bits hold the category. */
+typedef struct block_header {
+    _Alignas(16) rad_context *ctx;
+    size_t size_category;       /* bytes << 4 | category */
+} block_header;
+
+_Static_assert(sizeof(block_header) == 16, "the header keeps malloc's alignment");
+_Static_assert(RAD_MEM_CATEGORIES <= 16, "categories fit in 4 bits");
+
+static const char *const category_names[RAD_MEM_CATEGORIES] = {
+    "scene", "mesh", "visibility", "form_factors", "solver", "hierarchy", "render", "output",
+};
+
+const char *rad_memory_category_name(rad_memory_category category)
 {
-    if (size != 0 && count > SIZE_MAX / size) {
-        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: %zu x %zu bytes overflows the address space",
-                 what, count, size);
-        return NULL;
-    }
-    size_t bytes = count * size;
-    void *p = calloc(1, bytes ? bytes : 1);
-    if (!p)
-        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory allocating %.1f MiB", what,
-                 (double)bytes / 1048576.0);
-    return p;
+    return category < RAD_MEM_CATEGORIES ? category_names[category] : "all";
 }
 
-char *rad_strdup(const char *s)
+void rad_format_bytes(double bytes, char *text, size_t text_size)
+{
+    if (bytes < 1024.0)
+        snprintf(text, text_size, "%.0f bytes", bytes);
+    else if (bytes < 1048576.0)
+        snprintf(text, text_size, "%.1f KiB", bytes / 1024.0);
+    else if (bytes < 1073741824.0)
+        snprintf(text, text_size, "%.1f MiB", bytes / 1048576.0);
+    else
+        snprintf(text, text_size, "%.2f GiB", bytes / 1073741824.0);
+}
+
+static void raise_peak(atomic_size_t *peak, size_t now)
+{
+    size_t seen = atomic_load_explicit(peak, memory_order_relaxed);
+    while (seen < now &&
+           !atomic_compare_exchange_weak_explicit(peak, &seen, now, memory_order_relaxed, memory_order_relaxed))
+        ;
+}
+
+/* Count `bytes` more in use, or fail naming `what` when they would pass the
+ * call's limit or the test hook says so.  The check and the count are one
+ * atomic add, so threads sharing a context cannot pass the limit together. */
+static bool account(rad_context *ctx, rad_memory_category category, size_t bytes, const char *what)
+{
+    rad_memory *m = &ctx->memory;
+    uint64_t k = atomic_fetch_add_explicit(&m->allocations, 1, memory_order_relaxed) + 1;
+    if (k == m->fail_at) {
+        char amount[32];
+        rad_format_bytes((double)bytes, amount, sizeof amount);
+        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory allocating %s (test hook: allocation %llu)",
+                 what, amount, (unsigned long long)k);
+        return false;
+    }
+    size_t now = atomic_fetch_add_explicit(&m->in_use, bytes, memory_order_relaxed) + bytes;
+    if (now < bytes || now > m->call_limit) {
+        atomic_fetch_sub_explicit(&m->in_use, bytes, memory_order_relaxed);
+        char amount[32], limit[32], used[32];
+        rad_format_bytes((double)bytes, amount, sizeof amount);
+        rad_format_bytes((double)m->call_limit, limit, sizeof limit);
+        rad_format_bytes((double)(now - bytes), used, sizeof used);
+        /* Name the limit in force: a solution's own where it is lower. */
+        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: %s more would pass the memory limit of %s (%s in use; %s)", what,
+                 amount, limit, used,
+                 m->call_limit < m->limit ? "rad_options.max_memory_bytes" : "rad_context_options.max_memory_bytes");
+        return false;
+    }
+    raise_peak(&m->peak, now);
+    size_t in_category = atomic_fetch_add_explicit(&m->in_use_by[category], bytes, memory_order_relaxed) + bytes;
+    raise_peak(&m->peak_by[category], in_category);
+    return true;
+}
+
+static void unaccount(rad_context *ctx, rad_memory_category category, size_t bytes)
+{
+    atomic_fetch_sub_explicit(&ctx->memory.in_use, bytes, memory_order_relaxed);
+    atomic_fetch_sub_explicit(&ctx->memory.in_use_by[category], bytes, memory_order_relaxed);
+}
+
+/* count * size, or fail naming `what` when it overflows (or leaves no room
+ * for the header). */
+static bool block_bytes(rad_context *ctx, size_t count, size_t size, const char *what, size_t *bytes)
+{
+    if (size != 0 && count > (SIZE_MAX >> 4) / size) {
+        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: %zu x %zu bytes overflows the address space", what,
+                 count, size);
+        return false;
+    }
+    *bytes = count * size;
+    return true;
+}
+
+static void *block_fill(block_header *h, rad_context *ctx, rad_memory_category category, size_t bytes)
+{
+    if (ctx && ctx != h->ctx)
+        atomic_fetch_add_explicit(&ctx->memory.references, 1, memory_order_relaxed);
+    h->ctx = ctx;
+    h->size_category = bytes << 4 | (size_t)category;
+    return h + 1;
+}
+
+static void out_of_memory(rad_context *ctx, const char *what, size_t bytes)
+{
+    char amount[32];
+    rad_format_bytes((double)bytes, amount, sizeof amount);
+    rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory allocating %s", what, amount);
+}
+
+void *rad_alloc(rad_context *ctx, rad_memory_category category, size_t count, size_t size, const char *what)
+{
+    size_t bytes;
+    if (!block_bytes(ctx, count, size, what, &bytes))
+        return NULL;
+    if (ctx && !account(ctx, category, bytes, what))
+        return NULL;
+    block_header *h = calloc(1, sizeof *h + bytes); /* h->ctx == NULL: no reference yet */
+    if (!h) {
+        if (ctx)
+            unaccount(ctx, category, bytes);
+        out_of_memory(ctx, what, bytes);
+        return NULL;
+    }
+    return block_fill(h, ctx, category, bytes);
+}
+
+void *rad_realloc(rad_context *ctx, rad_memory_category category, void *block, size_t count, size_t size,
+                  const char *what)
+{
+    if (!block)
+        return rad_alloc(ctx, category, count, size, what);
+    size_t bytes;
+    if (!block_bytes(ctx, count, size, what, &bytes))
+        return NULL;
+    block_header *h = (block_header *)block - 1;
+    rad_context *old_ctx = h->ctx;
+    rad_memory_category old_category = (rad_memory_category)(h->size_category & 15);
+    size_t old_bytes = h->size_category >> 4;
+    /* Count the new size before letting go of the old: a realloc may need both. */
+    if (ctx && !account(ctx, category, bytes, what))
+        return NULL;
+    block_header *grown = realloc(h, sizeof *h + bytes);
+    if (!grown) {
+        if (ctx)
+            unaccount(ctx, category, bytes);
+        out_of_memory(ctx, what, bytes);
+        return NULL;
+    }
+    if (old_ctx)
+        unaccount(old_ctx, old_category, old_bytes);
+    if (bytes > old_bytes)
+        memset((char *)(grown + 1) + old_bytes, 0, bytes - old_bytes);
+    void *block_now = block_fill(grown, ctx, category, bytes);
+    if (old_ctx && old_ctx != ctx)
+        context_release(old_ctx);
+    return block_now;
+}
+
+void rad_free(void *block)
+{
+    if (!block)
+        return;
+    block_header *h = (block_header *)block - 1;
+    rad_context *ctx = h->ctx;
+    if (ctx)
+        unaccount(ctx, (rad_memory_category)(h->size_category & 15), h->size_category >> 4);
+    free(h);
+    if (ctx)
+        context_release(ctx);
+}
+
+char *rad_strdup(rad_context *ctx, rad_memory_category category, const char *s, const char *what)
 {
     if (!s)
         return NULL;
     size_t n = strlen(s) + 1;
-    char *d = malloc(n);
+    char *d = rad_alloc(ctx, category, n, 1, what);
     if (d)
         memcpy(d, s, n);
     return d;
+}
+
+double rad_memory_limit(const rad_context *ctx)
+{
+    return ctx ? (double)ctx->memory.call_limit : 0.8 * (double)rad_physical_memory_bytes();
+}
+
+void rad_memory_limit_call(rad_context *ctx, double bytes)
+{
+    if (ctx && bytes > 0.0 && bytes < (double)ctx->memory.call_limit)
+        ctx->memory.call_limit = (size_t)bytes;
+}
+
+size_t rad_memory_in_use(const rad_context *ctx, rad_memory_category category)
+{
+    if (!ctx)
+        return 0;
+    return category < RAD_MEM_CATEGORIES ? atomic_load(&ctx->memory.in_use_by[category])
+                                         : atomic_load(&ctx->memory.in_use);
+}
+
+size_t rad_memory_peak(const rad_context *ctx, rad_memory_category category)
+{
+    if (!ctx)
+        return 0;
+    return category < RAD_MEM_CATEGORIES ? atomic_load(&ctx->memory.peak_by[category])
+                                         : atomic_load(&ctx->memory.peak);
+}
+
+uint64_t rad_memory_allocations(const rad_context *ctx)
+{
+    return ctx ? (uint64_t)atomic_load(&ctx->memory.allocations) : 0;
+}
+
+void rad_context_fail_allocation(rad_context *ctx, uint64_t k)
+{
+    if (ctx)
+        ctx->memory.fail_at = k ? rad_memory_allocations(ctx) + k : 0;
 }
 
 void rad_path_extension(const char *path, char *ext, size_t ext_size)
@@ -174,13 +393,13 @@ rad_result rad_atomic_open(rad_context *ctx, const char *path, rad_atomic_file *
 {
     memset(out, 0, sizeof *out);
     size_t n = strlen(path) + 32;
-    out->final_path = rad_strdup(path);
-    out->temp_path = malloc(n);
+    out->final_path = rad_strdup(ctx, RAD_MEM_OUTPUT, path, "output file name");
+    out->temp_path = rad_alloc(ctx, RAD_MEM_OUTPUT, n, 1, "temporary file name");
     if (!out->final_path || !out->temp_path) { /* no temporary file to remove yet */
-        free(out->final_path);
-        free(out->temp_path);
+        rad_free(out->final_path);
+        rad_free(out->temp_path);
         memset(out, 0, sizeof *out);
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
     snprintf(out->temp_path, n, "%s.tmp.%ld", path, (long)getpid());
     out->file = fopen(out->temp_path, "wb");
@@ -211,8 +430,8 @@ rad_result rad_atomic_commit(rad_context *ctx, rad_atomic_file *f)
         rad_atomic_abort(f);
         return r;
     }
-    free(f->final_path);
-    free(f->temp_path);
+    rad_free(f->final_path);
+    rad_free(f->temp_path);
     f->final_path = f->temp_path = NULL;
     return RAD_OK;
 }
@@ -223,7 +442,7 @@ void rad_atomic_abort(rad_atomic_file *f)
         fclose(f->file);
     if (f->temp_path)
         remove(f->temp_path);
-    free(f->final_path);
-    free(f->temp_path);
+    rad_free(f->final_path);
+    rad_free(f->temp_path);
     memset(f, 0, sizeof *f);
 }

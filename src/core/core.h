@@ -1,8 +1,8 @@
 /*
  * core.h -- what every module shares: 3-vectors, the context (threads,
- * progress, cancellation, first error), timers, seeded random numbers and
- * atomic file output.  Upstream of everything; includes nothing of ours but
- * the public header.
+ * progress, cancellation, first error, the allocator and its memory
+ * limit), timers, seeded random numbers and atomic file output.  Upstream
+ * of everything; includes nothing of ours but the public header.
  */
 #ifndef RAD_CORE_H
 #define RAD_CORE_H
@@ -47,6 +47,38 @@ static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin(a.x, b.x), fmin(a.y, 
 static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
 static inline bool v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
+/* ---- memory accounting (the allocator is below the context) ---- */
+
+/* What a block is for, by pipeline stage: the stats report the peak of each
+ * (docs/stats.md). */
+typedef enum rad_memory_category {
+    RAD_MEM_SCENE = 0,      /* scenes, their builders, files read while loading */
+    RAD_MEM_MESH,           /* patches, elements, welded vertices, weld tables */
+    RAD_MEM_VISIBILITY,     /* our side of the ray structure (Embree's BVH is Embree's) */
+    RAD_MEM_FORM_FACTORS,   /* F, its variances, the methods' tables and scratch */
+    RAD_MEM_SOLVER,         /* element arrays, solver vectors, LU, groups, history */
+    RAD_MEM_HIERARCHY,      /* nodes, links, the leaves' mesh of hierarchical radiosity */
+    RAD_MEM_RENDER,         /* vertex values, ray batches, images */
+    RAD_MEM_OUTPUT,         /* the writers' tables and temporary names */
+    RAD_MEM_CATEGORIES      /* count; as an argument: all categories together */
+} rad_memory_category;
+
+/* A context's accounting.  The counters are atomic so that they stay exact
+ * whichever thread frees a block (an object may be destroyed on another
+ * thread than the one that made it); the engine itself allocates on the
+ * calling thread only, never inside a parallel region. */
+typedef struct rad_memory {
+    atomic_size_t references;                   /* live blocks, + 1 until rad_context_destroy */
+    size_t limit;                               /* bytes: rad_context_options.max_memory_bytes */
+    size_t call_limit;                          /* bytes: the limit of the running call (<= limit) */
+    atomic_size_t in_use;                       /* bytes in live blocks */
+    atomic_size_t peak;                         /* most bytes in use at once */
+    atomic_size_t in_use_by[RAD_MEM_CATEGORIES];
+    atomic_size_t peak_by[RAD_MEM_CATEGORIES];
+    atomic_uint_fast64_t allocations;           /* rad_alloc / rad_realloc calls so far */
+    uint64_t fail_at;                           /* test hook: this allocation fails; 0 = none */
+} rad_memory;
+
 /* ---- context ---- */
 
 struct rad_context {
@@ -59,13 +91,17 @@ struct rad_context {
     rad_result last_result;
     bool error_latched;         /* this call already recorded its first failure */
     char error[1024];           /* first line of the first failure of the most recent failed call */
+    rad_memory memory;
 };
 
 /* Record a failure and return `result`, so callers can write
  * `return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open", path);`.
  * Only the first failure of a public call is kept (and reported to the
  * error callback): it names the cause, where later ones would name its
- * consequences.  ctx may be NULL (then the message is dropped). */
+ * consequences; a later one returns the first one's result, so the code a
+ * call returns matches the message ("out of memory" stays
+ * RAD_ERROR_OUT_OF_MEMORY when assimp then fails to parse).  ctx may be
+ * NULL (then the message is dropped). */
 rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
@@ -84,8 +120,10 @@ static inline rad_result rad_null_argument(rad_context *ctx, const char *functio
  * failure will be the one kept.  NULL is a no-op. */
 static inline void rad_api_enter(rad_context *ctx)
 {
-    if (ctx)
+    if (ctx) {
         ctx->error_latched = false;
+        ctx->memory.call_limit = ctx->memory.limit;
+    }
 }
 
 /* True once the user asked to stop (rad_context_cancel).  Any thread. */
@@ -103,9 +141,59 @@ double rad_seconds(void);              /* monotonic wall clock, seconds */
 size_t rad_peak_memory_bytes(void);    /* peak resident set of the process */
 size_t rad_physical_memory_bytes(void);
 
-/* Checked allocation of count * size bytes: fails (returns NULL and sets the
- * context error naming `what`) on overflow or exhaustion. */
-void *rad_alloc_array(rad_context *ctx, size_t count, size_t size, const char *what);
+/* ---- the allocator: every block the engine owns comes from here ----
+ *
+ * Each block carries a 16-byte header (the alignment malloc gives) with its
+ * owning context and its size and category, so rad_free needs no context:
+ *
+ *     malloc'd:  | ctx | bytes << 4 | category |  the caller's bytes ...  |
+ *                ^ header (16 bytes)            ^ what rad_alloc returns
+ *
+ * Every block holds a reference to its context, so a context destroyed
+ * before the scenes, solutions and images made with it lives on (unusable,
+ * as SQLite's closed-but-busy connection does) until the last of them is
+ * destroyed.  Allocation is not for hot loops or
+ * parallel regions: per-thread scratch is allocated once, before the
+ * region, one slice per thread. */
+
+/* count * size bytes, zeroed, accounted to `category` of ctx.  Fails
+ * (NULL; the context error, one line, names `what`, the bytes and the
+ * limit) on overflow, when the context's bytes in use would pass its limit,
+ * when malloc fails, or when the test hook says so (RAD_ERROR_OUT_OF_MEMORY
+ * is the caller's to return).  ctx may be NULL: unaccounted, unlimited. */
+void *rad_alloc(rad_context *ctx, rad_memory_category category, size_t count, size_t size,
+                const char *what);
+/* Resize `block` (NULL: allocate) to count * size bytes, the part beyond its
+ * old size zeroed, accounted to `category` of ctx.  On failure NULL, as
+ * rad_alloc, and `block` is untouched (still the caller's to free). */
+void *rad_realloc(rad_context *ctx, rad_memory_category category, void *block, size_t count,
+                  size_t size, const char *what);
+/* Free a block of rad_alloc / rad_realloc / rad_strdup.  NULL is a no-op. */
+void rad_free(void *block);
+/* A copy of s in a block of `category` (NULL for NULL, or as rad_alloc). */
+char *rad_strdup(rad_context *ctx, rad_memory_category category, const char *s, const char *what);
+
+/* The limit of the running call, bytes: the context's, or lower where a
+ * solution has its own (rad_options.max_memory_bytes).  Every estimate that
+ * refuses work before doing it compares against this. */
+double rad_memory_limit(const rad_context *ctx);
+/* Lower the limit for the rest of this call to `bytes` (> 0), as a
+ * solution's calls do with its own limit; rad_api_enter restores it. */
+void rad_memory_limit_call(rad_context *ctx, double bytes);
+/* Bytes in use now and at most, in one category or all of them
+ * (RAD_MEM_CATEGORIES).  0 for NULL. */
+size_t rad_memory_in_use(const rad_context *ctx, rad_memory_category category);
+size_t rad_memory_peak(const rad_context *ctx, rad_memory_category category);
+/* "scene", "mesh", ... "output" (the stats' keys). */
+const char *rad_memory_category_name(rad_memory_category category);
+/* Allocations (rad_alloc, rad_realloc, rad_strdup) so far in this context. */
+uint64_t rad_memory_allocations(const rad_context *ctx);
+/* Test hook (SQLite's way): make the k-th allocation from now fail, as if
+ * malloc had; k = 0 turns it off.  Not API: tests/test_alloc.c uses it. */
+void rad_context_fail_allocation(rad_context *ctx, uint64_t k);
+
+/* Bytes as people read them: "512 bytes", "1.5 KiB", "12.0 MiB", "1.20 GiB". */
+void rad_format_bytes(double bytes, char *text, size_t text_size);
 
 /* ---- random numbers: counter-based, so a sample depends only on its key ---- */
 
@@ -157,7 +245,5 @@ void rad_atomic_abort(rad_atomic_file *file);
 
 /* Lower-case extension of a path without the dot ("" if none), in `ext`. */
 void rad_path_extension(const char *path, char *ext, size_t ext_size);
-
-char *rad_strdup(const char *s);
 
 #endif /* RAD_CORE_H */

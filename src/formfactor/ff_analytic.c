@@ -199,7 +199,7 @@ static rad_result analytic_prepare(rad_context *ctx, const rad_ff_request *req, 
 {
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
-    analytic_shared *a = rad_alloc_array(ctx, 1, sizeof *a + n * sizeof a->geom[0],
+    analytic_shared *a = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *a + n * sizeof a->geom[0],
                                          "form factors: element table");
     if (!a)
         return RAD_ERROR_OUT_OF_MEMORY;

@@ -348,7 +348,7 @@ typedef struct contour_shared {
 
 static rad_result contour_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
 {
-    contour_shared *c = rad_alloc_array(ctx, 1, sizeof *c, "form factors: settings");
+    contour_shared *c = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *c, "form factors: settings");
     if (!c)
         return RAD_ERROR_OUT_OF_MEMORY;
     c->base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;

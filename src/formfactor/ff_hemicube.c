@@ -383,7 +383,7 @@ static rad_result hemicube_prepare(rad_context *ctx, const rad_ff_request *req, 
     int R = req->hemicube_resolution > 0 ? req->hemicube_resolution : 256;
     R += R & 1; /* side faces are R/2 high */
     size_t pixels = 3 * (size_t)R * (size_t)R;
-    hc_setup *hs = rad_alloc_array(ctx, 1, sizeof *hs + pixels * sizeof hs->delta[0],
+    hc_setup *hs = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *hs + pixels * sizeof hs->delta[0],
                                    "hemicube: delta form factors");
     if (!hs)
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -402,20 +402,20 @@ static rad_result hemicube_prepare(rad_context *ctx, const rad_ff_request *req, 
 
 /* One block: the struct, then the vertices in the receiver's frame, the
  * accumulators, the depths and the items. */
-static void *hemicube_scratch(const rad_ff_request *req, const void *shared)
+static size_t hemicube_scratch(const rad_ff_request *req, const void *shared, void *block)
 {
     const hc_setup *hs = shared;
     size_t n = req->mesh->element_count, vertices = req->mesh->vertex_count;
-    hc_scratch *s = malloc(sizeof *s + vertices * sizeof *s->local + (2 * n + 3) * sizeof *s->sum +
-                           hs->pixels * (sizeof *s->depth + sizeof *s->item));
-    if (!s)
-        return NULL;
-    s->local = (vec3 *)(s + 1);
-    s->sum = (double *)(s->local + vertices);
-    s->row = s->sum + n + 2;
-    s->depth = (float *)(s->row + n + 1);
-    s->item = (uint32_t *)(s->depth + hs->pixels);
-    return s;
+    hc_scratch *s = block;
+    if (s) {
+        s->local = (vec3 *)(s + 1);
+        s->sum = (double *)(s->local + vertices);
+        s->row = s->sum + n + 2;
+        s->depth = (float *)(s->row + n + 1);
+        s->item = (uint32_t *)(s->depth + hs->pixels);
+    }
+    return sizeof *s + vertices * sizeof *s->local + (2 * n + 3) * sizeof *s->sum +
+           hs->pixels * (sizeof *s->depth + sizeof *s->item);
 }
 
 const rad_ff_method rad_ff_hemicube = {

@@ -183,7 +183,7 @@ static rad_result hemisphere_prepare(rad_context *ctx, const rad_ff_request *req
     if (!req->vis)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "hemisphere form factors need a ray backend (visibility)");
-    hs_shared *h = rad_alloc_array(ctx, 1, sizeof *h, "form factors: settings");
+    hs_shared *h = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *h, "form factors: settings");
     if (!h)
         return RAD_ERROR_OUT_OF_MEMORY;
     h->N = req->samples > 0 ? req->samples : 1024;
@@ -193,16 +193,16 @@ static rad_result hemisphere_prepare(rad_context *ctx, const rad_ff_request *req
 }
 
 /* One block: the struct, then the n accumulators, then the N strata. */
-static void *hemisphere_scratch(const rad_ff_request *req, const void *shared)
+static size_t hemisphere_scratch(const rad_ff_request *req, const void *shared, void *block)
 {
     const hs_shared *h = shared;
     size_t n = req->mesh->element_count;
-    hs_scratch *s = malloc(sizeof *s + n * sizeof *s->sum + (size_t)h->N * sizeof *s->perm);
-    if (!s)
-        return NULL;
-    s->sum = (double *)(s + 1);
-    s->perm = (uint32_t *)(s->sum + n);
-    return s;
+    hs_scratch *s = block;
+    if (s) {
+        s->sum = (double *)(s + 1);
+        s->perm = (uint32_t *)(s->sum + n);
+    }
+    return sizeof *s + n * sizeof *s->sum + (size_t)h->N * sizeof *s->perm;
 }
 
 const rad_ff_method rad_ff_hemisphere = {

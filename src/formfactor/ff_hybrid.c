@@ -55,7 +55,7 @@ static rad_result hybrid_prepare(rad_context *ctx, const rad_ff_request *req, vo
 {
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
-    hybrid_shared *h = rad_alloc_array(ctx, 1, sizeof *h + n * sizeof h->diameter[0], "form factors: sizes");
+    hybrid_shared *h = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *h + n * sizeof h->diameter[0], "form factors: sizes");
     if (!h)
         return RAD_ERROR_OUT_OF_MEMORY;
     h->base_rays = req->shadow_rays > 0 ? req->shadow_rays : 4;

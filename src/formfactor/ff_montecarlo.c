@@ -273,7 +273,7 @@ static rad_result montecarlo_prepare(rad_context *ctx, const rad_ff_request *req
 {
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
-    mc_shared *m = rad_alloc_array(ctx, 1, sizeof *m + n * sizeof m->radius[0], "form factors: element table");
+    mc_shared *m = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *m + n * sizeof m->radius[0], "form factors: element table");
     if (!m)
         return RAD_ERROR_OUT_OF_MEMORY;
     m->N = req->samples > 0 ? req->samples : 16;
@@ -290,11 +290,11 @@ static rad_result montecarlo_prepare(rad_context *ctx, const rad_ff_request *req
     return RAD_OK;
 }
 
-static void *montecarlo_scratch(const rad_ff_request *req, const void *shared)
+static size_t montecarlo_scratch(const rad_ff_request *req, const void *shared, void *block)
 {
-    (void)req;
+    (void)req, (void)block; /* nothing to lay out: the strata are the struct's last member */
     const mc_shared *m = shared;
-    return malloc(sizeof(mc_scratch) + (size_t)m->N * sizeof(uint32_t));
+    return sizeof(mc_scratch) + (size_t)m->N * sizeof(uint32_t);
 }
 
 /* F_ji = F_ij A_i / A_j: one estimate per pair, reciprocal by construction. */

@@ -167,17 +167,31 @@ static rad_result run_method(rad_context *ctx, const rad_ff_method *method, cons
 {
     size_t n = req->mesh->element_count;
     double plane_tol = rad_ff_plane_tolerance(req->mesh);
+    /* Every thread's scratch in one allocation before the region: a slice
+     * each, whole cache lines apart (64 bytes), so no thread allocates. */
+    size_t threads = (size_t)(ctx->threads > 0 ? ctx->threads : 1);
+    size_t slice = method->scratch ? (method->scratch(req, shared, NULL) + 63) / 64 * 64 : 0;
+    unsigned char *scratch_blocks = NULL;
+    if (slice) {
+        char what[64];
+        snprintf(what, sizeof what, "form factors (%s): threads' scratch", method->name);
+        scratch_blocks = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, threads, slice, what);
+        if (!scratch_blocks)
+            return RAD_ERROR_OUT_OF_MEMORY;
+    }
     uint64_t rays = 0, pairs = 0, near_pairs = 0, rows_done = 0;
-    volatile int stop = 0, failed = 0;
+    volatile int stop = 0;
 #pragma omp parallel num_threads(ctx->threads) reduction(+ : rays, pairs, near_pairs)
     {
-        void *scratch = method->scratch ? method->scratch(req, shared) : NULL;
-        if (method->scratch && !scratch)
-            failed = 1;
+        void *scratch = NULL;
+        if (slice) {
+            scratch = scratch_blocks + (size_t)omp_get_thread_num() * slice;
+            method->scratch(req, shared, scratch);
+        }
         rad_ff_tally tally = {0, 0, 0};
 #pragma omp for schedule(dynamic, 4)
         for (size_t i = 0; i < n; i++) {
-            if (stop || failed)
+            if (stop)
                 continue;
             if (method->row)
                 method->row(req, shared, scratch, (uint32_t)i, F + i * n, variance ? variance + i * n : NULL,
@@ -186,32 +200,27 @@ static rad_result run_method(rad_context *ctx, const rad_ff_method *method, cons
                 pair_row(method, req, shared, scratch, (uint32_t)i, plane_tol, F, variance, &tally);
             row_done(ctx, &rows_done, n, &stop);
         }
-        free(scratch);
         rays += tally.rays;
         pairs += tally.pairs;
         near_pairs += tally.near_pairs;
     }
+    rad_free(scratch_blocks);
     stats->rays = rays;
     stats->pairs = pairs;
     stats->near_pairs = near_pairs;
-    if (failed)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "form factors (%s): out of memory for a thread's buffers",
-                        method->name);
     if (stop)
         return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "form factors: interrupted");
     rad_progress(ctx, "form factors", n, n);
     return RAD_OK;
 }
 
-void rad_ff_close(const rad_mesh *mesh, float *F)
+rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F)
 {
     size_t n = mesh->element_count;
-    double *x = malloc((n ? n : 1) * sizeof *x), *row = malloc((n ? n : 1) * sizeof *row);
-    if (!x || !row) {
-        free(x);
-        free(row);
-        return;
-    }
+    double *x = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 2 * n, sizeof *x, "form factors: closure correction");
+    if (!x)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    double *row = x + n;
     for (size_t i = 0; i < n; i++)
         x[i] = 1.0;
     /* Symmetric Sinkhorn iteration on G_ij = A_i F_ij: with s_i = sum_j G_ij x_j,
@@ -239,8 +248,8 @@ void rad_ff_close(const rad_mesh *mesh, float *F)
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++)
             F[i * n + j] = (float)((double)F[i * n + j] * x[i] * x[j]);
-    free(x);
-    free(row);
+    rad_free(x);
+    return RAD_OK;
 }
 
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
@@ -262,12 +271,13 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
                         "solver 'shooting' (rad_options.solver, O(n) memory) or fewer elements "
                         "(rad_options.target_elements)",
                         n, bytes / 1073741824.0, max_memory / 1073741824.0);
-    float *F = rad_alloc_array(ctx, n * n, sizeof *F, "form factors: dense matrix");
-    float *var = want_variance ? rad_alloc_array(ctx, n * n, sizeof *var, "form factors: variances")
-                               : NULL;
+    float *F = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *F, "form factors: dense matrix");
+    float *var = F && want_variance
+                     ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *var, "form factors: variances")
+                     : NULL;
     if (!F || (want_variance && !var)) {
-        free(F);
-        free(var);
+        rad_free(F);
+        rad_free(var);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double t0 = rad_seconds();
@@ -275,15 +285,15 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     rad_result r = method->prepare ? method->prepare(ctx, req, &shared) : RAD_OK;
     if (r == RAD_OK)
         r = run_method(ctx, method, req, shared, F, var, stats);
-    free(shared);
+    rad_free(shared);
     if (r == RAD_OK && close) {
-        rad_ff_close(req->mesh, F);
-        stats->closure_corrected = true;
+        r = rad_ff_close(ctx, req->mesh, F);
+        stats->closure_corrected = r == RAD_OK;
     }
     stats->seconds = rad_seconds() - t0;
     if (r != RAD_OK && r != RAD_ERROR_INTERRUPTED) {
-        free(F);
-        free(var);
+        rad_free(F);
+        rad_free(var);
         return r;
     }
     diagnostics(req->mesh, F, stats);

@@ -70,12 +70,15 @@ typedef struct rad_ff_method {
     const char *description; /* one line: idea, cost, accuracy */
     unsigned flags;
     /* Optional.  Check the request and build what every kernel call
-     * reads (settings, per-element tables) as one block from malloc in
-     * *shared, which the caller frees; fail through rad_fail. */
+     * reads (settings, per-element tables) as one block of the context's
+     * (rad_alloc) in *shared, which the caller frees; fail through
+     * rad_fail. */
     rad_result (*prepare)(rad_context *ctx, const rad_ff_request *req, void **shared);
-    /* Optional.  One thread's scratch memory as one block from malloc,
-     * which the caller frees; NULL when out of memory. */
-    void *(*scratch)(const rad_ff_request *req, const void *shared);
+    /* Optional.  The bytes of one thread's scratch memory; with `block`
+     * (that many bytes, zeroed, 16-byte aligned) also lay it out there
+     * (pointers into it).  The loop allocates every thread's block before
+     * its parallel region and hands `block` to the kernels.  Cannot fail. */
+    size_t (*scratch)(const rad_ff_request *req, const void *shared, void *block);
     /* Exactly one of these.  pair: the factors of elements i < j into
      * *out (zeroed by the caller).  row: row i of F into F_row (n floats,
      * zeroed) and, when variance_row is not NULL, of the variances. */
@@ -124,8 +127,9 @@ bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_to
 /* Reciprocity-preserving closure correction for closed scenes: find x > 0
  * with sum_j x_i x_j A_i F_ij = A_i (symmetric Sinkhorn scaling of the
  * power-coupling matrix G = A F), then F_ij <- x_i x_j F_ij.  Keeps zeros,
- * positivity and A_i F_ij = A_j F_ji; rows that see nothing stay 0. */
-void rad_ff_close(const rad_mesh *mesh, float *F);
+ * positivity and A_i F_ij = A_j F_ji; rows that see nothing stay 0.
+ * Fails only for memory (2n doubles), F then unchanged. */
+rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F);
 
 /* ---- shared kernels (polygon.c) ---- */
 

@@ -70,6 +70,8 @@ static const double *node_reflectance(const hr_state *st, const hr_node *n)
     return st->tree.scene->materials[pa->material].reflectance;
 }
 
+#define VALUES_WHAT "hierarchical: node values (a larger rad_options.epsilon or rad_options.min_area makes fewer nodes)"
+
 /* Grow the per-node arrays to the tree; new nodes start from their
  * parent's radiosity. */
 static rad_result ensure_values(hr_state *st)
@@ -77,37 +79,35 @@ static rad_result ensure_values(hr_state *st)
     size_t n = st->tree.count;
     if (n == st->values)
         return RAD_OK;
-    double *B = realloc(st->B, 3 * n * sizeof *B);
+    double *B = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->B, 3 * n, sizeof *B, VALUES_WHAT);
     if (B)
         st->B = B;
-    double *H = realloc(st->H, 3 * n * sizeof *H);
+    double *H = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->H, 3 * n, sizeof *H, VALUES_WHAT);
     if (H)
         st->H = H;
-    double *Ht = realloc(st->Ht, 3 * n * sizeof *Ht);
+    double *Ht = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->Ht, 3 * n, sizeof *Ht, VALUES_WHAT);
     if (Ht)
         st->Ht = Ht;
-    double *sp = realloc(st->spread, n * sizeof *sp);
+    double *sp = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->spread, n, sizeof *sp, VALUES_WHAT);
     if (sp)
         st->spread = sp;
-    float *op = realloc(st->open, n * sizeof *op);
+    float *op = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->open, n, sizeof *op, VALUES_WHAT);
     if (op)
         st->open = op;
-    float *se = realloc(st->send, n * sizeof *se);
+    float *se = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->send, n, sizeof *se, VALUES_WHAT);
     if (se)
         st->send = se;
     bool correct = st->p->closure_correction;
-    double *Bs = correct ? realloc(st->Bsend, 3 * n * sizeof *Bs) : st->B;
+    double *Bs = correct ? rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->Bsend, 3 * n, sizeof *Bs, VALUES_WHAT) : st->B;
     if (correct && Bs)
         st->Bsend = Bs;
-    float *co = correct ? realloc(st->corr, n * sizeof *co) : NULL;
+    float *co = correct ? rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->corr, n, sizeof *co, VALUES_WHAT) : NULL;
     if (co)
         st->corr = co;
     if (!correct)
         st->Bsend = st->B;
     if (!B || !H || !Ht || !sp || !op || !se || !Bs || (correct && !co))
-        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: out of memory for %zu nodes; use a larger rad_options.epsilon or "
-                        "rad_options.min_area", n);
+        return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t k = st->values; k < n; k++) {
         const hr_node *nd = &st->tree.nodes[k];
         for (int c = 0; c < 3; c++) {
@@ -138,18 +138,19 @@ static rad_result ensure_values(hr_state *st)
 static rad_result sort_links(hr_state *st)
 {
     size_t n = st->tree.count, L = st->links.count;
-    size_t *off = realloc(st->offset, (n + 1) * sizeof *off);
+    size_t *off = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->offset, n + 1, sizeof *off, "hierarchical: link offsets");
     if (off)
         st->offset = off;
-    size_t *live = realloc(st->live, (n ? n : 1) * sizeof *live);
+    size_t *live = off ? rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->live, n, sizeof *live, "hierarchical: link offsets")
+                       : NULL;
     if (live)
         st->live = live;
-    hr_link *sorted = malloc((L ? L : 1) * sizeof *sorted);
-    size_t *fill = malloc((n ? n : 1) * sizeof *fill);
-    if (!off || !live || !sorted || !fill) {
-        free(sorted);
-        free(fill);
-        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory sorting %zu links", L);
+    hr_link *sorted = live ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, L, sizeof *sorted, "hierarchical: sorted links")
+                           : NULL;
+    size_t *fill = sorted ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *fill, "hierarchical: sorted links") : NULL;
+    if (!fill) {
+        rad_free(sorted);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
     memset(off, 0, (n + 1) * sizeof *off);
     memset(live, 0, n * sizeof *live);
@@ -169,8 +170,8 @@ static rad_result sort_links(hr_state *st)
     for (size_t i = 0; i < L; i++)
         if (!(st->links.items[i].k > 0.0f))
             sorted[fill[st->links.items[i].r]++] = st->links.items[i];
-    free(fill);
-    free(st->links.items);
+    rad_free(fill);
+    rad_free(st->links.items);
     st->links.items = sorted;
     st->links.capacity = L ? L : 1;
     return RAD_OK;
@@ -399,11 +400,11 @@ static rad_result measure_spread(hr_state *st)
 {
     const hr_tree *t = &st->tree;
     size_t n = t->count;
-    double *lo = malloc(3 * n * sizeof *lo), *hi = malloc(3 * n * sizeof *hi);
-    if (!lo || !hi) {
-        free(lo);
-        free(hi);
-        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+    double *lo = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 3 * n, sizeof *lo, "hierarchical: radiosity ranges");
+    double *hi = lo ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 3 * n, sizeof *hi, "hierarchical: radiosity ranges") : NULL;
+    if (!hi) {
+        rad_free(lo);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
     for (size_t k = n; k-- > 0;) {
         const hr_node *nd = &t->nodes[k];
@@ -430,8 +431,8 @@ static rad_result measure_spread(hr_state *st)
             d = fmax(d, fmax(h[c] - st->B[3 * k + (size_t)c], st->B[3 * k + (size_t)c] - l[c]));
         st->spread[k] = d;
     }
-    free(lo);
-    free(hi);
+    rad_free(lo);
+    rad_free(hi);
     return RAD_OK;
 }
 
@@ -459,9 +460,10 @@ static rad_result link_closure(const hr_state *st, double *acc)
 {
     const hr_tree *t = &st->tree;
     size_t n = t->count, C = t->clusters;
-    double *x = calloc(6 * C + 1, sizeof *x); /* clusters: sum k P_r bins(-w), pushed down */
+    /* clusters: sum k P_r bins(-w), pushed down */
+    double *x = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 6 * C + 1, sizeof *x, "hierarchical: closure");
     if (!x)
-        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     memset(acc, 0, n * sizeof *acc);
     for (size_t i = 0; i < st->links.count; i++) {
         const hr_link *l = &st->links.items[i];
@@ -500,7 +502,7 @@ static rad_result link_closure(const hr_state *st, double *acc)
             acc[k] += acc[up];
         }
     }
-    free(x);
+    rad_free(x);
     return RAD_OK;
 }
 
@@ -509,9 +511,9 @@ static rad_result link_closure(const hr_state *st, double *acc)
 static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
 {
     const hr_tree *t = &st->tree;
-    double *acc = malloc((t->count ? t->count : 1) * sizeof *acc);
+    double *acc = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, t->count, sizeof *acc, "hierarchical: closure");
     if (!acc)
-        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     rad_result r = link_closure(st, acc);
     double a_sum = 0.0, c_sum = 0.0, p_sum = 0.0, pc_sum = 0.0, lo = INFINITY, hi = -INFINITY;
     for (size_t k = 0; r == RAD_OK && k < t->count; k++) {
@@ -531,7 +533,7 @@ static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
     hs->closure_power = p_sum > 0.0 ? pc_sum / p_sum : 1.0;
     hs->closure_min = isfinite(lo) ? lo : 1.0;
     hs->closure_max = isfinite(hi) ? hi : 1.0;
-    free(acc);
+    rad_free(acc);
     return r;
 }
 
@@ -551,13 +553,15 @@ static rad_result correct_closure(hr_state *st, size_t *corrected)
 {
     const hr_tree *t = &st->tree;
     size_t n = t->count;
-    double *acc = malloc((n ? n : 1) * sizeof *acc), *sum = calloc(2 * n + 1, sizeof *sum);
-    uint32_t *root = malloc((n ? n : 1) * sizeof *root);
-    if (!acc || !sum || !root) {
-        free(acc);
-        free(sum);
-        free(root);
-        return rad_fail(st->ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+    double *acc = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *acc, "hierarchical: closure correction");
+    double *sum = acc ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 2 * n + 1, sizeof *sum, "hierarchical: closure correction")
+                      : NULL;
+    uint32_t *root = sum ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *root, "hierarchical: closure correction")
+                         : NULL;
+    if (!root) {
+        rad_free(acc);
+        rad_free(sum);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
     rad_result r = link_closure(st, acc);
     *corrected = 0;
@@ -585,9 +589,9 @@ static rad_result correct_closure(hr_state *st, size_t *corrected)
             (*corrected)++;
         }
     }
-    free(acc);
-    free(sum);
-    free(root);
+    rad_free(acc);
+    rad_free(sum);
+    rad_free(root);
     return r;
 }
 
@@ -636,11 +640,11 @@ static rad_result build_leaf_mesh(hr_state *st, rad_mesh **mesh, double **radios
             leaves++;
     }
     leaf_builder lb = {st, NULL, NULL, 0, NULL, 0};
-    lb.leaves = rad_alloc_array(st->ctx, leaves, sizeof *lb.leaves, "hierarchical: leaves");
-    lb.radiosity = rad_alloc_array(st->ctx, 3 * leaves, sizeof *lb.radiosity, "hierarchical: leaves");
-    lb.tree = rad_alloc_array(st->ctx, 4 * internal + 1, sizeof *lb.tree, "hierarchical: leaves");
+    lb.leaves = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, leaves, sizeof *lb.leaves, "hierarchical: leaves");
+    lb.radiosity = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 3 * leaves, sizeof *lb.radiosity, "hierarchical: leaves");
+    lb.tree = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 4 * internal + 1, sizeof *lb.tree, "hierarchical: leaves");
     size_t P = t->base->patch_count;
-    uint32_t *root = rad_alloc_array(st->ctx, P, sizeof *root, "hierarchical: leaves");
+    uint32_t *root = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, P, sizeof *root, "hierarchical: leaves");
     rad_result r = RAD_ERROR_OUT_OF_MEMORY;
     if (lb.leaves && lb.radiosity && lb.tree && root) {
         for (size_t p = 0; p < P; p++)
@@ -648,11 +652,11 @@ static rad_result build_leaf_mesh(hr_state *st, rad_mesh **mesh, double **radios
         r = rad_mesh_from_leaves(st->ctx, t->scene, t->base, lb.leaves, lb.leaf_count, lb.tree, lb.tree_count,
                                  root, st->p->crease_angle_degrees, mesh);
     }
-    free(lb.leaves);
-    free(lb.tree);
-    free(root);
+    rad_free(lb.leaves);
+    rad_free(lb.tree);
+    rad_free(root);
     if (r != RAD_OK) {
-        free(lb.radiosity);
+        rad_free(lb.radiosity);
         return r;
     }
     *radiosity = lb.radiosity;
@@ -709,9 +713,9 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     hs->clustered = st.tree.clusters > 0;
     hs->classic_oracle = p->classic_oracle;
     hs->clusters = st.tree.clusters;
-    st.bins_in = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
-    st.bins_total = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
-    st.bins_exit = rad_alloc_array(ctx, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
+    st.bins_in = rad_alloc(ctx, RAD_MEM_HIERARCHY, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
+    st.bins_total = rad_alloc(ctx, RAD_MEM_HIERARCHY, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
+    st.bins_exit = rad_alloc(ctx, RAD_MEM_HIERARCHY, 18 * st.tree.clusters + 1, sizeof(double), "hierarchical: cluster bins");
     if (!st.bins_in || !st.bins_total || !st.bins_exit) {
         r = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
@@ -839,20 +843,20 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     }
 done:
     hr_tree_free(&st.tree);
-    free(st.links.items);
-    free(st.offset);
-    free(st.live);
-    free(st.B);
-    free(st.H);
-    free(st.Ht);
-    free(st.spread);
-    free(st.open);
-    free(st.send);
+    rad_free(st.links.items);
+    rad_free(st.offset);
+    rad_free(st.live);
+    rad_free(st.B);
+    rad_free(st.H);
+    rad_free(st.Ht);
+    rad_free(st.spread);
+    rad_free(st.open);
+    rad_free(st.send);
     if (p->closure_correction)
-        free(st.Bsend);
-    free(st.corr);
-    free(st.bins_in);
-    free(st.bins_total);
-    free(st.bins_exit);
+        rad_free(st.Bsend);
+    rad_free(st.corr);
+    rad_free(st.bins_in);
+    rad_free(st.bins_total);
+    rad_free(st.bins_exit);
     return r;
 }

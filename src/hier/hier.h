@@ -93,9 +93,10 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
 void hr_tree_free(hr_tree *tree);
 
 /* Grow an array of `size`-byte items, capacity *capacity < count, to hold
- * `count` (doubling from 1024): the new array, or NULL when out of memory
- * (the old one and *capacity then unchanged). */
-void *hr_grow(void *items, size_t *capacity, size_t count, size_t size);
+ * `count` (doubling from 1024), in the hierarchy's memory of ctx: the new
+ * array, or NULL when out of memory (the error names `what`; the old array
+ * and *capacity then unchanged). */
+void *hr_grow(rad_context *ctx, void *items, size_t *capacity, size_t count, size_t size, const char *what);
 
 /* Projected area of node k toward unit direction d: A max(0, n.d) for a
  * surface; a cluster's members' as its area bins see it (exact for

@@ -420,12 +420,10 @@ static rad_result links_reserve(rad_context *ctx, hr_links *l, size_t count)
 {
     if (count <= l->capacity)
         return RAD_OK;
-    hr_link *items = hr_grow(l->items, &l->capacity, count, sizeof *items);
+    hr_link *items = hr_grow(ctx, l->items, &l->capacity, count, sizeof *items,
+                             "hierarchical: links (a larger rad_options.epsilon or rad_options.min_area makes fewer)");
     if (!items)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: out of memory for %zu links; use a larger rad_options.epsilon or "
-                        "rad_options.min_area",
-                        count);
+        return RAD_ERROR_OUT_OF_MEMORY;
     l->items = items;
     return RAD_OK;
 }
@@ -448,8 +446,8 @@ rad_result hr_links_initial(rad_context *ctx, hr_tree *t, const hr_refine_params
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "hierarchical: %zu patches make too many initial links; turn clustering on "
                         "(rad_options.clustering)", P);
-    hr_link *all = rad_alloc_array(ctx, P * P, sizeof *all, "hierarchical: initial links");
-    uint8_t *keep = rad_alloc_array(ctx, P * P, 1, "hierarchical: initial links");
+    hr_link *all = rad_alloc(ctx, RAD_MEM_HIERARCHY, P * P, sizeof *all, "hierarchical: initial links");
+    uint8_t *keep = rad_alloc(ctx, RAD_MEM_HIERARCHY, P * P, 1, "hierarchical: initial links");
     rad_result r = !all || !keep ? RAD_ERROR_OUT_OF_MEMORY : RAD_OK;
     uint64_t rays = 0, shafts = 0, clear = 0;
     link_ctx lc = {t, p};
@@ -473,8 +471,8 @@ rad_result hr_links_initial(rad_context *ctx, hr_tree *t, const hr_refine_params
     st->shafts += shafts;
     st->shafts_clear += clear;
     st->links_created += links->count;
-    free(all);
-    free(keep);
+    rad_free(all);
+    rad_free(keep);
     return r;
 }
 
@@ -496,32 +494,32 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
             r = RAD_ERROR_INTERRUPTED;
             break;
         }
-        uint8_t *a = realloc(action, (L ? L : 1) * sizeof *a);
-        size_t *f = realloc(first, (L + 1) * sizeof *f);
-        if (!a || !f) {
-            free(a ? a : action);
-            free(f ? f : first);
-            action = NULL;
-            first = NULL;
-            r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory refining %zu links", L);
+        uint8_t *a = rad_realloc(ctx, RAD_MEM_HIERARCHY, action, L, sizeof *a, "hierarchical: refinement");
+        if (a)
+            action = a;
+        size_t *f = a ? rad_realloc(ctx, RAD_MEM_HIERARCHY, first, L + 1, sizeof *f, "hierarchical: refinement")
+                      : NULL;
+        if (!f) {
+            r = RAD_ERROR_OUT_OF_MEMORY;
             break;
         }
-        action = a;
         first = f;
         /* Values for nodes made in earlier passes of this call. */
         if (t->count > known) {
-            double *nb = realloc(Bx, 3 * t->count * sizeof *nb);
+            double *nb = rad_realloc(ctx, RAD_MEM_HIERARCHY, Bx, 3 * t->count, sizeof *nb,
+                                     "hierarchical: refinement");
             if (nb && !Bx)
                 memcpy(nb, B, 3 * known * sizeof *nb);
             if (nb)
                 Bx = nb;
-            double *ns = realloc(Sx, t->count * sizeof *ns);
+            double *ns = nb ? rad_realloc(ctx, RAD_MEM_HIERARCHY, Sx, t->count, sizeof *ns, "hierarchical: refinement")
+                            : NULL;
             if (ns && !Sx)
                 memcpy(ns, spread, known * sizeof *ns);
             if (ns)
                 Sx = ns;
             if (!nb || !ns) {
-                r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: out of memory");
+                r = RAD_ERROR_OUT_OF_MEMORY;
                 break;
             }
             for (size_t k = known; k < t->count; k++) {
@@ -627,11 +625,11 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
         *links = done;
         done = tmp;
     }
-    free(done.items);
-    free(next.items);
-    free(action);
-    free(first);
-    free(Bx);
-    free(Sx);
+    rad_free(done.items);
+    rad_free(next.items);
+    rad_free(action);
+    rad_free(first);
+    rad_free(Bx);
+    rad_free(Sx);
     return r;
 }

@@ -57,12 +57,12 @@ static void surface_geometry(hr_node *n)
     n->radius = r;
 }
 
-void *hr_grow(void *items, size_t *capacity, size_t count, size_t size)
+void *hr_grow(rad_context *ctx, void *items, size_t *capacity, size_t count, size_t size, const char *what)
 {
     size_t cap = *capacity ? *capacity : 1024;
     while (cap < count)
         cap *= 2;
-    void *grown = cap <= SIZE_MAX / size ? realloc(items, cap * size) : NULL;
+    void *grown = rad_realloc(ctx, RAD_MEM_HIERARCHY, items, cap, size, what);
     if (grown)
         *capacity = cap;
     return grown;
@@ -72,12 +72,10 @@ static rad_result reserve(rad_context *ctx, hr_tree *t, size_t extra)
 {
     if (t->count + extra <= t->capacity)
         return RAD_OK;
-    hr_node *nodes = hr_grow(t->nodes, &t->capacity, t->count + extra, sizeof *nodes);
+    hr_node *nodes = hr_grow(ctx, t->nodes, &t->capacity, t->count + extra, sizeof *nodes,
+                             "hierarchical: nodes (a larger rad_options.min_area or rad_options.epsilon makes fewer)");
     if (!nodes)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "hierarchical: out of memory for %zu nodes; use a larger rad_options.min_area or "
-                        "rad_options.epsilon",
-                        t->count + extra);
+        return RAD_ERROR_OUT_OF_MEMORY;
     t->nodes = nodes;
     return RAD_OK;
 }
@@ -183,17 +181,17 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
     if (P < 2)
         clustered = false;
     size_t clusters = clustered ? P - 1 : 0;
-    t->root_of_patch = rad_alloc_array(ctx, P, sizeof *t->root_of_patch, "hierarchical: roots");
-    t->order = rad_alloc_array(ctx, P, sizeof *t->order, "hierarchical: cluster order");
-    t->order_area = rad_alloc_array(ctx, P + 1, sizeof *t->order_area, "hierarchical: cluster order");
-    t->lift = rad_alloc_array(ctx, P, sizeof *t->lift, "hierarchical: lifts");
-    hr_node *roots = rad_alloc_array(ctx, P, sizeof *roots, "hierarchical: roots");
-    sort_item *scratch = clustered ? rad_alloc_array(ctx, P, sizeof *scratch, "hierarchical: sort") : NULL;
+    t->root_of_patch = rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *t->root_of_patch, "hierarchical: roots");
+    t->order = rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *t->order, "hierarchical: cluster order");
+    t->order_area = rad_alloc(ctx, RAD_MEM_HIERARCHY, P + 1, sizeof *t->order_area, "hierarchical: cluster order");
+    t->lift = rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *t->lift, "hierarchical: lifts");
+    hr_node *roots = rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *roots, "hierarchical: roots");
+    sort_item *scratch = clustered ? rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *scratch, "hierarchical: sort") : NULL;
     rad_result r = RAD_OK;
     if (!t->root_of_patch || !t->order || !t->order_area || !t->lift || !roots ||
         (clustered && !scratch) || (r = reserve(ctx, t, clusters + P)) != RAD_OK) {
-        free(roots);
-        free(scratch);
+        rad_free(roots);
+        rad_free(scratch);
         hr_tree_free(t);
         return r != RAD_OK ? r : RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -227,12 +225,12 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
     t->count = clusters + P;
     t->clusters = clusters;
     /* Projected-area bins, bottom-up (children follow their parent). */
-    t->cluster_bins = rad_alloc_array(ctx, 6 * clusters + 1, sizeof *t->cluster_bins, "hierarchical: cluster bins");
-    t->power_bins = rad_alloc_array(ctx, 6 * clusters + 1, sizeof *t->power_bins, "hierarchical: cluster bins");
-    t->order_power = rad_alloc_array(ctx, P + 1, sizeof *t->order_power, "hierarchical: cluster order");
+    t->cluster_bins = rad_alloc(ctx, RAD_MEM_HIERARCHY, 6 * clusters + 1, sizeof *t->cluster_bins, "hierarchical: cluster bins");
+    t->power_bins = rad_alloc(ctx, RAD_MEM_HIERARCHY, 6 * clusters + 1, sizeof *t->power_bins, "hierarchical: cluster bins");
+    t->order_power = rad_alloc(ctx, RAD_MEM_HIERARCHY, P + 1, sizeof *t->order_power, "hierarchical: cluster order");
     if (!t->cluster_bins || !t->power_bins || !t->order_power) {
-        free(roots);
-        free(scratch);
+        rad_free(roots);
+        rad_free(scratch);
         hr_tree_free(t);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -253,21 +251,21 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
     t->order_area[0] = 0.0;
     for (size_t i = 0; i < P; i++)
         t->order_area[i + 1] = t->order_area[i] + roots[t->order[i]].area;
-    free(roots);
-    free(scratch);
+    rad_free(roots);
+    rad_free(scratch);
     return RAD_OK;
 }
 
 void hr_tree_free(hr_tree *t)
 {
-    free(t->nodes);
-    free(t->root_of_patch);
-    free(t->order);
-    free(t->order_area);
-    free(t->lift);
-    free(t->cluster_bins);
-    free(t->power_bins);
-    free(t->order_power);
+    rad_free(t->nodes);
+    rad_free(t->root_of_patch);
+    rad_free(t->order);
+    rad_free(t->order_area);
+    rad_free(t->lift);
+    rad_free(t->cluster_bins);
+    rad_free(t->power_bins);
+    rad_free(t->order_power);
     memset(t, 0, sizeof *t);
 }
 

@@ -140,16 +140,16 @@ rad_result rad_vertex_values(rad_context *ctx, const rad_mesh *mesh,
 {
     const size_t nv = mesh->vertex_count, ne = mesh->element_count;
     rad_result result = RAD_ERROR_OUT_OF_MEMORY;
-    double *weight = rad_alloc_array(ctx, nv, sizeof(double), "vertex weights");
-    uint32_t *adjacent_start = rad_alloc_array(ctx, nv + 1, sizeof(uint32_t), "vertex adjacency");
-    uint32_t *adjacent = rad_alloc_array(ctx, 4 * ne, sizeof(uint32_t), "vertex adjacency");
-    uint64_t *edges = rad_alloc_array(ctx, 4 * ne, sizeof(uint64_t), "element edges");
-    uint64_t *split_keys = rad_alloc_array(ctx, mesh->tvertex_count, sizeof(uint64_t), "T-edges");
-    uint64_t *tvertex_order = rad_alloc_array(ctx, mesh->tvertex_count, sizeof(uint64_t),
+    double *weight = rad_alloc(ctx, RAD_MEM_RENDER, nv, sizeof(double), "vertex weights");
+    uint32_t *adjacent_start = rad_alloc(ctx, RAD_MEM_RENDER, nv + 1, sizeof(uint32_t), "vertex adjacency");
+    uint32_t *adjacent = rad_alloc(ctx, RAD_MEM_RENDER, 4 * ne, sizeof(uint32_t), "vertex adjacency");
+    uint64_t *edges = rad_alloc(ctx, RAD_MEM_RENDER, 4 * ne, sizeof(uint64_t), "element edges");
+    uint64_t *split_keys = rad_alloc(ctx, RAD_MEM_RENDER, mesh->tvertex_count, sizeof(uint64_t), "T-edges");
+    uint64_t *tvertex_order = rad_alloc(ctx, RAD_MEM_RENDER, mesh->tvertex_count, sizeof(uint64_t),
                                               "T-vertex index");
-    bool *boundary = rad_alloc_array(ctx, nv, sizeof(bool), "boundary vertices");
-    uint32_t *stamp = rad_alloc_array(ctx, nv, sizeof(uint32_t), "vertex marks");
-    double *interior = rad_alloc_array(ctx, 3 * nv, sizeof(double), "interior vertex values");
+    bool *boundary = rad_alloc(ctx, RAD_MEM_RENDER, nv, sizeof(bool), "boundary vertices");
+    uint32_t *stamp = rad_alloc(ctx, RAD_MEM_RENDER, nv, sizeof(uint32_t), "vertex marks");
+    double *interior = rad_alloc(ctx, RAD_MEM_RENDER, 3 * nv, sizeof(double), "interior vertex values");
     if (!weight || !adjacent_start || !adjacent || !edges || !split_keys || !tvertex_order ||
         !boundary || !stamp || !interior)
         goto done;
@@ -279,15 +279,15 @@ rad_result rad_vertex_values(rad_context *ctx, const rad_mesh *mesh,
     result = RAD_OK;
 
 done:
-    free(weight);
-    free(adjacent_start);
-    free(adjacent);
-    free(edges);
-    free(split_keys);
-    free(tvertex_order);
-    free(boundary);
-    free(stamp);
-    free(interior);
+    rad_free(weight);
+    rad_free(adjacent_start);
+    rad_free(adjacent);
+    rad_free(edges);
+    rad_free(split_keys);
+    rad_free(tvertex_order);
+    rad_free(boundary);
+    rad_free(stamp);
+    rad_free(interior);
     return result;
 }
 

@@ -69,12 +69,12 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
     if (!(o.crease_angle_degrees > 0.0 && o.crease_angle_degrees <= 180.0))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "crease angle must be in (0, 180] degrees");
 
-    rad_mesh *mesh = calloc(1, sizeof *mesh);
+    rad_mesh *mesh = rad_alloc(ctx, RAD_MEM_MESH, 1, sizeof *mesh, "mesh");
     if (!mesh)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     rad_result r = mesh_patches_from_polygons(ctx, scene, &mesh->patches, &mesh->patch_count);
     if (r != RAD_OK) {
-        free(mesh);
+        rad_free(mesh);
         return r;
     }
 
@@ -112,12 +112,12 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
                         nelem, bytes / 1073741824.0, max_memory_bytes / 1073741824.0);
     }
     mesh->element_count = (size_t)nelem;
-    mesh->elements = rad_alloc_array(ctx, mesh->element_count, sizeof *mesh->elements, "mesh: elements");
-    raw_vertex *raw = rad_alloc_array(ctx, nraw, sizeof *raw, "mesh: grid points");
-    uint32_t *weld_of = rad_alloc_array(ctx, nraw, sizeof *weld_of, "mesh: grid points");
+    mesh->elements = rad_alloc(ctx, RAD_MEM_MESH, mesh->element_count, sizeof *mesh->elements, "mesh: elements");
+    raw_vertex *raw = rad_alloc(ctx, RAD_MEM_MESH, nraw, sizeof *raw, "mesh: grid points");
+    uint32_t *weld_of = rad_alloc(ctx, RAD_MEM_MESH, nraw, sizeof *weld_of, "mesh: grid points");
     if (!mesh->elements || !raw || !weld_of) {
-        free(raw);
-        free(weld_of);
+        rad_free(raw);
+        rad_free(weld_of);
         rad_mesh_destroy(mesh);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -142,8 +142,8 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
         double hg = fmax(fmin(h, typical), 10.0 * tol);
         r = mesh_find_tvertices(ctx, mesh, tol, hg);
     }
-    free(raw);
-    free(weld_of);
+    rad_free(raw);
+    rad_free(weld_of);
     if (r != RAD_OK) {
         rad_mesh_destroy(mesh);
         return r;
@@ -163,22 +163,22 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
     if (leaf_count >= RAD_TREE_LEAF || tree_count >= RAD_TREE_LEAF)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "mesh: %zu leaves exceed the limit of %u",
                         leaf_count, RAD_TREE_LEAF - 1);
-    rad_mesh *mesh = calloc(1, sizeof *mesh);
+    rad_mesh *mesh = rad_alloc(ctx, RAD_MEM_MESH, 1, sizeof *mesh, "mesh");
     if (!mesh)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     size_t nraw = 0;
     for (size_t i = 0; i < leaf_count; i++)
         nraw += leaves[i].corner_count;
     mesh->patch_count = base->patch_count;
-    mesh->patches = rad_alloc_array(ctx, base->patch_count, sizeof *mesh->patches, "mesh: patches");
-    mesh->elements = rad_alloc_array(ctx, leaf_count ? leaf_count : 1, sizeof *mesh->elements,
+    mesh->patches = rad_alloc(ctx, RAD_MEM_MESH, base->patch_count, sizeof *mesh->patches, "mesh: patches");
+    mesh->elements = rad_alloc(ctx, RAD_MEM_MESH, leaf_count ? leaf_count : 1, sizeof *mesh->elements,
                                      "mesh: elements");
-    mesh->tree = rad_alloc_array(ctx, 4 * tree_count + 1, sizeof *mesh->tree, "mesh: quadtree");
-    raw_vertex *raw = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *raw, "mesh: leaf corners");
-    uint32_t *weld_of = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *weld_of, "mesh: leaf corners");
+    mesh->tree = rad_alloc(ctx, RAD_MEM_MESH, 4 * tree_count + 1, sizeof *mesh->tree, "mesh: quadtree");
+    raw_vertex *raw = rad_alloc(ctx, RAD_MEM_MESH, nraw ? nraw : 1, sizeof *raw, "mesh: leaf corners");
+    uint32_t *weld_of = rad_alloc(ctx, RAD_MEM_MESH, nraw ? nraw : 1, sizeof *weld_of, "mesh: leaf corners");
     if (!mesh->patches || !mesh->elements || !mesh->tree || !raw || !weld_of) {
-        free(raw);
-        free(weld_of);
+        rad_free(raw);
+        rad_free(weld_of);
         rad_mesh_destroy(mesh);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -226,8 +226,8 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
         mesh->mesh_size = h;
         r = mesh_find_tvertices(ctx, mesh, tol, h > tol ? h : tol);
     }
-    free(raw);
-    free(weld_of);
+    rad_free(raw);
+    rad_free(weld_of);
     if (r != RAD_OK) {
         rad_mesh_destroy(mesh);
         return r;
@@ -240,10 +240,10 @@ void rad_mesh_destroy(rad_mesh *mesh)
 {
     if (!mesh)
         return;
-    free(mesh->patches);
-    free(mesh->elements);
-    free(mesh->vertices);
-    free(mesh->tvertices);
-    free(mesh->tree);
-    free(mesh);
+    rad_free(mesh->patches);
+    rad_free(mesh->elements);
+    rad_free(mesh->vertices);
+    rad_free(mesh->tvertices);
+    rad_free(mesh->tree);
+    rad_free(mesh);
 }

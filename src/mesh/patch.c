@@ -86,6 +86,7 @@ void rad_patch_parameters(const rad_patch *p, vec3 q, double *s, double *t)
 /* ---- polygons -> patches ---- */
 
 typedef struct patch_list {
+    rad_context *ctx;
     rad_patch *items;
     size_t count, capacity;
 } patch_list;
@@ -94,7 +95,7 @@ static bool patch_push(patch_list *l, const rad_patch *p)
 {
     if (l->count == l->capacity) {
         size_t cap = l->capacity ? 2 * l->capacity : 64;
-        rad_patch *n = realloc(l->items, cap * sizeof *n);
+        rad_patch *n = rad_realloc(l->ctx, RAD_MEM_MESH, l->items, cap, sizeof *n, "mesh: patches");
         if (!n)
             return false;
         l->items = n;
@@ -132,15 +133,46 @@ static bool convex_about(const vec3 *v, size_t n, vec3 normal)
     return true;
 }
 
+/* Working space for one polygon of n vertices: its corners, its triangles
+ * and the triangulation's scratch, grown as polygons need. */
+typedef struct polygon_scratch {
+    unsigned char *bytes;
+    size_t capacity;
+} polygon_scratch;
+
+static bool polygon_scratch_fit(rad_context *ctx, polygon_scratch *s, size_t n, vec3 **v, uint32_t **tri,
+                                void **work)
+{
+    /* vec3 and the triangulation's doubles first: every part stays 8-byte aligned. */
+    size_t need = n * sizeof **v + RAD_TRIANGULATE_SCRATCH(n) + 3 * n * sizeof **tri;
+    if (need > s->capacity) {
+        rad_free(s->bytes);
+        s->capacity = 0;
+        s->bytes = rad_alloc(ctx, RAD_MEM_MESH, need, 1, "mesh: polygon corners");
+        if (!s->bytes)
+            return false;
+        s->capacity = need;
+    }
+    *v = (vec3 *)(void *)s->bytes;
+    *work = s->bytes + n * sizeof **v;
+    *tri = (uint32_t *)(void *)(s->bytes + n * sizeof **v + RAD_TRIANGULATE_SCRATCH(n));
+    return true;
+}
+
 static rad_result make_patches(rad_context *ctx, const rad_scene *scene, patch_list *out)
 {
-    for (size_t pi = 0; pi < scene->polygon_count; pi++) {
+    polygon_scratch scratch = {NULL, 0};
+    rad_result r = RAD_OK;
+    for (size_t pi = 0; pi < scene->polygon_count && r == RAD_OK; pi++) {
         const rad_polygon *poly = &scene->polygons[pi];
         size_t n = poly->vertex_count;
-        vec3 stack_v[16];
-        vec3 *v = n <= 16 ? stack_v : malloc(n * sizeof *v);
-        if (!v)
-            return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+        vec3 *v;
+        uint32_t *tri;
+        void *work;
+        if (!polygon_scratch_fit(ctx, &scratch, n, &v, &tri, &work)) {
+            r = RAD_ERROR_OUT_OF_MEMORY;
+            break;
+        }
         for (size_t k = 0; k < n; k++)
             v[k] = scene->positions[scene->indices[poly->first_index + k]];
         bool ok = true;
@@ -164,30 +196,23 @@ static rad_result make_patches(rad_context *ctx, const rad_scene *scene, patch_l
             for (size_t k = 0; k < n && ok; k++)
                 ok = push_triangle(out, poly, (uint32_t)pi, c, v[k], v[(k + 1) % n]);
         } else {
-            uint32_t *tri = malloc(3 * n * sizeof *tri);
-            size_t nt = tri ? rad_triangulate_polygon(v, n, poly->normal, tri) : 0;
-            if (!tri)
-                ok = false;
-            else if (nt == 0) {
-                free(tri);
-                if (v != stack_v)
-                    free(v);
-                return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
-                                "%s: polygon %zu of surface '%s' cannot be triangulated "
-                                "(self-intersecting?)",
-                                scene->source, pi, scene->surfaces[poly->surface].name);
+            size_t nt = rad_triangulate_polygon(v, n, poly->normal, work, tri);
+            if (nt == 0) {
+                r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
+                             "%s: polygon %zu of surface '%s' cannot be triangulated "
+                             "(self-intersecting?)",
+                             scene->source, pi, scene->surfaces[poly->surface].name);
+                break;
             }
             for (size_t k = 0; k < nt && ok; k++)
                 ok = push_triangle(out, poly, (uint32_t)pi, v[tri[3 * k]], v[tri[3 * k + 1]],
                                    v[tri[3 * k + 2]]);
-            free(tri);
         }
-        if (v != stack_v)
-            free(v);
         if (!ok)
-            return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+            r = RAD_ERROR_OUT_OF_MEMORY; /* the allocator named what */
     }
-    return RAD_OK;
+    rad_free(scratch.bytes);
+    return r;
 }
 
 /* Merge consecutive triangle patches of one surface and material that share
@@ -254,10 +279,10 @@ static void merge_triangle_pairs(patch_list *l)
 rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene,
                                       rad_patch **patches, size_t *count)
 {
-    patch_list pl = {0};
+    patch_list pl = {ctx, NULL, 0, 0};
     rad_result r = make_patches(ctx, scene, &pl);
     if (r != RAD_OK) {
-        free(pl.items);
+        rad_free(pl.items);
         *patches = NULL;
         *count = 0;
         return r;

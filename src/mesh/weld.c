@@ -60,17 +60,17 @@ typedef struct cell_index {
     size_t mask;
 } cell_index;
 
-static bool cell_index_build(const cell_entry *e, size_t n, cell_index *ix)
+static bool cell_index_build(rad_context *ctx, const cell_entry *e, size_t n, cell_index *ix)
 {
     size_t size = 64;
     while (size < 2 * n)
         size *= 2;
-    ix->key = malloc(size * sizeof *ix->key);
-    ix->first = malloc(size * sizeof *ix->first);
+    ix->key = rad_alloc(ctx, RAD_MEM_MESH, size, sizeof *ix->key, "mesh: cell index");
+    ix->first = ix->key ? rad_alloc(ctx, RAD_MEM_MESH, size, sizeof *ix->first, "mesh: cell index") : NULL;
     ix->mask = size - 1;
-    if (!ix->key || !ix->first) {
-        free(ix->key);
-        free(ix->first);
+    if (!ix->first) {
+        rad_free(ix->key);
+        ix->key = NULL;
         return false;
     }
     memset(ix->first, 0xff, size * sizeof *ix->first);
@@ -97,8 +97,8 @@ static size_t cell_index_find(const cell_index *ix, size_t n, uint64_t key)
 
 static void cell_index_free(cell_index *ix)
 {
-    free(ix->key);
-    free(ix->first);
+    rad_free(ix->key);
+    rad_free(ix->first);
 }
 
 /* ---- welding ---- */
@@ -140,11 +140,11 @@ rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *r
                      double tol, double cos_crease, uint32_t *weld_of, vec3 **positions,
                      size_t *count)
 {
-    cell_entry *cells = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *cells, "mesh: weld table");
-    vec3 *pos = rad_alloc_array(ctx, nraw ? nraw : 1, sizeof *pos, "mesh: vertices");
+    cell_entry *cells = rad_alloc(ctx, RAD_MEM_MESH, nraw ? nraw : 1, sizeof *cells, "mesh: weld table");
+    vec3 *pos = rad_alloc(ctx, RAD_MEM_MESH, nraw ? nraw : 1, sizeof *pos, "mesh: vertices");
     if (!cells || !pos) {
-        free(cells);
-        free(pos);
+        rad_free(cells);
+        rad_free(pos);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double inv = 1.0 / tol;
@@ -155,10 +155,10 @@ rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *r
     }
     qsort(cells, nraw, sizeof *cells, cell_entry_cmp);
     cell_index cix;
-    if (!cell_index_build(cells, nraw, &cix)) {
-        free(cells);
-        free(pos);
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory for the weld index");
+    if (!cell_index_build(ctx, cells, nraw, &cix)) {
+        rad_free(cells);
+        rad_free(pos);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
     size_t nw = 0;
     for (size_t r = 0; r < nraw; r++) {
@@ -188,7 +188,7 @@ rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *r
             pos[nw++] = p;
         }
     }
-    free(cells);
+    rad_free(cells);
     cell_index_free(&cix);
     *positions = pos;
     *count = nw;
@@ -208,9 +208,14 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
     size_t ne = 0;
     for (size_t i = 0; i < mesh->element_count; i++)
         ne += mesh->elements[i].vertex_count;
-    edge_rec *edges = rad_alloc_array(ctx, ne ? ne : 1, sizeof *edges, "mesh: edges");
+    rad_result result = RAD_ERROR_OUT_OF_MEMORY;
+    cell_entry *order = NULL, *grid = NULL;
+    uint8_t *on_boundary = NULL;
+    uint32_t *vsurf = NULL;
+    cell_index gix = {NULL, NULL, 0};
+    edge_rec *edges = rad_alloc(ctx, RAD_MEM_MESH, ne, sizeof *edges, "mesh: edges");
     if (!edges)
-        return RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
     size_t k = 0;
     for (size_t i = 0; i < mesh->element_count; i++) {
         const rad_element *e = &mesh->elements[i];
@@ -223,24 +228,18 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
         }
     }
     /* Sort edges by (a, b) to find those used once (boundary edges). */
-    cell_entry *order = rad_alloc_array(ctx, ne ? ne : 1, sizeof *order, "mesh: edges");
-    if (!order) {
-        free(edges);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
+    order = rad_alloc(ctx, RAD_MEM_MESH, ne, sizeof *order, "mesh: edges");
+    if (!order)
+        goto done;
     for (size_t i = 0; i < ne; i++) {
         order[i].key = ((uint64_t)edges[i].a << 32) | edges[i].b;
         order[i].item = (uint32_t)i;
     }
     qsort(order, ne, sizeof *order, cell_entry_cmp);
     size_t nb = 0;
-    uint8_t *on_boundary = rad_alloc_array(ctx, mesh->vertex_count ? mesh->vertex_count : 1, 1,
-                                           "mesh: boundary flags");
-    if (!on_boundary) {
-        free(edges);
-        free(order);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
+    on_boundary = rad_alloc(ctx, RAD_MEM_MESH, mesh->vertex_count, 1, "mesh: boundary flags");
+    if (!on_boundary)
+        goto done;
     for (size_t i = 0; i < ne;) {
         size_t j = i;
         while (j < ne && order[j].key == order[i].key)
@@ -252,20 +251,13 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
         i = j;
     }
     /* Vertex -> a surface and normal, from any element that uses it. */
-    uint32_t *vsurf = rad_alloc_array(ctx, mesh->vertex_count ? mesh->vertex_count : 1,
-                                      sizeof *vsurf, "mesh: vertex surfaces");
+    vsurf = rad_alloc(ctx, RAD_MEM_MESH, mesh->vertex_count, sizeof *vsurf, "mesh: vertex surfaces");
     size_t nbv = 0;
     for (size_t v = 0; v < mesh->vertex_count; v++)
         nbv += on_boundary[v];
-    cell_entry *grid = rad_alloc_array(ctx, nbv ? nbv : 1, sizeof *grid, "mesh: vertex grid");
-    if (!vsurf || !grid) {
-        free(edges);
-        free(order);
-        free(on_boundary);
-        free(vsurf);
-        free(grid);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
+    grid = vsurf ? rad_alloc(ctx, RAD_MEM_MESH, nbv, sizeof *grid, "mesh: vertex grid") : NULL;
+    if (!grid)
+        goto done;
     for (size_t i = 0; i < mesh->element_count; i++)
         for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++)
             vsurf[mesh->elements[i].vertex[c]] = mesh->elements[i].surface;
@@ -288,18 +280,11 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
         g++;
     }
     qsort(grid, g, sizeof *grid, cell_entry_cmp);
-    cell_index gix;
-    if (!cell_index_build(grid, g, &gix)) {
-        free(edges);
-        free(order);
-        free(on_boundary);
-        free(vsurf);
-        free(grid);
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory for the T-vertex index");
-    }
+    if (!cell_index_build(ctx, grid, g, &gix))
+        goto done;
 
     size_t cap = 0;
-    rad_result result = RAD_OK;
+    result = RAD_OK;
     for (size_t bi = 0; bi < nb && result == RAD_OK; bi++) {
         const edge_rec *ed = &edges[order[bi].item];
         const rad_element *el = &mesh->elements[ed->element];
@@ -328,9 +313,10 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
                             continue;
                         if (mesh->tvertex_count == cap) {
                             size_t nc = cap ? 2 * cap : 64;
-                            rad_tvertex *nt = realloc(mesh->tvertices, nc * sizeof *nt);
+                            rad_tvertex *nt = rad_realloc(ctx, RAD_MEM_MESH, mesh->tvertices, nc, sizeof *nt,
+                                                          "mesh: T-vertices");
                             if (!nt) {
-                                result = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "mesh: out of memory");
+                                result = RAD_ERROR_OUT_OF_MEMORY;
                                 break;
                             }
                             mesh->tvertices = nt;
@@ -341,11 +327,12 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
                     }
                 }
     }
-    free(edges);
-    free(order);
-    free(on_boundary);
-    free(vsurf);
-    free(grid);
+done:
+    rad_free(edges);
+    rad_free(order);
+    rad_free(on_boundary);
+    rad_free(vsurf);
+    rad_free(grid);
     cell_index_free(&gix);
     return result;
 }

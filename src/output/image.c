@@ -46,15 +46,16 @@ rad_image *rad_image_create(rad_context *ctx, int width, int height)
         rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "image: bad size %d x %d", width, height);
         return NULL;
     }
-    rad_image *image = rad_alloc_array(ctx, 1, sizeof *image, "image");
+    rad_image *image = rad_alloc(ctx, RAD_MEM_RENDER, 1, sizeof *image, "image");
     if (!image)
         return NULL;
     size_t pixels = (size_t)width * (size_t)height;
-    image->pixels = rad_alloc_array(ctx, pixels, 3 * sizeof(float), "image pixels");
+    image->pixels = rad_alloc(ctx, RAD_MEM_RENDER, pixels, 3 * sizeof(float), "image pixels");
     if (!image->pixels) {
-        free(image);
+        rad_free(image);
         return NULL;
     }
+    image->ctx = ctx;
     image->width = width;
     image->height = height;
     return image;
@@ -64,8 +65,8 @@ void rad_image_destroy(rad_image *image)
 {
     if (!image)
         return;
-    free(image->pixels);
-    free(image);
+    rad_free(image->pixels);
+    rad_free(image);
 }
 
 int rad_image_width(const rad_image *image) { return image ? image->width : 0; }
@@ -110,32 +111,31 @@ static float select_kth(float *a, size_t n, size_t k)
 
 /* Unlit (black) and non-finite pixels are left out: an image that is mostly
  * background would otherwise be exposed for the background. */
-double rad_image_auto_exposure(const rad_image *image)
+rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *exposure)
 {
-    if (!image)
-        return 1.0;
+    *exposure = 1.0;
     size_t n = (size_t)image->width * (size_t)image->height, lit = 0;
-    float *y = malloc((n ? n : 1) * sizeof *y);
-    double sum = 0.0;
+    float *y = rad_alloc(ctx, RAD_MEM_RENDER, n, sizeof *y, "exposure: luminances");
+    if (!y)
+        return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n; i++) {
         double value = luminance(&image->pixels[3 * i]);
         if (!(value > 0.0) || !isfinite(value))
             continue;
-        sum += value;
-        if (y)
-            y[lit] = (float)value;
-        lit++;
+        y[lit++] = (float)value;
     }
-    if (lit == 0) {
-        free(y);
+    double key = lit ? select_kth(y, lit, (size_t)(0.95 * (double)(lit - 1))) : 0.0;
+    rad_free(y);
+    *exposure = key > 0.0 ? 0.8 / key : 1.0;
+    return RAD_OK;
+}
+
+double rad_image_auto_exposure(const rad_image *image)
+{
+    double exposure;
+    if (!image)
         return 1.0;
-    }
-    /* Without memory for the percentile, the mean is the next best key. */
-    double key = sum / (double)lit;
-    if (y)
-        key = select_kth(y, lit, (size_t)(0.95 * (double)(lit - 1)));
-    free(y);
-    return key > 0.0 ? 0.8 / key : 1.0;
+    return rad_image_exposure(image->ctx, image, &exposure) == RAD_OK ? exposure : 1.0;
 }
 
 /* ---- writers ---- */
@@ -167,7 +167,7 @@ static rad_result write_png(rad_context *ctx, const rad_image *image, const char
                             double exposure, rad_atomic_file *file)
 {
     size_t n = (size_t)image->width * (size_t)image->height;
-    unsigned char *bytes = rad_alloc_array(ctx, n, 3, "PNG pixels");
+    unsigned char *bytes = rad_alloc(ctx, RAD_MEM_RENDER, n, 3, "PNG pixels");
     if (!bytes)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < 3 * n; i++)
@@ -175,7 +175,7 @@ static rad_result write_png(rad_context *ctx, const rad_image *image, const char
     stb_sink sink = {file->file, 0};
     int ok = stbi_write_png_to_func(stb_write, &sink, image->width, image->height, 3, bytes,
                                     3 * image->width);
-    free(bytes);
+    rad_free(bytes);
     if (!ok)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: PNG encoding failed", path);
     if (sink.failed)
@@ -198,7 +198,7 @@ static rad_result write_pfm(rad_context *ctx, const rad_image *image, const char
                             rad_atomic_file *file)
 {
     size_t row_bytes = (size_t)image->width * 3 * 4;
-    unsigned char *row = rad_alloc_array(ctx, row_bytes, 1, "PFM row");
+    unsigned char *row = rad_alloc(ctx, RAD_MEM_RENDER, row_bytes, 1, "PFM row");
     if (!row)
         return RAD_ERROR_OUT_OF_MEMORY;
     int failed = fprintf(file->file, "PF\n%d %d\n-1.0\n", image->width, image->height) < 0;
@@ -212,7 +212,7 @@ static rad_result write_pfm(rad_context *ctx, const rad_image *image, const char
         }
         failed = fwrite(row, 1, row_bytes, file->file) != row_bytes;
     }
-    free(row);
+    rad_free(row);
     return failed ? rad_fail(ctx, RAD_ERROR_IO, "%s: write failed", path) : RAD_OK;
 }
 
@@ -235,11 +235,12 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
     if (image->width <= 0 || image->height <= 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: image is empty (%d x %d)", path,
                         image->width, image->height);
-    if (png && exposure == 0.0)
-        exposure = rad_image_auto_exposure(image);
+    rad_result r = png && exposure == 0.0 ? rad_image_exposure(ctx, image, &exposure) : RAD_OK;
+    if (r != RAD_OK)
+        return r;
 
     rad_atomic_file file;
-    rad_result r = rad_atomic_open(ctx, path, &file);
+    r = rad_atomic_open(ctx, path, &file);
     if (r != RAD_OK)
         return r;
     if (png)

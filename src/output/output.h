@@ -9,6 +9,7 @@
 #include "strategy/strategy.h"
 
 struct rad_image {
+    rad_context *ctx;       /* the context it was made in (and its auto exposure's scratch) */
     int width, height;
     float *pixels;          /* RGB radiance, W/(m^2 sr), row 0 at the top */
 };
@@ -45,8 +46,9 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
                                    double exposure);
 
 /* Automatic exposure: the multiplier that maps the 95th percentile of
- * luminance among non-saturated pixels to 0.8. */
-double rad_image_auto_exposure(const rad_image *image);
+ * luminance among lit pixels to 0.8, into *exposure.  Fails only for
+ * memory (a float per pixel). */
+rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *exposure);
 
 /* ---- results as files (stats.c); every file is written atomically ---- */
 

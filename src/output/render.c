@@ -104,17 +104,18 @@ static void shade(const rad_render_input *input, rad_shading shading, const rad_
     }
 }
 
-/* One row: width x samples^2 rays in batches; writes the row's pixels. */
+/* One row: width x samples^2 rays in batches of `batch`; writes the row's
+ * pixels. */
 static void render_row(const rad_render_input *input, rad_shading shading,
-                       const render_view *view, int y, rad_ray *rays, rad_hit *hits,
+                       const render_view *view, int y, size_t batch, rad_ray *rays, rad_hit *hits,
                        double *sum, float *pixels)
 {
     const uint64_t per_pixel = (uint64_t)view->samples * (uint64_t)view->samples;
     const uint64_t total = (uint64_t)view->width * per_pixel;
     for (int x = 0; x < 3 * view->width; x++)
         sum[x] = 0.0;
-    for (uint64_t first = 0; first < total; first += RAD_RENDER_BATCH) {
-        size_t count = (size_t)(total - first < RAD_RENDER_BATCH ? total - first : RAD_RENDER_BATCH);
+    for (uint64_t first = 0; first < total; first += batch) {
+        size_t count = (size_t)(total - first < batch ? total - first : batch);
         for (size_t k = 0; k < count; k++) {
             uint64_t r = first + k, x = r / per_pixel, sample = r % per_pixel;
             uint64_t pixel = (uint64_t)y * (uint64_t)view->width + x;
@@ -163,18 +164,22 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
         return r;
 
     int threads = ctx && ctx->threads > 0 ? ctx->threads : 1;
+    /* A row's rays, up to RAD_RENDER_BATCH at a time: small images need no more. */
+    uint64_t row_rays = (uint64_t)width * (uint64_t)samples * (uint64_t)samples;
+    size_t batch = row_rays < RAD_RENDER_BATCH ? (size_t)row_rays : RAD_RENDER_BATCH;
     rad_image *image = rad_image_create(ctx, width, height);
-    rad_ray *rays = rad_alloc_array(ctx, (size_t)threads * RAD_RENDER_BATCH, sizeof *rays,
-                                    "render rays");
-    rad_hit *hits = rad_alloc_array(ctx, (size_t)threads * RAD_RENDER_BATCH, sizeof *hits,
-                                    "render hits");
-    double *sums = rad_alloc_array(ctx, (size_t)threads * (size_t)width, 3 * sizeof(double),
-                                   "render rows");
-    if (!image || !rays || !hits || !sums) {
+    rad_ray *rays = image ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * batch, sizeof *rays, "render rays")
+                          : NULL;
+    rad_hit *hits = rays ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * batch, sizeof *hits, "render hits")
+                         : NULL;
+    double *sums = hits ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * (size_t)width, 3 * sizeof(double),
+                                    "render rows")
+                        : NULL;
+    if (!sums) {
         rad_image_destroy(image);
-        free(rays);
-        free(hits);
-        free(sums);
+        rad_free(rays);
+        rad_free(hits);
+        rad_free(sums);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
 
@@ -186,8 +191,8 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
 #ifdef _OPENMP
         thread = omp_get_thread_num();
 #endif
-        rad_ray *my_rays = rays + (size_t)thread * RAD_RENDER_BATCH;
-        rad_hit *my_hits = hits + (size_t)thread * RAD_RENDER_BATCH;
+        rad_ray *my_rays = rays + (size_t)thread * batch;
+        rad_hit *my_hits = hits + (size_t)thread * batch;
         double *my_sum = sums + (size_t)thread * (size_t)width * 3;
 #pragma omp for schedule(dynamic)
         for (int y = 0; y < height; y++) {
@@ -196,7 +201,7 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
                 rows_skipped++;
                 continue;
             }
-            render_row(input, o.shading, &view, y, my_rays, my_hits, my_sum,
+            render_row(input, o.shading, &view, y, batch, my_rays, my_hits, my_sum,
                        &image->pixels[(size_t)y * (size_t)width * 3]);
             int done;
 #pragma omp atomic capture
@@ -205,9 +210,9 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
                 rad_progress(ctx, "render", (uint64_t)done, (uint64_t)height);
         }
     }
-    free(rays);
-    free(hits);
-    free(sums);
+    rad_free(rays);
+    rad_free(hits);
+    rad_free(sums);
     rad_progress(ctx, "render", (uint64_t)rows_done, (uint64_t)height);
     *out = image;
     if (rows_skipped > 0)

@@ -27,22 +27,21 @@ static rad_result write_json(rad_context *ctx, cJSON *root, const char *path)
         fputc('\n', f.file);
         r = rad_atomic_commit(ctx, &f);
     }
-    free(text);
+    cJSON_free(text);
     return r;
 }
 
-/* Area-weighted material figures of one surface, over its elements. */
 /* Area-weighted means per surface of reflectance, emission and radiosity,
  * in one pass over the elements (9 doubles per surface: rho, E, B), so
  * that scenes of 10^5 surfaces and 10^6 elements are not S x n.  NULL when
  * out of memory. */
-static double *surface_means(const rad_solution_view *s)
+static double *surface_means(rad_context *ctx, const rad_solution_view *s)
 {
     size_t S = s->scene->surface_count;
-    double *m = calloc(S ? 9 * S : 1, sizeof *m), *area = calloc(S ? S : 1, sizeof *area);
-    if (!m || !area) {
-        free(m);
-        free(area);
+    double *m = rad_alloc(ctx, RAD_MEM_OUTPUT, 9 * S, sizeof *m, "stats: surface means");
+    double *area = m ? rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *area, "stats: surface means") : NULL;
+    if (!area) {
+        rad_free(m);
         return NULL;
     }
     for (size_t i = 0; i < s->n; i++) {
@@ -58,7 +57,7 @@ static double *surface_means(const rad_solution_view *s)
     for (size_t k = 0; k < S; k++)
         for (int q = 0; q < 9; q++)
             m[9 * k + (size_t)q] = area[k] > 0.0 ? m[9 * k + (size_t)q] / area[k] : 0.0;
-    free(area);
+    rad_free(area);
     return m;
 }
 
@@ -174,17 +173,20 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     }
 
     double emitted, absorbed;
-    rad_view_power(s, &emitted, &absorbed);
+    if (rad_view_power(ctx, s, &emitted, &absorbed) != RAD_OK) {
+        cJSON_Delete(root);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
     cJSON *power = cJSON_AddObjectToObject(root, "power_W");
     cJSON_AddNumberToObject(power, "emitted", emitted);
     cJSON_AddNumberToObject(power, "absorbed", absorbed);
     cJSON_AddNumberToObject(power, "escaped", emitted - absorbed);
 
     cJSON *surfaces = cJSON_AddArrayToObject(root, "surfaces");
-    double *means = surface_means(s);
+    double *means = surface_means(ctx, s);
     if (!means) {
         cJSON_Delete(root);
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
     for (size_t k = 0; k < s->scene->surface_count; k++) {
         cJSON *o = cJSON_CreateObject();
@@ -195,7 +197,7 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
         cJSON_AddItemToObject(o, "radiosity", rgb_array(&means[9 * k + 6]));
         cJSON_AddItemToArray(surfaces, o);
     }
-    free(means);
+    rad_free(means);
 
     cJSON *sec = cJSON_AddObjectToObject(root, "seconds");
     cJSON_AddNumberToObject(sec, "load", s->seconds.load);
@@ -214,6 +216,13 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddNumberToObject(mem, "peak_resident", (double)rad_peak_memory_bytes());
     cJSON_AddNumberToObject(mem, "form_factor_matrix", s->F ? (double)n * (double)n * sizeof(float) : 0.0);
     cJSON_AddNumberToObject(mem, "limit", s->options->max_memory_bytes);
+    /* The allocator's figures: everything the engine itself holds in this
+     * context, at its peak, and each stage's peak (docs/stats.md). */
+    cJSON_AddNumberToObject(mem, "allocator_peak", (double)rad_memory_peak(ctx, RAD_MEM_CATEGORIES));
+    cJSON *by_category = cJSON_AddObjectToObject(mem, "by_category");
+    for (int c = 0; c < RAD_MEM_CATEGORIES; c++)
+        cJSON_AddNumberToObject(by_category, rad_memory_category_name((rad_memory_category)c),
+                                (double)rad_memory_peak(ctx, (rad_memory_category)c));
 
     rad_result r = write_json(ctx, root, path);
     cJSON_Delete(root);
@@ -221,14 +230,15 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
 }
 
 /* Surface-level standard errors from element variances (independent
- * estimates): var F_IJ = sum_{i in I} (A_i / A_I)^2 sum_{j in J} var F_ij. */
-static void surface_std_errors(const rad_solution_view *s, double *err)
+ * estimates): var F_IJ = sum_{i in I} (A_i / A_I)^2 sum_{j in J} var F_ij.
+ * Fails only for memory. */
+static rad_result surface_std_errors(rad_context *ctx, const rad_solution_view *s, double *err)
 {
     size_t S = s->scene->surface_count, n = s->n;
-    double *area = calloc(S ? S : 1, sizeof *area);
-    memset(err, 0, S * S * sizeof *err);
+    double *area = rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *area, "view factors: surface areas");
     if (!area)
-        return;
+        return RAD_ERROR_OUT_OF_MEMORY;
+    memset(err, 0, S * S * sizeof *err);
     for (size_t i = 0; i < n; i++)
         area[s->mesh->elements[i].surface] += s->area[i];
     for (size_t i = 0; i < n; i++) {
@@ -239,7 +249,8 @@ static void surface_std_errors(const rad_solution_view *s, double *err)
     }
     for (size_t k = 0; k < S * S; k++)
         err[k] = sqrt(err[k]);
-    free(area);
+    rad_free(area);
+    return RAD_OK;
 }
 
 /* A CSV field: quoted (with doubled quotes) when it holds a comma, quote or
@@ -272,11 +283,12 @@ typedef struct vf_rows {
 static void vf_rows_free(vf_rows *r)
 {
     for (size_t k = 0; r->names && k < r->count; k++)
-        free(r->names[k]);
-    free(r->names);
-    free(r->area);
-    free(r->F);
-    free(r->err);
+        rad_free(r->names[k]);
+    rad_free(r->names);
+    rad_free(r->area);
+    rad_free(r->F);
+    rad_free(r->err);
+    memset(r, 0, sizeof *r);
 }
 
 static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bool elements, vf_rows *r)
@@ -293,30 +305,38 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
                         "rad_options.target_elements",
                         r->count, r->count, bytes / 1073741824.0,
                         s->options->max_memory_bytes / 1073741824.0);
-    r->names = rad_alloc_array(ctx, r->count, sizeof *r->names, "view factors");
-    r->area = rad_alloc_array(ctx, r->count, sizeof *r->area, "view factors");
-    r->F = rad_alloc_array(ctx, r->count * r->count, sizeof *r->F, "view factors");
-    if (with_err)
-        r->err = rad_alloc_array(ctx, r->count * r->count, sizeof *r->err, "view factors");
-    if (!r->names || !r->area || !r->F || (with_err && !r->err)) {
+    r->names = rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->names, "view factors: names");
+    r->area = r->names ? rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->area, "view factors: areas") : NULL;
+    r->F = r->area ? rad_alloc(ctx, RAD_MEM_OUTPUT, r->count * r->count, sizeof *r->F, "view factors: table")
+                   : NULL;
+    if (r->F && with_err)
+        r->err = rad_alloc(ctx, RAD_MEM_OUTPUT, r->count * r->count, sizeof *r->err, "view factors: errors");
+    if (!r->F || (with_err && !r->err)) {
         vf_rows_free(r);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
+    rad_result result = RAD_OK;
     if (!elements) {
-        rad_view_surface_view_factors(s, r->F);
-        if (with_err)
-            surface_std_errors(s, r->err);
-        for (size_t k = 0; k < S; k++) {
-            r->names[k] = rad_strdup(s->scene->surfaces[k].name);
+        result = rad_view_surface_view_factors(ctx, s, r->F);
+        if (result == RAD_OK && with_err)
+            result = surface_std_errors(ctx, s, r->err);
+        for (size_t k = 0; k < S && result == RAD_OK; k++) {
+            r->names[k] = rad_strdup(ctx, RAD_MEM_OUTPUT, s->scene->surfaces[k].name, "view factors: names");
             r->area[k] = s->scene->surfaces[k].area;
+            if (!r->names[k])
+                result = RAD_ERROR_OUT_OF_MEMORY;
         }
     } else {
-        size_t *seen = calloc(S ? S : 1, sizeof *seen);
-        for (size_t i = 0; i < n; i++) {
+        size_t *seen = rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *seen, "view factors: names");
+        if (!seen)
+            result = RAD_ERROR_OUT_OF_MEMORY;
+        for (size_t i = 0; i < n && result == RAD_OK; i++) {
             uint32_t si = s->mesh->elements[i].surface;
             char name[512];
-            snprintf(name, sizeof name, "%s#%zu", s->scene->surfaces[si].name, seen ? seen[si]++ : i);
-            r->names[i] = rad_strdup(name);
+            snprintf(name, sizeof name, "%s#%zu", s->scene->surfaces[si].name, seen[si]++);
+            r->names[i] = rad_strdup(ctx, RAD_MEM_OUTPUT, name, "view factors: names");
+            if (!r->names[i])
+                result = RAD_ERROR_OUT_OF_MEMORY;
             r->area[i] = s->area[i];
             for (size_t j = 0; j < n; j++) {
                 r->F[i * n + j] = s->F[i * n + j];
@@ -324,14 +344,11 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
                     r->err[i * n + j] = sqrt(s->F_variance[i * n + j]);
             }
         }
-        free(seen);
+        rad_free(seen);
     }
-    for (size_t k = 0; k < r->count; k++)
-        if (!r->names[k]) {
-            vf_rows_free(r);
-            return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "view factors: out of memory");
-        }
-    return RAD_OK;
+    if (result != RAD_OK)
+        vf_rows_free(r);
+    return result;
 }
 
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,

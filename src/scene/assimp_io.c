@@ -81,7 +81,7 @@ static const char *base_name(const char *path)
 
 static struct aiFile *memory_open(struct aiFileIO *io, const char *path, const char *mode)
 {
-    const import_memory_fs *fs = (const import_memory_fs *)(void *)io->UserData;
+    import_memory_fs *fs = (import_memory_fs *)(void *)io->UserData;
     if (!path || !mode || strpbrk(mode, "wa+"))
         return NULL;
     char extension[16];
@@ -97,9 +97,11 @@ static struct aiFile *memory_open(struct aiFileIO *io, const char *path, const c
     } else {
         return NULL;
     }
-    memory_file *m = calloc(1, sizeof *m);
-    if (!m)
+    memory_file *m = rad_alloc(fs->ctx, RAD_MEM_SCENE, 1, sizeof *m, path);
+    if (!m) {
+        fs->out_of_memory = true; /* assimp may take it for a missing file: the import fails anyway */
         return NULL;
+    }
     m->data = data;
     m->size = size;
     m->file.ReadProc = memory_read;
@@ -116,7 +118,7 @@ static void memory_close(struct aiFileIO *io, struct aiFile *file)
 {
     (void)io;
     if (file)
-        free(memory_file_of(file));
+        rad_free(memory_file_of(file));
 }
 
 void import_memory_io(struct aiFileIO *io, import_memory_fs *fs)

@@ -209,12 +209,12 @@ rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **out)
                                             sizeof cornell_box_mtl - 1, &scene);
     if (r != RAD_OK)
         return r;
-    char *source = rad_strdup("cornell-box");
+    char *source = rad_strdup(ctx, RAD_MEM_SCENE, "cornell-box", "cornell-box");
     if (!source) {
         rad_scene_destroy(scene);
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "cornell-box: out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
-    free(scene->source);
+    rad_free(scene->source);
     scene->source = source;
     rad_camera camera = {
         .position = {0.278, 0.273, -0.800},

@@ -606,9 +606,9 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
 
     char source[64];
     snprintf(source, sizeof source, "office:%d:%llu", o.rooms, (unsigned long long)o.seed);
-    g.x = rad_alloc_array(ctx, (size_t)g.columns + 1, sizeof *g.x, "office columns");
-    g.z = rad_alloc_array(ctx, (size_t)g.rows + 1, sizeof *g.z, "office rows");
-    g.builder = g.x && g.z ? rad_scene_builder_create(ctx, source) : NULL;
+    g.x = rad_alloc(ctx, RAD_MEM_SCENE, (size_t)g.columns + 1, sizeof *g.x, "office columns");
+    g.z = g.x ? rad_alloc(ctx, RAD_MEM_SCENE, (size_t)g.rows + 1, sizeof *g.z, "office rows") : NULL;
+    g.builder = g.z ? rad_scene_builder_create(ctx, source) : NULL;
     rad_result r = g.builder ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
 
     if (r == RAD_OK) {
@@ -649,8 +649,8 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
         g.builder = NULL;
     }
     rad_scene_builder_destroy(g.builder);
-    free(g.x);
-    free(g.z);
+    rad_free(g.x);
+    rad_free(g.z);
     if (r == RAD_OK)
         (*out)->load_seconds = rad_seconds() - start;
     return r;

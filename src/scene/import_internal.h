@@ -50,11 +50,13 @@ double import_gltf_camera_yfov(const struct cJSON *root);
 
 /* The files a memory import serves; the buffers are the caller's. */
 typedef struct import_memory_fs {
+    rad_context *ctx; /* the open files' handles are allocated in it */
     const char *name; /* the main buffer's file name */
     const char *data;
     size_t size;
     const char *mtl; /* served under any *.mtl name; NULL if none */
     size_t mtl_size;
+    bool out_of_memory; /* an open failed for memory: assimp may carry on without the file */
 } import_memory_fs;
 
 /* Fill `io` so that assimp reads `fs` (which must outlive the import).

@@ -44,6 +44,8 @@ struct rad_scene_builder {
     size_t polygon_scratch_capacity;
     uint32_t *triangle_scratch; /* its ear-clipped triangles */
     size_t triangle_scratch_capacity;
+    unsigned char *triangulate_scratch; /* rad_triangulate_polygon's working space */
+    size_t triangulate_scratch_capacity;
     bool has_camera;
     rad_camera camera;
 };
@@ -62,24 +64,23 @@ static void *reserve(rad_scene_builder *b, void *array, size_t *capacity, size_t
         rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: too many %s", b->source, what);
         return NULL;
     }
-    void *grown_array = realloc(array, grown * size);
-    if (!grown_array) {
-        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory for %zu %s", b->source,
-                 needed, what);
+    char named[320];
+    snprintf(named, sizeof named, "%s: %zu %s", b->source, needed, what);
+    void *grown_array = rad_realloc(b->ctx, RAD_MEM_SCENE, array, grown, size, named);
+    if (!grown_array)
         return NULL;
-    }
     *capacity = grown;
     return grown_array;
 }
 
 rad_scene_builder *rad_scene_builder_create(rad_context *ctx, const char *source)
 {
-    rad_scene_builder *b = calloc(1, sizeof *b);
+    source = source ? source : "scene";
+    rad_scene_builder *b = rad_alloc(ctx, RAD_MEM_SCENE, 1, sizeof *b, source);
     if (b)
-        b->source = rad_strdup(source ? source : "scene");
+        b->source = rad_strdup(ctx, RAD_MEM_SCENE, source, source);
     if (!b || !b->source) {
-        free(b);
-        rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", source ? source : "scene");
+        rad_free(b);
         return NULL;
     }
     b->ctx = ctx;
@@ -91,19 +92,20 @@ void rad_scene_builder_destroy(rad_scene_builder *b)
     if (!b)
         return;
     for (size_t i = 0; i < b->surface_count; i++)
-        free(b->surfaces[i].name);
+        rad_free(b->surfaces[i].name);
     for (size_t i = 0; i < b->material_count; i++)
-        free(b->materials[i].name);
-    free(b->source);
-    free(b->positions);
-    free(b->indices);
-    free(b->polygons);
-    free(b->surfaces);
-    free(b->surface_hash);
-    free(b->materials);
-    free(b->polygon_scratch);
-    free(b->triangle_scratch);
-    free(b);
+        rad_free(b->materials[i].name);
+    rad_free(b->source);
+    rad_free(b->positions);
+    rad_free(b->indices);
+    rad_free(b->polygons);
+    rad_free(b->surfaces);
+    rad_free(b->surface_hash);
+    rad_free(b->materials);
+    rad_free(b->polygon_scratch);
+    rad_free(b->triangle_scratch);
+    rad_free(b->triangulate_scratch);
+    rad_free(b);
 }
 
 int rad_scene_builder_material(rad_scene_builder *b, const char *name,
@@ -141,11 +143,9 @@ int rad_scene_builder_material(rad_scene_builder *b, const char *name,
         return -1;
     b->materials = materials;
     rad_material *m = &materials[b->material_count];
-    m->name = rad_strdup(name);
-    if (!m->name) {
-        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+    m->name = rad_strdup(b->ctx, RAD_MEM_SCENE, name, b->source);
+    if (!m->name)
         return -1;
-    }
     memcpy(m->reflectance, reflectance, sizeof m->reflectance);
     memcpy(m->emission, emission, sizeof m->emission);
     return (int)b->material_count++;
@@ -191,19 +191,16 @@ int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
         return -1;
     b->surfaces = surfaces;
     rad_surface *s = &surfaces[b->surface_count];
-    s->name = rad_strdup(name);
+    s->name = rad_strdup(b->ctx, RAD_MEM_SCENE, name, b->source);
     s->area = 0.0;
-    if (!s->name) {
-        rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+    if (!s->name)
         return -1;
-    }
     /* Grow the table to keep it under half full, then insert. */
     if (2 * (b->surface_count + 1) >= b->surface_hash_size) {
         size_t size = b->surface_hash_size ? 2 * b->surface_hash_size : 64;
-        uint32_t *table = calloc(size, sizeof *table);
+        uint32_t *table = rad_alloc(b->ctx, RAD_MEM_SCENE, size, sizeof *table, b->source);
         if (!table) {
-            free(s->name);
-            rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+            rad_free(s->name);
             return -1;
         }
         for (size_t i = 0; i < b->surface_count; i++) {
@@ -212,7 +209,7 @@ int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
                 k = (k + 1) & (size - 1);
             table[k] = (uint32_t)(i + 1);
         }
-        free(b->surface_hash);
+        rad_free(b->surface_hash);
         b->surface_hash = table;
         b->surface_hash_size = size;
     }
@@ -349,7 +346,12 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
         if (!triangles)
             return RAD_ERROR_OUT_OF_MEMORY;
         b->triangle_scratch = triangles;
-        triangle_count = rad_triangulate_polygon(polygon, n, normal, triangles);
+        unsigned char *scratch = reserve(b, b->triangulate_scratch, &b->triangulate_scratch_capacity,
+                                         RAD_TRIANGULATE_SCRATCH(n), 1, "polygon vertices");
+        if (!scratch)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        b->triangulate_scratch = scratch;
+        triangle_count = rad_triangulate_polygon(polygon, n, normal, scratch, triangles);
         if (triangle_count == 0)
             return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE,
                                  "intersects itself");
@@ -437,12 +439,13 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
                      b->source);
         goto done;
     }
-    surface_map = rad_alloc_array(b->ctx, b->surface_count, sizeof *surface_map, "surface map");
-    material_map =
-        rad_alloc_array(b->ctx, b->material_count, sizeof *material_map, "material map");
-    scene = calloc(1, sizeof *scene);
-    if (!surface_map || !material_map || !scene) {
-        r = rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", b->source);
+    surface_map = rad_alloc(b->ctx, RAD_MEM_SCENE, b->surface_count, sizeof *surface_map, b->source);
+    material_map = surface_map ? rad_alloc(b->ctx, RAD_MEM_SCENE, b->material_count, sizeof *material_map,
+                                           b->source)
+                               : NULL;
+    scene = material_map ? rad_alloc(b->ctx, RAD_MEM_SCENE, 1, sizeof *scene, b->source) : NULL;
+    if (!scene) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
     }
 
@@ -459,7 +462,7 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
     size_t kept = 0;
     for (size_t i = 0; i < b->surface_count; i++) {
         if (surface_map[i] == UINT32_MAX) {
-            free(b->surfaces[i].name);
+            rad_free(b->surfaces[i].name);
             continue;
         }
         b->surfaces[kept] = b->surfaces[i];
@@ -470,7 +473,7 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
     kept = 0;
     for (size_t i = 0; i < b->material_count; i++) {
         if (material_map[i] == UINT32_MAX) {
-            free(b->materials[i].name);
+            rad_free(b->materials[i].name);
             continue;
         }
         b->materials[kept] = b->materials[i];
@@ -502,17 +505,18 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
     scene->material_count = b->material_count;
     scene->has_camera = b->has_camera;
     scene->camera = b->camera;
-    free(b->polygon_scratch);
-    free(b->triangle_scratch);
-    free(b->surface_hash);
+    rad_free(b->polygon_scratch);
+    rad_free(b->triangle_scratch);
+    rad_free(b->triangulate_scratch);
+    rad_free(b->surface_hash);
     memset(b, 0, sizeof *b); /* all moved or freed: the destroy below frees the shell */
     *out = scene;
     scene = NULL;
 
 done:
-    free(surface_map);
-    free(material_map);
-    free(scene);
+    rad_free(surface_map);
+    rad_free(material_map);
+    rad_free(scene);
     rad_scene_builder_destroy(b);
     return r;
 }
@@ -554,16 +558,16 @@ void rad_scene_destroy(rad_scene *scene)
     if (!scene)
         return;
     for (size_t i = 0; i < scene->surface_count; i++)
-        free(scene->surfaces[i].name);
+        rad_free(scene->surfaces[i].name);
     for (size_t i = 0; i < scene->material_count; i++)
-        free(scene->materials[i].name);
-    free(scene->source);
-    free(scene->positions);
-    free(scene->indices);
-    free(scene->polygons);
-    free(scene->surfaces);
-    free(scene->materials);
-    free(scene);
+        rad_free(scene->materials[i].name);
+    rad_free(scene->source);
+    rad_free(scene->positions);
+    rad_free(scene->indices);
+    rad_free(scene->polygons);
+    rad_free(scene->surfaces);
+    rad_free(scene->materials);
+    rad_free(scene);
 }
 
 size_t rad_scene_surface_count(const rad_scene *scene) { return scene ? scene->surface_count : 0; }

@@ -88,11 +88,16 @@ rad_result rad_import_assimp_memory(rad_context *ctx, const char *name, const vo
 bool rad_scene_has_emitter(const rad_scene *scene);
 double rad_scene_diagonal(const rad_scene *scene); /* m */
 
+/* Bytes of working space rad_triangulate_polygon needs for n vertices. */
+#define RAD_TRIANGULATE_SCRATCH(n) ((size_t)(n) * (2 * sizeof(double) + 2 * sizeof(uint32_t)))
+
 /* Triangulate a simple planar polygon (convex or not) by ear clipping in
- * the plane of `normal`.  Writes (n - 2) * 3 local vertex indices into
+ * the plane of `normal`, in `scratch` (RAD_TRIANGULATE_SCRATCH(n) bytes,
+ * aligned as malloc aligns).  Writes (n - 2) * 3 local vertex indices into
  * `triangles`.  Returns the number of triangles, or 0 if the polygon is not
- * simple (self-intersecting) or degenerate. */
-size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, uint32_t *triangles);
+ * simple (self-intersecting) or degenerate.  Allocates nothing. */
+size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, void *scratch,
+                               uint32_t *triangles);
 
 /* Newell's normal (unnormalised; its length is twice the area). */
 vec3 rad_polygon_newell(const vec3 *vertices, size_t n);

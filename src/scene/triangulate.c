@@ -117,7 +117,8 @@ static bool is_ear(const point2 *pts, const uint32_t *next_of, uint32_t prev, ui
     return true;
 }
 
-size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, uint32_t *triangles)
+size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, void *scratch,
+                               uint32_t *triangles)
 {
     if (n < 3 || n >= UINT32_MAX || !v3_finite(normal) || v3_length(normal) == 0.0)
         return 0;
@@ -130,12 +131,10 @@ size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, uint
     vec3 axis_u = v3_normalize(v3_cross(helper, axis_n));
     vec3 axis_v = v3_cross(axis_n, axis_u);
 
-    point2 *pts = malloc(n * sizeof *pts);
-    uint32_t *prev_of = malloc(n * sizeof *prev_of);
-    uint32_t *next_of = malloc(n * sizeof *next_of);
+    point2 *pts = scratch;
+    uint32_t *prev_of = (uint32_t *)(pts + n);
+    uint32_t *next_of = prev_of + n;
     size_t count = 0;
-    if (!pts || !prev_of || !next_of)
-        goto done;
 
     double min_x = INFINITY, min_y = INFINITY, max_x = -INFINITY, max_y = -INFINITY;
     for (size_t i = 0; i < n; i++) {
@@ -200,8 +199,5 @@ size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, uint
     count++;
 
 done:
-    free(pts);
-    free(prev_of);
-    free(next_of);
     return count;
 }

@@ -97,11 +97,12 @@ static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE 
                                  const char *mtl_name)
 {
     size_t surfaces = scene->surface_count, polygons = scene->polygon_count;
-    size_t *start = rad_alloc_array(ctx, surfaces + 1, sizeof *start, "surface offsets");
-    uint32_t *order = rad_alloc_array(ctx, polygons ? polygons : 1, sizeof *order, "polygon order");
+    size_t *start = rad_alloc(ctx, RAD_MEM_OUTPUT, surfaces + 1, sizeof *start, "OBJ: surface offsets");
+    uint32_t *order = start ? rad_alloc(ctx, RAD_MEM_OUTPUT, polygons, sizeof *order, "OBJ: polygon order")
+                            : NULL;
     if (!start || !order) {
-        free(start);
-        free(order);
+        rad_free(start);
+        rad_free(order);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     memset(start, 0, (surfaces + 1) * sizeof *start);
@@ -148,8 +149,8 @@ static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE 
             written += p->vertex_count;
         }
     }
-    free(start);
-    free(order);
+    rad_free(start);
+    rad_free(order);
     return RAD_OK;
 }
 
@@ -165,9 +166,9 @@ rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const c
     char extension[8];
     rad_path_extension(path, extension, sizeof extension);
     size_t stem = strcmp(extension, "obj") == 0 ? length - 4 : length;
-    char *mtl_path = malloc(stem + 5);
+    char *mtl_path = rad_alloc(ctx, RAD_MEM_OUTPUT, stem + 5, 1, path);
     if (!mtl_path)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+        return RAD_ERROR_OUT_OF_MEMORY;
     memcpy(mtl_path, path, stem);
     memcpy(mtl_path + stem, ".mtl", 5);
     const char *slash = strrchr(mtl_path, '/');
@@ -190,7 +191,7 @@ rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const c
     if (r != RAD_OK) {
         rad_atomic_abort(&obj);
         rad_atomic_abort(&mtl);
-        free(mtl_path);
+        rad_free(mtl_path);
         return r;
     }
     r = rad_atomic_commit(ctx, &mtl);
@@ -199,6 +200,6 @@ rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const c
     } else if ((r = rad_atomic_commit(ctx, &obj)) != RAD_OK) {
         remove(mtl_path); /* no MTL without its OBJ */
     }
-    free(mtl_path);
+    rad_free(mtl_path);
     return r;
 }

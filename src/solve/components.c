@@ -133,11 +133,11 @@ typedef struct groups {
 
 static void groups_free(groups *g)
 {
-    free(g->label);
-    free(g->start);
-    free(g->members);
-    free(g->emitted);
-    free(g->residual);
+    rad_free(g->label);
+    rad_free(g->start);
+    rad_free(g->members);
+    rad_free(g->emitted);
+    rad_free(g->residual);
 }
 
 /* Find the groups; returns false only when out of memory. */
@@ -145,21 +145,21 @@ static bool groups_find(rad_context *ctx, const rad_system *sys, groups *g)
 {
     size_t n = sys->n;
     memset(g, 0, sizeof *g);
-    size_t *parent = rad_alloc_array(ctx, n, sizeof *parent, "solve: components: union-find");
-    size_t *size = rad_alloc_array(ctx, n, sizeof *size, "solve: components: union-find");
-    g->label = rad_alloc_array(ctx, n, sizeof *g->label, "solve: components: labels");
-    g->members = rad_alloc_array(ctx, n, sizeof *g->members, "solve: components: members");
+    size_t *parent = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *parent, "solve: components: union-find");
+    size_t *size = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *size, "solve: components: union-find");
+    g->label = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *g->label, "solve: components: labels");
+    g->members = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *g->members, "solve: components: members");
     if (!parent || !size || !g->label || !g->members) {
-        free(parent);
-        free(size);
+        rad_free(parent);
+        rad_free(size);
         return false;
     }
     g->count = label_components(sys, parent, size, g->label);
-    free(parent);
-    free(size);
-    g->start = rad_alloc_array(ctx, g->count + 1, sizeof *g->start, "solve: components: offsets");
-    g->emitted = rad_alloc_array(ctx, g->count, sizeof *g->emitted, "solve: components: power");
-    g->residual = rad_alloc_array(ctx, g->count, sizeof *g->residual, "solve: components: residuals");
+    rad_free(parent);
+    rad_free(size);
+    g->start = rad_alloc(ctx, RAD_MEM_SOLVER, g->count + 1, sizeof *g->start, "solve: components: offsets");
+    g->emitted = rad_alloc(ctx, RAD_MEM_SOLVER, g->count, sizeof *g->emitted, "solve: components: power");
+    g->residual = rad_alloc(ctx, RAD_MEM_SOLVER, g->count, sizeof *g->residual, "solve: components: residuals");
     if (!g->start || !g->emitted || !g->residual)
         return false;
     for (size_t i = 0; i < n; i++)
@@ -193,7 +193,7 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
     }
     /* One block (the usual case), or no room for a copy of the largest
      * block beside F (splitting is an optimisation): solve as a whole. */
-    double limit = sys->max_memory > 0.0 ? sys->max_memory : 0.8 * (double)rad_physical_memory_bytes();
+    double limit = sys->max_memory > 0.0 ? sys->max_memory : rad_memory_limit(ctx);
     double copy_bytes = 4.0 * (double)largest * (double)largest + 80.0 * (double)largest;
     if (multi < 2 || 4.0 * (double)n * (double)n + copy_bytes > limit) {
         groups_free(&g);
@@ -201,13 +201,13 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
     }
 
     double t0 = rad_seconds();
-    float *F_sub = rad_alloc_array(ctx, largest * largest, sizeof *F_sub, "solve: components: block of F");
-    double *vectors = rad_alloc_array(ctx, 10 * largest, sizeof *vectors, "solve: components: block vectors");
-    double *row = rad_alloc_array(ctx, n, sizeof *row, "solve: components: row residuals");
+    float *F_sub = rad_alloc(ctx, RAD_MEM_SOLVER, largest * largest, sizeof *F_sub, "solve: components: block of F");
+    double *vectors = rad_alloc(ctx, RAD_MEM_SOLVER, 10 * largest, sizeof *vectors, "solve: components: block vectors");
+    double *row = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *row, "solve: components: row residuals");
     if (!F_sub || !vectors || !row) {
-        free(F_sub);
-        free(vectors);
-        free(row);
+        rad_free(F_sub);
+        rad_free(vectors);
+        rad_free(row);
         groups_free(&g);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -308,13 +308,12 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
         for (int c = 0; c < 3; c++)
             ambient[c] += sub_stats.ambient[c] * group_area / area_total;
     }
-    free(F_sub);
-    free(vectors);
-    free(row);
-
     stats->components = g.count;
     stats->iterations = most_iterations;
-    stats->residual = rad_residual(sys, B);
+    stats->residual = rad_residual_in(sys, B, row);
+    rad_free(F_sub);
+    rad_free(vectors);
+    rad_free(row);
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
     memcpy(stats->ambient, ambient, sizeof ambient);
     if (any_unshot)

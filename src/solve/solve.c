@@ -46,18 +46,26 @@ void rad_residual_rows(const rad_system *sys, const double *B, double *row)
 /* Rows in parallel, each into its own slot, then a sequential sum: the
  * result is bit-identical whatever the thread count (a reduction clause
  * would add in a thread-dependent order). */
-double rad_residual(const rad_system *sys, const double *B)
+double rad_residual_in(const rad_system *sys, const double *B, double *row)
 {
     size_t n = sys->n;
-    double *row = malloc((n ? n : 1) * sizeof *row);
-    if (!row)
-        return INFINITY; /* cannot measure: never reported as converged */
     rad_residual_rows(sys, B, row);
     double num = 0.0, den = 0.0;
     for (size_t i = 0; i < n; i++) {
         num += row[i];
         den += sys->area[i] * (sys->emission[3 * i] + sys->emission[3 * i + 1] + sys->emission[3 * i + 2]);
     }
-    free(row);
     return den > 0.0 ? num / den : num;
+}
+
+rad_result rad_residual(rad_context *ctx, const rad_system *sys, const double *B, double *residual)
+{
+    double *row = rad_alloc(ctx, RAD_MEM_SOLVER, sys->n, sizeof *row, "solve: residual");
+    if (!row) {
+        *residual = INFINITY; /* not measured: never reported as converged */
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    *residual = rad_residual_in(sys, B, row);
+    rad_free(row);
+    return RAD_OK;
 }

@@ -28,7 +28,7 @@ typedef struct rad_system {
     const struct rad_vis *vis;
     uint64_t seed;
     int samples;              /* rays per shot; 0 = the solver's default */
-    double max_memory;        /* bytes a solver may allocate; 0 = 80% of physical memory */
+    double max_memory;        /* bytes a solver may allocate; 0 = the context's limit */
 } rad_system;
 
 /* Called after each iteration; a nonzero return stops the solve
@@ -108,8 +108,13 @@ static inline void rad_gather(const float *F_row, const double *B, size_t n, dou
 rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, const rad_system *sys,
                                    const rad_solve_params *p, double *B, rad_solve_stats *stats);
 
-/* The residual measure above (O(n^2)). */
-double rad_residual(const rad_system *sys, const double *B);
+/* The residual measure above (O(n^2)) into *residual.  Fails only for
+ * memory (n doubles of scratch). */
+rad_result rad_residual(rad_context *ctx, const rad_system *sys, const double *B, double *residual);
+
+/* The same with the caller's scratch `row` (n doubles), for solvers that
+ * measure it every sweep.  Cannot fail. */
+double rad_residual_in(const rad_system *sys, const double *B, double *row);
 
 /* Its per-row numerators: row[i] = A_i sum_c |r_ic| (row holds n doubles).
  * Parallel, thread-count independent.  Cannot fail. */

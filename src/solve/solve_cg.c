@@ -159,11 +159,11 @@ static rad_result conjugate_gradient(rad_context *ctx, const rad_system *sys, co
     int max_iterations = p->max_iterations > 0 ? p->max_iterations : 1000;
     cg_state s = {sys, n, sys->threads > 0 ? sys->threads : 1, NULL, NULL, NULL, NULL, NULL, NULL,
                   NULL, NULL, NULL, NULL, 0.0};
-    double *work = rad_alloc_array(ctx, 27 * n + 1, sizeof *work, "solve: conjugate-gradient: vectors");
-    s.row = rad_alloc_array(ctx, n + 1, sizeof *s.row, "solve: conjugate-gradient: row residuals");
+    double *work = rad_alloc(ctx, RAD_MEM_SOLVER, 27 * n + 1, sizeof *work, "solve: conjugate-gradient: vectors");
+    s.row = rad_alloc(ctx, RAD_MEM_SOLVER, n + 1, sizeof *s.row, "solve: conjugate-gradient: row residuals");
     if (!work || !s.row) {
-        free(work);
-        free(s.row);
+        rad_free(work);
+        rad_free(s.row);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double **vectors[] = {&s.diag, &s.Fx, &s.r, &s.z, &s.p, &s.Fp, &s.Ap, &s.FtAp, &s.q};
@@ -275,8 +275,8 @@ static rad_result conjugate_gradient(rad_context *ctx, const rad_system *sys, co
     }
     stats->iterations = it;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
-    free(work);
-    free(s.row);
+    rad_free(work);
+    rad_free(s.row);
     return result;
 }
 

@@ -68,7 +68,7 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
     double t0 = rad_seconds();
     /* K, the right-hand sides (up to 3 columns) and the pivots. */
     double needed = 8.0 * (double)n * (double)n + 24.0 * (double)n + 4.0 * (double)n;
-    double limit = sys->max_memory > 0.0 ? sys->max_memory : 0.8 * (double)rad_physical_memory_bytes();
+    double limit = sys->max_memory > 0.0 ? sys->max_memory : rad_memory_limit(ctx);
     if (needed > limit || n > (size_t)INT_MAX) {
         char need_text[32], limit_text[32];
         format_bytes(needed, need_text, sizeof need_text);
@@ -84,13 +84,13 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
         stats->converged = true;
         return RAD_OK;
     }
-    double *K = rad_alloc_array(ctx, n * n, sizeof *K, "solve: direct: LU matrix");
-    double *rhs = rad_alloc_array(ctx, 3 * n, sizeof *rhs, "solve: direct: right-hand sides");
-    lapack_int *pivots = rad_alloc_array(ctx, n, sizeof *pivots, "solve: direct: pivots");
+    double *K = rad_alloc(ctx, RAD_MEM_SOLVER, n * n, sizeof *K, "solve: direct: LU matrix");
+    double *rhs = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *rhs, "solve: direct: right-hand sides");
+    lapack_int *pivots = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *pivots, "solve: direct: pivots");
     if (!K || !rhs || !pivots) {
-        free(K);
-        free(rhs);
-        free(pivots);
+        rad_free(K);
+        rad_free(rhs);
+        rad_free(pivots);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     /* OpenBLAS keeps its thread count in a global: set it for the
@@ -132,12 +132,14 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
             result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: direct: interrupted after channel %d", c);
     }
     openblas_set_num_threads(blas_threads > 0 ? blas_threads : 1);
-    free(K);
-    free(rhs);
-    free(pivots);
+    rad_free(K);
+    rad_free(rhs);
+    rad_free(pivots);
 
     stats->iterations = result == RAD_OK ? 1 : 0;
-    stats->residual = rad_residual(sys, B);
+    rad_result measured = rad_residual(ctx, sys, B, &stats->residual);
+    if (result == RAD_OK)
+        result = measured;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
     if (result == RAD_OK && p->monitor) {
         rad_solve_step step = {1, rad_seconds() - t0, stats->residual, NAN};

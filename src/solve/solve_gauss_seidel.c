@@ -24,8 +24,12 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
     double emitted = 0.0;
     for (size_t i = 0; i < n; i++)
         emitted += sys->area[i] * (sys->emission[3 * i] + sys->emission[3 * i + 1] + sys->emission[3 * i + 2]);
+    double *row = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *row, "solve: gauss-seidel: row residuals");
+    if (!row)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_result result = RAD_OK;
     double t0 = rad_seconds();
-    stats->residual = rad_residual(sys, B);
+    stats->residual = rad_residual_in(sys, B, row);
     for (int sweep = 0; sweep < max_sweeps && stats->residual > p->tolerance; sweep++) {
         double change = 0.0;
         for (size_t i = 0; i < n; i++) {
@@ -45,19 +49,24 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
         stats->iterations = sweep + 1;
         double estimate = emitted > 0.0 ? change / emitted : change;
         bool measure = p->monitor != NULL || estimate <= p->tolerance || w != 1.0;
-        stats->residual = measure ? rad_residual(sys, B) : estimate;
+        stats->residual = measure ? rad_residual_in(sys, B, row) : estimate;
         if (p->monitor) {
             rad_solve_step step = {sweep + 1, rad_seconds() - t0, stats->residual, NAN};
-            if (p->monitor(p->monitor_user, &step, B, NULL))
-                return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: stopped after %d sweeps", sweep + 1);
+            if (p->monitor(p->monitor_user, &step, B, NULL)) {
+                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: stopped after %d sweeps", sweep + 1);
+                break;
+            }
         }
         rad_progress(ctx, "solve", (uint64_t)(sweep + 1), (uint64_t)max_sweeps);
-        if (rad_cancelled(ctx))
-            return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %d sweeps",
-                            sweep + 1);
+        if (rad_cancelled(ctx)) {
+            result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %d sweeps", sweep + 1);
+            break;
+        }
     }
-    stats->converged = stats->residual <= p->tolerance;
-    return RAD_OK;
+    rad_free(row);
+    if (result == RAD_OK)
+        stats->converged = stats->residual <= p->tolerance;
+    return result;
 }
 
 const rad_solver rad_solver_gauss_seidel = {

@@ -30,11 +30,11 @@ static rad_result jacobi(rad_context *ctx, const rad_system *sys, const rad_solv
     size_t n = sys->n;
     int max_sweeps = p->max_iterations > 0 ? p->max_iterations : 1000;
     double w = p->relaxation > 0.0 ? p->relaxation : 1.0;
-    double *next = rad_alloc_array(ctx, 3 * n + 1, sizeof *next, "solve: jacobi: next iterate");
-    double *row = rad_alloc_array(ctx, n + 1, sizeof *row, "solve: jacobi: row residuals");
+    double *next = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n + 1, sizeof *next, "solve: jacobi: next iterate");
+    double *row = rad_alloc(ctx, RAD_MEM_SOLVER, n + 1, sizeof *row, "solve: jacobi: row residuals");
     if (!next || !row) {
-        free(next);
-        free(row);
+        rad_free(next);
+        rad_free(row);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double emitted = 0.0;
@@ -86,8 +86,8 @@ static rad_result jacobi(rad_context *ctx, const rad_system *sys, const rad_solv
     }
     stats->iterations = sweep;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
-    free(next);
-    free(row);
+    rad_free(next);
+    rad_free(row);
     return result;
 }
 

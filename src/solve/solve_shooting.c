@@ -156,21 +156,21 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     int threads = sys->threads > 0 ? sys->threads : 1;
     /* O(n) vectors and the hit records of BATCH shots in flight: check the
      * estimate first, so that a huge --ff-samples is refused with a way out. */
-    double limit = sys->max_memory > 0.0 ? sys->max_memory : 0.8 * (double)rad_physical_memory_bytes();
+    double limit = sys->max_memory > 0.0 ? sys->max_memory : rad_memory_limit(ctx);
     double bytes = (double)BATCH * (double)N * (double)sizeof(hit_record) + 64.0 * (double)n;
     if (bytes > limit)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "shooting: %d rays per shot for %zu elements need %.2f GiB, above the "
                         "memory limit of %.2f GiB (rad_options.max_memory_bytes); use fewer rad_options.samples",
                         N, n, bytes / 1073741824.0, limit / 1073741824.0);
-    double *dB = rad_alloc_array(ctx, 3 * n, sizeof *dB, "shooting: unshot radiosity");
+    double *dB = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *dB, "shooting: unshot radiosity");
     heap h = {0};
-    h.item = rad_alloc_array(ctx, n, sizeof *h.item, "shooting: heap");
-    h.slot = rad_alloc_array(ctx, n, sizeof *h.slot, "shooting: heap");
-    h.key = rad_alloc_array(ctx, n, sizeof *h.key, "shooting: heap");
-    hit_record *hits = rad_alloc_array(ctx, (size_t)BATCH * (size_t)N, sizeof *hits, "shooting: hits");
-    rad_ray *rays = rad_alloc_array(ctx, (size_t)threads * RAY_BLOCK, sizeof *rays, "shooting: rays");
-    rad_hit *rhits = rad_alloc_array(ctx, (size_t)threads * RAY_BLOCK, sizeof *rhits, "shooting: rays");
+    h.item = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *h.item, "shooting: heap");
+    h.slot = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *h.slot, "shooting: heap");
+    h.key = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *h.key, "shooting: heap");
+    hit_record *hits = rad_alloc(ctx, RAD_MEM_SOLVER, (size_t)BATCH * (size_t)N, sizeof *hits, "shooting: hits");
+    rad_ray *rays = rad_alloc(ctx, RAD_MEM_SOLVER, (size_t)threads * RAY_BLOCK, sizeof *rays, "shooting: rays");
+    rad_hit *rhits = rad_alloc(ctx, RAD_MEM_SOLVER, (size_t)threads * RAY_BLOCK, sizeof *rhits, "shooting: rays");
     rad_result result = RAD_OK;
     if (!dB || !h.item || !h.slot || !h.key || !hits || !rays || !rhits) {
         result = RAD_ERROR_OUT_OF_MEMORY;
@@ -306,13 +306,13 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     stats->rays = rays_cast;
     stats->converged = result == RAD_OK && unshot <= goal;
 done:
-    free(dB);
-    free(h.item);
-    free(h.slot);
-    free(h.key);
-    free(hits);
-    free(rays);
-    free(rhits);
+    rad_free(dB);
+    rad_free(h.item);
+    rad_free(h.slot);
+    rad_free(h.key);
+    rad_free(hits);
+    rad_free(rays);
+    rad_free(rhits);
     return result;
 }
 

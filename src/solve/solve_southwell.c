@@ -48,7 +48,7 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
 {
     size_t n = sys->n;
     double w = p->relaxation > 0.0 ? p->relaxation : 1.0;
-    double *dB = rad_alloc_array(ctx, 3 * n, sizeof *dB, "solve: unshot radiosity");
+    double *dB = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *dB, "solve: unshot radiosity");
     if (!dB)
         return RAD_ERROR_OUT_OF_MEMORY;
     double emitted = 0.0;
@@ -125,8 +125,10 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
     stats->iterations = shot > 2147483647LL ? 2147483647 : (int)shot;
     stats->unshot = unshot;
     rad_southwell_ambient(sys, dB, stats->ambient);
-    free(dB);
-    stats->residual = rad_residual(sys, B);
+    rad_free(dB);
+    rad_result measured = rad_residual(ctx, sys, B, &stats->residual);
+    if (result == RAD_OK)
+        result = measured;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
     return result;
 }

@@ -64,21 +64,21 @@ static void dense_destroy(void *state)
     if (!st)
         return;
     rad_meshed_free(&st->base);
-    free(st->F);
-    free(st->F_variance);
-    free(st);
+    rad_free(st->F);
+    rad_free(st->F_variance);
+    rad_free(st);
 }
 
 static rad_result dense_create(rad_context *ctx, const rad_scene *scene, const rad_options *o, void **out)
 {
     *out = NULL;
-    dense_state *st = calloc(1, sizeof *st);
+    dense_state *st = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *st, "solution: dense state");
     if (!st)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     rad_meshed *m = &st->base;
     rad_result r = rad_meshed_init(ctx, scene, o, m);
     if (r != RAD_OK) {
-        free(st);
+        rad_free(st);
         return r;
     }
     r = check_ff_scratch(ctx, o, m->mesh->element_count, m->threads);

@@ -47,16 +47,16 @@ static void hierarchical_destroy(void *state)
     rad_mesh_destroy(st->leaves);
     rad_elements_free(&st->patch_elements);
     rad_elements_free(&st->leaf_elements);
-    free(st);
+    rad_free(st);
 }
 
 static rad_result hierarchical_create(rad_context *ctx, const rad_scene *scene, const rad_options *o,
                                       void **out)
 {
     *out = NULL;
-    hierarchical_state *st = calloc(1, sizeof *st);
+    hierarchical_state *st = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *st, "solution: hierarchical state");
     if (!st)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     st->scene = scene;
     st->options = o;
     st->ff_stats.method = "none (matrix-free solver)";
@@ -118,11 +118,11 @@ static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_st
         /* The leaves, also of an interrupted solve, become the elements. */
         rad_elements e;
         if (rad_elements_create(ctx, st->scene, leaves, &e) != RAD_OK) {
-            free(B);
+            rad_free(B);
             rad_mesh_destroy(leaves);
             return RAD_ERROR_OUT_OF_MEMORY;
         }
-        free(e.radiosity);
+        rad_free(e.radiosity);
         e.radiosity = B;
         rad_mesh_destroy(st->leaves);
         rad_elements_free(&st->leaf_elements);

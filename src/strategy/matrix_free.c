@@ -24,7 +24,7 @@ static void matrix_free_destroy(void *state)
     if (!m)
         return;
     rad_meshed_free(m);
-    free(m);
+    rad_free(m);
 }
 
 static rad_result matrix_free_create(rad_context *ctx, const rad_scene *scene, const rad_options *o, void **out)
@@ -35,12 +35,12 @@ static rad_result matrix_free_create(rad_context *ctx, const rad_scene *scene, c
                         "rad_options.closure_correction rescales form factors, and solver '%s' computes "
                         "them afresh for every shot: use a gathering solver or hierarchical",
                         o->solver);
-    rad_meshed *m = malloc(sizeof *m);
+    rad_meshed *m = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *m, "solution: matrix-free state");
     if (!m)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "out of memory");
+        return RAD_ERROR_OUT_OF_MEMORY;
     rad_result r = rad_meshed_init(ctx, scene, o, m);
     if (r != RAD_OK) {
-        free(m);
+        rad_free(m);
         return r;
     }
     m->ff_stats.method = "none (matrix-free solver)";

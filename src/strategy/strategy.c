@@ -51,10 +51,10 @@ rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const r
     memset(out, 0, sizeof *out);
     size_t n = mesh->element_count;
     rad_elements e;
-    e.area = rad_alloc_array(ctx, n, sizeof *e.area, "solution: areas");
-    e.reflectance = rad_alloc_array(ctx, 3 * n, sizeof *e.reflectance, "solution: reflectance");
-    e.emission = rad_alloc_array(ctx, 3 * n, sizeof *e.emission, "solution: emission");
-    e.radiosity = rad_alloc_array(ctx, 3 * n, sizeof *e.radiosity, "solution: radiosity");
+    e.area = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *e.area, "solution: areas");
+    e.reflectance = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *e.reflectance, "solution: reflectance");
+    e.emission = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *e.emission, "solution: emission");
+    e.radiosity = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *e.radiosity, "solution: radiosity");
     if (!e.area || !e.reflectance || !e.emission || !e.radiosity) {
         rad_elements_free(&e);
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -75,10 +75,10 @@ rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const r
 
 void rad_elements_free(rad_elements *e)
 {
-    free(e->area);
-    free(e->reflectance);
-    free(e->emission);
-    free(e->radiosity);
+    rad_free(e->area);
+    rad_free(e->reflectance);
+    rad_free(e->emission);
+    rad_free(e->radiosity);
     memset(e, 0, sizeof *e);
 }
 
@@ -212,17 +212,21 @@ void rad_view_surface_radiosity(const rad_solution_view *v, size_t surface, doub
         rgb[c] = area > 0.0 ? sum[c] / area : 0.0;
 }
 
-void rad_view_surface_view_factors(const rad_solution_view *v, double *F)
+rad_result rad_view_surface_view_factors(rad_context *ctx, const rad_solution_view *v, double *F)
 {
     size_t S = v->scene->surface_count, n = v->n;
     memset(F, 0, S * S * sizeof *F);
     if (!v->F) /* no factors were computed */
-        return;
-    double *area = calloc(S ? S : 1, sizeof *area);
+        return RAD_OK;
+    double *area = rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *area, "view factors: surface areas");
+    if (!area) {
+        for (size_t k = 0; k < S * S; k++)
+            F[k] = NAN;
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
     for (size_t i = 0; i < n; i++) {
         uint32_t si = v->mesh->elements[i].surface;
-        if (area)
-            area[si] += v->area[i];
+        area[si] += v->area[i];
         const float *Fi = v->F + i * n;
         double *row = F + (size_t)si * S;
         for (size_t j = 0; j < n; j++)
@@ -230,11 +234,12 @@ void rad_view_surface_view_factors(const rad_solution_view *v, double *F)
     }
     for (size_t a = 0; a < S; a++)
         for (size_t b = 0; b < S; b++)
-            F[a * S + b] = area && area[a] > 0.0 ? F[a * S + b] / area[a] : 0.0;
-    free(area);
+            F[a * S + b] = area[a] > 0.0 ? F[a * S + b] / area[a] : 0.0;
+    rad_free(area);
+    return RAD_OK;
 }
 
-void rad_view_power(const rad_solution_view *v, double *emitted, double *absorbed)
+rad_result rad_view_power(rad_context *ctx, const rad_solution_view *v, double *emitted, double *absorbed)
 {
     size_t n = v->n;
     double em = 0.0;
@@ -244,13 +249,13 @@ void rad_view_power(const rad_solution_view *v, double *emitted, double *absorbe
                 em += v->area[i] * v->emission[3 * i + c];
         *emitted = em / 3.0;
         *absorbed = v->solve->absorbed;
-        return;
+        return RAD_OK;
     }
     /* Per-element absorption in parallel, summed in order (thread-independent). */
-    double *absorbed_by = malloc((n ? n : 1) * sizeof *absorbed_by), ab = 0.0;
+    double *absorbed_by = rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *absorbed_by, "power balance"), ab = 0.0;
     if (!absorbed_by) {
         *emitted = *absorbed = NAN;
-        return;
+        return RAD_ERROR_OUT_OF_MEMORY;
     }
 #pragma omp parallel for schedule(static) num_threads(v->threads)
     for (size_t i = 0; i < n; i++) {
@@ -266,7 +271,8 @@ void rad_view_power(const rad_solution_view *v, double *emitted, double *absorbe
         for (int c = 0; c < 3; c++)
             em += v->area[i] * v->emission[3 * i + c];
     }
-    free(absorbed_by);
+    rad_free(absorbed_by);
     *emitted = em / 3.0;
     *absorbed = ab / 3.0;
+    return RAD_OK;
 }

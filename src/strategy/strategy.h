@@ -159,13 +159,14 @@ void rad_meshed_view(const rad_meshed *m, rad_solution_view *v);
 
 /* Power in W (means over RGB): emitted = sum A_i E_i; absorbed = sum A_i
  * (1 - rho_i) H_i from F where the view has it, else the strategy's own
- * count.  NAN, NAN when out of memory. */
-void rad_view_power(const rad_solution_view *view, double *emitted, double *absorbed);
+ * count.  Fails only for memory (n doubles; then NAN, NAN). */
+rad_result rad_view_power(rad_context *ctx, const rad_solution_view *view, double *emitted, double *absorbed);
 
 /* Area-weighted mean radiosity of one surface. */
 void rad_view_surface_radiosity(const rad_solution_view *view, size_t surface, double rgb[3]);
 
-/* Surface-to-surface factors F[a * S + b] (S surfaces), zero without F. */
-void rad_view_surface_view_factors(const rad_solution_view *view, double *F);
+/* Surface-to-surface factors F[a * S + b] (S surfaces), zero without F.
+ * Fails only for memory (S doubles; F is then NAN). */
+rad_result rad_view_surface_view_factors(rad_context *ctx, const rad_solution_view *view, double *F);
 
 #endif /* RAD_STRATEGY_H */

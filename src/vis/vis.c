@@ -33,13 +33,13 @@ rad_result rad_vis_create(rad_context *ctx, const char *name, const rad_mesh *me
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "unknown visibility backend '%s' (known: embree, brute)",
                         name ? name : "(null)");
-    rad_vis *vis = rad_alloc_array(ctx, 1, sizeof *vis, "visibility");
+    rad_vis *vis = rad_alloc(ctx, RAD_MEM_VISIBILITY, 1, sizeof *vis, "visibility");
     if (!vis)
         return RAD_ERROR_OUT_OF_MEMORY;
     double start = rad_seconds();
     rad_result r = backend->create(ctx, mesh, &vis->state);
     if (r != RAD_OK) {
-        free(vis);
+        rad_free(vis);
         return r;
     }
     vis->backend = backend;
@@ -53,7 +53,7 @@ void rad_vis_destroy(rad_vis *vis)
     if (!vis)
         return;
     vis->backend->destroy(vis->state);
-    free(vis);
+    rad_free(vis);
 }
 
 double rad_vis_epsilon(const rad_mesh *mesh)
@@ -95,7 +95,7 @@ rad_result rad_vis_primitives(rad_context *ctx, const rad_mesh *mesh, rad_vis_pr
     size_t n = 0;
     for (size_t i = 0; i < mesh->patch_count; i++)
         n += patch_bend(&mesh->patches[i]) > limit ? mesh->patches[i].element_count : 1;
-    rad_vis_prim *prims = rad_alloc_array(ctx, n ? n : 1, sizeof *prims, "visibility primitives");
+    rad_vis_prim *prims = rad_alloc(ctx, RAD_MEM_VISIBILITY, n ? n : 1, sizeof *prims, "visibility primitives");
     if (!prims)
         return RAD_ERROR_OUT_OF_MEMORY;
     size_t k = 0;

@@ -31,21 +31,21 @@ typedef struct brute_state {
 static rad_result brute_create(rad_context *ctx, const rad_mesh *mesh, void **state)
 {
     *state = NULL;
-    brute_state *s = rad_alloc_array(ctx, 1, sizeof *s, "brute-force visibility");
+    brute_state *s = rad_alloc(ctx, RAD_MEM_VISIBILITY, 1, sizeof *s, "brute-force visibility");
     if (!s)
         return RAD_ERROR_OUT_OF_MEMORY;
     rad_vis_prim *prims = NULL;
     size_t nprims = 0;
     rad_result r = rad_vis_primitives(ctx, mesh, &prims, &nprims);
     if (r != RAD_OK) {
-        free(s);
+        rad_free(s);
         return r;
     }
-    s->triangles = rad_alloc_array(ctx, nprims ? nprims : 1, 2 * sizeof *s->triangles,
+    s->triangles = rad_alloc(ctx, RAD_MEM_VISIBILITY, nprims ? nprims : 1, 2 * sizeof *s->triangles,
                                    "brute-force visibility triangles");
     if (!s->triangles) {
-        free(prims);
-        free(s);
+        rad_free(prims);
+        rad_free(s);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     /* Quads become triangles (0 1 2) and (0 2 3); primitives are flat
@@ -60,7 +60,7 @@ static rad_result brute_create(rad_context *ctx, const rad_mesh *mesh, void **st
             tri->patch = p->patch;
         }
     }
-    free(prims);
+    rad_free(prims);
     *state = s;
     return RAD_OK;
 }
@@ -70,8 +70,8 @@ static void brute_destroy(void *state)
     brute_state *s = state;
     if (!s)
         return;
-    free(s->triangles);
-    free(s);
+    rad_free(s->triangles);
+    rad_free(s);
 }
 
 /* Moller-Trumbore: the ray parameter of the hit, or INFINITY if the ray's

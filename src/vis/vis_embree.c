@@ -60,10 +60,10 @@ static void embree_destroy(void *state)
         rtcReleaseScene(s->scene);
     if (s->device)
         rtcReleaseDevice(s->device);
-    free(s->prims);
-    free(s->triangle_prim);
-    free(s->quad_prim);
-    free(s);
+    rad_free(s->prims);
+    rad_free(s->triangle_prim);
+    rad_free(s->quad_prim);
+    rad_free(s);
 }
 
 /* Add the primitives with `corners` corners as one geometry; returns its
@@ -112,7 +112,7 @@ static unsigned embree_add_prims(embree_state *s, uint32_t corners, size_t count
 static rad_result embree_create(rad_context *ctx, const rad_mesh *mesh, void **state)
 {
     *state = NULL;
-    embree_state *s = rad_alloc_array(ctx, 1, sizeof *s, "Embree visibility");
+    embree_state *s = rad_alloc(ctx, RAD_MEM_VISIBILITY, 1, sizeof *s, "Embree visibility");
     if (!s)
         return RAD_ERROR_OUT_OF_MEMORY;
     s->mesh = mesh;
@@ -143,8 +143,8 @@ static rad_result embree_create(rad_context *ctx, const rad_mesh *mesh, void **s
         }
     }
     s->shift = v3_scale(v3_add(lo, hi), 0.5);
-    s->triangle_prim = rad_alloc_array(ctx, triangles, sizeof(uint32_t), "Embree triangle map");
-    s->quad_prim = rad_alloc_array(ctx, quads, sizeof(uint32_t), "Embree quad map");
+    s->triangle_prim = rad_alloc(ctx, RAD_MEM_VISIBILITY, triangles, sizeof(uint32_t), "Embree triangle map");
+    s->quad_prim = rad_alloc(ctx, RAD_MEM_VISIBILITY, quads, sizeof(uint32_t), "Embree quad map");
     if (!s->triangle_prim || !s->quad_prim) {
         embree_destroy(s);
         return RAD_ERROR_OUT_OF_MEMORY;

@@ -1,0 +1,555 @@
+/*
+ * test_alloc.c -- the context's allocator (core.c): the memory limit, the
+ * accounting by category, and every allocation failing in turn.
+ *
+ * The sweep is SQLite's way of testing out-of-memory handling: run a small
+ * scene through loading and every strategy with all its outputs once,
+ * counting the allocations N; then for k = 1..N run it again with the
+ * k-th allocation failing.  Every run must end with RAD_ERROR_OUT_OF_MEMORY
+ * and the allocator's one-line message (not a later consequence, and not
+ * success with something quietly missing), leave no file but those of the
+ * writers that had finished, and give all its memory back (the accounting
+ * returns to 0; the sanitizer build checks for leaks and bad frees).
+ *
+ *   test_alloc           every 7th k of each sweep (the unit run)
+ *   test_alloc --full    every k (label slow)
+ */
+#include "api/solution.h"
+
+#include <cjson/cJSON.h>
+#include <dirent.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+static int stride = 7;
+
+/* ---- the scene: a closed unit box, normals inward, a glowing ceiling ---- */
+
+static const char box_obj[] = "mtllib box.mtl\n"
+                              "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                              "v 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                              "usemtl white\n"
+                              "o floor\nf 1 5 6 2\n"
+                              "o back\nf 1 2 3 4\n"
+                              "o front\nf 5 8 7 6\n"
+                              "o left\nf 1 4 8 5\n"
+                              "o right\nf 2 6 7 3\n"
+                              "usemtl lamp\n"
+                              "o ceiling\nf 4 3 7 8\n";
+
+static const char box_mtl[] = "newmtl white\nKd 0.5 0.5 0.5\n"
+                              "newmtl lamp\nKd 0.3 0.3 0.3\nKe 1 1 1\n";
+
+/* One emissive triangle, positions only (no indices), in a data URI. */
+static const char triangle_gltf[] =
+    "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],\n"
+    " \"nodes\": [{\"name\": \"lamp\", \"mesh\": 0}],\n"
+    " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"material\": 0}]}],\n"
+    " \"materials\": [{\"emissiveFactor\": [1, 1, 1],\n"
+    "                \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}}],\n"
+    " \"buffers\": [{\"byteLength\": 36,\n"
+    "              \"uri\": \"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],\n"
+    " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}],\n"
+    " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\",\n"
+    "                \"min\": [0, 0, 0], \"max\": [1, 1, 0]}]}\n";
+
+/* ---- folders ---- */
+
+static char input_dir[256], output_dir[256];
+
+static void write_text(const char *dir, const char *name, const char *text)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* Remove every file in the output folder. */
+static void clear_outputs(void)
+{
+    DIR *dir = opendir(output_dir);
+    assert_non_null(dir);
+    for (struct dirent *e; (e = readdir(dir));) {
+        char path[600];
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        snprintf(path, sizeof path, "%s/%s", output_dir, e->d_name);
+        remove(path);
+    }
+    closedir(dir);
+}
+
+/* ---- one run: the outputs its writers finished ---- */
+
+#define MAX_OUTPUTS 8
+
+typedef struct outputs {
+    const char *written[MAX_OUTPUTS]; /* names in the output folder */
+    int count;
+} outputs;
+
+static rad_result write_done(rad_result r, outputs *out, const char *name)
+{
+    if (r == RAD_OK) {
+        assert_true(out->count < MAX_OUTPUTS);
+        out->written[out->count++] = name;
+    }
+    return r;
+}
+
+static void output_path(const char *name, char *path, size_t size)
+{
+    snprintf(path, size, "%s/%s", output_dir, name);
+}
+
+typedef struct scenario {
+    const char *name;
+    const char *solver;          /* NULL: loading only */
+    const char *form_factors;
+    int hemicube_resolution, samples, closure_correction;
+    bool view_factors;           /* the strategy keeps F */
+} scenario;
+
+static const scenario scenarios[] = {
+    {"loading", NULL, NULL, 0, 0, 0, false},
+    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true},
+    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true},
+    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true},
+    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true},
+    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false},
+    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false},
+};
+
+/* Loading: the OBJ + MTL from a file and from memory, the glTF from
+ * memory, the built-in Cornell box written as OBJ, a generated office. */
+static rad_result run_loading(rad_context *ctx, outputs *out)
+{
+    char path[512];
+    rad_scene *scene = NULL;
+    snprintf(path, sizeof path, "%s/box.obj", input_dir);
+    rad_result r = rad_scene_load_file(ctx, path, &scene);
+    rad_scene_destroy(scene);
+    if (r == RAD_OK) {
+        r = rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), box_mtl, strlen(box_mtl), &scene);
+        rad_scene_destroy(scene);
+    }
+    if (r == RAD_OK) {
+        r = rad_scene_load_memory(ctx, "triangle.gltf", triangle_gltf, strlen(triangle_gltf), NULL, 0, &scene);
+        rad_scene_destroy(scene);
+    }
+    if (r == RAD_OK) {
+        r = rad_scene_create_cornell_box(ctx, &scene);
+        if (r == RAD_OK) {
+            output_path("cornell.obj", path, sizeof path);
+            r = rad_scene_write_obj(ctx, scene, path);
+            if (r == RAD_OK) {
+                write_done(r, out, "cornell.obj");
+                write_done(r, out, "cornell.mtl");
+            }
+        }
+        rad_scene_destroy(scene);
+    }
+    if (r == RAD_OK) {
+        rad_office_options oo = {1, 3};
+        r = rad_scene_generate_office(ctx, &oo, &scene);
+        rad_scene_destroy(scene);
+    }
+    return r;
+}
+
+/* A strategy: solve, every accessor that allocates, render, every writer. */
+static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *out)
+{
+    rad_scene *scene = NULL;
+    rad_solution *s = NULL;
+    rad_image *image = NULL;
+    double *vertex = NULL;
+    char path[512];
+    rad_result r = rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), box_mtl, strlen(box_mtl), &scene);
+    if (r == RAD_OK) {
+        rad_options o = {0};
+        o.target_elements = 48;
+        o.solver = sc->solver;
+        o.form_factors = sc->form_factors;
+        o.hemicube_resolution = sc->hemicube_resolution;
+        o.samples = sc->samples;
+        o.closure_correction = sc->closure_correction;
+        o.record_history = 1;
+        o.epsilon = 1e-3;
+        o.seed = 1;
+        r = rad_solution_create(ctx, scene, &o, &s);
+    }
+    if (r == RAD_OK)
+        r = rad_solution_solve(ctx, s);
+    if (r == RAD_OK) {
+        vertex = malloc(3 * rad_solution_vertex_count(s) * sizeof *vertex + 1);
+        assert_non_null(vertex);
+        r = rad_solution_vertex_radiosity(ctx, s, vertex);
+    }
+    if (r == RAD_OK) {
+        rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0};
+        r = rad_solution_render(ctx, s, &ro, &image);
+    }
+    if (r == RAD_OK) {
+        output_path("image.png", path, sizeof path);
+        r = write_done(rad_image_write(ctx, image, path), out, "image.png");
+    }
+    if (r == RAD_OK) {
+        output_path("image.pfm", path, sizeof path);
+        r = write_done(rad_image_write(ctx, image, path), out, "image.pfm");
+    }
+    if (r == RAD_OK) {
+        output_path("stats.json", path, sizeof path);
+        r = write_done(rad_solution_write_stats(ctx, s, path, 0), out, "stats.json");
+    }
+    if (r == RAD_OK && sc->view_factors) {
+        output_path("surfaces.json", path, sizeof path);
+        r = write_done(rad_solution_write_view_factors(ctx, s, path, 0), out, "surfaces.json");
+        if (r == RAD_OK) {
+            output_path("elements.mtx", path, sizeof path);
+            r = write_done(rad_solution_write_view_factors(ctx, s, path, 1), out, "elements.mtx");
+        }
+    }
+    if (r == RAD_OK) {
+        output_path("history.csv", path, sizeof path);
+        r = write_done(rad_solution_write_history(ctx, s, path), out, "history.csv");
+    }
+    free(vertex);
+    rad_image_destroy(image);
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+    return r;
+}
+
+/* One run in a fresh context of 2 threads (per-thread scratch included),
+ * with allocation `fail_at` failing (0: none).  Checks that everything
+ * made was given back; returns the run's result, its context's error in
+ * `error` and its allocation count in *allocations. */
+static rad_result run_once(const scenario *sc, uint64_t fail_at, outputs *out, char *error, size_t error_size,
+                           uint64_t *allocations)
+{
+    rad_context_options co = {0};
+    co.threads = 2;
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
+    rad_context_fail_allocation(ctx, fail_at);
+    memset(out, 0, sizeof *out);
+    rad_result r = sc->solver ? run_strategy(sc, ctx, out) : run_loading(ctx, out);
+    snprintf(error, error_size, "%s", rad_context_error(ctx));
+    *allocations = rad_memory_allocations(ctx);
+    for (int c = 0; c <= RAD_MEM_CATEGORIES; c++)
+        if (rad_memory_in_use(ctx, (rad_memory_category)c) != 0)
+            fail_msg("%s, allocation %llu failing: %zu bytes of %s still in use after everything was destroyed",
+                     sc->name, (unsigned long long)fail_at, rad_memory_in_use(ctx, (rad_memory_category)c),
+                     rad_memory_category_name((rad_memory_category)c));
+    rad_context_destroy(ctx);
+    return r;
+}
+
+/* The output folder holds exactly what the finished writers wrote: no
+ * partial file, no temporary name. */
+static void check_outputs(const scenario *sc, uint64_t k, const outputs *out)
+{
+    DIR *dir = opendir(output_dir);
+    assert_non_null(dir);
+    int found = 0;
+    for (struct dirent *e; (e = readdir(dir));) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        bool expected = false;
+        for (int i = 0; i < out->count; i++)
+            expected |= strcmp(out->written[i], e->d_name) == 0;
+        if (!expected)
+            fail_msg("%s, allocation %llu failing: '%s' left in the output folder", sc->name,
+                     (unsigned long long)k, e->d_name);
+        found++;
+    }
+    closedir(dir);
+    assert_int_equal(found, out->count);
+}
+
+static void sweep(const scenario *sc)
+{
+    outputs out;
+    char error[1100];
+    uint64_t n, again;
+    rad_result clean = run_once(sc, 0, &out, error, sizeof error, &n);
+    if (clean != RAD_OK)
+        fail_msg("%s: %s", sc->name, error);
+    check_outputs(sc, 0, &out);
+    clear_outputs();
+    /* The count is the same every time: allocations happen on the calling
+     * thread only, never inside a parallel region. */
+    assert_int_equal(run_once(sc, 0, &out, error, sizeof error, &again), RAD_OK);
+    assert_int_equal(again, n);
+    clear_outputs();
+    printf("    %s: %llu allocations\n", sc->name, (unsigned long long)n);
+    for (uint64_t k = 1; k <= n; k += (uint64_t)stride) {
+        uint64_t count;
+        rad_result r = run_once(sc, k, &out, error, sizeof error, &count);
+        if (r != RAD_ERROR_OUT_OF_MEMORY || !strstr(error, "(test hook: allocation") || strchr(error, '\n'))
+            fail_msg("%s, allocation %llu of %llu failing: %s, '%s'", sc->name, (unsigned long long)k,
+                     (unsigned long long)n, rad_result_string(r), error);
+        check_outputs(sc, k, &out);
+        clear_outputs();
+    }
+}
+
+static void test_fail_each_allocation(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof scenarios / sizeof *scenarios; i++)
+        sweep(&scenarios[i]);
+}
+
+/* ---- the limit ---- */
+
+static rad_context *limited_context(double bytes)
+{
+    rad_context_options co = {0};
+    co.threads = 1;
+    co.max_memory_bytes = bytes;
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
+    return ctx;
+}
+
+static void assert_contains(const char *text, const char *part)
+{
+    if (!strstr(text, part))
+        fail_msg("'%s' does not contain '%s'", text, part);
+}
+
+/* A request over the limit is refused with one line naming what, the
+ * bytes and the limit; the accounting returns to 0 and the context's
+ * limit holds for everything (loading too). */
+static void test_limit(void **state)
+{
+    (void)state;
+    rad_context *ctx = limited_context(1048576.0);
+    assert_int_equal(rad_memory_limit(ctx), 1048576.0);
+    rad_api_enter(ctx);
+    assert_null(rad_alloc(ctx, RAD_MEM_SOLVER, 2, 1048576, "a big table"));
+    assert_contains(rad_context_error(ctx), "a big table: 2.0 MiB more would pass the memory limit of 1.0 MiB");
+    assert_contains(rad_context_error(ctx), "max_memory_bytes");
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+
+    /* Blocks are counted in their category until freed, peaks kept. */
+    void *a = rad_alloc(ctx, RAD_MEM_MESH, 1000, 1, "a");
+    void *b = rad_alloc(ctx, RAD_MEM_RENDER, 500, 2, "b");
+    assert_non_null(a);
+    assert_non_null(b);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_MESH), 1000);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_RENDER), 1000);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 2000);
+    a = rad_realloc(ctx, RAD_MEM_MESH, a, 3000, 1, "a");
+    assert_non_null(a);
+    assert_int_equal(((unsigned char *)a)[2999], 0); /* grown and zeroed */
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_MESH), 3000);
+    rad_free(a);
+    rad_free(b);
+    rad_free(NULL);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+    /* A resize counts both sizes while it copies. */
+    assert_int_equal(rad_memory_peak(ctx, RAD_MEM_MESH), 4000);
+    assert_int_equal(rad_memory_peak(ctx, RAD_MEM_CATEGORIES), 5000);
+
+    /* The scene loads within 1 MiB; 2000 elements' form factors do not fit
+     * and are refused before they are computed, naming the limit. */
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), box_mtl, strlen(box_mtl), &scene),
+                     RAD_OK);
+    assert_true(rad_memory_in_use(ctx, RAD_MEM_SCENE) > 0);
+    rad_options o = {0};
+    o.target_elements = 2000;
+    rad_solution *s = (rad_solution *)&o;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_OUT_OF_MEMORY);
+    assert_null(s);
+    assert_contains(rad_context_error(ctx), "memory limit of");
+    assert_contains(rad_context_error(ctx), "max_memory_bytes");
+    /* A solution's own limit is never above the context's. */
+    o.target_elements = 48;
+    o.max_memory_bytes = 1e12;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    assert_true(s->options.max_memory_bytes <= 1048576.0);
+    rad_solution_destroy(s);
+    /* ... and lower where asked: 1 byte refuses the first block. */
+    o.max_memory_bytes = 1.0;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_OUT_OF_MEMORY);
+    assert_contains(rad_context_error(ctx), "the memory limit of 1 bytes");
+    rad_scene_destroy(scene);
+    for (int c = 0; c <= RAD_MEM_CATEGORIES; c++)
+        assert_int_equal(rad_memory_in_use(ctx, (rad_memory_category)c), 0);
+    rad_context_destroy(ctx);
+
+    rad_context_options bad = {0};
+    bad.max_memory_bytes = -1.0;
+    assert_int_equal(rad_context_create(&bad, &ctx), RAD_ERROR_INVALID_ARGUMENT);
+}
+
+/* A context destroyed before what was made with it lives on until the
+ * last of them goes (the sanitizer build checks the order is safe). */
+static void test_context_outlived(void **state)
+{
+    (void)state;
+    rad_context *ctx = limited_context(0.0);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    rad_context_destroy(ctx);
+    assert_true(rad_scene_surface_count(scene) > 0);
+    rad_scene_destroy(scene);
+}
+
+/* ---- loading within the limit ---- */
+
+/* Files with no size (a FIFO, /dev/zero under an OBJ name) are read in
+ * growing blocks and stopped at the limit; a regular file larger than the
+ * limit is refused before it is read; one whose import would need more
+ * than the limit is refused before assimp sees it. */
+static void test_loading_limit(void **state)
+{
+    (void)state;
+    rad_context *ctx = limited_context(8.0 * 1048576.0);
+    char path[512];
+    rad_scene *scene = (rad_scene *)&path;
+
+    snprintf(path, sizeof path, "%s/zero.obj", input_dir);
+    remove(path);
+    assert_int_equal(symlink("/dev/zero", path), 0);
+    assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_ERROR_OUT_OF_MEMORY);
+    assert_null(scene);
+    assert_contains(rad_context_error(ctx), "zero.obj");
+    assert_contains(rad_context_error(ctx), "the memory limit of 8.0 MiB");
+    assert_null(strchr(rad_context_error(ctx), '\n'));
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+    remove(path);
+
+    /* A sparse file of 1 GiB: refused by its size, without reading it. */
+    snprintf(path, sizeof path, "%s/huge.obj", input_dir);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fclose(f);
+    assert_int_equal(truncate(path, (off_t)1 << 30), 0);
+    double t0 = rad_seconds();
+    assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_ERROR_OUT_OF_MEMORY);
+    assert_true(rad_seconds() - t0 < 1.0);
+    assert_contains(rad_context_error(ctx), "huge.obj: a file of 1.00 GiB, larger than the memory limit of 8.0 MiB");
+    remove(path);
+
+    /* 1 MiB of text fits in 8 MiB, but not the 20 MiB assimp may need. */
+    size_t size = 1048576;
+    char *text = malloc(size);
+    assert_non_null(text);
+    for (size_t i = 0; i < size; i++)
+        text[i] = i % 64 == 63 ? '\n' : '#';
+    assert_int_equal(rad_scene_load_memory(ctx, "comments.obj", text, size, NULL, 0, &scene),
+                     RAD_ERROR_OUT_OF_MEMORY);
+    assert_contains(rad_context_error(ctx), "comments.obj: a file of 1.0 MiB may need 20.0 MiB to import");
+    assert_contains(rad_context_error(ctx), "the memory limit of 8.0 MiB");
+    free(text);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+    rad_context_destroy(ctx);
+}
+
+/* The stats report the allocator's peaks by category. */
+static void test_stats_by_category(void **state)
+{
+    (void)state;
+    rad_context *ctx = limited_context(0.0);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), box_mtl, strlen(box_mtl), &scene),
+                     RAD_OK);
+    rad_options o = {0};
+    o.target_elements = 48;
+    rad_solution *s = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+    rad_image *image = NULL;
+    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0};
+    assert_int_equal(rad_solution_render(ctx, s, &ro, &image), RAD_OK);
+    char path[512];
+    output_path("stats.json", path, sizeof path);
+    assert_int_equal(rad_solution_write_stats(ctx, s, path, 0), RAD_OK);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char text[16384];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    cJSON *root = cJSON_Parse(text);
+    assert_non_null(root);
+    const cJSON *mem = cJSON_GetObjectItemCaseSensitive(root, "memory_bytes");
+    const cJSON *by = cJSON_GetObjectItemCaseSensitive(mem, "by_category");
+    double total = cJSON_GetObjectItemCaseSensitive(mem, "allocator_peak")->valuedouble;
+    const char *expected[] = {"scene", "mesh", "visibility", "form_factors", "solver", "render"};
+    double largest = 0.0;
+    for (size_t i = 0; i < sizeof expected / sizeof *expected; i++) {
+        const cJSON *v = cJSON_GetObjectItemCaseSensitive(by, expected[i]);
+        assert_non_null(v);
+        assert_true(v->valuedouble > 0.0);
+        largest = fmax(largest, v->valuedouble);
+    }
+    assert_non_null(cJSON_GetObjectItemCaseSensitive(by, "hierarchy"));
+    assert_non_null(cJSON_GetObjectItemCaseSensitive(by, "output"));
+    /* F alone is 48^2 floats or more; the total peak is at least any stage's. */
+    assert_true(cJSON_GetObjectItemCaseSensitive(by, "form_factors")->valuedouble >= 4.0 * 48 * 48);
+    assert_true(total >= largest);
+    cJSON_Delete(root);
+    clear_outputs();
+    rad_image_destroy(image);
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+    rad_context_destroy(ctx);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(input_dir, sizeof input_dir, "/tmp/test_alloc_in.XXXXXX");
+    snprintf(output_dir, sizeof output_dir, "/tmp/test_alloc_out.XXXXXX");
+    if (!mkdtemp(input_dir) || !mkdtemp(output_dir))
+        return -1;
+    write_text(input_dir, "box.obj", box_obj);
+    write_text(input_dir, "box.mtl", box_mtl);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    clear_outputs();
+    rmdir(output_dir);
+    char path[600];
+    snprintf(path, sizeof path, "%s/box.obj", input_dir);
+    remove(path);
+    snprintf(path, sizeof path, "%s/box.mtl", input_dir);
+    remove(path);
+    rmdir(input_dir);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && strcmp(argv[1], "--full") == 0)
+        stride = 1;
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_limit),
+        cmocka_unit_test(test_context_outlived),
+        cmocka_unit_test(test_loading_limit),
+        cmocka_unit_test(test_stats_by_category),
+        cmocka_unit_test(test_fail_each_allocation),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
