@@ -557,6 +557,7 @@ void rad_scene_destroy(rad_scene *scene)
         free(scene->surfaces[i].name);
     for (size_t i = 0; i < scene->material_count; i++)
         free(scene->materials[i].name);
+    rad_scene_set_inputs(scene, NULL, 0);
     free(scene->source);
     free(scene->positions);
     free(scene->indices);
@@ -564,6 +565,22 @@ void rad_scene_destroy(rad_scene *scene)
     free(scene->surfaces);
     free(scene->materials);
     free(scene);
+}
+
+void rad_scene_set_inputs(rad_scene *scene, char **paths, size_t count)
+{
+    for (size_t i = 0; i < scene->input_count; i++)
+        free(scene->inputs[i]);
+    free(scene->inputs);
+    scene->inputs = paths;
+    scene->input_count = count;
+}
+
+size_t rad_scene_input_count(const rad_scene *scene) { return scene ? scene->input_count : 0; }
+
+const char *rad_scene_input_path(const rad_scene *scene, size_t index)
+{
+    return scene && index < scene->input_count ? scene->inputs[index] : NULL;
 }
 
 size_t rad_scene_surface_count(const rad_scene *scene) { return scene ? scene->surface_count : 0; }
