@@ -472,8 +472,12 @@ RAD_API int rad_image_height(const rad_image *image);
 RAD_API const float *rad_image_pixels(const rad_image *image);
 
 /* Write by extension: .png (exposed, sRGB, 8 bit), .hdr (Radiance RGBE) or
- * .pfm (32-bit float).  The file is written to a temporary name and renamed,
- * so a failure never leaves a partial file.  Fails with RAD_ERROR_IO;
+ * .pfm (32-bit float).  The file is written to a temporary name (created
+ * with O_EXCL beside it) and renamed, so a failure never leaves a partial
+ * file; a symbolic link's target is replaced, a device, a FIFO or the
+ * program's own stdout is written in place once the bytes are complete, a
+ * dangling link or a folder is refused (docs/robustness.md).  Several
+ * files as one: rad_output_set below.  Fails with RAD_ERROR_IO;
  * an unknown extension, an empty image or a NULL ctx, image or path:
  * RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
