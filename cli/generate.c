@@ -2,7 +2,8 @@
  * generate.c -- `radiosity generate office [--rooms N] [--seed S]
  * [-o office.obj] [--quiet]`: build a procedural scene with the library
  * (rad_scene_generate_office) and write it as OBJ + MTL
- * (rad_scene_write_obj, atomic: both files or neither).  Its flags are
+ * (rad_scene_write_obj, atomic: both files or neither; a signal before
+ * they are in place leaves neither).  Its flags are
  * parsed by the parser every command shares (options.c).  The kinds of
  * scene and their options are in docs/scenes.md.
  */
@@ -23,14 +24,8 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-int cli_generate(const cli_settings *s)
+int cli_generate(const cli_settings *s, rad_context *ctx)
 {
-    rad_context *ctx = NULL;
-    rad_context_options co = {.threads = 1};
-    if (rad_context_create(&co, &ctx) != RAD_OK) {
-        fprintf(stderr, "radiosity: cannot create a context\n");
-        return EXIT_FAILED;
-    }
     double start = now_seconds();
     rad_scene *scene = NULL;
     rad_result r = rad_scene_generate_office(ctx, &s->office, &scene);
@@ -38,7 +33,10 @@ int cli_generate(const cli_settings *s)
     if (r == RAD_OK)
         r = rad_scene_write_obj(ctx, scene, s->output);
     int status = 0;
-    if (r != RAD_OK) {
+    if (r == RAD_ERROR_INTERRUPTED) {
+        fprintf(stderr, "radiosity: interrupted; nothing written\n");
+        status = EXIT_FAILED; /* main() answers 130 / 143 */
+    } else if (r != RAD_OK) {
         char message[1024];
         cli_rewrite_message(rad_context_error(ctx), message, sizeof message);
         fprintf(stderr, "radiosity: %s\n", message);
@@ -53,6 +51,5 @@ int cli_generate(const cli_settings *s)
                rad_scene_polygon_count(scene), generated - start, now_seconds() - generated);
     }
     rad_scene_destroy(scene);
-    rad_context_destroy(ctx);
     return status;
 }

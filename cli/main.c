@@ -110,18 +110,49 @@ static void progress_end(progress_state *p)
     p->phase = NULL;
 }
 
-/* ---- interruption ---- */
+/* ---- interruption ----
+ *
+ * The first SIGINT or SIGTERM decides the exit status (130 / 143).  While
+ * the pipeline works, it cancels the context: the running phase stops and
+ * what exists is saved (a partial solution, or the stats of an interrupted
+ * run).  Once the outputs are being made (`saving`), signals only note
+ * themselves: a second Ctrl-C cannot lose the results being saved, and the
+ * output set removes every temporary whatever happens. */
 
 /* The context whose work a signal cancels (set once, before the handler
  * can see anything but NULL); rad_context_cancel is an atomic store. */
 static rad_context *volatile cancel_context;
 static volatile sig_atomic_t cancel_signal;
+static volatile sig_atomic_t saving;
 
 static void on_signal(int sig)
 {
-    rad_context_cancel(cancel_context, true);
-    cancel_signal = sig;
+    if (!cancel_signal)
+        cancel_signal = sig;
+    if (!saving)
+        rad_context_cancel(cancel_context, true);
 }
+
+static void install_signal_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    /* A FIFO whose reader left is a write error, not a silent death. */
+    sa.sa_handler = SIG_IGN;
+    sigaction(SIGPIPE, &sa, NULL);
+}
+
+/* From here on signals are noted, not acted upon (see above). */
+static void begin_saving(rad_context *ctx)
+{
+    saving = 1;
+    rad_context_cancel(ctx, false);
+}
+
+static int interrupted_status(void) { return cancel_signal == SIGTERM ? 143 : 130; }
 
 /* ---- progressive display: an image every K solver steps ---- */
 
@@ -143,6 +174,8 @@ static int on_step(void *user, rad_solution *solution, const rad_solve_step *ste
     char path[4096];
     snprintf(path, sizeof path, "%s/step_%08d.png", p->dir, step->iteration);
     rad_result r = rad_solution_render(p->ctx, solution, p->render, &image);
+    if (r == RAD_ERROR_INTERRUPTED)
+        return 1; /* a signal: the solve stops and its iterate is saved, frame or not */
     if (r == RAD_OK && p->exposure == 0.0)
         p->exposure = rad_image_auto_exposure(image); /* fixed from the first frame on */
     if (r == RAD_OK)
@@ -167,13 +200,53 @@ static int fail(rad_context *ctx, rad_result r)
     return 1;
 }
 
-static int interrupted_status(void) { return cancel_signal == SIGTERM ? 143 : 130; }
-
 /* The absolute path of a file just written, for telling the user where it
  * is; falls back to the name as given. */
 static const char *where(const char *path, char *buf)
 {
     return realpath(path, buf) ? buf : path;
+}
+
+/* The outputs of a run, checked before any work and written as one output
+ * set: every file appears at the end, or none (docs/robustness.md). */
+typedef struct run_outputs {
+    rad_output_set *set;
+    const char *main;      /* the image or view-factor file: its temporary */
+    const char *stats, *history;
+} run_outputs;
+
+/* Plan the outputs and name the scene file as an input.  Returns -1 to go
+ * on, else an exit status: 2 when a path is refused as an argument (an
+ * alias, an unknown format), 1 when it cannot be written. */
+static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
+{
+    rad_output_kind kind = s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS : RAD_OUTPUT_IMAGE;
+    rad_result r = rad_output_set_create(ctx, &o->set);
+    if (r == RAD_OK && s->scene_path)
+        r = rad_output_set_add_input(ctx, o->set, s->scene_path);
+    if (r == RAD_OK)
+        r = rad_output_set_add(ctx, o->set, s->output, kind, &o->main);
+    if (r == RAD_OK && s->stats)
+        r = rad_output_set_add(ctx, o->set, s->stats, RAD_OUTPUT_FILE, &o->stats);
+    if (r == RAD_OK && s->history && s->command == CLI_RENDER)
+        r = rad_output_set_add(ctx, o->set, s->history, RAD_OUTPUT_FILE, &o->history);
+    if (r == RAD_OK)
+        return -1;
+    fail(ctx, r);
+    return r == RAD_ERROR_INVALID_ARGUMENT ? EXIT_USAGE : 1;
+}
+
+/* Every file the loader read is an input no output may be. */
+static int check_scene_inputs(rad_context *ctx, const rad_scene *scene, run_outputs *o)
+{
+    for (size_t i = 0; i < rad_scene_input_count(scene); i++) {
+        rad_result r = rad_output_set_add_input(ctx, o->set, rad_scene_input_path(scene, i));
+        if (r != RAD_OK) {
+            fail(ctx, r);
+            return r == RAD_ERROR_INVALID_ARGUMENT ? EXIT_USAGE : 1;
+        }
+    }
+    return -1;
 }
 
 int main(int argc, char **argv)
@@ -185,21 +258,14 @@ int main(int argc, char **argv)
     int status = parse_args(argc, argv, &s);
     if (status >= 0)
         return status;
-    if (s.command == CLI_GENERATE)
-        return cli_generate(&s);
-
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    install_signal_handlers();
 
     progress_state progress = {0};
     rad_context_options co = {0};
-    co.threads = s.threads;
+    co.threads = s.command == CLI_GENERATE ? 1 : s.threads;
     /* --max-memory limits everything the engine allocates, loading included. */
     co.max_memory_bytes = s.solve.max_memory_bytes;
-    if (!s.quiet && isatty(STDERR_FILENO)) {
+    if (!s.quiet && isatty(STDERR_FILENO) && s.command != CLI_GENERATE) {
         co.progress = progress_bar;
         co.progress_user = &progress;
     }
@@ -209,12 +275,25 @@ int main(int argc, char **argv)
         return 1;
     }
     cancel_context = ctx;
+    if (s.command == CLI_GENERATE) {
+        status = cli_generate(&s, ctx);
+        cancel_context = NULL;
+        rad_context_destroy(ctx);
+        return cancel_signal ? interrupted_status() : status;
+    }
+
     const char *output = s.output; /* the parser gives the command's default */
     rad_camera camera;
     rad_scene *scene = NULL;
     rad_solution *sol = NULL;
     rad_image *image = NULL;
+    run_outputs out = {0};
     rad_result r = RAD_OK;
+
+    /* 0. every output path checked before any work */
+    status = plan_outputs(ctx, &s, &out);
+    if (status >= 0)
+        goto done;
     status = 1;
 
     /* 1. load */
@@ -225,6 +304,10 @@ int main(int argc, char **argv)
         status = fail(ctx, r);
         goto done;
     }
+    status = check_scene_inputs(ctx, scene, &out);
+    if (status >= 0)
+        goto done;
+    status = 1;
     if (s.camera) {
         /* The library owns the camera syntax (docs/cli.md).  Its messages
          * begin "camera: "; with "--" before them they name our flag. */
@@ -242,7 +325,8 @@ int main(int argc, char **argv)
     /* Progressive display keeps one exposure for all frames (the user's, or
      * the first frame's automatic one), so the picture visibly brightens as
      * light is shot; with the ambient term the first frame is already close
-     * to the final brightness. */
+     * to the final brightness.  Each frame is its own atomic file, written
+     * during the solve (not part of the output set). */
     progressive prog = {ctx, s.progress_dir, s.every ? s.every : 1, &s.render, s.render.exposure, 0};
     if (s.progress_dir) {
         if (mkdir(s.progress_dir, 0777) != 0 && errno != EEXIST) {
@@ -258,8 +342,13 @@ int main(int argc, char **argv)
     progress_end(&progress);
     if (r == RAD_ERROR_INTERRUPTED) {
         /* No radiosity yet, so no image: only the stats say what happened. */
-        int wrote = s.stats && rad_scene_write_interrupted_stats(ctx, scene, "form factors", now_seconds() - t0,
-                                                                 s.stats) == RAD_OK;
+        begin_saving(ctx);
+        rad_output_set_drop(out.set, output);
+        rad_output_set_drop(out.set, s.history);
+        int wrote = s.stats &&
+                    rad_scene_write_interrupted_stats(ctx, scene, "form factors", now_seconds() - t0,
+                                                      out.stats) == RAD_OK &&
+                    rad_output_set_commit(ctx, out.set) == RAD_OK;
         fprintf(stderr, "radiosity: interrupted while computing form factors; %s\n",
                 wrote ? "wrote partial stats only" : "nothing written");
         status = interrupted_status();
@@ -272,9 +361,12 @@ int main(int argc, char **argv)
 
     if (s.command == CLI_VIEWFACTORS) {
         /* 5. view factors */
-        r = rad_solution_write_view_factors(ctx, sol, output, s.element_level);
+        begin_saving(ctx);
+        r = rad_solution_write_view_factors(ctx, sol, out.main, s.element_level);
         if (r == RAD_OK && s.stats)
-            r = rad_solution_write_stats(ctx, sol, s.stats, 0);
+            r = rad_solution_write_stats(ctx, sol, out.stats, 0);
+        if (r == RAD_OK)
+            r = rad_output_set_commit(ctx, out.set);
         if (r != RAD_OK) {
             status = fail(ctx, r);
             goto done;
@@ -284,7 +376,7 @@ int main(int argc, char **argv)
             printf("wrote %s (%zu surfaces, %zu elements, %.2f s)\n", where(output, full),
                    rad_scene_surface_count(scene), rad_solution_element_count(sol),
                    now_seconds() - t0);
-        status = 0;
+        status = cancel_signal ? interrupted_status() : 0;
         goto done;
     }
 
@@ -306,17 +398,21 @@ int main(int argc, char **argv)
         fprintf(stderr, "radiosity: warning: stopped at residual %.3g after %d iterations\n",
                 rad_solution_residual(sol), rad_solution_iterations(sol));
 
-    /* 5. image and stats.  A second signal during output is ignored: the
-     * partial results are being saved. */
-    rad_context_cancel(ctx, false);
+    /* 5. image, stats and history, into their temporaries, then all put in
+     * place together.  Signals from here on are noted, not acted upon. */
+    begin_saving(ctx);
     r = rad_solution_render(ctx, sol, &s.render, &image);
     progress_end(&progress);
     if (r == RAD_OK)
-        r = rad_image_write_exposed(ctx, image, output, s.render.exposure);
+        r = rad_image_write_exposed(ctx, image, out.main, s.render.exposure);
     if (r == RAD_OK && s.stats)
-        r = rad_solution_write_stats(ctx, sol, s.stats, partial);
+        r = rad_solution_write_stats(ctx, sol, out.stats, partial);
     if (r == RAD_OK && s.history)
-        r = rad_solution_write_history(ctx, sol, s.history);
+        r = rad_solution_write_history(ctx, sol, out.history);
+    if (r == RAD_OK) {
+        fflush(stdout); /* what we printed comes before an output sent to stdout */
+        r = rad_output_set_commit(ctx, out.set);
+    }
     if (r != RAD_OK) {
         status = fail(ctx, r);
         goto done;
@@ -336,9 +432,12 @@ int main(int argc, char **argv)
                rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
                measure, now_seconds() - t0, partial ? " [partial]" : "");
     }
-    status = partial ? interrupted_status() : 0;
+    if (cancel_signal && !partial)
+        fprintf(stderr, "radiosity: interrupted while writing the outputs; they were completed first\n");
+    status = cancel_signal ? interrupted_status() : 0;
 
 done:
+    rad_output_set_destroy(out.set);
     rad_image_destroy(image);
     rad_solution_destroy(sol);
     rad_scene_destroy(scene);

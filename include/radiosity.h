@@ -207,7 +207,8 @@ typedef struct rad_office_options {
 
 /* `options` may be NULL (the defaults).  Fails with
  * RAD_ERROR_INVALID_ARGUMENT when rooms is out of range or ctx or out is
- * NULL, RAD_ERROR_OUT_OF_MEMORY when the scene does not fit. */
+ * NULL, RAD_ERROR_OUT_OF_MEMORY when the scene does not fit,
+ * RAD_ERROR_INTERRUPTED (no scene) when the context was cancelled. */
 RAD_API rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options *options,
                                              rad_scene **out);
 
@@ -217,9 +218,22 @@ RAD_API rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_
  * in the shortest decimal that parses back to the same double (the loader
  * reads them through assimp's float); the camera is not written.  Both
  * files go to temporary names first and are renamed only when both are
- * complete, so a failure leaves neither.  Fails with RAD_ERROR_IO; NULL
+ * complete, so a failure leaves neither (they are an output set, below:
+ * a path that is a symbolic link, a device or /dev/stdout is treated as
+ * there).  A context cancelled before the files are put in place leaves
+ * neither and returns RAD_ERROR_INTERRUPTED.  Fails with RAD_ERROR_IO; NULL
  * ctx, scene or path, or an empty path: RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const char *path);
+
+/* The files a scene was read from, so that a program can keep its outputs
+ * off them (rad_output_set_add_input): the scene file first, then every
+ * file the loader opened (an OBJ's material libraries, a glTF's buffers
+ * and images where the loader reads them), each once, as the loader named
+ * it (relative to the working folder when the scene's path was).  A scene
+ * from memory, the Cornell box or a generated one has none.  NULL scene:
+ * 0 / NULL; an index out of range: NULL.  Strings owned by the scene. */
+RAD_API size_t rad_scene_input_count(const rad_scene *scene);
+RAD_API const char *rad_scene_input_path(const rad_scene *scene, size_t index);
 
 /* Free the scene.  Every solution made from it must be destroyed first.
  * NULL: no-op. */
@@ -470,8 +484,12 @@ RAD_API int rad_image_height(const rad_image *image);
 RAD_API const float *rad_image_pixels(const rad_image *image);
 
 /* Write by extension: .png (exposed, sRGB, 8 bit), .hdr (Radiance RGBE) or
- * .pfm (32-bit float).  The file is written to a temporary name and renamed,
- * so a failure never leaves a partial file.  Fails with RAD_ERROR_IO;
+ * .pfm (32-bit float).  The file is written to a temporary name (created
+ * with O_EXCL beside it) and renamed, so a failure never leaves a partial
+ * file; a symbolic link's target is replaced, a device, a FIFO or the
+ * program's own stdout is written in place once the bytes are complete, a
+ * dangling link or a folder is refused (docs/robustness.md).  Several
+ * files as one: rad_output_set below.  Fails with RAD_ERROR_IO;
  * an unknown extension, an empty image or a NULL ctx, image or path:
  * RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_image_write(rad_context *ctx, const rad_image *image, const char *path);
@@ -510,6 +528,83 @@ RAD_API rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad
  * RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *solution,
                                                    const char *path, bool elements);
+
+/* ------------------------------------------------------------------------
+ * Output sets: the files of one run, written all together or not at all.
+ *
+ *     rad_output_set *set;
+ *     rad_output_set_create(ctx, &set);
+ *     rad_output_set_add_input(ctx, set, "scene.obj");   // never an output
+ *     const char *png, *stats;                           // checked here,
+ *     rad_output_set_add(ctx, set, "out.png", RAD_OUTPUT_IMAGE, &png);   // before
+ *     rad_output_set_add(ctx, set, "run.json", RAD_OUTPUT_FILE, &stats); // any work
+ *     ... load, solve, render ...
+ *     rad_image_write(ctx, image, png);                  // into the temporaries
+ *     rad_solution_write_stats(ctx, solution, stats, false);
+ *     rad_output_set_commit(ctx, set);                   // all appear, or none
+ *     rad_output_set_destroy(set);                       // removes what is left
+ *
+ * Every writer above is atomic on its own; a set makes several of them one
+ * transaction, so a run that fails after writing its image (a stats file
+ * in a missing folder, an interrupted render) leaves the old image.  Paths
+ * are compared by the file they lead to (device and inode; for a file not
+ * there yet, its folder and name), so "a.png", "./a.png" and a hard link
+ * to it are one file.  What each kind of path does (regular files,
+ * symbolic links, devices, FIFOs, /dev/stdout): docs/robustness.md.
+ * A set is used by one thread at a time.
+ * ---------------------------------------------------------------------- */
+
+typedef struct rad_output_set rad_output_set;
+
+/* What an output holds, for the check of its extension at rad_output_set_add. */
+typedef enum rad_output_kind {
+    RAD_OUTPUT_FILE = 0,        /* any name: stats, history, OBJ */
+    RAD_OUTPUT_IMAGE = 1,       /* .png, .hdr, .pfm (rad_image_write) */
+    RAD_OUTPUT_VIEW_FACTORS = 2 /* .json, .csv, .mtx (rad_solution_write_view_factors) */
+} rad_output_kind;
+
+/* An empty set.  Fails with RAD_ERROR_OUT_OF_MEMORY; NULL ctx or out:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_output_set_create(rad_context *ctx, rad_output_set **out);
+
+/* Name a file the run reads (rad_scene_input_path gives a loaded scene's):
+ * no output of the set may be it, before or after this call.  A path that
+ * does not exist is ignored.  Fails with RAD_ERROR_INVALID_ARGUMENT
+ * ("out.json: is the same file as the input scene.obj ...") when an output
+ * already added is that file, RAD_ERROR_OUT_OF_MEMORY; NULL ctx, set or
+ * path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_output_set_add_input(rad_context *ctx, rad_output_set *set, const char *path);
+
+/* Plan the output `path` and check it now: its format (by `kind`), that it
+ * is not an input or another output of the set (RAD_ERROR_INVALID_ARGUMENT,
+ * naming both paths), that it can be written (RAD_ERROR_IO: missing or
+ * read-only folder, a directory, a dangling symbolic link).  On success
+ * *temp_path is a new empty file (in the output's folder, or the temporary
+ * folder for a device or FIFO) with the same extension: write the output
+ * there with any of this header's writers.  The string is owned by the set
+ * (valid until commit, drop or destroy).  On failure *temp_path is NULL and
+ * the set is unchanged.  NULL ctx, set, path or temp_path:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_output_set_add(rad_context *ctx, rad_output_set *set, const char *path,
+                                      rad_output_kind kind, const char **temp_path);
+
+/* Leave the output added as `path` out of the commit (the run could not
+ * make it: no image when interrupted before a solution); the old file
+ * stays and its temporary is removed.  An unknown path or a NULL set or
+ * path: no-op.  Cannot fail. */
+RAD_API void rad_output_set_drop(rad_output_set *set, const char *path);
+
+/* Put every output not dropped in place: devices, FIFOs and the program's
+ * own stdout/stderr are written in place first (a failure there changes no
+ * file), then the files are renamed over the old ones (a failed rename
+ * puts back those already replaced).  Commit once, after every output was
+ * written to its temporary.  Fails with RAD_ERROR_IO naming the output;
+ * NULL ctx or set: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_output_set_commit(rad_context *ctx, rad_output_set *set);
+
+/* Free the set, removing every temporary not committed (the old files
+ * stay).  NULL: no-op. */
+RAD_API void rad_output_set_destroy(rad_output_set *set);
 
 /* ------------------------------------------------------------------------
  * Method registries

@@ -253,7 +253,8 @@ static void test_unwritable_output(void **state)
     write_file("good.mtl", good_mtl);
     assert_int_equal(run("render good.obj --elements 50 -o no_such_dir/out.png"), 1);
     assert_one_line_error("no_such_dir/out.png", NULL);
-    assert_int_equal(run("render good.obj --elements 50 -o out.xyz"), 1);
+    /* An unknown format is refused before any work, as a usage error. */
+    assert_int_equal(run("render good.obj --elements 50 -o out.xyz"), 2);
     assert_one_line_error("out.xyz", ".png");
     assert_no_output("out.xyz");
 }

@@ -1,6 +1,6 @@
 /*
- * core.c -- context, errors, progress, clocks, memory figures, the
- * accounting allocator and atomic file output.
+ * core.c -- context, errors, progress, clocks, memory figures and the
+ * accounting allocator (atomic file output is in file.c).
  */
 #include "core/core.h"
 
@@ -387,62 +387,4 @@ void rad_path_extension(const char *path, char *ext, size_t ext_size)
     for (dot++; *dot && i + 1 < ext_size; dot++)
         ext[i++] = (char)tolower((unsigned char)*dot);
     ext[i] = '\0';
-}
-
-rad_result rad_atomic_open(rad_context *ctx, const char *path, rad_atomic_file *out)
-{
-    memset(out, 0, sizeof *out);
-    size_t n = strlen(path) + 32;
-    out->final_path = rad_strdup(ctx, RAD_MEM_OUTPUT, path, "output file name");
-    out->temp_path = rad_alloc(ctx, RAD_MEM_OUTPUT, n, 1, "temporary file name");
-    if (!out->final_path || !out->temp_path) { /* no temporary file to remove yet */
-        rad_free(out->final_path);
-        rad_free(out->temp_path);
-        memset(out, 0, sizeof *out);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    snprintf(out->temp_path, n, "%s.tmp.%ld", path, (long)getpid());
-    out->file = fopen(out->temp_path, "wb");
-    if (!out->file) {
-        int err = errno;
-        rad_atomic_abort(out);
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot write: %s", path, strerror(err));
-    }
-    return RAD_OK;
-}
-
-rad_result rad_atomic_commit(rad_context *ctx, rad_atomic_file *f)
-{
-    int failed = ferror(f->file);
-    int err = errno;
-    if (fclose(f->file) != 0 && !failed) {
-        failed = 1;
-        err = errno;
-    }
-    f->file = NULL;
-    if (!failed && rename(f->temp_path, f->final_path) != 0) {
-        failed = 1;
-        err = errno;
-    }
-    if (failed) {
-        rad_result r = rad_fail(ctx, RAD_ERROR_IO, "%s: write failed: %s", f->final_path,
-                                strerror(err));
-        rad_atomic_abort(f);
-        return r;
-    }
-    rad_free(f->final_path);
-    rad_free(f->temp_path);
-    f->final_path = f->temp_path = NULL;
-    return RAD_OK;
-}
-
-void rad_atomic_abort(rad_atomic_file *f)
-{
-    if (f->file)
-        fclose(f->file);
-    if (f->temp_path)
-        remove(f->temp_path);
-    rad_free(f->final_path);
-    rad_free(f->temp_path);
-    memset(f, 0, sizeof *f);
 }

@@ -229,18 +229,78 @@ static inline double rad_rng_uniform(rad_rng *r)
     return (double)(z >> 11) * (1.0 / 9007199254740992.0);
 }
 
-/* ---- atomic output: write to "path.tmp.<pid>", then rename ---- */
+/* ---- file output (file.c): where an output really goes, its identity,
+ * temporaries that cannot be hijacked, and atomic replacement ----
+ *
+ *   out.png (regular, or not there yet)  -> .out.png.k3x9qz in its folder,
+ *                                            renamed over out.png at commit
+ *   link.png -> data/real.png (regular)  -> the temporary beside real.png,
+ *                                            renamed over real.png (the link stays)
+ *   /dev/null, a FIFO, /dev/stdout        -> written in place at commit, from
+ *                                            an anonymous temporary; never renamed over
+ *   a folder, a socket, a block device,
+ *   a dangling link                       -> refused
+ */
+
+/* An output path, resolved.  Two outputs, or an output and an input, are
+ * the same file when their identities match: (device, inode) of a file
+ * that exists, else (device, inode) of its folder and its base name; so
+ * "./a.png", "a.png", "d/../a.png" and a hard link all match. */
+typedef struct rad_output_target {
+    char *path;            /* the file replaced: the path as given, or a symlink's target */
+    const char *name;      /* its base name, within `path` */
+    bool stream;           /* written in place (character device, FIFO, our stdout/stderr) */
+    int stream_fd;         /* 1 or 2 when the target is the program's stdout/stderr, else -1 */
+    bool exists;
+    uint64_t device, inode; /* of the file when it exists, else of its folder */
+} rad_output_target;
+
+/* Resolve `path` for writing and check, before any work, that it can be
+ * written: its folder exists and is writable (regular files), or the
+ * device or FIFO is writable (streams).  Fails with RAD_ERROR_IO naming the
+ * path ("out/x.png: cannot write: No such file or directory", "d: is a
+ * directory", "l.png: is a dangling symbolic link"), RAD_ERROR_OUT_OF_MEMORY;
+ * *out is then empty.  Free with rad_output_target_free. */
+rad_result rad_output_target_resolve(rad_context *ctx, const char *path, rad_output_target *out);
+void rad_output_target_free(rad_output_target *target);
+/* Whether two targets are the same file.  Character devices never alias
+ * (writing /dev/null twice is harmless). */
+bool rad_output_target_same(const rad_output_target *a, const rad_output_target *b);
+/* The identity of an existing file (following links); false if it cannot
+ * be had. */
+bool rad_file_identity(const char *path, uint64_t *device, uint64_t *inode);
+
+/* Create a new, empty file named ".PREFIX.XXXXXX" + suffix (PREFIX: the
+ * start of `name`, cut so that the whole name stays short) in `folder`,
+ * with O_CREAT | O_EXCL and mode 0666 & ~umask: it cannot be a file or a
+ * link that was there before.  *path (malloc'd) and *fd (O_WRONLY) are the
+ * caller's.  Fails with RAD_ERROR_IO naming `what`. */
+rad_result rad_temp_create(rad_context *ctx, const char *folder, const char *name, const char *suffix,
+                           const char *what, char **path, int *fd);
+/* The folder part of a path ("." when none), malloc'd; NULL when out of memory. */
+char *rad_path_folder(const char *path);
+
+/* Copy the bytes of `from` (read from its start) into a stream target,
+ * opened now without O_CREAT or O_TRUNC (a FIFO waits for its reader).
+ * RAD_ERROR_IO naming `what` on failure. */
+rad_result rad_stream_copy(rad_context *ctx, const rad_output_target *target, FILE *from,
+                           const char *what);
+
+/* ---- atomic output: a temporary beside the target, renamed over it ---- */
 
 typedef struct rad_atomic_file {
-    FILE *file;
-    char *final_path;
-    char *temp_path;
+    FILE *file;                /* where the caller writes */
+    char *final_path;          /* the path as given, for messages */
+    char *temp_path;           /* the temporary; NULL for a stream (anonymous temporary) */
+    rad_output_target target;
 } rad_atomic_file;
 
+/* Resolve `path` (rad_output_target_resolve) and open a temporary for it. */
 rad_result rad_atomic_open(rad_context *ctx, const char *path, rad_atomic_file *out);
-/* Flush, close and rename; on any error removes the temporary file. */
+/* Flush, close and rename over the target (or copy into a stream); on any
+ * error removes the temporary file. */
 rad_result rad_atomic_commit(rad_context *ctx, rad_atomic_file *file);
-/* Remove the temporary file (after a failed write). */
+/* Remove the temporary file (after a failed write).  Cannot fail. */
 void rad_atomic_abort(rad_atomic_file *file);
 
 /* Lower-case extension of a path without the dot ("" if none), in `ext`. */

@@ -9,6 +9,10 @@
  *       open(other)       -> NULL: not found
  *
  * Reads, seeks and sizes behave like assimp's own MemoryIOStream.
+ *
+ * And a file system for file imports that reads files as assimp's default
+ * one does (stdio) and logs every file it opens, so that a scene can say
+ * which files it was read from (rad_scene_input_path).
  */
 #include "scene/import_internal.h"
 
@@ -126,4 +130,107 @@ void import_memory_io(struct aiFileIO *io, import_memory_fs *fs)
     io->OpenProc = memory_open;
     io->CloseProc = memory_close;
     io->UserData = (aiUserData)(void *)fs;
+}
+
+/* ---- the logging file system ---- */
+
+void import_file_log_add(import_file_log *log, const char *path)
+{
+    for (size_t i = 0; i < log->count; i++)
+        if (strcmp(log->paths[i], path) == 0)
+            return;
+    if (log->count == log->capacity) {
+        size_t grown = log->capacity ? 2 * log->capacity : 4;
+        char **paths = rad_realloc(NULL, RAD_MEM_SCENE, log->paths, grown, sizeof *paths, "input file names");
+        if (!paths) {
+            log->failed = true;
+            return;
+        }
+        log->paths = paths;
+        log->capacity = grown;
+    }
+    char *copy = rad_strdup(NULL, RAD_MEM_SCENE, path, "input file name");
+    if (!copy) {
+        log->failed = true;
+        return;
+    }
+    log->paths[log->count++] = copy;
+}
+
+void import_file_log_free(import_file_log *log)
+{
+    for (size_t i = 0; i < log->count; i++)
+        rad_free(log->paths[i]);
+    rad_free(log->paths);
+    memset(log, 0, sizeof *log);
+}
+
+static FILE *stdio_of(struct aiFile *file) { return (FILE *)(void *)file->UserData; }
+
+static size_t stdio_read(struct aiFile *file, char *buffer, size_t size, size_t count)
+{
+    return fread(buffer, size, count, stdio_of(file));
+}
+
+static size_t stdio_tell(struct aiFile *file)
+{
+    long at = ftell(stdio_of(file));
+    return at < 0 ? 0 : (size_t)at;
+}
+
+static size_t stdio_size(struct aiFile *file)
+{
+    FILE *f = stdio_of(file);
+    long at = ftell(f);
+    if (at < 0 || fseek(f, 0, SEEK_END) != 0)
+        return 0;
+    long end = ftell(f);
+    fseek(f, at, SEEK_SET);
+    return end < 0 ? 0 : (size_t)end;
+}
+
+static enum aiReturn stdio_seek(struct aiFile *file, size_t offset, enum aiOrigin origin)
+{
+    int whence = origin == aiOrigin_END ? SEEK_END : origin == aiOrigin_CUR ? SEEK_CUR : SEEK_SET;
+    /* aiOrigin_CUR and _END offsets are two's-complement in a size_t. */
+    return fseek(stdio_of(file), (long)offset, whence) == 0 ? aiReturn_SUCCESS : aiReturn_FAILURE;
+}
+
+static void stdio_flush(struct aiFile *file) { fflush(stdio_of(file)); }
+
+static struct aiFile *logged_open(struct aiFileIO *io, const char *path, const char *mode)
+{
+    if (!path || !mode || strpbrk(mode, "wa+"))
+        return NULL; /* an import only reads */
+    struct aiFile *file = rad_alloc(NULL, RAD_MEM_SCENE, 1, sizeof *file, "input file");
+    FILE *f = file ? fopen(path, "rb") : NULL;
+    if (!f) {
+        rad_free(file);
+        return NULL;
+    }
+    import_file_log_add((import_file_log *)(void *)io->UserData, path);
+    file->ReadProc = stdio_read;
+    file->WriteProc = memory_write;
+    file->TellProc = stdio_tell;
+    file->FileSizeProc = stdio_size;
+    file->SeekProc = stdio_seek;
+    file->FlushProc = stdio_flush;
+    file->UserData = (aiUserData)(void *)f;
+    return file;
+}
+
+static void logged_close(struct aiFileIO *io, struct aiFile *file)
+{
+    (void)io;
+    if (!file)
+        return;
+    fclose(stdio_of(file));
+    rad_free(file);
+}
+
+void import_file_io(struct aiFileIO *io, import_file_log *log)
+{
+    io->OpenProc = logged_open;
+    io->CloseProc = logged_close;
+    io->UserData = (aiUserData)(void *)log;
 }

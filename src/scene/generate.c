@@ -633,8 +633,13 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
                 r = last_error(&g);
         }
     }
-    for (int i = 0; i < o.rooms && r == RAD_OK; i++)
-        r = build_room(&g, i);
+    for (int i = 0; i < o.rooms && r == RAD_OK; i++) {
+        if (rad_cancelled(ctx))
+            r = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "office: interrupted after %d of %d rooms", i,
+                         o.rooms);
+        else
+            r = build_room(&g, i);
+    }
 
     if (r == RAD_OK) {
         /* From the free corner of room 0 at eye height, across the room. */

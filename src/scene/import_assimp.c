@@ -288,7 +288,7 @@ static void convert_camera(converter *cv, bool gltf, double gltf_yfov)
     rad_scene_builder_camera(cv->builder, &c);
 }
 
-/* Import `name` with assimp (through `io`, or the file system when NULL);
+/* Import `name` with assimp (through `io`);
  * `data` holds the file's bytes when the caller has them (glTF needs them
  * for the JSON), else NULL. */
 static rad_result import_scene(rad_context *ctx, const char *name, const char *data, size_t size,
@@ -433,7 +433,7 @@ static rad_result read_file(rad_context *ctx, const char *path, const char *what
 
 /* Pre-scan the material library an OBJ file names, relative to its folder. */
 static rad_result prescan_mtl_file(rad_context *ctx, const char *obj_path, const char *mtllib,
-                                   int line)
+                                   int line, import_file_log *log)
 {
     const char *slash = strrchr(obj_path, '/');
     size_t folder = mtllib[0] == '/' || !slash ? 0 : (size_t)(slash - obj_path) + 1;
@@ -449,6 +449,8 @@ static rad_result prescan_mtl_file(rad_context *ctx, const char *obj_path, const
     char *text;
     size_t size;
     rad_result r = read_file(ctx, path, what, &text, &size);
+    if (r == RAD_OK)
+        import_file_log_add(log, path);
     if (r == RAD_OK)
         r = import_mtl_prescan(ctx, path, text, size);
     rad_free(text);
@@ -466,6 +468,8 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
     char *text = NULL;
     size_t size = 0;
     rad_result r = RAD_OK;
+    import_file_log log = {0};
+    import_file_log_add(&log, path);
     if (wanted) {
         r = read_file(ctx, path, path, &text, &size);
     } else {
@@ -480,18 +484,33 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
             size = (size_t)st.st_size;
         int unreadable = fgetc(file) == EOF && ferror(file), error = errno;
         fclose(file);
-        if (unreadable)
+        if (unreadable) {
+            import_file_log_free(&log);
             return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: %s", path, strerror(error));
+        }
     }
     if (r == RAD_OK && is_obj) {
         char mtllib[256];
         int mtllib_line;
         r = import_obj_prescan(ctx, path, text, size, mtllib, sizeof mtllib, &mtllib_line);
         if (r == RAD_OK && mtllib[0])
-            r = prescan_mtl_file(ctx, path, mtllib, mtllib_line);
+            r = prescan_mtl_file(ctx, path, mtllib, mtllib_line, &log);
     }
+    struct aiFileIO io;
+    import_file_io(&io, &log);
     if (r == RAD_OK)
-        r = import_scene(ctx, path, text, size, NULL, out);
+        r = import_scene(ctx, path, text, size, &io, out);
+    if (r == RAD_OK && log.failed) {
+        r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
+        rad_scene_destroy(*out);
+        *out = NULL;
+    }
+    if (r == RAD_OK) {
+        rad_scene_set_inputs(*out, log.paths, log.count);
+        log.paths = NULL;
+        log.count = 0;
+    }
+    import_file_log_free(&log);
     rad_free(text);
     return r;
 }

@@ -63,4 +63,22 @@ typedef struct import_memory_fs {
  * Cannot fail. */
 void import_memory_io(struct aiFileIO *io, import_memory_fs *fs);
 
+/* The files a file import opened: assimp reads through the file system as
+ * its default would, and every file it opens for reading is named here (the
+ * MTL of an OBJ, a glTF's buffers), so the scene can list its inputs. */
+typedef struct import_file_log {
+    char **paths;     /* malloc'd, each malloc'd; no repeats */
+    size_t count, capacity;
+    bool failed;      /* a name could not be kept (out of memory) */
+} import_file_log;
+
+/* Fill `io` so that assimp reads files and logs them into `log` (which must
+ * outlive the import).  Cannot fail. */
+void import_file_io(struct aiFileIO *io, import_file_log *log);
+/* Note a file read outside assimp (the pre-scans); sets log->failed when
+ * out of memory. */
+void import_file_log_add(import_file_log *log, const char *path);
+/* Free the names.  Cannot fail. */
+void import_file_log_free(import_file_log *log);
+
 #endif /* RAD_SCENE_IMPORT_INTERNAL_H */

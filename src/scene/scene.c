@@ -561,6 +561,7 @@ void rad_scene_destroy(rad_scene *scene)
         rad_free(scene->surfaces[i].name);
     for (size_t i = 0; i < scene->material_count; i++)
         rad_free(scene->materials[i].name);
+    rad_scene_set_inputs(scene, NULL, 0);
     rad_free(scene->source);
     rad_free(scene->positions);
     rad_free(scene->indices);
@@ -568,6 +569,22 @@ void rad_scene_destroy(rad_scene *scene)
     rad_free(scene->surfaces);
     rad_free(scene->materials);
     rad_free(scene);
+}
+
+void rad_scene_set_inputs(rad_scene *scene, char **paths, size_t count)
+{
+    for (size_t i = 0; i < scene->input_count; i++)
+        rad_free(scene->inputs[i]);
+    rad_free(scene->inputs);
+    scene->inputs = paths;
+    scene->input_count = count;
+}
+
+size_t rad_scene_input_count(const rad_scene *scene) { return scene ? scene->input_count : 0; }
+
+const char *rad_scene_input_path(const rad_scene *scene, size_t index)
+{
+    return scene && index < scene->input_count ? scene->inputs[index] : NULL;
 }
 
 size_t rad_scene_surface_count(const rad_scene *scene) { return scene ? scene->surface_count : 0; }

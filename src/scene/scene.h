@@ -48,7 +48,13 @@ struct rad_scene {
     double load_seconds;      /* time the importer took */
     bool has_camera;
     rad_camera camera;
+    char **inputs;            /* the files read to make it (rad_scene_input_path) */
+    size_t input_count;
 };
+
+/* Take over a list of malloc'd paths as the scene's inputs (freeing any it
+ * had).  Cannot fail. */
+void rad_scene_set_inputs(rad_scene *scene, char **paths, size_t count);
 
 /* ---- building a scene ---- */
 

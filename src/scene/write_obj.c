@@ -7,7 +7,7 @@
  * shortest decimal that reads back as the same double, emission as the
  * MTL's radiance Ke = E / pi, and names made safe for the format.  Both
  * files are written in full before either replaces what was there
- * (rad_atomic_open), so a failure leaves neither behind.
+ * (an output set), so a failure leaves neither behind.
  */
 #include "scene/scene.h"
 
@@ -174,32 +174,35 @@ rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const c
     const char *slash = strrchr(mtl_path, '/');
     const char *mtl_name = slash ? slash + 1 : mtl_path;
 
+    /* Both written in full before either is put in place; a write error
+     * (full disk) or an interruption leaves neither. */
+    rad_output_set *set = NULL;
+    const char *obj_temp = NULL, *mtl_temp = NULL;
     rad_atomic_file obj = {0}, mtl = {0};
-    rad_result r = rad_atomic_open(ctx, path, &obj);
+    rad_result r = rad_output_set_create(ctx, &set);
     if (r == RAD_OK)
-        r = rad_atomic_open(ctx, mtl_path, &mtl);
+        r = rad_output_set_add(ctx, set, path, RAD_OUTPUT_FILE, &obj_temp);
+    if (r == RAD_OK)
+        r = rad_output_set_add(ctx, set, mtl_path, RAD_OUTPUT_FILE, &mtl_temp);
+    if (r == RAD_OK)
+        r = rad_atomic_open(ctx, obj_temp, &obj);
+    if (r == RAD_OK)
+        r = rad_atomic_open(ctx, mtl_temp, &mtl);
     if (r == RAD_OK)
         r = write_mtl(scene, mtl.file);
     if (r == RAD_OK)
         r = write_obj_body(ctx, scene, obj.file, mtl_name);
-    /* Both written in full before either is renamed; a write error shows
-     * here (full disk) and leaves neither file behind. */
-    if (r == RAD_OK && (fflush(obj.file) != 0 || ferror(obj.file)))
-        r = rad_fail(ctx, RAD_ERROR_IO, "%s: write failed: %s", path, strerror(errno));
-    if (r == RAD_OK && (fflush(mtl.file) != 0 || ferror(mtl.file)))
-        r = rad_fail(ctx, RAD_ERROR_IO, "%s: write failed: %s", mtl_path, strerror(errno));
-    if (r != RAD_OK) {
-        rad_atomic_abort(&obj);
-        rad_atomic_abort(&mtl);
-        rad_free(mtl_path);
-        return r;
-    }
-    r = rad_atomic_commit(ctx, &mtl);
-    if (r != RAD_OK) {
-        rad_atomic_abort(&obj);
-    } else if ((r = rad_atomic_commit(ctx, &obj)) != RAD_OK) {
-        remove(mtl_path); /* no MTL without its OBJ */
-    }
+    if (r == RAD_OK)
+        r = rad_atomic_commit(ctx, &mtl);
+    if (r == RAD_OK)
+        r = rad_atomic_commit(ctx, &obj);
+    if (r == RAD_OK && rad_cancelled(ctx))
+        r = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "%s: interrupted; nothing written", path);
+    if (r == RAD_OK)
+        r = rad_output_set_commit(ctx, set);
+    rad_atomic_abort(&obj);
+    rad_atomic_abort(&mtl);
+    rad_output_set_destroy(set);
     rad_free(mtl_path);
     return r;
 }

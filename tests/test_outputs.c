@@ -1,0 +1,868 @@
+/*
+ * test_outputs.c -- where output files go, and what is left when a run
+ * fails or is interrupted (docs/robustness.md, "Output files").
+ *
+ *   temporaries   unpredictable names made with O_EXCL: a link planted at
+ *                 the old predictable name is never followed; names short
+ *                 enough for a 255-byte output name
+ *   targets       devices, FIFOs and stdout written in place, never renamed
+ *                 over; a link to a regular file replaces its target; a
+ *                 dangling link, a folder, a missing folder are refused
+ *   aliasing      an output that is an input (the scene, its MTL, a glTF's
+ *                 buffer) or another output, by any name: exit 2
+ *   all or none   the output set: a failure leaves every old file
+ *   signals       at each stage: exit 130 / 143, what exists saved and
+ *                 marked, no temporary left; a second signal loses nothing
+ *
+ * The library's output set is tested directly; the rest drives the
+ * `radiosity` program (argv[1]).  Runs that must be caught at a stage are
+ * watched, never timed: the program's progress on a pseudo-terminal names
+ * the phase it is in, a progress frame appearing marks the solve, and
+ * /proc shows when `generate` has its signal handlers.
+ */
+/* posix_openpt, grantpt, unlockpt and ptsname are X/Open. */
+#define _XOPEN_SOURCE 700
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "core/core.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char *radiosity_bin;
+static char workdir[256];
+static char err_text[8192], out_text[65536];
+
+/* The longest any watched run may take before the test gives up on it. */
+enum { WATCH_SECONDS = 300 };
+
+/* A short pause inside a polling loop (never a wait for a stage). */
+static void pause_ms(long ms)
+{
+    struct timespec t = {ms / 1000, (ms % 1000) * 1000000L};
+    nanosleep(&t, NULL);
+}
+
+/* ---- files in the work folder ---- */
+
+static const char *in_work(const char *name)
+{
+    static char paths[4][1024];
+    static int next;
+    char *p = paths[next++ % 4];
+    snprintf(p, sizeof paths[0], "%s/%s", workdir, name);
+    return p;
+}
+
+static void write_file(const char *name, const char *text)
+{
+    FILE *f = fopen(in_work(name), "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void slurp(const char *path, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return;
+    size_t n = fread(buf, 1, size - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+}
+
+/* The whole of a work file (static buffer), "" when missing. */
+static const char *text_of(const char *name)
+{
+    static char text[65536];
+    slurp(in_work(name), text, sizeof text);
+    return text;
+}
+
+static bool exists(const char *name)
+{
+    struct stat st;
+    return lstat(in_work(name), &st) == 0;
+}
+
+/* No temporary of ours in a folder: no hidden file, no "*.tmp.*". */
+static void assert_no_temporaries(const char *folder)
+{
+    DIR *d = opendir(folder);
+    assert_non_null(d);
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if ((e->d_name[0] == '.' && strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) ||
+            strstr(e->d_name, ".tmp."))
+            fail_msg("temporary left in %s: %s", folder, e->d_name);
+    closedir(d);
+}
+
+/* Run `radiosity ARGS` in the work folder; stdout and stderr captured. */
+static int run(const char *fmt, ...)
+{
+    char args[4096], cmd[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >stdout.txt 2>stderr.txt </dev/null", workdir,
+             radiosity_bin, args);
+    int status = system(cmd);
+    slurp(in_work("stderr.txt"), err_text, sizeof err_text);
+    slurp(in_work("stdout.txt"), out_text, sizeof out_text);
+    unlink(in_work("stderr.txt"));
+    unlink(in_work("stdout.txt"));
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static void assert_one_line_error(const char *needle1, const char *needle2)
+{
+    size_t len = strlen(err_text);
+    if (len == 0 || err_text[len - 1] != '\n' || strchr(err_text, '\n') != err_text + len - 1)
+        fail_msg("expected exactly one line on stderr, got: <%s>", err_text);
+    if (needle1 && !strstr(err_text, needle1))
+        fail_msg("stderr lacks '%s': %s", needle1, err_text);
+    if (needle2 && !strstr(err_text, needle2))
+        fail_msg("stderr lacks '%s': %s", needle2, err_text);
+}
+
+static const char *good_mtl = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
+static const char *good_obj = "mtllib good.mtl\n"
+                              "o floor\nusemtl white\n"
+                              "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
+                              "o lamp\nusemtl lamp\n"
+                              "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n";
+
+/* A quad lamp over a quad floor as glTF whose geometry is the external
+ * buffer quad.bin (the loader reads it). */
+static void write_gltf_with_buffer(void)
+{
+    float positions[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1},
+                             {0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}};
+    uint16_t indices[12] = {0, 3, 2, 0, 2, 1, 4, 7, 6, 4, 6, 5};
+    FILE *f = fopen(in_work("quad.bin"), "wb");
+    assert_non_null(f);
+    fwrite(positions, sizeof positions, 1, f);
+    fwrite(indices, sizeof indices, 1, f);
+    fclose(f);
+    write_file("quad.gltf",
+               "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1]}],"
+               "\"nodes\": [{\"name\": \"floor\", \"mesh\": 0}, {\"name\": \"lamp\", \"mesh\": 1}],"
+               "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, "
+               "\"material\": 0}]}, {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, "
+               "\"indices\": 2, \"material\": 1}]}],"
+               "\"materials\": [{\"name\": \"white\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}}, "
+               "{\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}, "
+               "\"emissiveFactor\": [1, 1, 1]}],"
+               "\"buffers\": [{\"byteLength\": 120, \"uri\": \"quad.bin\"}],"
+               "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 96}, "
+               "{\"buffer\": 0, \"byteOffset\": 96, \"byteLength\": 24}],"
+               "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 8, "
+               "\"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 1]}, "
+               "{\"bufferView\": 1, \"byteOffset\": 0, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
+               "{\"bufferView\": 1, \"byteOffset\": 12, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}");
+}
+
+/* ======================================================================
+ * The library: targets, temporaries, the output set, a scene's inputs
+ * ==================================================================== */
+
+static void test_temporary_names(void **state)
+{
+    (void)state;
+    /* Unpredictable, new (O_EXCL), hidden, short, mode 0666 & ~umask. */
+    char name[256];
+    memset(name, 'n', 250);
+    strcpy(name + 250, ".png");
+    mode_t mask = umask(022);
+    umask(mask);
+    char *a, *b;
+    int fa, fb;
+    assert_int_equal(rad_temp_create(NULL, workdir, name, ".png", "t", &a, &fa), RAD_OK);
+    assert_int_equal(rad_temp_create(NULL, workdir, name, ".png", "t", &b, &fb), RAD_OK);
+    assert_string_not_equal(a, b);
+    struct stat st;
+    assert_int_equal(lstat(a, &st), 0);
+    assert_true(S_ISREG(st.st_mode));
+    assert_int_equal(st.st_mode & 0777, 0666 & ~mask);
+    const char *base = strrchr(a, '/') + 1;
+    assert_true(base[0] == '.' && strlen(base) < 64);
+    assert_non_null(strstr(base, ".png"));
+    close(fa);
+    close(fb);
+    unlink(a);
+    unlink(b);
+    rad_free(a);
+    rad_free(b);
+}
+
+static void test_output_targets(void **state)
+{
+    (void)state;
+    rad_output_target t;
+    /* A link to a regular file resolves to the file. */
+    write_file("real.json", "old");
+    assert_int_equal(symlink("real.json", in_work("link.json")), 0);
+    assert_int_equal(rad_output_target_resolve(NULL, in_work("link.json"), &t), RAD_OK);
+    assert_false(t.stream);
+    assert_string_equal(t.name, "real.json");
+    rad_output_target_free(&t);
+    /* Devices are streams. */
+    assert_int_equal(rad_output_target_resolve(NULL, "/dev/null", &t), RAD_OK);
+    assert_true(t.stream);
+    rad_output_target_free(&t);
+    /* Refused: a dangling link, a folder, a missing folder. */
+    assert_int_equal(symlink("nowhere.json", in_work("dangling.json")), 0);
+    assert_int_equal(rad_output_target_resolve(NULL, in_work("dangling.json"), &t), RAD_ERROR_IO);
+    assert_int_equal(rad_output_target_resolve(NULL, workdir, &t), RAD_ERROR_IO);
+    assert_int_equal(rad_output_target_resolve(NULL, in_work("no/such.json"), &t), RAD_ERROR_IO);
+    assert_null(t.path);
+    unlink(in_work("link.json"));
+    unlink(in_work("dangling.json"));
+    unlink(in_work("real.json"));
+}
+
+/* Write `text` to an output set's temporary as a writer would. */
+static void fill(const char *temp, const char *text)
+{
+    FILE *f = fopen(temp, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void test_output_set_all_or_none(void **state)
+{
+    (void)state;
+    rad_context *ctx;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    write_file("a.json", "old a");
+    write_file("b.json", "old b");
+
+    /* Committed: both replaced, nothing else left. */
+    rad_output_set *set;
+    const char *ta, *tb;
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("b.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
+    fill(ta, "new a");
+    fill(tb, "new b");
+    assert_string_equal(text_of("a.json"), "old a"); /* nothing visible before the commit */
+    assert_int_equal(rad_output_set_commit(ctx, set), RAD_OK);
+    rad_output_set_destroy(set);
+    assert_string_equal(text_of("a.json"), "new a");
+    assert_string_equal(text_of("b.json"), "new b");
+    assert_no_temporaries(workdir);
+
+    /* Abandoned (a failure before the commit): the old files, no temporary. */
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    fill(ta, "lost");
+    rad_output_set_destroy(set);
+    assert_string_equal(text_of("a.json"), "new a");
+    assert_no_temporaries(workdir);
+
+    /* Dropped: that file stays, the others are replaced. */
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("b.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
+    fill(tb, "b3");
+    rad_output_set_drop(set, in_work("a.json"));
+    assert_int_equal(rad_output_set_commit(ctx, set), RAD_OK);
+    rad_output_set_destroy(set);
+    assert_string_equal(text_of("a.json"), "new a");
+    assert_string_equal(text_of("b.json"), "b3");
+    assert_no_temporaries(workdir);
+
+    /* A stream that fails at the commit (/dev/full) changes no file. */
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    const char *tf;
+    assert_int_equal(rad_output_set_add(ctx, set, "/dev/full", RAD_OUTPUT_FILE, &tf), RAD_OK);
+    fill(ta, "a4");
+    fill(tf, "into a full device");
+    assert_int_equal(rad_output_set_commit(ctx, set), RAD_ERROR_IO);
+    assert_non_null(strstr(rad_context_error(ctx), "/dev/full"));
+    rad_output_set_destroy(set);
+    assert_string_equal(text_of("a.json"), "new a");
+    assert_no_temporaries(workdir);
+
+    /* A rename that fails half-way (its target became a folder) puts back
+     * the file already replaced. */
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("c.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
+    fill(ta, "a5");
+    fill(tb, "c5");
+    assert_int_equal(mkdir(in_work("c.json"), 0777), 0);
+    assert_int_equal(rad_output_set_commit(ctx, set), RAD_ERROR_IO);
+    rad_output_set_destroy(set);
+    assert_string_equal(text_of("a.json"), "new a");
+    assert_int_equal(rmdir(in_work("c.json")), 0);
+    assert_no_temporaries(workdir);
+
+    unlink(in_work("a.json"));
+    unlink(in_work("b.json"));
+    rad_context_destroy(ctx);
+}
+
+static void test_output_set_aliasing(void **state)
+{
+    (void)state;
+    rad_context *ctx;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    write_file("in.obj", "o x\n");
+    assert_int_equal(link(in_work("in.obj"), in_work("hard.json")), 0);
+    char dotted[1024];
+    snprintf(dotted, sizeof dotted, "%s/./new.png", workdir);
+
+    rad_output_set *set;
+    const char *t;
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_output_set_add_input(ctx, set, in_work("in.obj")), RAD_OK);
+    /* The input by a hard link. */
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("hard.json"), RAD_OUTPUT_FILE, &t),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    assert_null(t);
+    assert_non_null(strstr(rad_context_error(ctx), "hard.json"));
+    assert_non_null(strstr(rad_context_error(ctx), "in.obj"));
+    /* A file not there yet, by two spellings. */
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("new.png"), RAD_OUTPUT_IMAGE, &t), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, dotted, RAD_OUTPUT_FILE, &t),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    /* An input named after the output: refused as well. */
+    write_file("late.mtl", "");
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("late.mtl"), RAD_OUTPUT_FILE, &t), RAD_OK);
+    assert_int_equal(rad_output_set_add_input(ctx, set, in_work("late.mtl")),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    /* /dev/null twice is harmless; formats are checked. */
+    assert_int_equal(rad_output_set_add(ctx, set, "/dev/null", RAD_OUTPUT_FILE, &t), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, "/dev/null", RAD_OUTPUT_FILE, &t), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("x.xyz"), RAD_OUTPUT_IMAGE, &t),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_output_set_add(ctx, set, in_work("x.png"), RAD_OUTPUT_VIEW_FACTORS, &t),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    rad_output_set_destroy(set);
+    assert_no_temporaries(workdir);
+    assert_string_equal(text_of("late.mtl"), "");
+    unlink(in_work("in.obj"));
+    unlink(in_work("hard.json"));
+    unlink(in_work("late.mtl"));
+    rad_context_destroy(ctx);
+}
+
+static void test_scene_inputs(void **state)
+{
+    (void)state;
+    rad_context *ctx;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    write_file("good.obj", good_obj);
+    write_file("good.mtl", good_mtl);
+    rad_scene *scene;
+    assert_int_equal(rad_scene_load_file(ctx, in_work("good.obj"), &scene), RAD_OK);
+    assert_int_equal(rad_scene_input_count(scene), 2);
+    assert_string_equal(rad_scene_input_path(scene, 0), in_work("good.obj"));
+    assert_non_null(strstr(rad_scene_input_path(scene, 1), "good.mtl"));
+    assert_null(rad_scene_input_path(scene, 2));
+    rad_scene_destroy(scene);
+
+    write_gltf_with_buffer();
+    assert_int_equal(rad_scene_load_file(ctx, in_work("quad.gltf"), &scene), RAD_OK);
+    bool buffer = false;
+    for (size_t i = 0; i < rad_scene_input_count(scene); i++)
+        buffer |= strstr(rad_scene_input_path(scene, i), "quad.bin") != NULL;
+    assert_true(buffer);
+    rad_scene_destroy(scene);
+
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    assert_int_equal(rad_scene_input_count(scene), 0);
+    rad_scene_destroy(scene);
+    assert_int_equal(rad_scene_input_count(NULL), 0);
+    assert_null(rad_scene_input_path(NULL, 0));
+    rad_context_destroy(ctx);
+}
+
+/* ======================================================================
+ * The program: targets
+ * ==================================================================== */
+
+#define QUICK "--elements 50 --width 16 --height 16 --quiet"
+
+/* The old scheme's temporary was "PATH.tmp.<pid>": a link planted there
+ * (the pid is known between fork and exec) must not be followed. */
+static void test_link_at_old_temporary_name(void **state)
+{
+    (void)state;
+    write_file("victim.txt", "precious");
+    int go[2];
+    assert_int_equal(pipe(go), 0);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        char byte;
+        close(go[1]);
+        if (read(go[0], &byte, 1) != 1 || chdir(workdir) != 0)
+            _exit(127);
+        int null = open("/dev/null", O_WRONLY);
+        dup2(null, 1);
+        dup2(null, 2);
+        execl(radiosity_bin, radiosity_bin, "render", "--elements", "50", "--width", "16",
+              "--height", "16", "--quiet", "-o", "planted.png", "--stats", "planted.json",
+              (char *)NULL);
+        _exit(127);
+    }
+    close(go[0]);
+    char link_name[64];
+    snprintf(link_name, sizeof link_name, "planted.png.tmp.%ld", (long)pid);
+    assert_int_equal(symlink(in_work("victim.txt"), in_work(link_name)), 0);
+    snprintf(link_name, sizeof link_name, "planted.json.tmp.%ld", (long)pid);
+    assert_int_equal(symlink(in_work("victim.txt"), in_work(link_name)), 0);
+    assert_int_equal(write(go[1], "x", 1), 1);
+    close(go[1]);
+    int status;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    assert_string_equal(text_of("victim.txt"), "precious");
+    assert_non_null(strstr(text_of("planted.json"), "\"version\""));
+}
+
+static void test_links_and_folders(void **state)
+{
+    (void)state;
+    /* A link to a regular file: the file is replaced, the link stays. */
+    write_file("target.json", "old");
+    assert_int_equal(symlink("target.json", in_work("via_link.json")), 0);
+    assert_int_equal(run("render " QUICK " -o l.png --stats via_link.json"), 0);
+    struct stat st;
+    assert_int_equal(lstat(in_work("via_link.json"), &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    assert_non_null(strstr(text_of("target.json"), "\"version\""));
+    /* A dangling link: refused before any work, nothing created. */
+    assert_int_equal(symlink("ghost.json", in_work("dangling.json")), 0);
+    assert_int_equal(run("render " QUICK " -o l.png --stats dangling.json"), 1);
+    assert_one_line_error("dangling.json", "dangling symbolic link");
+    assert_false(exists("ghost.json"));
+    /* A folder as the output, a missing folder. */
+    assert_int_equal(mkdir(in_work("folder.png"), 0777), 0);
+    assert_int_equal(run("render " QUICK " -o folder.png"), 1);
+    assert_one_line_error("folder.png", "is a directory");
+    assert_int_equal(run("render " QUICK " -o l.png --history missing/h.csv"), 1);
+    assert_one_line_error("missing/h.csv", "No such file or directory");
+    assert_no_temporaries(workdir);
+}
+
+static void test_read_only_folder(void **state)
+{
+    (void)state;
+    if (geteuid() == 0)
+        skip(); /* root writes anywhere */
+    assert_int_equal(mkdir(in_work("ro"), 0555), 0);
+    assert_int_equal(run("render " QUICK " -o ro/out.png"), 1);
+    assert_one_line_error("ro/out.png", "Permission denied");
+    chmod(in_work("ro"), 0755);
+    rmdir(in_work("ro"));
+}
+
+static void test_long_names(void **state)
+{
+    (void)state;
+    /* 250 and 255 bytes (NAME_MAX): legal, so written; 256: the system's error. */
+    char name[300], args[600];
+    for (size_t length = 250; length <= 256; length += length == 250 ? 5 : 1) {
+        memset(name, 'x', length - 4);
+        strcpy(name + length - 4, ".png");
+        snprintf(args, sizeof args, "render " QUICK " -o %s", name);
+        int status = run("%s", args);
+        if (length <= 255) {
+            assert_int_equal(status, 0);
+            assert_true(exists(name));
+            unlink(in_work(name));
+        } else {
+            assert_int_equal(status, 1);
+            assert_one_line_error("File name too long", NULL);
+        }
+    }
+    assert_no_temporaries(workdir);
+}
+
+static void test_devices_fifos_stdout(void **state)
+{
+    (void)state;
+    /* /dev/null stays the device. */
+    assert_int_equal(run("render " QUICK " -o d.png --stats /dev/null --history /dev/null"), 0);
+    struct stat st;
+    assert_int_equal(stat("/dev/null", &st), 0);
+    assert_true(S_ISCHR(st.st_mode));
+    /* /dev/stdout, a regular file here: written through stdout, after it. */
+    assert_int_equal(run("render --elements 50 --width 16 --height 16 -o d.png --stats /dev/stdout"),
+                     0);
+    assert_non_null(strstr(out_text, "\"version\""));
+    assert_non_null(strstr(out_text, "wrote "));
+    /* A full device fails at the commit: the old image stays. */
+    write_file("keep.png", "old image");
+    assert_int_equal(run("render " QUICK " -o keep.png --stats /dev/full"), 1);
+    assert_one_line_error("/dev/full", NULL);
+    assert_string_equal(text_of("keep.png"), "old image");
+    /* A FIFO with a reader: the stats go through it, it stays a FIFO. */
+    assert_int_equal(mkfifo(in_work("pipe.json"), 0666), 0);
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "cd '%s' && (cat pipe.json > from_pipe.json &) && '%s' render " QUICK
+             " -o f.png --stats pipe.json; echo $? > fifo_status.txt; wait",
+             workdir, radiosity_bin);
+    assert_int_equal(system(cmd), 0);
+    assert_int_equal(atoi(text_of("fifo_status.txt")), 0);
+    /* The reader may still be finishing: wait for its file to be whole. */
+    for (int i = 0; i < 100 * WATCH_SECONDS && !strstr(text_of("from_pipe.json"), "}\n"); i++)
+        pause_ms(10);
+    assert_non_null(strstr(text_of("from_pipe.json"), "\"version\""));
+    assert_int_equal(lstat(in_work("pipe.json"), &st), 0);
+    assert_true(S_ISFIFO(st.st_mode));
+    assert_no_temporaries(workdir);
+}
+
+/* ======================================================================
+ * The program: aliasing and all-or-none
+ * ==================================================================== */
+
+static void test_outputs_aliasing_inputs(void **state)
+{
+    (void)state;
+    write_file("good.obj", good_obj);
+    write_file("good.mtl", good_mtl);
+    assert_int_equal(run("render good.obj " QUICK " -o a.png --stats good.obj"), 2);
+    assert_one_line_error("good.obj: is the same file as the input good.obj", NULL);
+    assert_int_equal(run("render good.obj " QUICK " -o a.png --history good.mtl"), 2);
+    assert_one_line_error("good.mtl", "input");
+    assert_int_equal(run("render good.obj " QUICK " -o a.png --history ./good.mtl"), 2);
+    assert_int_equal(link(in_work("good.mtl"), in_work("mtl_link.csv")), 0);
+    assert_int_equal(run("render good.obj " QUICK " -o a.png --history mtl_link.csv"), 2);
+    assert_string_equal(text_of("good.obj"), good_obj);
+    assert_string_equal(text_of("good.mtl"), good_mtl);
+    /* A glTF's buffer, by a hard link with a view-factor name. */
+    write_gltf_with_buffer();
+    assert_int_equal(link(in_work("quad.bin"), in_work("buffer.json")), 0);
+    assert_int_equal(run("viewfactors quad.gltf --elements 20 --quiet -o buffer.json"), 2);
+    assert_one_line_error("buffer.json", "quad.bin");
+    assert_int_equal(run("viewfactors quad.gltf --elements 20 --quiet -o vf.json"), 0);
+    assert_false(exists("a.png"));
+    assert_no_temporaries(workdir);
+}
+
+static void test_outputs_aliasing_each_other(void **state)
+{
+    (void)state;
+    assert_int_equal(run("render " QUICK " -o same.png --stats same.png"), 2);
+    assert_one_line_error("same.png: is the same file as the output same.png", NULL);
+    assert_int_equal(run("render " QUICK " -o same.png --stats ./same.png"), 2);
+    assert_int_equal(run("viewfactors --elements 50 --quiet -o vf.json --stats vf.json"), 2);
+    write_file("one.csv", "old");
+    assert_int_equal(link(in_work("one.csv"), in_work("two.json")), 0);
+    assert_int_equal(run("render " QUICK " -o o.png --history one.csv --stats two.json"), 2);
+    assert_string_equal(text_of("one.csv"), "old");
+    assert_false(exists("same.png") || exists("o.png"));
+    assert_no_temporaries(workdir);
+}
+
+static void test_all_or_none(void **state)
+{
+    (void)state;
+    write_file("old.png", "old image");
+    write_file("old.json", "old stats");
+    /* Stats into a missing folder: refused before any work; nothing replaced. */
+    assert_int_equal(run("render " QUICK " -o old.png --stats nowhere/s.json"), 1);
+    assert_one_line_error("nowhere/s.json", NULL);
+    assert_string_equal(text_of("old.png"), "old image");
+    /* A view-factor run with a bad stats path, likewise. */
+    write_file("old_vf.json", "old vf");
+    assert_int_equal(run("viewfactors --elements 50 --quiet -o old_vf.json --stats nowhere/s.json"), 1);
+    assert_string_equal(text_of("old_vf.json"), "old vf");
+    /* A failure after the work (the solve refuses the scene): nothing replaced. */
+    write_file("dark.obj", "o floor\nv 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 3 2\n");
+    assert_int_equal(run("render dark.obj " QUICK " -o old.png --stats old.json"), 1);
+    assert_string_equal(text_of("old.png"), "old image");
+    assert_string_equal(text_of("old.json"), "old stats");
+    assert_no_temporaries(workdir);
+}
+
+/* ======================================================================
+ * The program: signals at each stage
+ * ==================================================================== */
+
+typedef struct watched {
+    pid_t pid;
+    int terminal;        /* the master side of the child's stderr */
+    char seen[1 << 16];  /* what it printed there, the last 64 KiB */
+    size_t length;
+} watched;
+
+/* Start `radiosity ARGS` (split at blanks) in the work folder with stderr on
+ * a pseudo-terminal, so that it draws its progress (phase names). */
+static void watch_start(watched *w, const char *args)
+{
+    memset(w, 0, sizeof *w);
+    w->terminal = posix_openpt(O_RDWR | O_NOCTTY);
+    assert_true(w->terminal >= 0);
+    assert_int_equal(grantpt(w->terminal), 0);
+    assert_int_equal(unlockpt(w->terminal), 0);
+    const char *slave = ptsname(w->terminal);
+    assert_non_null(slave);
+    static char copy[2048], program[1024];
+    snprintf(copy, sizeof copy, "%s", args);
+    snprintf(program, sizeof program, "%s", radiosity_bin);
+    char *argv[64] = {program};
+    int argc = 1;
+    for (char *t = strtok(copy, " "); t && argc < 63; t = strtok(NULL, " "))
+        argv[argc++] = t;
+    argv[argc] = NULL;
+    w->pid = fork();
+    assert_true(w->pid >= 0);
+    if (w->pid == 0) {
+        int err = open(slave, O_RDWR | O_NOCTTY);
+        int out = open(in_work("watched_out.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0666);
+        int in = open("/dev/null", O_RDONLY);
+        if (err < 0 || out < 0 || in < 0 || chdir(workdir) != 0)
+            _exit(127);
+        dup2(in, 0);
+        dup2(out, 1);
+        dup2(err, 2);
+        execv(radiosity_bin, argv);
+        _exit(127);
+    }
+}
+
+/* Read what the child printed for up to `ms` milliseconds; false at its end. */
+static bool watch_read(watched *w, int ms)
+{
+    struct pollfd p = {w->terminal, POLLIN, 0};
+    if (poll(&p, 1, ms) <= 0)
+        return true;
+    char buffer[4096];
+    ssize_t n = read(w->terminal, buffer, sizeof buffer);
+    if (n <= 0)
+        return false; /* EIO: every writer closed, the child is gone */
+    if (w->length + (size_t)n >= sizeof w->seen) {
+        size_t keep = sizeof w->seen / 2;
+        memmove(w->seen, w->seen + w->length - keep, keep);
+        w->length = keep;
+    }
+    memcpy(w->seen + w->length, buffer, (size_t)n);
+    w->length += (size_t)n;
+    w->seen[w->length] = '\0';
+    return true;
+}
+
+/* Wait until the child has printed `text` (a phase name) after `from`. */
+static void watch_for_text(watched *w, const char *text)
+{
+    size_t from = w->length;
+    time_t end = time(NULL) + WATCH_SECONDS;
+    while (!strstr(w->seen + (from < w->length ? from : w->length), text))
+        if (!watch_read(w, 100) || time(NULL) > end)
+            fail_msg("the run never reached '%s'; it printed: %s", text, w->seen);
+}
+
+/* Wait until a work file exists. */
+static void watch_for_file(watched *w, const char *name)
+{
+    time_t end = time(NULL) + WATCH_SECONDS;
+    while (!exists(name))
+        if (!watch_read(w, 10) || time(NULL) > end)
+            fail_msg("the run never wrote %s; it printed: %s", name, w->seen);
+}
+
+/* Read to the child's end; its exit status (-1 when a signal killed it). */
+static int watch_end(watched *w)
+{
+    while (watch_read(w, 100)) {
+        int status;
+        if (waitpid(w->pid, &status, WNOHANG) == w->pid) {
+            close(w->terminal);
+            return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        }
+    }
+    int status;
+    assert_int_equal(waitpid(w->pid, &status, 0), w->pid);
+    close(w->terminal);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* A run in the solve for as long as we like: shooting never reaches 1e-12. */
+#define LONG_SOLVE "--solver shooting --elements 4000 --unshot-tolerance 1e-12 --ff-samples 64"
+
+static void test_signal_during_form_factors(void **state)
+{
+    (void)state;
+    watched w;
+    watch_start(&w, "render --elements 12000 --width 16 --height 16 -o ff.png --stats ff.json "
+                    "--history ff.csv");
+    watch_for_text(&w, "form factors");
+    kill(w.pid, SIGTERM);
+    assert_int_equal(watch_end(&w), 143);
+    assert_false(exists("ff.png") || exists("ff.csv"));
+    const char *stats = text_of("ff.json");
+    assert_non_null(strstr(stats, "\"partial\":\ttrue"));
+    assert_non_null(strstr(stats, "\"interrupted\":\t\"form factors\""));
+    assert_non_null(strstr(w.seen, "interrupted while computing form factors; wrote partial stats"));
+    assert_no_temporaries(workdir);
+}
+
+static void test_signal_during_solve_with_progress_images(void **state)
+{
+    (void)state;
+    watched w;
+    watch_start(&w, "render " LONG_SOLVE " --width 16 --height 16 --progress-images frames "
+                    "--every 1 -o solve.png --stats solve.json");
+    watch_for_file(&w, "frames/step_00000002.png");
+    kill(w.pid, SIGINT);
+    assert_int_equal(watch_end(&w), 130);
+    assert_true(exists("solve.png"));
+    const char *stats = text_of("solve.json");
+    assert_non_null(strstr(stats, "\"partial\":\ttrue"));
+    assert_non_null(strstr(stats, "\"converged\":\tfalse"));
+    assert_no_temporaries(workdir);
+    assert_no_temporaries(in_work("frames"));
+}
+
+/* The first signal stops the solve; a second one, while the partial
+ * solution is rendered and saved, loses nothing. */
+static void test_second_signal_while_saving(void **state)
+{
+    (void)state;
+    watched w;
+    watch_start(&w, "render " LONG_SOLVE " --width 400 --height 400 -o twice.png --stats twice.json");
+    watch_for_text(&w, "solve");
+    kill(w.pid, SIGINT);
+    watch_for_text(&w, "render");
+    kill(w.pid, SIGINT);
+    assert_int_equal(watch_end(&w), 130);
+    assert_true(exists("twice.png"));
+    assert_non_null(strstr(text_of("twice.json"), "\"partial\":\ttrue"));
+    assert_no_temporaries(workdir);
+}
+
+/* Signals during the final render of a converged solution: the render and
+ * the outputs are completed (not marked partial: the solution is whole),
+ * then the run exits 143. */
+static void test_signal_during_final_render(void **state)
+{
+    (void)state;
+    watched w;
+    watch_start(&w, "render --elements 60 --width 700 --height 700 --samples 8 -o final.png "
+                    "--stats final.json --history final.csv");
+    watch_for_text(&w, "render");
+    kill(w.pid, SIGTERM);
+    kill(w.pid, SIGINT);
+    assert_int_equal(watch_end(&w), 143);
+    assert_true(exists("final.png") && exists("final.csv"));
+    assert_non_null(strstr(text_of("final.json"), "\"partial\":\tfalse"));
+    assert_non_null(strstr(w.seen, "interrupted while writing the outputs"));
+    assert_no_temporaries(workdir);
+}
+
+/* Whether the process has a handler for SIGINT (Linux /proc). */
+static bool catches_sigint(pid_t pid)
+{
+    char path[64], line[256];
+    snprintf(path, sizeof path, "/proc/%ld/status", (long)pid);
+    FILE *f = fopen(path, "r");
+    bool caught = false;
+    while (f && fgets(line, sizeof line, f))
+        if (strncmp(line, "SigCgt:", 7) == 0)
+            caught = (strtoull(line + 7, NULL, 16) & (1ull << (SIGINT - 1))) != 0;
+    if (f)
+        fclose(f);
+    return caught;
+}
+
+/* generate: exit 130, both files or neither, no temporary. */
+static void test_signal_during_generate(void **state)
+{
+    (void)state;
+    watched w;
+    watch_start(&w, "generate office --rooms 3000 -o gen.obj");
+    time_t end = time(NULL) + WATCH_SECONDS;
+    while (!catches_sigint(w.pid)) {
+        if (time(NULL) > end)
+            fail_msg("generate never set up its signal handlers");
+        pause_ms(1);
+    }
+    kill(w.pid, SIGINT);
+    assert_int_equal(watch_end(&w), 130);
+    assert_int_equal(exists("gen.obj"), exists("gen.mtl"));
+    if (exists("gen.obj"))
+        assert_non_null(strstr(text_of("gen.mtl"), "newmtl"));
+    assert_no_temporaries(workdir);
+    unlink(in_work("gen.obj"));
+    unlink(in_work("gen.mtl"));
+}
+
+/* ---- the work folder ---- */
+
+static int remove_tree(const char *path)
+{
+    char cmd[600];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", path);
+    return system(cmd);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    snprintf(workdir, sizeof workdir, "/tmp/radiosity-outputs-XXXXXX");
+    return mkdtemp(workdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    return remove_tree(workdir) == 0 ? 0 : -1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s PATH-TO-radiosity\n", argv[0]);
+        return 2;
+    }
+    radiosity_bin = argv[1];
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_temporary_names, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_output_targets, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_output_set_all_or_none, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_output_set_aliasing, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_scene_inputs, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_link_at_old_temporary_name, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_links_and_folders, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_read_only_folder, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_long_names, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_devices_fifos_stdout, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_outputs_aliasing_inputs, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_outputs_aliasing_each_other, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_all_or_none, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_signal_during_form_factors, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_signal_during_solve_with_progress_images, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_second_signal_while_saving, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_signal_during_final_render, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_signal_during_generate, setup, teardown),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
