@@ -174,8 +174,10 @@ static int on_step(void *user, rad_solution *solution, const rad_solve_step *ste
     char path[4096];
     snprintf(path, sizeof path, "%s/step_%08d.png", p->dir, step->iteration);
     rad_result r = rad_solution_render(p->ctx, solution, p->render, &image);
-    if (r == RAD_ERROR_INTERRUPTED)
+    if (r == RAD_ERROR_INTERRUPTED) {
+        rad_image_destroy(image); /* the interrupted render still hands back its image */
         return 1; /* a signal: the solve stops and its iterate is saved, frame or not */
+    }
     if (r == RAD_OK && p->exposure == 0.0)
         p->exposure = rad_image_auto_exposure(image); /* fixed from the first frame on */
     if (r == RAD_OK)
