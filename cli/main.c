@@ -267,6 +267,7 @@ int main(int argc, char **argv)
     co.threads = s.command == CLI_GENERATE ? 1 : s.threads;
     /* --max-memory limits everything the engine allocates, loading included. */
     co.max_memory_bytes = s.solve.max_memory_bytes;
+    co.read_outside_scene_folder = s.read_outside != 0;
     if (!s.quiet && isatty(STDERR_FILENO) && s.command != CLI_GENERATE) {
         co.progress = progress_bar;
         co.progress_user = &progress;

@@ -115,6 +115,9 @@ static const cli_flag FLAGS[] = {
     {"stats", 0, "FILE.json", RV, OWN(stats, RAD_OPTION_STRING),
      .own.help = "write run statistics as JSON (docs/stats.md)"},
     {"max-memory", 0, "SIZE", RV, SOLVE(max_memory_bytes)},
+    {"read-outside-scene-folder", 0, NULL, RV, OWN(read_outside, RAD_OPTION_FLAG),
+     .own.help = "let the scene refer to files outside its folder (by default an mtllib, glTF "
+                 "buffer or image that resolves outside the scene file's folder is refused)"},
     {"quiet", 'q', NULL, ALL, OWN(quiet, RAD_OPTION_FLAG), .own.help = "print nothing but errors"},
     {"list-methods", 0, NULL, 0, ACTION(CLI_LIST_METHODS),
      .help = "list form-factor methods, solvers and ray backends"},

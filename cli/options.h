@@ -53,6 +53,7 @@ typedef struct cli_settings {
     rad_office_options office;
     int threads;
     int quiet;
+    int read_outside;         /* --read-outside-scene-folder */
 } cli_settings;
 
 /* Where a flag's value goes. */

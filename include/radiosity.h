@@ -126,6 +126,11 @@ typedef struct rad_context_options {
     void *progress_user;         /* passed to `progress` */
     rad_error_fn on_error;       /* optional: told of every failure */
     void *error_user;            /* passed to `on_error` */
+    /* Files a scene refers to (an OBJ's mtllib, a glTF's buffers and images)
+     * are read only from the scene file's folder and below, after symbolic
+     * links are resolved: a file that asks for "../../etc/passwd" or
+     * "/etc/shadow" fails to load, naming the reference.  true lifts this. */
+    bool read_outside_scene_folder;
     double max_memory_bytes;     /* the memory limit: everything the engine allocates in
                                     this context (scenes while loading included) stays
                                     below it, else RAD_ERROR_OUT_OF_MEMORY with the limit

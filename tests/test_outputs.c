@@ -154,7 +154,9 @@ static const char *good_obj = "mtllib good.mtl\n"
 
 /* A quad lamp over a quad floor as glTF whose geometry is the external
  * buffer quad.bin (the loader reads it). */
-static void write_gltf_with_buffer(void)
+/* A glTF `name` (in the work folder) whose buffer is at `uri`; the buffer
+ * itself is always written as work/quad.bin. */
+static void write_gltf_referring(const char *name, const char *uri)
 {
     float positions[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1},
                              {0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}};
@@ -164,7 +166,8 @@ static void write_gltf_with_buffer(void)
     fwrite(positions, sizeof positions, 1, f);
     fwrite(indices, sizeof indices, 1, f);
     fclose(f);
-    write_file("quad.gltf",
+    char text[4096];
+    snprintf(text, sizeof text,
                "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1]}],"
                "\"nodes\": [{\"name\": \"floor\", \"mesh\": 0}, {\"name\": \"lamp\", \"mesh\": 1}],"
                "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, "
@@ -173,14 +176,18 @@ static void write_gltf_with_buffer(void)
                "\"materials\": [{\"name\": \"white\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}}, "
                "{\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}, "
                "\"emissiveFactor\": [1, 1, 1]}],"
-               "\"buffers\": [{\"byteLength\": 120, \"uri\": \"quad.bin\"}],"
+               "\"buffers\": [{\"byteLength\": 120, \"uri\": \"%s\"}],"
                "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 96}, "
                "{\"buffer\": 0, \"byteOffset\": 96, \"byteLength\": 24}],"
                "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 8, "
                "\"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 1]}, "
                "{\"bufferView\": 1, \"byteOffset\": 0, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
-               "{\"bufferView\": 1, \"byteOffset\": 12, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}");
+               "{\"bufferView\": 1, \"byteOffset\": 12, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}",
+             uri);
+    write_file(name, text);
 }
+
+static void write_gltf_with_buffer(void) { write_gltf_referring("quad.gltf", "quad.bin"); }
 
 /* ======================================================================
  * The library: targets, temporaries, the output set, a scene's inputs
@@ -399,6 +406,92 @@ static void test_scene_inputs(void **state)
     assert_int_equal(rad_scene_input_count(NULL), 0);
     assert_null(rad_scene_input_path(NULL, 0));
     rad_context_destroy(ctx);
+}
+
+/* A scene reads nothing outside its folder (links resolved) unless the
+ * context allows it: a buffer or material library that climbs out, is
+ * absolute, or is a link pointing out is refused, named, and nothing
+ * loads. */
+static void test_scene_references_confined(void **state)
+{
+    (void)state;
+    rad_context *ctx;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    assert_int_equal(mkdir(in_work("scene"), 0777), 0);
+    write_gltf_with_buffer(); /* work/quad.bin, outside work/scene */
+    char absolute[600], uri_line[700];
+    snprintf(absolute, sizeof absolute, "%s", in_work("quad.bin"));
+    assert_int_equal(symlink("../quad.bin", in_work("scene/link.bin")), 0);
+    const char *uris[] = {"../quad.bin", absolute, "link.bin", "./../scene/../quad.bin"};
+    for (size_t k = 0; k < sizeof uris / sizeof uris[0]; k++) {
+        write_gltf_referring("scene/out.gltf", uris[k]);
+        rad_scene *scene = (rad_scene *)(void *)ctx; /* must come back NULL */
+        rad_result r = rad_scene_load_file(ctx, in_work("scene/out.gltf"), &scene);
+        assert_null(scene);
+        if (uris[k] == absolute) {
+            /* assimp 5.2 joins even an absolute URI to the folder: nothing
+             * there, nothing read; the load fails naming the URI. */
+            assert_int_not_equal(r, RAD_OK);
+            assert_non_null(strstr(rad_context_error(ctx), absolute));
+            continue;
+        }
+        snprintf(uri_line, sizeof uri_line, "%s'", uris[k]); /* as opened: folder + uri */
+        if (r != RAD_ERROR_IO || !strstr(rad_context_error(ctx), uri_line) ||
+            !strstr(rad_context_error(ctx), "outside the scene's folder"))
+            fail_msg("uri %s: %s: '%s'", uris[k], rad_result_string(r), rad_context_error(ctx));
+    }
+    /* Inside, also through a link that stays inside: loads. */
+    assert_int_equal(symlink("../quad.bin", in_work("scene/ignored")), 0);
+    write_file("scene/copy.bin", "");
+    {
+        FILE *from = fopen(in_work("quad.bin"), "rb"), *to = fopen(in_work("scene/copy.bin"), "wb");
+        char bytes[256];
+        size_t n = fread(bytes, 1, sizeof bytes, from);
+        fwrite(bytes, 1, n, to);
+        fclose(from);
+        fclose(to);
+    }
+    assert_int_equal(symlink("copy.bin", in_work("scene/inner.bin")), 0);
+    write_gltf_referring("scene/in.gltf", "inner.bin");
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/in.gltf"), &scene), RAD_OK);
+    rad_scene_destroy(scene);
+
+    /* An OBJ's material library: relative and absolute, refused. */
+    write_file("good.mtl", good_mtl);
+    char obj[8192];
+    snprintf(obj, sizeof obj, "mtllib ../good.mtl\n%s", strstr(good_obj, "\n") + 1);
+    write_file("scene/up.obj", obj);
+    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/up.obj"), &scene), RAD_ERROR_IO);
+    assert_non_null(strstr(rad_context_error(ctx), "/../good.mtl'"));
+    snprintf(obj, sizeof obj, "mtllib %s\n%s", in_work("good.mtl"), strstr(good_obj, "\n") + 1);
+    write_file("scene/abs.obj", obj);
+    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/abs.obj"), &scene), RAD_ERROR_IO);
+    assert_non_null(strstr(rad_context_error(ctx), "outside the scene's folder"));
+    rad_context_destroy(ctx);
+
+    /* The explicit option lifts it. */
+    rad_context_options co = {0};
+    co.read_outside_scene_folder = true;
+    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
+    write_gltf_referring("scene/out.gltf", "../quad.bin");
+    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/out.gltf"), &scene), RAD_OK);
+    rad_scene_destroy(scene);
+    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/up.obj"), &scene), RAD_OK);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+
+    /* The program: one line naming the reference, exit 1, no output;
+     * --read-outside-scene-folder lets it through. */
+    int status = run("render scene/out.gltf --elements 50 --width 16 --height 16 --quiet -o out.png");
+    if (status != 1)
+        fail_msg("status %d: %s", status, text_of("stderr.txt"));
+    assert_one_line_error("/../quad.bin'", "outside the scene's folder");
+    assert_false(exists("out.png"));
+    assert_int_equal(run("render scene/out.gltf --read-outside-scene-folder --elements 50 --width 16 "
+                         "--height 16 --quiet -o out.png"),
+                     0);
+    assert_true(exists("out.png"));
 }
 
 /* ======================================================================
@@ -850,6 +943,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_setup_teardown(test_output_set_all_or_none, setup, teardown),
         cmocka_unit_test_setup_teardown(test_output_set_aliasing, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scene_inputs, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_scene_references_confined, setup, teardown),
         cmocka_unit_test_setup_teardown(test_link_at_old_temporary_name, setup, teardown),
         cmocka_unit_test_setup_teardown(test_links_and_folders, setup, teardown),
         cmocka_unit_test_setup_teardown(test_read_only_folder, setup, teardown),

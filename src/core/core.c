@@ -71,6 +71,7 @@ rad_result rad_context_create(const rad_context_options *options, rad_context **
     ctx->progress = options->progress;
     ctx->progress_user = options->progress_user;
     ctx->on_error = options->on_error;
+    ctx->read_outside_scene_folder = options->read_outside_scene_folder;
     ctx->error_user = options->error_user;
     atomic_init(&ctx->cancel, 0);
     *out = ctx;

@@ -87,6 +87,7 @@ struct rad_context {
     void *progress_user;
     rad_error_fn on_error;
     void *error_user;
+    bool read_outside_scene_folder; /* see rad_context_options */
     atomic_int cancel;          /* raised by rad_context_cancel, even from a signal handler */
     rad_result last_result;
     bool error_latched;         /* this call already recorded its first failure */

@@ -12,9 +12,16 @@
  *
  * And a file system for file imports that reads files as assimp's default
  * one does (stdio) and logs every file it opens, so that a scene can say
- * which files it was read from (rad_scene_input_path).
+ * which files it was read from (rad_scene_input_path).  It reads nothing
+ * outside the scene file's folder (symbolic links resolved) unless the
+ * context allows it: a glTF buffer "../../etc/passwd" is refused, named.
  */
+/* realpath is an X/Open (XSI) addition to POSIX. */
+#define _XOPEN_SOURCE 700
+
 #include "scene/import_internal.h"
+
+#include <errno.h>
 
 #include <assimp/cfileio.h>
 
@@ -162,7 +169,50 @@ void import_file_log_free(import_file_log *log)
     for (size_t i = 0; i < log->count; i++)
         rad_free(log->paths[i]);
     rad_free(log->paths);
+    rad_free(log->root);
     memset(log, 0, sizeof *log);
+}
+
+rad_result import_file_log_confine(rad_context *ctx, import_file_log *log, const char *scene_path)
+{
+    log->ctx = ctx;
+    log->scene = scene_path;
+    if (ctx && ctx->read_outside_scene_folder)
+        return RAD_OK;
+    const char *slash = strrchr(scene_path, '/');
+    char *folder = slash ? rad_strdup(ctx, RAD_MEM_SCENE, scene_path, scene_path)
+                         : rad_strdup(ctx, RAD_MEM_SCENE, ".", scene_path);
+    if (!folder)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    if (slash)
+        folder[slash == scene_path ? 1 : slash - scene_path] = '\0';
+    char *resolved = realpath(folder, NULL);
+    rad_free(folder);
+    /* Unresolvable: an empty root, under which nothing lies. */
+    log->root = rad_strdup(ctx, RAD_MEM_SCENE, resolved ? resolved : "", scene_path);
+    free(resolved); /* realpath's copy is libc's */
+    return log->root ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+}
+
+bool import_file_allowed(import_file_log *log, const char *path)
+{
+    if (!log->root)
+        return true;
+    char *resolved = realpath(path, NULL);
+    if (!resolved)
+        return true; /* not there: the open fails and says so */
+    size_t n = strlen(log->root);
+    bool inside = n > 0 && strncmp(resolved, log->root, n) == 0 &&
+                  (resolved[n] == '/' || (n == 1 && log->root[0] == '/'));
+    if (!inside && !log->refused) {
+        log->refused = true;
+        rad_fail(log->ctx, RAD_ERROR_IO,
+                 "%s: refers to '%s' (%s), outside the scene's folder %s: refused "
+                 "(rad_context_options.read_outside_scene_folder allows it)",
+                 log->scene, path, resolved, log->root[0] ? log->root : "(unresolvable)");
+    }
+    free(resolved);
+    return inside;
 }
 
 static FILE *stdio_of(struct aiFile *file) { return (FILE *)(void *)file->UserData; }
@@ -202,13 +252,16 @@ static struct aiFile *logged_open(struct aiFileIO *io, const char *path, const c
 {
     if (!path || !mode || strpbrk(mode, "wa+"))
         return NULL; /* an import only reads */
+    import_file_log *log = (import_file_log *)(void *)io->UserData;
+    if (!import_file_allowed(log, path))
+        return NULL;
     struct aiFile *file = rad_alloc(NULL, RAD_MEM_SCENE, 1, sizeof *file, "input file");
     FILE *f = file ? fopen(path, "rb") : NULL;
     if (!f) {
         rad_free(file);
         return NULL;
     }
-    import_file_log_add((import_file_log *)(void *)io->UserData, path);
+    import_file_log_add(log, path);
     file->ReadProc = stdio_read;
     file->WriteProc = memory_write;
     file->TellProc = stdio_tell;

@@ -446,7 +446,11 @@ static rad_result prescan_mtl_file(rad_context *ctx, const char *obj_path, const
 
     char what[512];
     snprintf(what, sizeof what, "%s:%d: material library '%s'", obj_path, line, mtllib);
-    char *text;
+    if (!import_file_allowed(log, path)) {
+        rad_free(path);
+        return RAD_ERROR_IO;
+    }
+    char *text = NULL;
     size_t size;
     rad_result r = read_file(ctx, path, what, &text, &size);
     if (r == RAD_OK)
@@ -470,6 +474,10 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
     rad_result r = RAD_OK;
     import_file_log log = {0};
     import_file_log_add(&log, path);
+    if (import_file_log_confine(ctx, &log, path) != RAD_OK) {
+        import_file_log_free(&log);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
     if (wanted) {
         r = read_file(ctx, path, path, &text, &size);
     } else {
@@ -500,6 +508,14 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
     import_file_io(&io, &log);
     if (r == RAD_OK)
         r = import_scene(ctx, path, text, size, &io, out);
+    if (log.refused && (r == RAD_OK || r == RAD_ERROR_PARSE)) {
+        /* The refusal is the cause (and the message kept); a scene that
+         * loaded without the file is still refused: it asked for it. */
+        if (r == RAD_OK)
+            rad_scene_destroy(*out);
+        *out = NULL;
+        r = RAD_ERROR_IO;
+    }
     if (r == RAD_OK && log.failed) {
         r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
         rad_scene_destroy(*out);

@@ -67,10 +67,24 @@ void import_memory_io(struct aiFileIO *io, import_memory_fs *fs);
  * its default would, and every file it opens for reading is named here (the
  * MTL of an OBJ, a glTF's buffers), so the scene can list its inputs. */
 typedef struct import_file_log {
-    char **paths;     /* malloc'd, each malloc'd; no repeats */
+    char **paths;     /* rad_alloc'd, each rad_alloc'd; no repeats */
     size_t count, capacity;
     bool failed;      /* a name could not be kept (out of memory) */
+    /* Confinement: when root is set, files outside it are refused. */
+    rad_context *ctx; /* where a refusal is reported */
+    const char *scene;/* the scene file, for the message */
+    char *root;       /* realpath of the scene's folder (rad_alloc'd), or NULL */
+    bool refused;     /* a file was refused (the context has the message) */
 } import_file_log;
+
+/* Confine `log` to the folder of `scene_path` unless the context allows
+ * reading outside it.  Fails only for memory; a folder that cannot be
+ * resolved confines to nothing looser: every reference is then refused. */
+rad_result import_file_log_confine(rad_context *ctx, import_file_log *log, const char *scene_path);
+/* Whether `path` may be read (inside the root, or no root); a refusal is
+ * reported once to the context ("scene.gltf: refers to '../x.bin' outside
+ * its folder ...") and sets log->refused. */
+bool import_file_allowed(import_file_log *log, const char *path);
 
 /* Fill `io` so that assimp reads files and logs them into `log` (which must
  * outlive the import).  Cannot fail. */
