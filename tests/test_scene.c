@@ -381,6 +381,37 @@ static void test_builder_non_planar(void **state)
     rad_scene_destroy(scene);
 }
 
+/* Emission whose total power would overflow a double on its way through
+ * the solver is refused, naming the material; a large but solvable one
+ * loads. */
+static void test_emitted_power_overflow(void **state)
+{
+    (void)state;
+    const double grey[3] = {0.5, 0.5, 0.5};
+    const vec3 square[] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    const double emissions[][3] = {{5e307, 0, 0}, {1e296, 1e296, 1e296}, {1e280, 1e280, 1e280}};
+    const rad_result expected[] = {RAD_ERROR_INVALID_SCENE, RAD_ERROR_INVALID_SCENE, RAD_OK};
+    for (size_t k = 0; k < 3; k++) {
+        rad_scene_builder *b = rad_scene_builder_create(ctx, "lamp.obj");
+        int material = rad_scene_builder_material(b, "sun", grey, emissions[k]);
+        int surface = rad_scene_builder_surface(b, "panel");
+        /* two panels: the overflow is in the sum, not in one of them */
+        assert_int_equal(rad_scene_builder_polygon(b, surface, material, square, 4, 1), RAD_OK);
+        assert_int_equal(rad_scene_builder_polygon(b, surface, material, square, 4, 2), RAD_OK);
+        rad_scene *scene = NULL;
+        rad_api_enter(ctx); /* a new call: its first failure is kept */
+        assert_int_equal(rad_scene_builder_finish(b, &scene), expected[k]);
+        if (expected[k] == RAD_OK) {
+            assert_non_null(scene);
+            rad_scene_destroy(scene);
+            continue;
+        }
+        assert_null(scene);
+        assert_contains(rad_context_error(ctx), "lamp.obj: material 'sun'");
+        assert_contains(rad_context_error(ctx), "overflow");
+    }
+}
+
 static void test_builder_errors(void **state)
 {
     (void)state;
@@ -676,6 +707,7 @@ int main(void)
         cmocka_unit_test(test_builder_surfaces_and_materials),
         cmocka_unit_test(test_builder_non_planar),
         cmocka_unit_test(test_builder_errors),
+        cmocka_unit_test(test_emitted_power_overflow),
         cmocka_unit_test(test_triangulate_l_shape),
         cmocka_unit_test(test_triangulate_collinear),
         cmocka_unit_test(test_triangulate_rejects),
