@@ -18,8 +18,6 @@ static void refresh_view(rad_solution *s)
     s->view.scene = s->scene;
     s->view.options = &s->options;
     s->view.threads = s->threads;
-    s->view.history = s->history;
-    s->view.history_count = s->history_count;
 }
 
 rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const rad_options *options,
@@ -119,7 +117,6 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
         if (isnan(tail->unshot))
             tail->unshot = last.unshot;
     }
-    refresh_view(s);
     /* A history that could not grow stopped the solve (or lost its last row):
      * out of memory, as the allocator's message says, not an interruption. */
     return s->history_failed ? RAD_ERROR_OUT_OF_MEMORY : r;
@@ -340,7 +337,7 @@ rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, c
     if (!ctx || !s || !path)
         return rad_null_argument(ctx, __func__);
     rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
-    return rad_write_history(ctx, &s->view, path);
+    return rad_write_history(ctx, s->history, s->history_count, path);
 }
 
 rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera)

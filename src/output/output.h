@@ -62,6 +62,6 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *vie
                                   bool elements);
 
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
-rad_result rad_write_history(rad_context *ctx, const rad_solution_view *view, const char *path);
+rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path);
 
 #endif /* RAD_OUTPUT_H */

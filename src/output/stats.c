@@ -438,15 +438,15 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
     return r;
 }
 
-rad_result rad_write_history(rad_context *ctx, const rad_solution_view *s, const char *path)
+rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path)
 {
     rad_atomic_file f;
     rad_result r = rad_atomic_open(ctx, path, &f);
     if (r != RAD_OK)
         return r;
     fputs("iteration,seconds,residual,unshot\n", f.file);
-    for (size_t k = 0; k < s->history_count; k++) {
-        const rad_solve_step *h = &s->history[k];
+    for (size_t k = 0; k < count; k++) {
+        const rad_solve_step *h = &steps[k];
         fprintf(f.file, "%d,%.9g,", h->iteration, h->seconds);
         if (!isnan(h->residual))
             fprintf(f.file, "%.9g", h->residual);

@@ -33,7 +33,7 @@ typedef struct rad_phase_seconds {
 
 /* A solution as downstream code (interpolation, output, the api's
  * accessors) reads it.  Every pointer is owned by the strategy (or, for
- * scene, options and history, by the solution) and valid until the next
+ * scene and options, by the solution) and valid until the next
  * solve or the solution's end. */
 typedef struct rad_solution_view {
     const rad_scene *scene;
@@ -53,8 +53,6 @@ typedef struct rad_solution_view {
     const rad_hier_stats *hier;     /* hierarchical only, else NULL */
     bool solved;
     rad_phase_seconds seconds;
-    const rad_solve_step *history;  /* the last solve's steps */
-    size_t history_count;
     uint64_t render_rays;
 } rad_solution_view;
 
