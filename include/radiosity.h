@@ -98,7 +98,9 @@ typedef enum rad_result {
     RAD_ERROR_INVALID_ARGUMENT, /* an option out of range, an unknown method name */
     RAD_ERROR_OUT_OF_MEMORY,    /* an allocation failed or would exceed the memory limit */
     RAD_ERROR_INTERRUPTED,      /* the cancel flag was raised; results are partial */
-    RAD_ERROR_INTERNAL          /* a library (Embree, LAPACK) failed unexpectedly */
+    RAD_ERROR_INTERNAL,         /* a library (Embree, LAPACK) failed unexpectedly */
+    RAD_ERROR_NUMERICAL         /* the numbers cannot be trusted: a solve diverged (form
+                                   factors that make up power), a system is singular */
 } rad_result;
 
 /* A short name for a result code ("RAD_ERROR_IO"), a static string;

@@ -127,6 +127,7 @@ static void test_null_context(void **unused)
     assert_false(rad_context_cancelled(NULL));
 
     assert_string_equal(rad_result_string(RAD_ERROR_INVALID_ARGUMENT), "RAD_ERROR_INVALID_ARGUMENT");
+    assert_string_equal(rad_result_string(RAD_ERROR_NUMERICAL), "RAD_ERROR_NUMERICAL");
     assert_string_equal(rad_result_string((rad_result)99), "RAD_ERROR_UNKNOWN");
 }
 

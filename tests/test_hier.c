@@ -624,6 +624,120 @@ static void test_bad_options(void **state)
     rad_scene_destroy(scene);
 }
 
+/* Overlapping, interpenetrating polygons (a fuzz_solve find) whose links
+ * make up power: at epsilon 1e-3 the sweeps grew to infinity and the solve
+ * returned NaN as a success.  Now the power bound stops it with an error;
+ * the dense solver, which has no links, solves the same scene. */
+static void test_diverging_links_refused(void **state)
+{
+    (void)state;
+    static const char obj[] =
+        "mtllib t.mtl\n"
+        "o white\n"
+        "usemtl white\n"
+        "v 0.375 0.0 0.0\n"
+        "v 0.0 0.0 1.0\n"
+        "v 1.0 0.0 1.0\n"
+        "v 1.0 2.9375 0.0\n"
+        "f 1 2 3 4\n"
+        "o white\n"
+        "usemtl white\n"
+        "v 0.0 1.0 1.0\n"
+        "v 1.0 0.3125 0.0\n"
+        "v 0.0 0.0 1.0\n"
+        "v 0.0 0.0 5.0\n"
+        "f 5 6 7 8\n"
+        "o lamp\n"
+        "usemtl lamp\n"
+        "v 0.0 0.0 1.0\n"
+        "v 1.0 0.0 1.0\n"
+        "v 1.0 2.9375 0.0\n"
+        "f 9 10 11\n"
+        "o white\n"
+        "usemtl white\n"
+        "v 0.0 1.0 1.0\n"
+        "v 1.0 0.3125 0.0\n"
+        "v 0.0 0.0 1.0\n"
+        "v 0.0 0.0 5.0\n"
+        "f 12 13 14 15\n"
+        "o lamp\n"
+        "usemtl lamp\n"
+        "v 0.0 0.0 1.0\n"
+        "v 0.0 0.5625 0.0\n"
+        "v 0.0 1.4375 0.0\n"
+        "f 16 17 18\n"
+        "o lamp\n"
+        "usemtl lamp\n"
+        "v 0.0 0.0 1.0\n"
+        "v 1.0 0.0 1.0\n"
+        "v 1.0 2.9375 0.0\n"
+        "f 19 20 21\n"
+        "o white\n"
+        "usemtl white\n"
+        "v 0.0 1.0 1.0\n"
+        "v 1.0 0.3125 0.0\n"
+        "v 0.0 0.0 1.0\n"
+        "v 2.375 0.0 6.1875\n"
+        "f 22 23 24 25\n"
+        "o black\n"
+        "usemtl black\n"
+        "v 6.875 0.0 0.0\n"
+        "v 0.3125 0.0 1.0\n"
+        "v 0.0 3.625 2.0\n"
+        "v 7.375 6.0625 6.75\n"
+        "v 7.3125 6.3125 2.0\n"
+        "v 6.5625 7.1875 2.0\n"
+        "f 26 27 28 29 30 31\n"
+        "o black\n"
+        "usemtl black\n"
+        "v -0.4375 6.9375 7.25\n"
+        "v 2.0 6.25 6.3125\n"
+        "v 6.375 6.5625 6.875\n"
+        "v 6.3125 6.25 0.0\n"
+        "v 0.5625 0.0 0.0\n"
+        "f 32 33 34 35 36\n"
+        "o white\n"
+        "usemtl white\n"
+        "v 0.0 0.0 0.0\n"
+        "v 6.1875 6.9375 6.875\n"
+        "v 7.25 6.9375 7.3125\n"
+        "v 0.5 0.0 1.0\n"
+        "v 0.0 0.0 1.0\n"
+        "v 0.3125 0.0 0.0\n"
+        "f 37 38 39 40 41 42\n";
+    static const char mtl[] =
+        "newmtl lamp\n"
+        "Kd 0.3 0.3 0.3\n"
+        "Ke 3.183098861837907 3.183098861837907 3.183098861837907\n"
+        "newmtl white\n"
+        "Kd 0.8 0.8 0.8\n"
+        "Ke 0.0 0.0 0.0\n"
+        "newmtl red\n"
+        "Kd 0.7 0.1 0.1\n"
+        "Ke 0.0 0.0 0.0\n"
+        "newmtl black\n"
+        "Kd 0.0 0.0 0.0\n"
+        "Ke 0.0 0.0 0.0\n";
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "t.obj", obj, strlen(obj), mtl, strlen(mtl), &scene), RAD_OK);
+    rad_options o = {.solver = "hierarchical", .epsilon = 1e-3, .seed = 1};
+    rad_solution *s = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_NUMERICAL);
+    assert_non_null(strstr(rad_context_error(ctx), "hierarchical: the solution diverges"));
+    rad_solution_destroy(s);
+    rad_options dense = {.target_elements = 64};
+    assert_int_equal(rad_solution_create(ctx, scene, &dense, &s), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+    for (size_t i = 0; i < rad_solution_element_count(s); i++) {
+        double b[3];
+        assert_true(rad_solution_element_values(s, i, NULL, NULL, b));
+        assert_true(isfinite(b[0]) && b[0] >= 0.0 && b[0] < 10.0 / (1.0 - 0.8));
+    }
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -639,6 +753,7 @@ int main(void)
         cmocka_unit_test(test_cluster_sampling),
         cmocka_unit_test(test_office_energy),
         cmocka_unit_test(test_bad_options),
+        cmocka_unit_test(test_diverging_links_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

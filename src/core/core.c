@@ -32,6 +32,7 @@ const char *rad_result_string(rad_result result)
     case RAD_ERROR_OUT_OF_MEMORY: return "RAD_ERROR_OUT_OF_MEMORY";
     case RAD_ERROR_INTERRUPTED: return "RAD_ERROR_INTERRUPTED";
     case RAD_ERROR_INTERNAL: return "RAD_ERROR_INTERNAL";
+    case RAD_ERROR_NUMERICAL: return "RAD_ERROR_NUMERICAL";
     }
     return "RAD_ERROR_UNKNOWN";
 }

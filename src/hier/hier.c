@@ -54,6 +54,8 @@ typedef struct hr_state {
     size_t values;        /* nodes the arrays cover */
     double emitted;       /* sum_leaves A E, channels summed */
     double absorbed;      /* W, channels summed */
+    double radiant;       /* sum_leaves A B, channels summed: the power leaving */
+    double rho_max;       /* the largest reflectance of any channel of any patch */
     int sweeps;
     double start;
 } hr_state;
@@ -223,7 +225,7 @@ static double push_pull(hr_state *st)
 {
     const hr_tree *t = &st->tree;
     size_t n = t->count;
-    double change = 0.0, absorbed = 0.0;
+    double change = 0.0, absorbed = 0.0, radiant = 0.0;
     for (size_t k = 0; k < n; k++) {
         const hr_node *nd = &t->nodes[k];
         uint32_t up = nd->parent;
@@ -250,6 +252,7 @@ static double push_pull(hr_state *st)
                 double b = E[c] + rho[c] * ht[c];
                 change += nd->area * fabs(b - st->B[3 * k + (size_t)c]);
                 absorbed += nd->area * (1.0 - rho[c]) * ht[c];
+                radiant += nd->area * b;
                 st->B[3 * k + (size_t)c] = b;
             }
         }
@@ -298,6 +301,7 @@ static double push_pull(hr_state *st)
         }
     }
     st->absorbed = absorbed;
+    st->radiant = radiant;
     return st->emitted > 0.0 ? change / st->emitted : 0.0;
 }
 
@@ -321,6 +325,21 @@ static rad_result solve(hr_state *st, double tol, int cap, double *residual, boo
             *converged = true;
             return RAD_OK;
         }
+        /* Power conservation bounds what leaves the surfaces: each bounce
+         * reflects at most rho_max of what arrives, so sum A B <= emitted /
+         * (1 - rho_max) when no link delivers more than its source sends.
+         * Links whose estimates make up power (overlapping or interpenetrating
+         * polygons, found by fuzz_solve) can make the sweeps diverge to
+         * infinity and NaN: four times the bound, or a value that is not
+         * finite, stops the solve with an error instead. */
+        double bound = 4.0 * st->emitted / (1.0 - st->rho_max);
+        if (!(st->radiant <= bound) && st->rho_max < 1.0)
+            return rad_fail(st->ctx, RAD_ERROR_NUMERICAL,
+                            "hierarchical: the solution diverges after %d sweeps (the surfaces send %.3g W, "
+                            "more than four times the %.3g W that conservation allows): the links make up "
+                            "power, as overlapping or interpenetrating polygons can (a dense solver, "
+                            "rad_options.solver \"gauss-seidel\", does not use links)",
+                            st->sweeps, st->radiant / 3.0, st->emitted / 3.0 / (1.0 - st->rho_max));
     }
     return RAD_OK;
 }
@@ -722,6 +741,9 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     }
     if ((r = ensure_values(&st)) != RAD_OK)
         goto done;
+    for (size_t i = 0; i < base->element_count; i++)
+        for (int c = 0; c < 3; c++)
+            st.rho_max = fmax(st.rho_max, scene->materials[base->elements[i].material].reflectance[c]);
     /* B = E, clusters pulled up; emitted power over the roots. */
     for (size_t k = st.tree.clusters; k < st.tree.count; k++) {
         const double *E = node_emission(&st, &st.tree.nodes[k]);

@@ -619,7 +619,8 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
     }
     /* The links still active are kept too; the result is all of them. */
     if (r == RAD_OK && (r = links_reserve(ctx, &done, done.count + links->count)) == RAD_OK) {
-        memcpy(done.items + done.count, links->items, links->count * sizeof *links->items);
+        if (links->count) /* done.items may be NULL: no offset from it (UB) */
+            memcpy(done.items + done.count, links->items, links->count * sizeof *links->items);
         done.count += links->count;
         hr_links tmp = *links;
         *links = done;
