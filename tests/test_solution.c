@@ -289,6 +289,75 @@ static void test_cancellation_flag(void **state)
     assert_false(rad_context_cancelled(NULL));
 }
 
+/* Estimated factors that make up power: Monte Carlo at 16 samples on
+ * polygons that touch at sharp angles (a fuzz_solve find) has rows summing
+ * to 3.4, and Gauss-Seidel returned B = 1e5 (1e66 at other seeds) as a
+ * success.  Now the solve fails with RAD_ERROR_NUMERICAL naming the row
+ * sums; the analytic factors solve the same scene within the bound. */
+static void test_diverged_solution_refused(void **state)
+{
+    (void)state;
+    static const char obj[] =
+        "mtllib m.mtl\n"
+        "o white\n"
+        "usemtl white\n"
+        "v 0.0 0.0 0.0\n"
+        "v 0.0 0.0 1.0\n"
+        "v 1.0 0.0 1.0\n"
+        "v 1.0 0.0 0.0\n"
+        "f 1 2 3 4\n"
+        "o white\n"
+        "usemtl white\n"
+        "v 0.0 1.0 0.0\n"
+        "v 1.0 1.0 0.0\n"
+        "v 1.0 1.0 1.0\n"
+        "v 1.0 1.0 1.0\n"
+        "f 5 6 7 8\n"
+        "o lamp\n"
+        "usemtl lamp\n"
+        "v 2.75 0.3125 0.0\n"
+        "v 0.0 1.0 0.0\n"
+        "v 1.0 1.0 1.0\n"
+        "f 9 10 11\n"
+        "o lamp\n"
+        "usemtl lamp\n"
+        "v 1.0 1.0 0.0\n"
+        "v 1.0 0.0625 0.375\n"
+        "v 0.9375 0.375 0.625\n"
+        "f 12 13 14\n"
+        "o black\n"
+        "usemtl black\n"
+        "v 0.5 4.0625 0.9375\n"
+        "v 0.625 0.375 0.9375\n"
+        "v 0.5 4.0625 0.9375\n"
+        "v 0.625 0.375 0.9375\n"
+        "v 0.625 0.0 0.0\n"
+        "v 0.0 0.0 0.0\n"
+        "f 15 16 17 18 19 20\n";
+    static const char mtl[] = "newmtl lamp\nKd 0.3 0.3 0.3\nKe 3.1830988618379 3.1830988618379 3.1830988618379\n"
+                              "newmtl white\nKd 0.8 0.8 0.8\nnewmtl black\nKd 0 0 0\n";
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "m.obj", obj, strlen(obj), mtl, strlen(mtl), &scene), RAD_OK);
+    rad_options o = {.target_elements = 32, .form_factors = "montecarlo", .samples = 16,
+                     .max_iterations = 200, .seed = 1};
+    rad_solution *s = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_NUMERICAL);
+    assert_non_null(strstr(rad_context_error(ctx), "the solution diverged"));
+    assert_non_null(strstr(rad_context_error(ctx), "('montecarlo') have rows summing to"));
+    rad_solution_destroy(s);
+    o.form_factors = "analytic";
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+    for (size_t i = 0; i < rad_solution_element_count(s); i++) {
+        double b[3];
+        assert_true(rad_solution_element_values(s, i, NULL, NULL, b));
+        assert_true(isfinite(b[0]) && b[0] >= 0.0 && b[0] <= 10.0 / (1.0 - 0.8));
+    }
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -297,6 +366,7 @@ int main(void)
         cmocka_unit_test(test_hierarchical_elements_are_leaves),
         cmocka_unit_test(test_first_error_kept_and_reported_once),
         cmocka_unit_test(test_cancellation_flag),
+        cmocka_unit_test(test_diverged_solution_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -83,6 +83,43 @@ static int on_strategy_step(void *user, const rad_solve_step *step, bool display
     return 0;
 }
 
+/* Conservation bounds every solution: when no element gathers more than
+ * its whole hemisphere (rows of F summing to at most 1), B_i <= E_max /
+ * (1 - rho_max) for every element (the maximum norm of rho F is below
+ * rho_max).  Estimated factors can break that premise: Monte Carlo rows
+ * reaching 2.8 on hostile geometry made Gauss-Seidel return B = 1e66 as a
+ * success (fuzz_solve).  A solution four times over the bound, or not
+ * finite, is refused; its values stay readable for inspection.  Not
+ * checked where rho_max >= 1 (refused at scene validation anyway). */
+static rad_result check_bounded(rad_context *ctx, const rad_solution_view *v)
+{
+    double e_max = 0.0, rho_max = 0.0;
+    for (size_t i = 0; i < 3 * v->n; i++) {
+        e_max = fmax(e_max, v->emission[i]);
+        rho_max = fmax(rho_max, v->reflectance[i]);
+    }
+    if (!(rho_max < 1.0))
+        return RAD_OK;
+    double bound = 4.0 * e_max / (1.0 - rho_max);
+    for (size_t i = 0; i < 3 * v->n; i++) {
+        double b = v->radiosity[i];
+        if (isfinite(b) && b >= -1e-9 * bound && b <= bound)
+            continue;
+        const rad_element *e = &v->mesh->elements[i / 3];
+        char rows[160] = "";
+        if (v->F && v->ff->row_sum_max > 1.0)
+            snprintf(rows, sizeof rows, "; the form factors ('%s') have rows summing to %.3g, above 1",
+                     v->ff->method, v->ff->row_sum_max);
+        return rad_fail(ctx, RAD_ERROR_NUMERICAL,
+                        "the solution diverged: element %zu (surface '%s') has B = %.3g W/m^2, outside "
+                        "[0, %.3g], four times what conservation allows (E_max / (1 - rho_max))%s; "
+                        "more samples or the analytic method (rad_options.form_factors) keep the "
+                        "factors within their hemisphere",
+                        i / 3, rad_scene_surface_name(v->scene, e->surface), b, bound, rows);
+    }
+    return RAD_OK;
+}
+
 rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
 {
     rad_api_enter(ctx);
@@ -102,6 +139,8 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     s->vertex_radiosity = NULL;
     rad_result r = s->strategy->solve(ctx, s->state, &hook);
     refresh_view(s);
+    if (r == RAD_OK)
+        r = check_bounded(ctx, &s->view);
     /* The final state always ends the history: as a new row, or completing
      * the last one where it was the same step with the residual unmeasured.
      * (Steps count across independent groups, so the last row's iteration
