@@ -13,6 +13,7 @@
 
 #include "scene/scene.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -307,6 +308,352 @@ static void test_gltf(void **state)
                      RAD_OK);
     check_quad_gltf(scene);
     rad_scene_destroy(scene);
+}
+
+/* ---- glTF built in memory: hostile and awkward files ---- */
+
+/* Text that grows: printf into it. */
+typedef struct text {
+    char *data;
+    size_t length, capacity;
+} text;
+
+static void put(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void put(text *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    assert_true(n >= 0);
+    if (t->length + (size_t)n + 1 > t->capacity) {
+        t->capacity = 2 * (t->length + (size_t)n + 1);
+        t->data = realloc(t->data, t->capacity);
+        assert_non_null(t->data);
+    }
+    va_start(ap, fmt);
+    vsnprintf(t->data + t->length, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+    t->length += (size_t)n;
+}
+
+/* One mesh of a glTF made by gltf_text: its single primitive's float
+ * positions, its 32-bit indices (NULL: none), its topology and material
+ * (0: "white", reflectance 0.5; 1: "lamp", black, emissive 1: E = pi). */
+typedef struct gltf_mesh {
+    const float *positions;
+    size_t vertices;
+    const uint32_t *indices;
+    size_t index_count;
+    int mode;
+    int material;
+} gltf_mesh;
+
+static void put_base64(text *t, const unsigned char *bytes, size_t n)
+{
+    static const char alphabet[] =
+        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    for (size_t i = 0; i < n; i += 3) {
+        unsigned v = (unsigned)bytes[i] << 16 | (i + 1 < n ? (unsigned)bytes[i + 1] << 8 : 0) |
+                     (i + 2 < n ? bytes[i + 2] : 0);
+        put(t, "%c%c%c%c", alphabet[v >> 18], alphabet[v >> 12 & 63],
+            i + 1 < n ? alphabet[v >> 6 & 63] : '=', i + 2 < n ? alphabet[v & 63] : '=');
+    }
+}
+
+/* A glTF 2.0 file: `nodes` and the default scene's `roots` as JSON
+ * arrays, mesh i made of meshes[i] with accessors 2i (POSITION, VEC3
+ * float) and 2i + 1 (indices, SCALAR uint32), all in one base64 buffer;
+ * `extra` is more top-level JSON (", \"cameras\": [...]") or "". */
+static text gltf_text(const char *nodes, const char *roots, const gltf_mesh *meshes, size_t count,
+                      const char *extra)
+{
+    size_t bytes = 0;
+    for (size_t m = 0; m < count; m++)
+        bytes += 12 * meshes[m].vertices + 4 * meshes[m].index_count;
+    unsigned char *buffer = calloc(bytes + 1, 1);
+    assert_non_null(buffer);
+    text t = {0}, views = {0}, accessors = {0};
+    put(&t, "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": %s}],\n"
+            " \"nodes\": %s,\n \"meshes\": [",
+        roots, nodes);
+    size_t offset = 0;
+    for (size_t m = 0; m < count; m++) {
+        const gltf_mesh *mesh = &meshes[m];
+        put(&t, "%s{\"name\": \"m%zu\", \"primitives\": [{\"attributes\": {\"POSITION\": %zu}, "
+                "\"mode\": %d, \"material\": %d",
+            m ? ",\n  " : "", m, 2 * m, mesh->mode, mesh->material);
+        if (mesh->indices)
+            put(&t, ", \"indices\": %zu", 2 * m + 1);
+        put(&t, "}]}");
+        for (int pass = 0; pass < 2; pass++) {
+            size_t length = pass ? 4 * mesh->index_count : 12 * mesh->vertices;
+            const void *data = pass ? (const void *)mesh->indices : (const void *)mesh->positions;
+            if (length)
+                memcpy(buffer + offset, data, length); /* little-endian, as glTF */
+            /* no indices: a dummy view of the first 4 bytes, never read */
+            put(&views, "%s{\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": %zu}",
+                views.length ? ", " : "", length ? offset : 0, length ? length : 4);
+            if (pass == 0)
+                put(&accessors, "%s{\"bufferView\": %zu, \"componentType\": 5126, \"count\": %zu, "
+                                "\"type\": \"VEC3\"}",
+                    accessors.length ? ",\n  " : "", 2 * m, mesh->vertices);
+            else
+                put(&accessors, ",\n  {\"bufferView\": %zu, \"componentType\": 5125, "
+                                "\"count\": %zu, \"type\": \"SCALAR\"}",
+                    2 * m + 1, mesh->index_count ? mesh->index_count : 1);
+            offset += length;
+        }
+    }
+    put(&t, "],\n \"materials\": [{\"name\": \"white\", \"pbrMetallicRoughness\": "
+            "{\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}},\n"
+            "  {\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]},"
+            " \"emissiveFactor\": [1, 1, 1]}],\n"
+            " \"buffers\": [{\"byteLength\": %zu, \"uri\": \"data:application/octet-stream;base64,",
+        offset ? offset : 4);
+    put_base64(&t, buffer, offset ? offset : 4);
+    put(&t, "\"}],\n \"bufferViews\": [%s],\n \"accessors\": [%s]%s}\n", views.data,
+        accessors.data, extra);
+    free(buffer);
+    free(views.data);
+    free(accessors.data);
+    return t;
+}
+
+/* The unit quad in the z = 0 plane, facing +z (two triangles). */
+static const float unit_quad[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+static const uint32_t unit_quad_indices[] = {0, 1, 2, 0, 2, 3};
+
+static rad_result load_gltf(const text *t, rad_scene **scene)
+{
+    *scene = NULL;
+    rad_api_enter(ctx);
+    return rad_scene_load_memory(ctx, "x.gltf", t->data, t->length, NULL, 0, scene);
+}
+
+/* Load `t`; it must fail with `expected` and a one-line message naming
+ * x.gltf and holding every part given. */
+static void assert_gltf_refused(text *t, rad_result expected, const char *part1,
+                                const char *part2)
+{
+    rad_scene sentinel, *scene = &sentinel;
+    rad_result r = rad_scene_load_memory(ctx, "x.gltf", t->data, t->length, NULL, 0, &scene);
+    if (r != expected)
+        fail_msg("got %s (\"%s\"), expected %s", rad_result_string(r), rad_context_error(ctx),
+                 rad_result_string(expected));
+    assert_null(scene);
+    assert_null(strchr(rad_context_error(ctx), '\n'));
+    assert_contains(rad_context_error(ctx), "x.gltf: ");
+    if (part1)
+        assert_contains(rad_context_error(ctx), part1);
+    if (part2)
+        assert_contains(rad_context_error(ctx), part2);
+    free(t->data);
+    t->data = NULL;
+}
+
+/* A zigzag triangle strip of `triangles` triangles of area 1/2 (vertex 2k
+ * at (0, k), 2k + 1 at (1, k)), all facing +z. */
+static float *zigzag(size_t triangles, size_t *vertices)
+{
+    *vertices = triangles + 2;
+    float *p = calloc(3 * *vertices, sizeof *p);
+    assert_non_null(p);
+    for (size_t v = 0; v < *vertices; v++) {
+        p[3 * v] = (float)(v % 2);
+        p[3 * v + 1] = (float)(v / 2);
+    }
+    return p;
+}
+
+/* ---- mirrored nodes: the floor's radiosity under a lamp ---- */
+
+/* Radiosity of the floor ([-1, 1]^2 at z = 0, reflectance 0.5) lit by the
+ * lamp of `lamp` (a black emitter of E = pi at z = 1 over [0.25, 0.75]^2
+ * when placed right), and the lamp's polygon normals checked to face the
+ * floor. */
+static double floor_radiosity(const char *lamp_nodes, const float *lamp_positions,
+                              const uint32_t *lamp_indices)
+{
+    gltf_mesh meshes[2] = {{unit_quad, 4, unit_quad_indices, 6, 4, 0},
+                           {lamp_positions, 4, lamp_indices, 6, 4, 1}};
+    text nodes = {0};
+    put(&nodes, "[{\"name\": \"floor\", \"mesh\": 0, \"translation\": [-1, -1, 0], "
+                "\"scale\": [2, 2, 1]}, %s]",
+        lamp_nodes);
+    text t = gltf_text(nodes.data, "[0, 1]", meshes, 2, "");
+    rad_scene *scene = NULL;
+    if (load_gltf(&t, &scene) != RAD_OK)
+        fail_msg("%s", rad_context_error(ctx));
+    size_t lamp = surface_index(scene, "lamp"), floor = surface_index(scene, "floor");
+    assert_close(rad_scene_surface_area(scene, lamp), 0.25, 1e-12);
+    for (size_t p = 0; p < scene->polygon_count; p++)
+        if (scene->polygons[p].surface == lamp) {
+            assert_close(scene->polygons[p].normal.z, -1.0, 1e-12);
+            for (uint32_t k = 0; k < scene->polygons[p].vertex_count; k++) {
+                vec3 v = scene->positions[scene->indices[scene->polygons[p].first_index + k]];
+                assert_true(v.x >= 0.25 - 1e-12 && v.x <= 0.75 + 1e-12 && fabs(v.z - 1.0) < 1e-12);
+            }
+        }
+    rad_options o = {0};
+    o.mesh_size = 0.25;
+    o.tolerance = 1e-12;
+    rad_solution *solution = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &solution), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, solution), RAD_OK);
+    double B[3];
+    rad_solution_surface_radiosity(solution, floor, B);
+    rad_solution_destroy(solution);
+    rad_scene_destroy(scene);
+    free(nodes.data);
+    free(t.data);
+    return B[0];
+}
+
+/* A node whose world transform mirrors (negative determinant) flips the
+ * winding (glTF 2.0, "Instantiation"): a lamp modelled facing down and
+ * mirrored lights the floor exactly as the same lamp placed there without
+ * a mirror (it used to face away: the floor got 0).  Neighbours: a mirror
+ * given as a matrix, a mirror in z, a mirror on the parent only, two
+ * mirrors that cancel (parent and child) and a half turn (-1, -1, 1)
+ * (determinant positive: no flip). */
+static void test_gltf_mirrored(void **state)
+{
+    (void)state;
+    /* The lamp where it belongs, facing down: the reference. */
+    static const float lamp[] = {0.25f, 0.25f, 1,     0.25f, 0.75f, 1,
+                                 0.75f, 0.75f, 1,     0.75f, 0.25f, 1};
+    static const uint32_t order[] = {0, 1, 2, 0, 2, 3}, reversed[] = {0, 2, 1, 0, 3, 2};
+    float mirror_x[12], mirror_z[12], half_turn[12];
+    for (int v = 0; v < 4; v++) {
+        for (int k = 0; k < 3; k++)
+            mirror_x[3 * v + k] = mirror_z[3 * v + k] = half_turn[3 * v + k] = lamp[3 * v + k];
+        mirror_x[3 * v] = -lamp[3 * v];
+        mirror_z[3 * v + 2] = -lamp[3 * v + 2];
+        half_turn[3 * v] = -lamp[3 * v];
+        half_turn[3 * v + 1] = -lamp[3 * v + 1];
+    }
+    double reference = floor_radiosity("{\"name\": \"lamp\", \"mesh\": 1}", lamp, order);
+    /* E F rho with F < 0.25 / (pi 1^2): well above 0, below its bound */
+    assert_true(reference > 0.02 && reference < 0.5 * M_PI * 0.25 / M_PI);
+    static const struct {
+        const char *nodes;
+        int positions; /* modelled: 0 in place, 1 mirrored in x, 2 in z, 3 turned */
+    } cases[] = {
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"scale\": [-1, 1, 1]}", 1},
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"matrix\": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, "
+         "0, 0, 0, 1]}",
+         1},
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"scale\": [1, 1, -1]}", 2},
+        /* the mirror on the parent, the mesh on an unmirrored child */
+        {"{\"scale\": [-1, 1, 1], \"children\": [2]}, {\"name\": \"lamp\", \"mesh\": 1, "
+         "\"translation\": [0, 0, 0]}",
+         1},
+        /* two mirrors that cancel: no flip */
+        {"{\"scale\": [-1, 1, 1], \"children\": [2]}, {\"name\": \"lamp\", \"mesh\": 1, "
+         "\"scale\": [-1, 1, 1]}",
+         0},
+        /* a half turn about z: determinant +1, no flip */
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"scale\": [-1, -1, 1]}", 3},
+    };
+    const float *positions[4] = {lamp, mirror_x, mirror_z, half_turn};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        /* Modelled mirrored, a lamp that faces the floor once placed has
+         * the reference's vertex order reversed (a mirror turns the
+         * orientation of its vertex order; glTF's rule turns it back). */
+        bool mirrored = cases[k].positions == 1 || cases[k].positions == 2;
+        double B = floor_radiosity(cases[k].nodes, positions[cases[k].positions],
+                                   mirrored ? reversed : order);
+        if (!(fabs(B - reference) <= 1e-9 * reference))
+            fail_msg("case %zu: floor radiosity %.17g, expected %.17g", k, B, reference);
+    }
+}
+
+/* ---- primitives: indices, accessors, buffers, topologies ---- */
+
+/* Area and orientation of every polygon of surface 0: all face +z. */
+static void check_faces_up(const rad_scene *scene, size_t polygons, double area)
+{
+    assert_int_equal(rad_scene_polygon_count(scene), polygons);
+    for (size_t p = 0; p < scene->polygon_count; p++)
+        assert_close(scene->polygons[p].normal.z, 1.0, 1e-12);
+    assert_close(rad_scene_surface_area(scene, 0), area, 1e-12);
+}
+
+/* Triangle strips and fans (glTF 2.0, "Meshes": strip triangle i is
+ * (i, i + 1 + i % 2, i + 2 - i % 2), fan triangle i is (i + 1, i + 2, 0))
+ * keep their winding; a triangle whose indices repeat (the stitches that
+ * join strips, a repeated fan vertex) has no area and is dropped (it used
+ * to fail the whole file).  Points and lines carry no area: ignored. */
+static void test_gltf_strips_and_fans(void **state)
+{
+    (void)state;
+    /* Two strips of 2 triangles, x in [0, 1] and [3, 4], joined by the
+     * stitches 3 3 4 4 (4 triangles of no area). */
+    static const float two_strips[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0,
+                                       3, 0, 0, 4, 0, 0, 3, 1, 0, 4, 1, 0};
+    static const uint32_t stitched[] = {0, 1, 2, 3, 3, 4, 4, 5, 6, 7};
+    gltf_mesh strips = {two_strips, 8, stitched, 10, 5, 0};
+    text t = gltf_text("[{\"mesh\": 0}]", "[0]", &strips, 1, "");
+    rad_scene *scene = NULL;
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 4, 2.0);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* A strip without indices: consecutive vertices, nothing repeated. */
+    size_t vertices;
+    float *zigzag_positions = zigzag(4, &vertices);
+    gltf_mesh plain = {zigzag_positions, vertices, NULL, 0, 5, 0};
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &plain, 1, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 4, 2.0);
+    rad_scene_destroy(scene);
+    free(t.data);
+    free(zigzag_positions);
+
+    /* A fan around (0, 0) over (1, 0), (1, 1), (0, 1), (-1, 1), with its
+     * second vertex repeated: 3 triangles of 1/2. */
+    static const float fan[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, -1, 1, 0};
+    static const uint32_t fan_indices[] = {0, 1, 2, 2, 3, 4};
+    gltf_mesh fans = {fan, 5, fan_indices, 6, 6, 0};
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &fans, 1, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 3, 1.5);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* A triangle list with one triangle of a repeated index among two. */
+    static const uint32_t listed[] = {0, 1, 2, 0, 0, 2, 0, 2, 3};
+    gltf_mesh list = {unit_quad, 4, listed, 9, 4, 0};
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &list, 1, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 2, 1.0);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* Points, lines, a line loop and a line strip beside one triangle:
+     * only the triangle has area. */
+    gltf_mesh mixed[5] = {{unit_quad, 4, unit_quad_indices, 3, 4, 0},
+                          {unit_quad, 4, unit_quad_indices, 1, 0, 0},
+                          {unit_quad, 4, unit_quad_indices, 6, 1, 0},
+                          {unit_quad, 4, unit_quad_indices, 4, 2, 0},
+                          {unit_quad, 4, NULL, 0, 3, 0}};
+    t = gltf_text("[{\"name\": \"t\", \"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}, {\"mesh\": 3}, "
+                  "{\"mesh\": 4}]",
+                  "[0, 1, 2, 3, 4]", mixed, 5, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    assert_int_equal(rad_scene_surface_count(scene), 1);
+    assert_string_equal(rad_scene_surface_name(scene, 0), "t");
+    check_faces_up(scene, 1, 0.5);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* Lines alone: nothing has area. */
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &mixed[2], 1, "");
+    rad_api_enter(ctx);
+    assert_gltf_refused(&t, RAD_ERROR_INVALID_SCENE, "scene is empty (no polygons)", NULL);
 }
 
 /* ---- the builder ---- */
@@ -704,6 +1051,8 @@ int main(void)
         cmocka_unit_test(test_obj_from_memory),
         cmocka_unit_test(test_obj_groups),
         cmocka_unit_test(test_gltf),
+        cmocka_unit_test(test_gltf_mirrored),
+        cmocka_unit_test(test_gltf_strips_and_fans),
         cmocka_unit_test(test_builder_surfaces_and_materials),
         cmocka_unit_test(test_builder_non_planar),
         cmocka_unit_test(test_builder_errors),

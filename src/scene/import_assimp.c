@@ -22,7 +22,13 @@
  *    translation into aiCamera::mPosition (counting it twice): the glTF
  *    JSON is read with cJSON for the strength and yfov (gltf_fixes.c), and
  *    a glTF camera is placed as the glTF 2.0 spec says (at its node's
- *    origin, looking down -Z with +Y up).
+ *    origin, looking down -Z with +Y up);
+ *  - it keeps the vertex order of a mirrored node: a node whose world
+ *    transform has a negative determinant has its polygons reversed here
+ *    (glTF 2.0, "Instantiation": the determinant's sign defines the
+ *    winding), and a triangle whose indices repeat (a triangle strip's
+ *    stitches) is dropped: it has no area by construction.
+ * The node tree is walked with an explicit stack: its depth is the file's.
  * MTL/glTF emissive colours are emitted RADIANCE: exitance E = pi * Ke.
  *
  * Memory: files are read through the context's allocator, in chunks when
@@ -177,6 +183,23 @@ static int convert_material(converter *cv, unsigned index)
     return cv->material_of[index];
 }
 
+/* The determinant of a transform's linear part: negative when it mirrors. */
+static double affine_determinant(const affine *t)
+{
+    const double(*m)[4] = t->m;
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+/* A face of three corners with a repeated vertex index: no area whatever
+ * the positions (a triangle strip's stitches, a fan's start). */
+static bool face_repeats_index(const struct aiFace *face)
+{
+    const unsigned *v = face->mIndices;
+    return face->mNumIndices == 3 && (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]);
+}
+
 static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigned mesh_index,
                                const affine *world)
 {
@@ -189,10 +212,11 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
                                : mesh->mName.length ? mesh->mName.data
                                                     : fallback;
     int surface = -1, material = -1; /* made on the first real polygon */
+    bool mirrored = affine_determinant(world) < 0.0;
     for (unsigned f = 0; f < mesh->mNumFaces; f++) {
         const struct aiFace *face = &mesh->mFaces[f];
-        if (face->mNumIndices < 3)
-            continue; /* points and lines */
+        if (face->mNumIndices < 3 || face_repeats_index(face))
+            continue; /* points and lines; stitches */
         if (surface < 0) {
             surface = rad_scene_builder_surface(cv->builder, surface_name);
             material = surface < 0 ? -1 : convert_material(cv, mesh->mMaterialIndex);
@@ -213,7 +237,8 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
                 return rad_fail(cv->ctx, RAD_ERROR_PARSE,
                                 "%s: mesh '%s': face references vertex %u of %u", cv->name,
                                 mesh->mName.data, v, mesh->mNumVertices);
-            cv->face[i] = affine_point(world, vec3_of(&mesh->mVertices[v]));
+            cv->face[mirrored ? face->mNumIndices - 1 - i : i] =
+                affine_point(world, vec3_of(&mesh->mVertices[v]));
         }
         rad_result r = rad_scene_builder_polygon(cv->builder, surface, material, cv->face,
                                                  face->mNumIndices, 0);
@@ -223,38 +248,92 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
     return RAD_OK;
 }
 
-static rad_result convert_node(converter *cv, const struct aiNode *node, const affine *parent)
+/* A node to visit and its parent's world transform. */
+typedef struct node_visit {
+    const struct aiNode *node;
+    affine parent;
+} node_visit;
+
+/* Push the children of `node` (world transform `world`) onto the stack,
+ * the last first so that the first is visited next: the order of a
+ * recursive walk, in memory the file cannot blow up (a tree 20,000 deep
+ * is 20,000 entries, not 20,000 frames). */
+static rad_result push_children(converter *cv, node_visit **stack, size_t *top, size_t *capacity,
+                                const struct aiNode *node, const affine *world)
 {
-    affine world = affine_then(parent, &node->mTransformation);
-    for (unsigned k = 0; k < node->mNumMeshes; k++) {
-        if (node->mMeshes[k] >= cv->ai->mNumMeshes)
-            return rad_fail(cv->ctx, RAD_ERROR_PARSE, "%s: node '%s' refers to mesh %u of %u",
-                            cv->name, node->mName.data, node->mMeshes[k], cv->ai->mNumMeshes);
-        rad_result r = convert_mesh(cv, node, node->mMeshes[k], &world);
-        if (r != RAD_OK)
-            return r;
+    if (node->mNumChildren > *capacity - *top) {
+        size_t grown = *capacity * 2 + node->mNumChildren;
+        node_visit *bigger = rad_realloc(cv->ctx, RAD_MEM_SCENE, *stack, grown, sizeof *bigger,
+                                         cv->name);
+        if (!bigger)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        *stack = bigger;
+        *capacity = grown;
     }
-    for (unsigned c = 0; c < node->mNumChildren; c++) {
-        rad_result r = convert_node(cv, node->mChildren[c], &world);
-        if (r != RAD_OK)
-            return r;
+    for (unsigned c = node->mNumChildren; c-- > 0;) {
+        (*stack)[*top].node = node->mChildren[c];
+        (*stack)[*top].parent = *world;
+        (*top)++;
     }
     return RAD_OK;
 }
 
-/* The world transform of the node called `name`; false if there is none. */
-static bool find_node(const struct aiNode *node, const char *name, const affine *parent,
-                      affine *world)
+/* Every node's meshes, placed by its world transform, depth first. */
+static rad_result convert_nodes(converter *cv, const struct aiNode *root)
 {
-    affine here = affine_then(parent, &node->mTransformation);
-    if (strcmp(node->mName.data, name) == 0) {
-        *world = here;
-        return true;
+    size_t top = 0, capacity = 0;
+    node_visit *stack = NULL;
+    affine identity = affine_identity();
+    const struct aiNode *node = root;
+    const affine *parent = &identity;
+    rad_result r = RAD_OK;
+    for (;;) {
+        affine world = affine_then(parent, &node->mTransformation);
+        for (unsigned k = 0; k < node->mNumMeshes && r == RAD_OK; k++) {
+            if (node->mMeshes[k] >= cv->ai->mNumMeshes)
+                r = rad_fail(cv->ctx, RAD_ERROR_PARSE, "%s: node '%s' refers to mesh %u of %u",
+                             cv->name, node->mName.data, node->mMeshes[k], cv->ai->mNumMeshes);
+            else
+                r = convert_mesh(cv, node, node->mMeshes[k], &world);
+        }
+        if (r == RAD_OK)
+            r = push_children(cv, &stack, &top, &capacity, node, &world);
+        if (r != RAD_OK || top == 0)
+            break;
+        top--;
+        node = stack[top].node;
+        parent = &stack[top].parent;
     }
-    for (unsigned c = 0; c < node->mNumChildren; c++)
-        if (find_node(node->mChildren[c], name, &here, world))
-            return true;
-    return false;
+    rad_free(stack);
+    return r;
+}
+
+/* The world transform of the first node called `name`, depth first; false
+ * if there is none.  Cannot fail otherwise: out of memory, the search
+ * stops. */
+static bool find_node(converter *cv, const struct aiNode *root, const char *name, affine *world)
+{
+    size_t top = 0, capacity = 0;
+    node_visit *stack = NULL;
+    affine identity = affine_identity();
+    const struct aiNode *node = root;
+    const affine *parent = &identity;
+    bool found = false;
+    for (;;) {
+        affine here = affine_then(parent, &node->mTransformation);
+        if (strcmp(node->mName.data, name) == 0) {
+            *world = here;
+            found = true;
+            break;
+        }
+        if (push_children(cv, &stack, &top, &capacity, node, &here) != RAD_OK || top == 0)
+            break;
+        top--;
+        node = stack[top].node;
+        parent = &stack[top].parent;
+    }
+    rad_free(stack);
+    return found;
 }
 
 /* The first camera, placed by its node.  `gltf_yfov` (radians, 0 if
@@ -262,8 +341,8 @@ static bool find_node(const struct aiNode *node, const char *name, const affine 
 static void convert_camera(converter *cv, bool gltf, double gltf_yfov)
 {
     const struct aiCamera *camera = cv->ai->mCameras[0];
-    affine identity = affine_identity(), world = identity;
-    find_node(cv->ai->mRootNode, camera->mName.data, &identity, &world);
+    affine world = affine_identity();
+    find_node(cv, cv->ai->mRootNode, camera->mName.data, &world);
     vec3 position = v3(0.0, 0.0, 0.0), direction = v3(0.0, 0.0, -1.0), up = v3(0.0, 1.0, 0.0);
     if (!gltf) {
         position = vec3_of(&camera->mPosition);
@@ -352,8 +431,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
     }
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
         cv.material_of[i] = -1;
-    affine identity = affine_identity();
-    r = convert_node(&cv, ai->mRootNode, &identity);
+    r = convert_nodes(&cv, ai->mRootNode);
     if (r != RAD_OK)
         goto done;
     if (ai->mNumCameras > 0 && ai->mCameras[0])
