@@ -338,6 +338,19 @@ static void put(text *t, const char *fmt, ...)
     t->length += (size_t)n;
 }
 
+/* Replace the first `old` in t by `new_text`; fails the test if absent. */
+static void patch(text *t, const char *old, const char *new_text)
+{
+    char *at = strstr(t->data, old);
+    if (!at)
+        fail_msg("patch: '%s' not in the glTF", old);
+    size_t before = (size_t)(at - t->data), old_length = strlen(old);
+    text patched = {0};
+    put(&patched, "%.*s%s%s", (int)before, t->data, new_text, at + old_length);
+    free(t->data);
+    *t = patched;
+}
+
 /* One mesh of a glTF made by gltf_text: its single primitive's float
  * positions, its 32-bit indices (NULL: none), its topology and material
  * (0: "white", reflectance 0.5; 1: "lamp", black, emissive 1: E = pi). */
@@ -453,6 +466,121 @@ static void assert_gltf_refused(text *t, rad_result expected, const char *part1,
     t->data = NULL;
 }
 
+/* A chain of `depth` nested nodes, each moved 1 mm up in y, the last
+ * holding the unit quad. */
+static text nested(size_t depth)
+{
+    text nodes = {0};
+    put(&nodes, "[");
+    for (size_t i = 0; i + 1 < depth; i++)
+        put(&nodes, "{\"translation\": [0, 0.001, 0], \"children\": [%zu]},", i + 1);
+    put(&nodes, "{\"translation\": [0, 0.001, 0], \"mesh\": 0}]");
+    gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
+    text t = gltf_text(nodes.data, "[0]", &quad, 1, "");
+    free(nodes.data);
+    return t;
+}
+
+/* 1,000 levels load, every level's transform applied (walked without
+ * recursion); 1,001 and 20,000 (which overflowed the stack inside assimp)
+ * are refused before assimp reads them, naming the deepest node and the
+ * limit. */
+static void test_gltf_nesting(void **state)
+{
+    (void)state;
+    text t = nested(1000);
+    rad_scene *scene = NULL;
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    assert_int_equal(rad_scene_polygon_count(scene), 2);
+    assert_close(rad_scene_surface_area(scene, 0), 1.0, 1e-12);
+    /* 1000 x 0.001 (a float: 0.0010000000475) */
+    assert_close(scene->bounds_min.y, 1.0, 1e-6);
+    assert_close(scene->bounds_max.y, 2.0, 1e-6);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    t = nested(1001);
+    assert_gltf_refused(&t, RAD_ERROR_PARSE, "node 1000 is nested 1001 levels deep",
+                        "at most 1000 levels");
+    t = nested(20000);
+    assert_gltf_refused(&t, RAD_ERROR_PARSE, "node 19999 is nested 20000 levels deep", NULL);
+}
+
+/* Node graphs that are not disjoint strict trees (glTF 2.0, "Nodes and
+ * Hierarchy"), among them the instance bomb: 9 levels of 10 nodes, each
+ * listing all 10 of the next level, which assimp expanded to 10^8 copies. */
+static void test_gltf_node_graphs(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *nodes, *roots, *message[2];
+    } cases[] = {
+        {"[{\"name\": \"a\", \"children\": [2]}, {\"name\": \"b\", \"children\": [2]}, "
+         "{\"name\": \"c\", \"mesh\": 0}]",
+         "[0, 1]", {"node 'c' (2) is a child of both node 'a' (0) and node 'b' (1)", NULL}},
+        {"[{\"name\": \"a\", \"children\": [1]}, {\"name\": \"b\", \"children\": [0], "
+         "\"mesh\": 0}]",
+         "[0]", {"is its own ancestor (the nodes form a cycle)", NULL}},
+        {"[{\"name\": \"r\", \"mesh\": 0}, {\"children\": [2]}, {\"children\": [3]}, "
+         "{\"children\": [1], \"mesh\": 0}]",
+         "[0]", {"is its own ancestor", NULL}},
+        /* a cycle hung under a root: some node of it has two parents */
+        {"[{\"name\": \"r\", \"children\": [1]}, {\"children\": [2]}, {\"children\": [1], "
+         "\"mesh\": 0}]",
+         "[0]", {"node 1 is a child of both node 'r' (0) and node 2", NULL}},
+        {"[{\"name\": \"a\", \"children\": [0], \"mesh\": 0}]", "[0]",
+         {"node 'a' (0) is its own child", NULL}},
+        {"[{\"name\": \"a\", \"children\": [1, 1]}, {\"mesh\": 0}]", "[0]",
+         {"node 'a' (0) lists node 1 twice", NULL}},
+        {"[{\"name\": \"a\", \"children\": [1]}, {\"name\": \"b\", \"mesh\": 0}]", "[0, 1]",
+         {"scene 0 lists node 'b' (1), a child of node 'a' (0)", NULL}},
+        {"[{\"mesh\": 0}]", "[0, 0]", {"scene 0 lists node 0 twice", NULL}},
+        {"[{\"children\": [7], \"mesh\": 0}]", "[0]",
+         {"node 0: a child is not a node index", NULL}},
+        {"[{\"children\": [0.5], \"mesh\": 0}]", "[0]", {"a child is not a node index", NULL}},
+        {"[{\"children\": [-1], \"mesh\": 0}]", "[0]", {"a child is not a node index", NULL}},
+        {"[{\"mesh\": 3}]", "[0]", {"node 0 refers to no mesh (1 meshes)", NULL}},
+        {"[{\"mesh\": 0}]", "[4]", {"scene 0 lists something that is not a node index", NULL}},
+        {"[{\"mesh\": 0, \"scale\": [1, 1]}]", "[0]", {"scale must be 3 finite numbers", NULL}},
+        {"[{\"mesh\": 0, \"translation\": [0, 1e999, 0]}]", "[0]",
+         {"translation must be 3 finite numbers", NULL}},
+        {"[{\"mesh\": 0, \"rotation\": [0, 0, 0, 0]}]", "[0]", {"the zero quaternion", NULL}},
+        {"[{\"mesh\": 0, \"matrix\": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0]}]", "[0]",
+         {"matrix must be 16 finite numbers", NULL}},
+    };
+    gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, "");
+        rad_api_enter(ctx);
+        assert_gltf_refused(&t, RAD_ERROR_PARSE, cases[k].message[0], cases[k].message[1]);
+    }
+
+    /* The instance bomb (1.8 KB of nodes in the original). */
+    text nodes = {0}, roots = {0};
+    put(&nodes, "[");
+    for (int level = 0; level < 9; level++)
+        for (int i = 0; i < 10; i++) {
+            put(&nodes, "%s{\"name\": \"n%d_%d\"", level + i ? ", " : "", level, i);
+            if (level == 8)
+                put(&nodes, ", \"mesh\": 0}");
+            else {
+                put(&nodes, ", \"children\": [");
+                for (int k = 0; k < 10; k++)
+                    put(&nodes, "%s%d", k ? ", " : "", 10 * (level + 1) + k);
+                put(&nodes, "]}");
+            }
+        }
+    put(&nodes, "]");
+    put(&roots, "[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]");
+    text t = gltf_text(nodes.data, roots.data, &quad, 1, "");
+    rad_api_enter(ctx);
+    assert_gltf_refused(&t, RAD_ERROR_PARSE,
+                        "node 'n1_0' (10) is a child of both node 'n0_0' (0) and node 'n0_1' (1)",
+                        "one parent at most");
+    free(nodes.data);
+    free(roots.data);
+}
+
 /* A zigzag triangle strip of `triangles` triangles of area 1/2 (vertex 2k
  * at (0, k), 2k + 1 at (1, k)), all facing +z. */
 static float *zigzag(size_t triangles, size_t *vertices)
@@ -465,6 +593,58 @@ static float *zigzag(size_t triangles, size_t *vertices)
         p[3 * v + 1] = (float)(v / 2);
     }
     return p;
+}
+
+/* Instances times triangles against the memory limit: 100 nodes each
+ * instancing one strip of 10,000 triangles would hold 10^6 triangles
+ * (about 130 MB) and are refused under a 64 MiB limit before assimp reads
+ * the file; 10 instances load, every triangle of every instance there. */
+static void test_gltf_instances_memory(void **state)
+{
+    (void)state;
+    rad_context_options co = {.threads = 1, .max_memory_bytes = 64.0 * 1048576.0};
+    rad_context *limited = NULL;
+    assert_int_equal(rad_context_create(&co, &limited), RAD_OK);
+    size_t vertices;
+    float *strip = zigzag(10000, &vertices);
+    gltf_mesh mesh = {strip, vertices, NULL, 0, 5, 0};
+    for (int instances = 10; instances <= 100; instances *= 10) {
+        text nodes = {0}, roots = {0};
+        put(&nodes, "[");
+        put(&roots, "[");
+        for (int i = 0; i < instances; i++) {
+            put(&nodes, "%s{\"mesh\": 0, \"translation\": [%d, 0, 0]}", i ? ", " : "", 2 * i);
+            put(&roots, "%s%d", i ? ", " : "", i);
+        }
+        put(&nodes, "]");
+        put(&roots, "]");
+        text t = gltf_text(nodes.data, roots.data, &mesh, 1, "");
+        rad_scene *scene = NULL;
+        rad_api_enter(limited);
+        rad_result r = rad_scene_load_memory(limited, "x.gltf", t.data, t.length, NULL, 0, &scene);
+        if (instances == 10) {
+            if (r != RAD_OK)
+                fail_msg("%s", rad_context_error(limited));
+            assert_int_equal(rad_scene_polygon_count(scene), 100000);
+            assert_int_equal(rad_scene_surface_count(scene), 10); /* one per node */
+            for (size_t i = 0; i < 10; i++)
+                assert_close(rad_scene_surface_area(scene, i), 5000.0, 1e-9);
+            rad_scene_destroy(scene);
+        } else {
+            assert_int_equal(r, RAD_ERROR_OUT_OF_MEMORY);
+            assert_null(scene);
+            assert_contains(rad_context_error(limited), "x.gltf: importing it needs about");
+            assert_contains(rad_context_error(limited), "100 instances holding 1e+06 triangles");
+            assert_contains(rad_context_error(limited),
+                            "above the memory limit of 64.0 MiB "
+                            "(rad_context_options.max_memory_bytes)");
+        }
+        free(t.data);
+        free(nodes.data);
+        free(roots.data);
+    }
+    free(strip);
+    rad_context_destroy(limited);
 }
 
 /* ---- mirrored nodes: the floor's radiosity under a lamp ---- */
@@ -571,6 +751,107 @@ static void test_gltf_mirrored(void **state)
 }
 
 /* ---- primitives: indices, accessors, buffers, topologies ---- */
+
+/* The unit quad file with `old` patched to `new_text` (NULL: as it is),
+ * topology `mode`, indices `indices` (NULL: the quad's), positions
+ * `positions` (NULL: the quad's). */
+static text quad_patched(const float *positions, const uint32_t *indices, size_t index_count,
+                         int mode, const char *old, const char *new_text)
+{
+    gltf_mesh mesh = {positions ? positions : unit_quad, 4,
+                      indices ? indices : unit_quad_indices, indices ? index_count : 6, mode, 0};
+    text t = gltf_text("[{\"mesh\": 0}]", "[0]", &mesh, 1, "");
+    if (old)
+        patch(&t, old, new_text);
+    return t;
+}
+
+/* Every primitive assimp would misread, or drop part of without a word,
+ * or crash on, is refused before assimp sees it, naming the file, mesh,
+ * primitive and accessor (and, for an index out of range, the index and
+ * the vertex count). */
+static void test_gltf_bad_primitives(void **state)
+{
+    (void)state;
+    static const uint32_t out_of_range[] = {0, 1, 2, 0, 2, 7}, strip_out[] = {0, 1, 9, 3},
+                          four[] = {0, 1, 2, 3}, one[] = {0};
+    static const float nan_quad[] = {0, 0, 0, 1, 0, 0, NAN, 1, 0, 0, 1, 0};
+    static const float inf_quad[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, -INFINITY};
+    const char *sparse_without_view =
+        "\"type\": \"VEC3\", \"sparse\": {\"count\": 1, \"indices\": {\"componentType\": 5125}, "
+        "\"values\": {\"bufferView\": 0}}}";
+    const char *sparse_decreasing =
+        "\"type\": \"VEC3\", \"sparse\": {\"count\": 4, \"indices\": {\"bufferView\": 1, "
+        "\"componentType\": 5125}, \"values\": {\"bufferView\": 0}}}";
+    const struct {
+        text t;
+        rad_result expected;
+        const char *message[2];
+    } cases[] = {
+        /* assimp dropped the triangle silently */
+        {quad_patched(NULL, out_of_range, 6, 4, NULL, NULL), RAD_ERROR_PARSE,
+         {"x.gltf: mesh 'm0' (0) primitive 0: index 5 refers to vertex 7 of 4", NULL}},
+        {quad_patched(NULL, strip_out, 4, 5, NULL, NULL), RAD_ERROR_PARSE,
+         {"primitive 0: index 2 refers to vertex 9 of 4", NULL}},
+        /* assimp read a float index accessor as integers */
+        {quad_patched(NULL, NULL, 0, 4, "\"componentType\": 5125", "\"componentType\": 5126"),
+         RAD_ERROR_PARSE, {"indices (accessor 1) must be SCALAR unsigned integers", "5126"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"componentType\": 5125", "\"componentType\": 5122"),
+         RAD_ERROR_PARSE, {"unsigned integers", "not componentType 5122"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"count\": 6, \"type\": \"SCALAR\"",
+                      "\"count\": 3, \"type\": \"VEC2\""),
+         RAD_ERROR_PARSE, {"indices (accessor 1) must be SCALAR", NULL}},
+        /* a view past its buffer, an accessor past its view, no vertices */
+        {quad_patched(NULL, NULL, 0, 4, "\"byteLength\": 48", "\"byteLength\": 4800"),
+         RAD_ERROR_PARSE, {"bufferView 0 (bytes 0 to 4800) lies outside buffer 0 of 72 bytes",
+                           NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"count\": 6", "\"count\": 60"), RAD_ERROR_PARSE,
+         {"accessor 1 needs bytes 0 to 240 of bufferView 1, which has 24", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"count\": 4", "\"count\": 0"), RAD_ERROR_PARSE,
+         {"primitive 0: accessor 0 has count 0", "at least 1"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"byteLength\": 72, \"uri\"",
+                      "\"byteLength\": 720, \"uri\""),
+         RAD_ERROR_PARSE, {"buffer 0: byteLength is 720, but its data has 72 bytes", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "base64,", "base64,*"), RAD_ERROR_PARSE,
+         {"base64", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"uri\": \"data:application/octet-stream;base64,",
+                      "\"uri\": \"quad.bin\", \"x\": \""),
+         RAD_ERROR_IO, {"buffer 0: cannot open 'quad.bin'", NULL}},
+        /* positions: finite float triples, as OBJ's */
+        {quad_patched(nan_quad, NULL, 0, 4, NULL, NULL), RAD_ERROR_INVALID_SCENE,
+         {"x.gltf: mesh 'm0' (0) primitive 0: vertex 2 (nan, 1, 0) is not finite", NULL}},
+        {quad_patched(inf_quad, NULL, 0, 4, NULL, NULL), RAD_ERROR_INVALID_SCENE,
+         {"vertex 3 (0, 1, -inf) is not finite", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"componentType\": 5126", "\"componentType\": 5123"),
+         RAD_ERROR_PARSE, {"POSITION (accessor 0) must be VEC3 of float", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "{\"POSITION\": 0}", "{\"NORMAL\": 0}"), RAD_ERROR_PARSE,
+         {"primitive 0 has no POSITION attribute", NULL}},
+        /* counts for the topology; assimp allocated 2^32 faces for a
+         * one-index strip */
+        {quad_patched(NULL, four, 4, 4, NULL, NULL), RAD_ERROR_PARSE,
+         {"triangles (mode 4) of 4 indices, not a multiple of 3", NULL}},
+        {quad_patched(NULL, one, 1, 5, NULL, NULL), RAD_ERROR_PARSE,
+         {"a triangle strip (mode 5) of 1 index (3 or more are needed)", NULL}},
+        {quad_patched(NULL, one, 1, 6, NULL, NULL), RAD_ERROR_PARSE,
+         {"a triangle fan (mode 6) of 1 index", NULL}},
+        {quad_patched(NULL, one, 1, 1, NULL, NULL), RAD_ERROR_PARSE,
+         {"lines (mode 1) of 1 index (2 or more are needed)", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"mode\": 4", "\"mode\": 9"), RAD_ERROR_PARSE,
+         {"mode must be 0 to 6", NULL}},
+        /* sparse accessors: assimp 5.2 dereferenced the missing view */
+        {quad_patched(NULL, NULL, 0, 4, "\"type\": \"VEC3\"}", sparse_without_view),
+         RAD_ERROR_PARSE, {"accessor 0: sparse indices and values each need a bufferView", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"type\": \"VEC3\"}", sparse_decreasing),
+         RAD_ERROR_PARSE, {"accessor 0: sparse index 3 is 0", "must increase"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"version\": \"2.0\"", "\"version\": \"1.0\""),
+         RAD_ERROR_PARSE, {"glTF version '1.0' is not read (2.0 is)", NULL}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        text t = cases[k].t;
+        rad_api_enter(ctx);
+        assert_gltf_refused(&t, cases[k].expected, cases[k].message[0], cases[k].message[1]);
+    }
+}
 
 /* Area and orientation of every polygon of surface 0: all face +z. */
 static void check_faces_up(const rad_scene *scene, size_t polygons, double area)
@@ -941,7 +1222,7 @@ static const bad_input bad_inputs[] = {
      {"empty.obj: scene is empty (no polygons)", NULL, NULL}},
     {"lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
      {"lines.obj: scene is empty (no polygons)", NULL, NULL}},
-    {"bad.gltf", "{ garbage", NULL, NULL, RAD_ERROR_PARSE, {"bad.gltf: ", NULL, NULL}},
+    {"bad.gltf", "{\n garbage", NULL, NULL, RAD_ERROR_PARSE, {"bad.gltf:2:", "not JSON", NULL}},
     {"white.gltf",
      "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": "
      "[{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, "
@@ -1051,7 +1332,11 @@ int main(void)
         cmocka_unit_test(test_obj_from_memory),
         cmocka_unit_test(test_obj_groups),
         cmocka_unit_test(test_gltf),
+        cmocka_unit_test(test_gltf_nesting),
+        cmocka_unit_test(test_gltf_node_graphs),
+        cmocka_unit_test(test_gltf_instances_memory),
         cmocka_unit_test(test_gltf_mirrored),
+        cmocka_unit_test(test_gltf_bad_primitives),
         cmocka_unit_test(test_gltf_strips_and_fans),
         cmocka_unit_test(test_builder_surfaces_and_materials),
         cmocka_unit_test(test_builder_non_planar),

@@ -6,7 +6,8 @@
  * with the file's size.  After assimp: it ignores
  * KHR_materials_emissive_strength and turns the camera's yfov into an
  * approximate horizontal angle, so the glTF JSON (all of a .gltf, the
- * first chunk of a .glb) is read with cJSON for both.
+ * first chunk of a .glb) is read with cJSON for both (and for the checks
+ * of gltf_check.c).
  *
  *    GLB:  "glTF" version length | chunk length "JSON" text | chunk length "BIN\0" data
  *
@@ -25,19 +26,27 @@ static size_t le32(const unsigned char *p)
 }
 
 /* The JSON of a .gltf (all of it) or a .glb (its first chunk), parsed;
- * NULL if it is not JSON (assimp then reports the problem). */
-cJSON *import_gltf_json(const char *data, size_t size, bool binary)
+ * NULL if it is not JSON, with the offset in the file where parsing
+ * stopped. */
+cJSON *import_gltf_json(const char *data, size_t size, bool binary, size_t *error_offset)
 {
-    if (!binary)
-        return cJSON_ParseWithLength(data, size);
-    /* GLB: magic "glTF", version, length; then chunk length, "JSON", text. */
-    const unsigned char *bytes = (const unsigned char *)data;
-    if (size < 20 || memcmp(bytes, "glTF", 4) != 0 || memcmp(bytes + 16, "JSON", 4) != 0)
-        return NULL;
-    size_t length = le32(bytes + 12);
-    if (length > size - 20)
-        return NULL;
-    return cJSON_ParseWithLength(data + 20, length);
+    *error_offset = 0;
+    size_t start = 0, length = size;
+    if (binary) {
+        /* GLB: magic "glTF", version, length; then chunk length, "JSON", text. */
+        const unsigned char *bytes = (const unsigned char *)data;
+        if (size < 20 || memcmp(bytes, "glTF", 4) != 0 || memcmp(bytes + 16, "JSON", 4) != 0)
+            return NULL;
+        length = le32(bytes + 12);
+        if (length > size - 20)
+            return NULL;
+        start = 20;
+    }
+    const char *end = NULL;
+    cJSON *json = cJSON_ParseWithLengthOpts(data + start, length, &end, false);
+    if (!json)
+        *error_offset = start + (end && end >= data + start ? (size_t)(end - (data + start)) : 0);
+    return json;
 }
 
 /* Check the framing of a GLB file before assimp reads it: assimp 5.2
@@ -66,6 +75,12 @@ rad_result import_glb_check_framing(rad_context *ctx, const char *name, const ch
             return rad_fail(ctx, RAD_ERROR_PARSE,
                             "%s: GLB chunk %d claims %zu bytes, %zu are left in the file", name,
                             chunk, length, declared - offset - 8);
+        /* Chunks start and end on 4-byte boundaries; assimp rounds the
+         * JSON chunk up to one to find the next, so a JSON chunk of
+         * another length would hide its BIN chunk from the checks. */
+        if (chunk == 0 && length % 4 != 0)
+            return rad_fail(ctx, RAD_ERROR_PARSE,
+                            "%s: GLB JSON chunk of %zu bytes, not a multiple of 4", name, length);
         offset += 8 + length;
     }
     return RAD_OK;

@@ -23,6 +23,11 @@
  *    JSON is read with cJSON for the strength and yfov (gltf_fixes.c), and
  *    a glTF camera is placed as the glTF 2.0 spec says (at its node's
  *    origin, looking down -Z with +Y up);
+ *  - it reads glTF node trees recursively (20,000 levels overflow the
+ *    stack), copies a subtree for each parent that lists it, drops a
+ *    triangle with an index out of range without a word and misreads
+ *    accessors of the wrong type: the JSON and the buffers are checked
+ *    before assimp sees them (gltf_check.c);
  *  - it keeps the vertex order of a mirrored node: a node whose world
  *    transform has a negative determinant has its polygons reversed here
  *    (glTF 2.0, "Instantiation": the determinant's sign defines the
@@ -367,6 +372,35 @@ static void convert_camera(converter *cv, bool gltf, double gltf_yfov)
     rad_scene_builder_camera(cv->builder, &c);
 }
 
+/* The JSON of a glTF (the file's bytes `data`), parsed into *json (the
+ * caller's to cJSON_Delete) and checked (gltf_check.c) before assimp reads
+ * it; JSON that does not parse is refused here, naming the line. */
+static rad_result import_gltf_parse_and_check(rad_context *ctx, const char *name,
+                                              const char *data, size_t size, bool glb,
+                                              struct aiFileIO *io, cJSON **json)
+{
+    size_t stop;
+    *json = import_gltf_json(data, size, glb, &stop);
+    if (!*json && glb)
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s: the JSON chunk is not JSON (byte %zu)", name,
+                        stop);
+    if (!*json) {
+        size_t line = 1, column = 1;
+        for (size_t i = 0; i < stop && i < size; i++, column++)
+            if (data[i] == '\n') {
+                line++;
+                column = 0;
+            }
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%zu:%zu: not JSON", name, line, column);
+    }
+    rad_result r = import_gltf_check(ctx, name, data, size, glb, *json, io);
+    if (r != RAD_OK) {
+        cJSON_Delete(*json);
+        *json = NULL;
+    }
+    return r;
+}
+
 /* Import `name` with assimp (through `io`);
  * `data` holds the file's bytes when the caller has them (glTF needs them
  * for the JSON), else NULL. */
@@ -393,7 +427,12 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
                         "limit of %s (rad_context_options.max_memory_bytes)",
                         name, file_size, need, ASSIMP_PEAK_PER_BYTE, limit_text);
     }
-    cJSON *json = gltf && data ? import_gltf_json(data, size, glb) : NULL;
+    cJSON *json = NULL;
+    if (gltf && data) {
+        rad_result checked = import_gltf_parse_and_check(ctx, name, data, size, glb, io, &json);
+        if (checked != RAD_OK)
+            return checked;
+    }
 
     struct aiPropertyStore *properties = aiCreatePropertyStore();
     if (!properties) {
