@@ -231,6 +231,22 @@ static void write_gltf(const char *name, const char *extra_nodes, const char *ex
     free(text);
 }
 
+/* An orthographic glTF camera, which the renderer does not draw, no longer
+ * fails the run: one warning line, the view framed automatically, exit 0. */
+static void test_gltf_orthographic_camera(void **state)
+{
+    (void)state;
+    write_gltf("ortho.gltf",
+               ",\n   {\"name\": \"top\", \"camera\": 0, \"translation\": [0.5, 0.5, 3]}",
+               ", \"cameras\": [{\"type\": \"orthographic\", \"orthographic\": "
+               "{\"xmag\": 1, \"ymag\": 1, \"znear\": 0.1, \"zfar\": 10}}]");
+    assert_int_equal(run("render ortho.gltf -o ortho.png --elements 50 --width 32 --height 32"), 0);
+    assert_one_line_error("radiosity: warning: ortho.gltf: camera 0 of node 'top' (2) is "
+                          "orthographic, which the renderer does not draw",
+                          "the view is framed automatically");
+    assert_true(exists("ortho.png"));
+}
+
 /* glTF files refused before assimp reads them: a tree 2,000 nodes deep
  * (20,000 overflowed the stack inside assimp), an index out of range
  * (assimp dropped the triangle): one line, exit 1, no output. */
@@ -609,6 +625,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_no_emitter),
         cmocka_unit_test(test_empty_scene),
         cmocka_unit_test(test_malformed_gltf),
+        cmocka_unit_test(test_gltf_orthographic_camera),
         cmocka_unit_test(test_gltf_refused),
         cmocka_unit_test(test_unknown_method_names),
         cmocka_unit_test(test_usage_errors),

@@ -937,6 +937,80 @@ static void test_gltf_strips_and_fans(void **state)
     assert_gltf_refused(&t, RAD_ERROR_INVALID_SCENE, "scene is empty (no polygons)", NULL);
 }
 
+/* ---- cameras ---- */
+
+typedef struct warnings {
+    int count;
+    char last[1024];
+} warnings;
+
+static void note_warning(void *user, const char *message)
+{
+    warnings *w = user;
+    w->count++;
+    snprintf(w->last, sizeof w->last, "%s", message);
+}
+
+/* An orthographic camera (which the renderer does not draw) no longer
+ * fails the file: the scene's first perspective camera is used, or none
+ * (the view is framed automatically), with one warning naming the file
+ * and the camera.  The first camera node in depth-first order is the
+ * scene's camera. */
+static void test_gltf_orthographic_camera(void **state)
+{
+    (void)state;
+    warnings seen = {0};
+    rad_context_options co = {.threads = 1, .on_warning = note_warning, .warning_user = &seen};
+    rad_context *warned = NULL;
+    assert_int_equal(rad_context_create(&co, &warned), RAD_OK);
+    const char *cameras = ", \"cameras\": [{\"name\": \"top\", \"type\": \"orthographic\", "
+                          "\"orthographic\": {\"xmag\": 2, \"ymag\": 1.5, \"znear\": 0.1, "
+                          "\"zfar\": 100}},\n {\"name\": \"eye\", \"type\": \"perspective\", "
+                          "\"perspective\": {\"yfov\": 0.8, \"znear\": 0.1}}]";
+    gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
+    static const struct {
+        const char *nodes, *roots;
+        bool has_camera;
+        double z, vfov;  /* the camera's position z and field of view, degrees */
+        const char *warning[2];
+    } cases[] = {
+        {"[{\"mesh\": 0}, {\"name\": \"above\", \"camera\": 0, \"translation\": [0, 0, 5]}]",
+         "[0, 1]", false, 0, 0,
+         {"x.gltf: camera 'top' (0) of node 'above' (1) is orthographic",
+          "the view is framed automatically"}},
+        {"[{\"mesh\": 0, \"children\": [2]}, {\"name\": \"side\", \"camera\": 1, "
+         "\"translation\": [0, 0, 7]}, {\"name\": \"above\", \"camera\": 0}]",
+         "[0, 1]", true, 7, 0.8 * 180 / M_PI,
+         {"camera 'top' (0) of node 'above' (2) is orthographic",
+          "using the perspective camera of node 'side' (1)"}},
+        {"[{\"mesh\": 0, \"children\": [2]}, {\"name\": \"above\", \"camera\": 0}, "
+         "{\"name\": \"near\", \"camera\": 1, \"translation\": [0, 0, 3]}]",
+         "[0, 1]", true, 3, 0.8 * 180 / M_PI, {NULL, NULL}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        seen.count = 0;
+        text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, cameras);
+        rad_scene *scene = NULL;
+        rad_api_enter(warned);
+        if (rad_scene_load_memory(warned, "x.gltf", t.data, t.length, NULL, 0, &scene) != RAD_OK)
+            fail_msg("case %zu: %s", k, rad_context_error(warned));
+        rad_camera camera;
+        assert_int_equal(rad_scene_camera(scene, &camera), cases[k].has_camera);
+        if (cases[k].has_camera) {
+            assert_close(camera.position[2], cases[k].z, 1e-12);
+            assert_close(camera.look_at[2], cases[k].z - 1.0, 1e-12);
+            assert_close(camera.vfov_degrees, cases[k].vfov, 1e-9);
+        }
+        assert_int_equal(seen.count, cases[k].warning[0] ? 1 : 0);
+        for (int i = 0; i < 2 && cases[k].warning[i]; i++)
+            assert_contains(seen.last, cases[k].warning[i]);
+        assert_null(strchr(seen.last, '\n'));
+        rad_scene_destroy(scene);
+        free(t.data);
+    }
+    rad_context_destroy(warned);
+}
+
 /* ---- the builder ---- */
 
 static void test_builder_surfaces_and_materials(void **state)
@@ -1338,6 +1412,7 @@ int main(void)
         cmocka_unit_test(test_gltf_mirrored),
         cmocka_unit_test(test_gltf_bad_primitives),
         cmocka_unit_test(test_gltf_strips_and_fans),
+        cmocka_unit_test(test_gltf_orthographic_camera),
         cmocka_unit_test(test_builder_surfaces_and_materials),
         cmocka_unit_test(test_builder_non_planar),
         cmocka_unit_test(test_builder_errors),

@@ -1,6 +1,6 @@
 /*
  * gltf_check.c -- a glTF 2.0 file checked on its JSON and its buffers
- * before assimp 5.2 reads it.
+ * before assimp 5.2 reads it, and the camera the scene is seen through.
  *
  *   JSON (cJSON) --version-->  2.x only
  *                --nodes--->   disjoint strict trees, at most GLTF_MAX_DEPTH
@@ -12,6 +12,7 @@
  *                --memory-->   assimp's nodes, faces, vertices and buffers,
  *                              and our triangles after instancing, against
  *                              the memory limit
+ *                --camera-->   the first perspective camera of the scene
  *
  * assimp 5.2 reads the node tree recursively (about 400 bytes of stack a
  * level: 20,000 nested nodes overflow an 8 MiB stack), copies a subtree for
@@ -26,7 +27,7 @@
  * hierarchy is a set of disjoint strict trees: no cycles, one parent at
  * most; a scene lists root nodes), "Accessors" (index component types,
  * sparse accessors: indices strictly increasing), "Meshes" (topologies and
- * their counts).
+ * their counts), "Cameras" (a camera looks down its node's -Z with +Y up).
  * Buffers are read through the import's file system (for a file import the
  * confined and logged one; a memory import has only its data: URIs and its
  * GLB chunk), a block at a time.
@@ -926,6 +927,95 @@ static rad_result check_scenes(checker *c, const cJSON *root, size_t *scene)
     return RAD_OK;
 }
 
+/* ---- the camera ---- */
+
+/* A node's local transform, glTF's column vectors: T * R * S, or its matrix
+ * (column-major).  The values were checked by check_transform. */
+static void node_local(const cJSON *node, double m[3][4])
+{
+    double values[16];
+    if (json_numbers(member(node, "matrix"), 16, values)) {
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 4; k++)
+                m[r][k] = values[4 * k + r];
+        return;
+    }
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    json_numbers(member(node, "translation"), 3, t);
+    json_numbers(member(node, "rotation"), 4, q);
+    json_numbers(member(node, "scale"), 3, s);
+    double norm = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    double x = q[0] / norm, y = q[1] / norm, z = q[2] / norm, w = q[3] / norm;
+    const double rotation[3][3] = {
+        {1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+        {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+        {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+    for (int r = 0; r < 3; r++) {
+        for (int k = 0; k < 3; k++)
+            m[r][k] = rotation[r][k] * s[k];
+        m[r][3] = t[r];
+    }
+}
+
+/* The world transform of `node`: its ancestors' locals, root first. */
+static void node_world(const checker *c, size_t node, double world[3][4])
+{
+    double local[3][4], product[3][4];
+    node_local(c->nodes.items[node], world);
+    for (size_t p = c->parent[node]; p != NONE; p = c->parent[p]) {
+        node_local(c->nodes.items[p], local);
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 4; k++)
+                product[r][k] = local[r][0] * world[0][k] + local[r][1] * world[1][k] +
+                                local[r][2] * world[2][k] + (k == 3 ? local[r][3] : 0.0);
+        memcpy(world, product, sizeof product);
+    }
+}
+
+static bool camera_is_orthographic(const cJSON *camera)
+{
+    const cJSON *type = member(camera, "type");
+    return cJSON_IsString(type) && strcmp(type->valuestring, "orthographic") == 0;
+}
+
+/* The camera of `node` placed as the spec says: at the node's origin,
+ * looking down its -Z with +Y up, yfov (default pi/2, as assimp's) the full
+ * vertical angle. */
+static rad_result place_camera(checker *c, size_t node, import_gltf_facts *facts)
+{
+    size_t index = (size_t)member(c->nodes.items[node], "camera")->valuedouble;
+    const cJSON *yfov = member(member(c->cameras.items[index], "perspective"), "yfov");
+    double vfov = M_PI / 2.0;
+    char what[160];
+    if (yfov && !(cJSON_IsNumber(yfov) && yfov->valuedouble > 0.0 && yfov->valuedouble < M_PI))
+        return fail(c, RAD_ERROR_INVALID_SCENE, "%s: yfov must be in (0, pi) radians",
+                    label(&c->cameras, index, "camera", what, sizeof what));
+    if (yfov)
+        vfov = yfov->valuedouble;
+    double w[3][4];
+    node_world(c, node, w);
+    double position[3], direction[3], up[3];
+    for (int r = 0; r < 3; r++) {
+        position[r] = w[r][3];
+        direction[r] = -w[r][2];
+        up[r] = w[r][1];
+    }
+    /* unit directions, so that a node scaled by 1e-9 or 1e9 still looks
+     * one metre ahead (a zero one stays zero: the builder refuses it) */
+    double up_length = sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+    double length = sqrt(direction[0] * direction[0] + direction[1] * direction[1] +
+                         direction[2] * direction[2]);
+    rad_camera camera = {{0}, {0}, {0}, vfov * 180.0 / M_PI};
+    for (int r = 0; r < 3; r++) {
+        camera.position[r] = position[r];
+        camera.look_at[r] = position[r] + (length > 0.0 ? direction[r] / length : 0.0);
+        camera.up[r] = up_length > 0.0 ? up[r] / up_length : up[r];
+    }
+    facts->has_camera = true;
+    facts->camera = camera;
+    return RAD_OK;
+}
+
 /* ---- the whole file ---- */
 
 /* Push the node indices of `array` (checked) so that the first is popped
@@ -944,28 +1034,55 @@ static void push_reversed(size_t *stack, size_t *top, const cJSON *array)
     }
 }
 
-/* Walk the chosen scene depth first (an explicit stack, roots in order),
- * counting instances and their triangles. */
+/* Walk the chosen scene depth first (an explicit stack, roots in order):
+ * count instances and their triangles, and pick the camera: the first camera
+ * node, or, when its camera is orthographic (which the renderer does not
+ * draw), the first perspective one, with a warning. */
 static rad_result walk_scene(checker *c, size_t scene, const double *mesh_triangles,
-                             double *instances, double *triangles)
+                             double *instances, double *triangles, import_gltf_facts *facts)
 {
     size_t n = c->nodes.count, top = 0;
     size_t *stack = rad_alloc(c->ctx, RAD_MEM_SCENE, n + 1, sizeof *stack, c->name);
     if (!stack)
         return RAD_ERROR_OUT_OF_MEMORY;
     push_reversed(stack, &top, member(c->scenes.items[scene], "nodes"));
+    size_t first_camera = NONE, perspective = NONE;
     while (top > 0) {
         size_t node = stack[--top];
         const cJSON *json = c->nodes.items[node];
         *instances += 1.0;
         if (member(json, "mesh"))
             *triangles += mesh_triangles[(size_t)member(json, "mesh")->valuedouble];
+        if (member(json, "camera")) {
+            const cJSON *camera = c->cameras.items[(size_t)member(json, "camera")->valuedouble];
+            if (first_camera == NONE)
+                first_camera = node;
+            if (perspective == NONE && !camera_is_orthographic(camera))
+                perspective = node;
+        }
         /* the first child is walked next; a tree holds each node once, so
          * the stack never holds more than n */
         push_reversed(stack, &top, member(json, "children"));
     }
     rad_free(stack);
-    return RAD_OK;
+    if (first_camera != NONE && first_camera != perspective) {
+        char camera[160], node[160], other[160];
+        size_t index = (size_t)member(c->nodes.items[first_camera], "camera")->valuedouble;
+        label(&c->cameras, index, "camera", camera, sizeof camera);
+        label(&c->nodes, first_camera, "node", node, sizeof node);
+        if (perspective != NONE)
+            rad_warn(c->ctx,
+                     "%s: %s of %s is orthographic, which the renderer does not draw; using the "
+                     "perspective camera of %s",
+                     c->name, camera, node,
+                     label(&c->nodes, perspective, "node", other, sizeof other));
+        else
+            rad_warn(c->ctx,
+                     "%s: %s of %s is orthographic, which the renderer does not draw; the view "
+                     "is framed automatically",
+                     c->name, camera, node);
+    }
+    return perspective != NONE ? place_camera(c, perspective, facts) : RAD_OK;
 }
 
 /* The GLB's BIN chunk: the chunk after the JSON one, if it is there and of
@@ -1000,8 +1117,10 @@ static rad_result check_version(checker *c, const cJSON *root)
 }
 
 rad_result import_gltf_check(rad_context *ctx, const char *name, const char *data, size_t size,
-                             bool binary, const cJSON *root, struct aiFileIO *io)
+                             bool binary, const cJSON *root, struct aiFileIO *io,
+                             import_gltf_facts *facts)
 {
+    memset(facts, 0, sizeof *facts);
     checker c = {.ctx = ctx, .name = name, .io = io, .binary = binary};
     if (binary)
         find_bin_chunk(&c, data, size);
@@ -1063,7 +1182,7 @@ rad_result import_gltf_check(rad_context *ctx, const char *name, const char *dat
     }
     double instances = 0.0, triangles = 0.0;
     if (r == RAD_OK && scene != NONE)
-        r = walk_scene(&c, scene, mesh_triangles, &instances, &triangles);
+        r = walk_scene(&c, scene, mesh_triangles, &instances, &triangles, facts);
 
     /* What the import will take, against the memory limit. */
     if (r == RAD_OK) {
@@ -1102,5 +1221,7 @@ rad_result import_gltf_check(rad_context *ctx, const char *name, const char *dat
     rad_free(c.buffer);
     for (size_t k = 0; k < sizeof tables / sizeof tables[0]; k++)
         rad_free(tables[k].t->items);
+    if (r != RAD_OK)
+        memset(facts, 0, sizeof *facts);
     return r;
 }

@@ -4,10 +4,9 @@
  * Before assimp: the framing of a GLB file is checked, because assimp
  * allocates what the header and chunk headers claim before comparing it
  * with the file's size.  After assimp: it ignores
- * KHR_materials_emissive_strength and turns the camera's yfov into an
- * approximate horizontal angle, so the glTF JSON (all of a .gltf, the
- * first chunk of a .glb) is read with cJSON for both (and for the checks
- * of gltf_check.c).
+ * KHR_materials_emissive_strength, so the glTF JSON (all of a .gltf, the
+ * first chunk of a .glb) is read with cJSON for it (and for the checks of
+ * gltf_check.c).
  *
  *    GLB:  "glTF" version length | chunk length "JSON" text | chunk length "BIN\0" data
  *
@@ -108,14 +107,4 @@ double import_gltf_emissive_strength(const cJSON *materials, unsigned index, con
         cJSON_GetObjectItemCaseSensitive(extensions, "KHR_materials_emissive_strength");
     const cJSON *strength = cJSON_GetObjectItemCaseSensitive(extension, "emissiveStrength");
     return cJSON_IsNumber(strength) ? strength->valuedouble : 1.0;
-}
-
-/* The full vertical field of view (radians) of the first glTF camera, or 0. */
-double import_gltf_camera_yfov(const cJSON *root)
-{
-    const cJSON *cameras = cJSON_GetObjectItemCaseSensitive(root, "cameras");
-    const cJSON *perspective =
-        cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(cameras, 0), "perspective");
-    const cJSON *yfov = cJSON_GetObjectItemCaseSensitive(perspective, "yfov");
-    return cJSON_IsNumber(yfov) ? yfov->valuedouble : 0.0;
 }

@@ -20,9 +20,10 @@
  *  - it ignores KHR_materials_emissive_strength, turns the glTF camera's
  *    yfov into an approximate horizontal angle and copies the camera node's
  *    translation into aiCamera::mPosition (counting it twice): the glTF
- *    JSON is read with cJSON for the strength and yfov (gltf_fixes.c), and
- *    a glTF camera is placed as the glTF 2.0 spec says (at its node's
- *    origin, looking down -Z with +Y up);
+ *    JSON is read with cJSON for the strength (gltf_fixes.c), and the glTF
+ *    camera is placed from it as the spec says (gltf_check.c: at its node's
+ *    origin, looking down -Z with +Y up; an orthographic one, which the
+ *    renderer does not draw, is replaced, with a warning);
  *  - it reads glTF node trees recursively (20,000 levels overflow the
  *    stack), copies a subtree for each parent that lists it, drops a
  *    triangle with an index out of range without a word and misreads
@@ -341,28 +342,19 @@ static bool find_node(converter *cv, const struct aiNode *root, const char *name
     return found;
 }
 
-/* The first camera, placed by its node.  `gltf_yfov` (radians, 0 if
- * unknown) overrides assimp's field of view for glTF. */
-static void convert_camera(converter *cv, bool gltf, double gltf_yfov)
+/* The first camera of a format other than glTF (whose camera
+ * gltf_check.c places), placed by its node. */
+static void convert_camera(converter *cv)
 {
     const struct aiCamera *camera = cv->ai->mCameras[0];
     affine world = affine_identity();
     find_node(cv, cv->ai->mRootNode, camera->mName.data, &world);
-    vec3 position = v3(0.0, 0.0, 0.0), direction = v3(0.0, 0.0, -1.0), up = v3(0.0, 1.0, 0.0);
-    if (!gltf) {
-        position = vec3_of(&camera->mPosition);
-        direction = vec3_of(&camera->mLookAt); /* a direction, not a point */
-        up = vec3_of(&camera->mUp);
-    }
-    position = affine_point(&world, position);
-    direction = affine_direction(&world, direction);
-    up = v3_normalize(affine_direction(&world, up));
-    double vfov = gltf_yfov;
-    if (!(vfov > 0.0)) {
-        /* Read as the full horizontal angle, as assimp's importers fill it. */
-        double aspect = camera->mAspect > 0.0f ? (double)camera->mAspect : 1.0;
-        vfov = 2.0 * atan(tan(0.5 * (double)camera->mHorizontalFOV) / aspect);
-    }
+    vec3 position = affine_point(&world, vec3_of(&camera->mPosition));
+    vec3 direction = affine_direction(&world, vec3_of(&camera->mLookAt)); /* a direction */
+    vec3 up = v3_normalize(affine_direction(&world, vec3_of(&camera->mUp)));
+    /* Read as the full horizontal angle, as assimp's importers fill it. */
+    double aspect = camera->mAspect > 0.0f ? (double)camera->mAspect : 1.0;
+    double vfov = 2.0 * atan(tan(0.5 * (double)camera->mHorizontalFOV) / aspect);
     rad_camera c = {
         .position = {position.x, position.y, position.z},
         .look_at = {position.x + direction.x, position.y + direction.y, position.z + direction.z},
@@ -377,7 +369,8 @@ static void convert_camera(converter *cv, bool gltf, double gltf_yfov)
  * it; JSON that does not parse is refused here, naming the line. */
 static rad_result import_gltf_parse_and_check(rad_context *ctx, const char *name,
                                               const char *data, size_t size, bool glb,
-                                              struct aiFileIO *io, cJSON **json)
+                                              struct aiFileIO *io, cJSON **json,
+                                              import_gltf_facts *facts)
 {
     size_t stop;
     *json = import_gltf_json(data, size, glb, &stop);
@@ -393,7 +386,7 @@ static rad_result import_gltf_parse_and_check(rad_context *ctx, const char *name
             }
         return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%zu:%zu: not JSON", name, line, column);
     }
-    rad_result r = import_gltf_check(ctx, name, data, size, glb, *json, io);
+    rad_result r = import_gltf_check(ctx, name, data, size, glb, *json, io, facts);
     if (r != RAD_OK) {
         cJSON_Delete(*json);
         *json = NULL;
@@ -428,8 +421,10 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
                         name, file_size, need, ASSIMP_PEAK_PER_BYTE, limit_text);
     }
     cJSON *json = NULL;
+    import_gltf_facts facts = {0};
     if (gltf && data) {
-        rad_result checked = import_gltf_parse_and_check(ctx, name, data, size, glb, io, &json);
+        rad_result checked = import_gltf_parse_and_check(ctx, name, data, size, glb, io, &json,
+                                                         &facts);
         if (checked != RAD_OK)
             return checked;
     }
@@ -473,8 +468,10 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
     r = convert_nodes(&cv, ai->mRootNode);
     if (r != RAD_OK)
         goto done;
-    if (ai->mNumCameras > 0 && ai->mCameras[0])
-        convert_camera(&cv, gltf, import_gltf_camera_yfov(json));
+    if (gltf && facts.has_camera)
+        rad_scene_builder_camera(cv.builder, &facts.camera);
+    else if (!gltf && ai->mNumCameras > 0 && ai->mCameras[0])
+        convert_camera(&cv);
     r = rad_scene_builder_finish(cv.builder, out);
     cv.builder = NULL;
 
