@@ -598,7 +598,8 @@ static float *zigzag(size_t triangles, size_t *vertices)
 /* Instances times triangles against the memory limit: 100 nodes each
  * instancing one strip of 10,000 triangles would hold 10^6 triangles
  * (about 130 MB) and are refused under a 64 MiB limit before assimp reads
- * the file; 10 instances load, every triangle of every instance there. */
+ * the file; 10 instances load, every triangle of every instance there.
+ * And an external buffer larger than the limit allows. */
 static void test_gltf_instances_memory(void **state)
 {
     (void)state;
@@ -644,6 +645,35 @@ static void test_gltf_instances_memory(void **state)
         free(roots.data);
     }
     free(strip);
+
+    /* An external buffer of 1 MiB under a 1 MiB limit: assimp would hold it
+     * and copy out of it; refused before a byte of it is read. */
+    char bin_path[512];
+    snprintf(bin_path, sizeof bin_path, "%s/big.bin", temp_dir);
+    FILE *bin = fopen(bin_path, "wb");
+    assert_non_null(bin);
+    assert_int_equal(fseek(bin, 1048575, SEEK_SET), 0);
+    assert_int_equal(fputc(0, bin), 0);
+    fclose(bin);
+    rad_context *small = NULL;
+    co.max_memory_bytes = 1048576.0;
+    assert_int_equal(rad_context_create(&co, &small), RAD_OK);
+    const char *path = write_temp(
+        "big.gltf",
+        "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": "
+        "[{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}], "
+        "\"buffers\": [{\"byteLength\": 1048576, \"uri\": \"big.bin\"}], \"bufferViews\": "
+        "[{\"buffer\": 0, \"byteLength\": 36}], \"accessors\": [{\"bufferView\": 0, "
+        "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}]}");
+    rad_scene *scene = NULL;
+    rad_api_enter(small);
+    assert_int_equal(rad_scene_load_file(small, path, &scene), RAD_ERROR_OUT_OF_MEMORY);
+    assert_null(scene);
+    assert_contains(rad_context_error(small), "big.gltf: its buffers need about 2.0 MiB to import");
+    assert_contains(rad_context_error(small), "above the memory limit of 1.0 MiB");
+    remove(bin_path);
+    remove(path);
+    rad_context_destroy(small);
     rad_context_destroy(limited);
 }
 

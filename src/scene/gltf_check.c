@@ -142,6 +142,7 @@ typedef struct checker {
     size_t bin_size;
     table nodes, meshes, accessors, views, buffers, cameras, scenes;
     gltf_buffer *buffer;          /* per buffer, opened on first use */
+    double buffer_bytes;          /* the opened buffers' byteLengths */
     size_t *parent;               /* per node: its parent, or NONE */
     unsigned char *block[2];      /* two streams' blocks of GLTF_BLOCK bytes */
     unsigned char *positions_ok;  /* per accessor: its positions were found finite */
@@ -246,6 +247,24 @@ static size_t folder_length(const char *name)
     return slash ? (size_t)(slash - name) + 1 : 0;
 }
 
+/* Count an opened buffer: assimp will hold it, and copies out of it; a
+ * buffer that alone passes the memory limit is refused before a byte of it
+ * is read. */
+static rad_result buffer_count(checker *c, const gltf_buffer *b)
+{
+    c->buffer_bytes += (double)b->declared;
+    double need = ASSIMP_BUFFER_COPIES * c->buffer_bytes, limit = rad_memory_limit(c->ctx);
+    if (need <= limit)
+        return RAD_OK;
+    char need_text[32], limit_text[32];
+    rad_format_bytes(need, need_text, sizeof need_text);
+    rad_format_bytes(limit, limit_text, sizeof limit_text);
+    return fail(c, RAD_ERROR_OUT_OF_MEMORY,
+                "its buffers need about %s to import (%.0fx their size), above the memory "
+                "limit of %s (rad_context_options.max_memory_bytes)",
+                need_text, ASSIMP_BUFFER_COPIES, limit_text);
+}
+
 static rad_result buffer_open(checker *c, size_t index, gltf_buffer **out)
 {
     gltf_buffer *b = &c->buffer[index];
@@ -269,7 +288,7 @@ static rad_result buffer_open(checker *c, size_t index, gltf_buffer **out)
             return fail(c, RAD_ERROR_PARSE,
                         "%s: byteLength is %zu, but the BIN chunk has %zu bytes", what,
                         b->declared, b->available);
-        return RAD_OK;
+        return buffer_count(c, b);
     }
     if (!uri) {
         return fail(c, RAD_ERROR_PARSE,
@@ -315,7 +334,7 @@ static rad_result buffer_open(checker *c, size_t index, gltf_buffer **out)
     if (b->declared > b->available)
         return fail(c, RAD_ERROR_PARSE, "%s: byteLength is %zu, but its data has %zu bytes", what,
                     b->declared, b->available);
-    return RAD_OK;
+    return buffer_count(c, b);
 }
 
 /* Bytes [offset, offset + length) of an opened buffer, within its
@@ -672,9 +691,9 @@ typedef struct mesh_cost {
     double vertices;  /* assimp's vertices: each primitive copies its own */
 } mesh_cost;
 
-static const char *const mode_names[] = {"points",    "lines",           "a line loop",
-                                         "a line strip", "triangles",   "a triangle strip",
-                                         "a triangle fan"};
+static const char *const mode_names[] = {
+    "points", "lines", "a line loop", "a line strip", "triangles", "a triangle strip",
+    "a triangle fan"};
 
 /* One primitive: its topology, its POSITION (finite float triples), its
  * indices (unsigned, below the vertex count) and its count for the mode. */
@@ -1186,9 +1205,7 @@ rad_result import_gltf_check(rad_context *ctx, const char *name, const char *dat
 
     /* What the import will take, against the memory limit. */
     if (r == RAD_OK) {
-        double buffers = 0.0;
-        for (size_t b = 0; b < c.buffers.count; b++)
-            buffers += (double)c.buffer[b].declared;
+        double buffers = c.buffer_bytes;
         double need = ASSIMP_BYTES_PER_NODE * (double)c.nodes.count +
                       ASSIMP_BYTES_PER_FACE * cost.faces +
                       ASSIMP_BYTES_PER_VERTEX * cost.vertices + ASSIMP_BUFFER_COPIES * buffers +
