@@ -202,6 +202,16 @@ static int fail(rad_context *ctx, rad_result r)
     return 1;
 }
 
+/* The library's warnings (an orthographic glTF camera replaced): one line
+ * each, its field names written as our flags, as its errors are. */
+static void print_warning(void *user, const char *message)
+{
+    (void)user;
+    char text[1024];
+    cli_rewrite_message(message, text, sizeof text);
+    fprintf(stderr, "radiosity: warning: %s\n", text);
+}
+
 /* The absolute path of a file just written, for telling the user where it
  * is; falls back to the name as given. */
 static const char *where(const char *path, char *buf)
@@ -268,6 +278,7 @@ int main(int argc, char **argv)
     /* --max-memory limits everything the engine allocates, loading included. */
     co.max_memory_bytes = s.solve.max_memory_bytes;
     co.read_outside_scene_folder = s.read_outside != 0;
+    co.on_warning = print_warning;
     if (!s.quiet && isatty(STDERR_FILENO) && s.command != CLI_GENERATE) {
         co.progress = progress_bar;
         co.progress_user = &progress;

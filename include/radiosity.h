@@ -122,6 +122,12 @@ typedef void (*rad_progress_fn)(void *user, const char *phase, uint64_t done, ui
  * rad_context_error() will return, from the thread that made the call. */
 typedef void (*rad_error_fn)(void *user, rad_result result, const char *message);
 
+/* Called when a call succeeds but reads its input differently from what the
+ * file asks (a glTF orthographic camera, which the renderer does not draw,
+ * replaced): one line naming the file, valid during the callback only; from
+ * the thread that made the call. */
+typedef void (*rad_warning_fn)(void *user, const char *message);
+
 typedef struct rad_context_options {
     int threads;                 /* worker threads; 0 = all cores */
     rad_progress_fn progress;    /* optional progress callback */
@@ -140,10 +146,12 @@ typedef struct rad_context_options {
                                     assimp, Embree, LAPACK and cJSON allocate themselves
                                     is not counted (loading refuses files that assimp
                                     would need more than the limit for: docs/robustness.md) */
+    rad_warning_fn on_warning;   /* optional: told of input read differently from the file */
+    void *warning_user;          /* passed to `on_warning` */
 } rad_context_options;
 
 /* Create a context.  `options` may be NULL (all defaults); it is copied, but
- * the pointers in it (progress_user, error_user) are kept and must stay
+ * the pointers in it (progress_user, error_user, warning_user) are kept and must stay
  * valid until the context is destroyed.  Fails with
  * RAD_ERROR_INVALID_ARGUMENT when `out` is NULL, threads < 0 or
  * max_memory_bytes < 0, RAD_ERROR_OUT_OF_MEMORY when the allocation fails

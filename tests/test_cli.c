@@ -195,6 +195,101 @@ static void test_malformed_gltf(void **state)
               "broken.gltf", NULL);
 }
 
+/* A glTF of the unit quad (4 float positions, 6 ushort indices, base64):
+ * a white floor facing +z, a lamp turned over it at z = 1, and `extra`
+ * top-level JSON (", \"cameras\": ...") with its `extra_nodes`. */
+static void write_gltf(const char *name, const char *extra_nodes, const char *extra)
+{
+    size_t size = strlen(extra_nodes) + strlen(extra) + 4096;
+    char *text = malloc(size);
+    assert_non_null(text);
+    snprintf(text, size,
+             "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0,\n"
+             " \"scenes\": [{\"nodes\": [0, 1%s]}],\n"
+             " \"nodes\": [{\"name\": \"floor\", \"mesh\": 0},\n"
+             "   {\"name\": \"lamp\", \"mesh\": 1, \"translation\": [0, 1, 1], "
+             "\"rotation\": [1, 0, 0, 0]}%s],\n"
+             " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, "
+             "\"material\": 0}]},\n"
+             "   {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, "
+             "\"material\": 1}]}],\n"
+             " \"materials\": [{\"pbrMetallicRoughness\": "
+             "{\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}},\n"
+             "   {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}, "
+             "\"emissiveFactor\": [1, 1, 1]}],\n"
+             " \"buffers\": [{\"byteLength\": 60, \"uri\": \"data:application/octet-stream;base64,"
+             "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8"
+             "AAAAAAAABAAIAAAACAAMA\"}],\n"
+             " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 48}, "
+             "{\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 12}],\n"
+             " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, "
+             "\"type\": \"VEC3\"},\n"
+             "   {\"bufferView\": 1, \"componentType\": 5123, \"count\": 6, "
+             "\"type\": \"SCALAR\"}]%s}\n",
+             extra_nodes[0] ? ", 2" : "", extra_nodes, extra);
+    write_file(name, text);
+    free(text);
+}
+
+/* An orthographic glTF camera, which the renderer does not draw, no longer
+ * fails the run: one warning line, the view framed automatically, exit 0. */
+static void test_gltf_orthographic_camera(void **state)
+{
+    (void)state;
+    write_gltf("ortho.gltf",
+               ",\n   {\"name\": \"top\", \"camera\": 0, \"translation\": [0.5, 0.5, 3]}",
+               ", \"cameras\": [{\"type\": \"orthographic\", \"orthographic\": "
+               "{\"xmag\": 1, \"ymag\": 1, \"znear\": 0.1, \"zfar\": 10}}]");
+    assert_int_equal(run("render ortho.gltf -o ortho.png --elements 50 --width 32 --height 32"), 0);
+    assert_one_line_error("radiosity: warning: ortho.gltf: camera 0 of node 'top' (2) is "
+                          "orthographic, which the renderer does not draw",
+                          "the view is framed automatically");
+    assert_true(exists("ortho.png"));
+}
+
+/* glTF files refused before assimp reads them: a tree 2,000 nodes deep
+ * (20,000 overflowed the stack inside assimp), an index out of range
+ * (assimp dropped the triangle): one line, exit 1, no output. */
+static void test_gltf_refused(void **state)
+{
+    (void)state;
+    size_t size = 64 * 2000 + 256, length = 0;
+    char *nodes = malloc(size);
+    assert_non_null(nodes);
+    for (int i = 0; i < 1999; i++)
+        length += (size_t)snprintf(nodes + length, size - length, ",\n   {\"children\": [%d]}",
+                                   i + 3);
+    snprintf(nodes + length, size - length, ",\n   {\"name\": \"bottom\"}");
+    write_gltf("deep.gltf", nodes, "");
+    free(nodes);
+    assert_int_equal(run("render deep.gltf -o bad_out.png"), 1);
+    assert_one_line_error("deep.gltf: node 'bottom' (2001) is nested 2000 levels deep",
+                          "at most 1000 levels are read");
+    assert_no_output("bad_out");
+
+    write_gltf("range.gltf", "", "");
+    char *text = NULL;
+    char path[600];
+    snprintf(path, sizeof path, "%s/range.gltf", workdir);
+    FILE *f = fopen(path, "r+b");
+    assert_non_null(f);
+    text = calloc(1, 8192);
+    assert_non_null(text);
+    size_t n = fread(text, 1, 8191, f);
+    /* the last index, 3 (its group of bytes 00 03 00 is "AAMA"), becomes 9
+     * (00 09 00, "AAkA") */
+    char *last = strstr(text, "AAACAAMA");
+    assert_non_null(last);
+    memcpy(last + 4, "AAkA", 4);
+    rewind(f);
+    assert_int_equal(fwrite(text, 1, n, f), n);
+    fclose(f);
+    free(text);
+    assert_int_equal(run("render range.gltf -o bad_out.png"), 1);
+    assert_one_line_error("range.gltf: mesh 0 primitive 0: index 5 refers to vertex 9 of 4", NULL);
+    assert_no_output("bad_out");
+}
+
 /* ---- bad input: the command line ---- */
 
 /* A method name is checked against the library's registry while parsing:
@@ -530,6 +625,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_no_emitter),
         cmocka_unit_test(test_empty_scene),
         cmocka_unit_test(test_malformed_gltf),
+        cmocka_unit_test(test_gltf_orthographic_camera),
+        cmocka_unit_test(test_gltf_refused),
         cmocka_unit_test(test_unknown_method_names),
         cmocka_unit_test(test_usage_errors),
         cmocka_unit_test(test_unwritable_output),

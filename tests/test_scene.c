@@ -13,6 +13,7 @@
 
 #include "scene/scene.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -309,6 +310,737 @@ static void test_gltf(void **state)
     rad_scene_destroy(scene);
 }
 
+/* ---- glTF built in memory: hostile and awkward files ---- */
+
+/* Text that grows: printf into it. */
+typedef struct text {
+    char *data;
+    size_t length, capacity;
+} text;
+
+static void put(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+static void put(text *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    assert_true(n >= 0);
+    if (t->length + (size_t)n + 1 > t->capacity) {
+        t->capacity = 2 * (t->length + (size_t)n + 1);
+        t->data = realloc(t->data, t->capacity);
+        assert_non_null(t->data);
+    }
+    va_start(ap, fmt);
+    vsnprintf(t->data + t->length, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+    t->length += (size_t)n;
+}
+
+/* Replace the first `old` in t by `new_text`; fails the test if absent. */
+static void patch(text *t, const char *old, const char *new_text)
+{
+    char *at = strstr(t->data, old);
+    if (!at)
+        fail_msg("patch: '%s' not in the glTF", old);
+    size_t before = (size_t)(at - t->data), old_length = strlen(old);
+    text patched = {0};
+    put(&patched, "%.*s%s%s", (int)before, t->data, new_text, at + old_length);
+    free(t->data);
+    *t = patched;
+}
+
+/* One mesh of a glTF made by gltf_text: its single primitive's float
+ * positions, its 32-bit indices (NULL: none), its topology and material
+ * (0: "white", reflectance 0.5; 1: "lamp", black, emissive 1: E = pi). */
+typedef struct gltf_mesh {
+    const float *positions;
+    size_t vertices;
+    const uint32_t *indices;
+    size_t index_count;
+    int mode;
+    int material;
+} gltf_mesh;
+
+static void put_base64(text *t, const unsigned char *bytes, size_t n)
+{
+    static const char alphabet[] =
+        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    for (size_t i = 0; i < n; i += 3) {
+        unsigned v = (unsigned)bytes[i] << 16 | (i + 1 < n ? (unsigned)bytes[i + 1] << 8 : 0) |
+                     (i + 2 < n ? bytes[i + 2] : 0);
+        put(t, "%c%c%c%c", alphabet[v >> 18], alphabet[v >> 12 & 63],
+            i + 1 < n ? alphabet[v >> 6 & 63] : '=', i + 2 < n ? alphabet[v & 63] : '=');
+    }
+}
+
+/* A glTF 2.0 file: `nodes` and the default scene's `roots` as JSON
+ * arrays, mesh i made of meshes[i] with accessors 2i (POSITION, VEC3
+ * float) and 2i + 1 (indices, SCALAR uint32), all in one base64 buffer;
+ * `extra` is more top-level JSON (", \"cameras\": [...]") or "". */
+static text gltf_text(const char *nodes, const char *roots, const gltf_mesh *meshes, size_t count,
+                      const char *extra)
+{
+    size_t bytes = 0;
+    for (size_t m = 0; m < count; m++)
+        bytes += 12 * meshes[m].vertices + 4 * meshes[m].index_count;
+    unsigned char *buffer = calloc(bytes + 1, 1);
+    assert_non_null(buffer);
+    text t = {0}, views = {0}, accessors = {0};
+    put(&t, "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": %s}],\n"
+            " \"nodes\": %s,\n \"meshes\": [",
+        roots, nodes);
+    size_t offset = 0;
+    for (size_t m = 0; m < count; m++) {
+        const gltf_mesh *mesh = &meshes[m];
+        put(&t, "%s{\"name\": \"m%zu\", \"primitives\": [{\"attributes\": {\"POSITION\": %zu}, "
+                "\"mode\": %d, \"material\": %d",
+            m ? ",\n  " : "", m, 2 * m, mesh->mode, mesh->material);
+        if (mesh->indices)
+            put(&t, ", \"indices\": %zu", 2 * m + 1);
+        put(&t, "}]}");
+        for (int pass = 0; pass < 2; pass++) {
+            size_t length = pass ? 4 * mesh->index_count : 12 * mesh->vertices;
+            const void *data = pass ? (const void *)mesh->indices : (const void *)mesh->positions;
+            if (length)
+                memcpy(buffer + offset, data, length); /* little-endian, as glTF */
+            /* no indices: a dummy view of the first 4 bytes, never read */
+            put(&views, "%s{\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": %zu}",
+                views.length ? ", " : "", length ? offset : 0, length ? length : 4);
+            if (pass == 0)
+                put(&accessors, "%s{\"bufferView\": %zu, \"componentType\": 5126, \"count\": %zu, "
+                                "\"type\": \"VEC3\"}",
+                    accessors.length ? ",\n  " : "", 2 * m, mesh->vertices);
+            else
+                put(&accessors, ",\n  {\"bufferView\": %zu, \"componentType\": 5125, "
+                                "\"count\": %zu, \"type\": \"SCALAR\"}",
+                    2 * m + 1, mesh->index_count ? mesh->index_count : 1);
+            offset += length;
+        }
+    }
+    put(&t, "],\n \"materials\": [{\"name\": \"white\", \"pbrMetallicRoughness\": "
+            "{\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}},\n"
+            "  {\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]},"
+            " \"emissiveFactor\": [1, 1, 1]}],\n"
+            " \"buffers\": [{\"byteLength\": %zu, \"uri\": \"data:application/octet-stream;base64,",
+        offset ? offset : 4);
+    put_base64(&t, buffer, offset ? offset : 4);
+    put(&t, "\"}],\n \"bufferViews\": [%s],\n \"accessors\": [%s]%s}\n", views.data,
+        accessors.data, extra);
+    free(buffer);
+    free(views.data);
+    free(accessors.data);
+    return t;
+}
+
+/* The unit quad in the z = 0 plane, facing +z (two triangles). */
+static const float unit_quad[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+static const uint32_t unit_quad_indices[] = {0, 1, 2, 0, 2, 3};
+
+static rad_result load_gltf(const text *t, rad_scene **scene)
+{
+    *scene = NULL;
+    rad_api_enter(ctx);
+    return rad_scene_load_memory(ctx, "x.gltf", t->data, t->length, NULL, 0, scene);
+}
+
+/* Load `t`; it must fail with `expected` and a one-line message naming
+ * x.gltf and holding every part given. */
+static void assert_gltf_refused(text *t, rad_result expected, const char *part1,
+                                const char *part2)
+{
+    rad_scene sentinel, *scene = &sentinel;
+    rad_result r = rad_scene_load_memory(ctx, "x.gltf", t->data, t->length, NULL, 0, &scene);
+    if (r != expected)
+        fail_msg("got %s (\"%s\"), expected %s", rad_result_string(r), rad_context_error(ctx),
+                 rad_result_string(expected));
+    assert_null(scene);
+    assert_null(strchr(rad_context_error(ctx), '\n'));
+    assert_contains(rad_context_error(ctx), "x.gltf: ");
+    if (part1)
+        assert_contains(rad_context_error(ctx), part1);
+    if (part2)
+        assert_contains(rad_context_error(ctx), part2);
+    free(t->data);
+    t->data = NULL;
+}
+
+/* A chain of `depth` nested nodes, each moved 1 mm up in y, the last
+ * holding the unit quad. */
+static text nested(size_t depth)
+{
+    text nodes = {0};
+    put(&nodes, "[");
+    for (size_t i = 0; i + 1 < depth; i++)
+        put(&nodes, "{\"translation\": [0, 0.001, 0], \"children\": [%zu]},", i + 1);
+    put(&nodes, "{\"translation\": [0, 0.001, 0], \"mesh\": 0}]");
+    gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
+    text t = gltf_text(nodes.data, "[0]", &quad, 1, "");
+    free(nodes.data);
+    return t;
+}
+
+/* 1,000 levels load, every level's transform applied (walked without
+ * recursion); 1,001 and 20,000 (which overflowed the stack inside assimp)
+ * are refused before assimp reads them, naming the deepest node and the
+ * limit. */
+static void test_gltf_nesting(void **state)
+{
+    (void)state;
+    text t = nested(1000);
+    rad_scene *scene = NULL;
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    assert_int_equal(rad_scene_polygon_count(scene), 2);
+    assert_close(rad_scene_surface_area(scene, 0), 1.0, 1e-12);
+    /* 1000 x 0.001 (a float: 0.0010000000475) */
+    assert_close(scene->bounds_min.y, 1.0, 1e-6);
+    assert_close(scene->bounds_max.y, 2.0, 1e-6);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    t = nested(1001);
+    assert_gltf_refused(&t, RAD_ERROR_PARSE, "node 1000 is nested 1001 levels deep",
+                        "at most 1000 levels");
+    t = nested(20000);
+    assert_gltf_refused(&t, RAD_ERROR_PARSE, "node 19999 is nested 20000 levels deep", NULL);
+}
+
+/* Node graphs that are not disjoint strict trees (glTF 2.0, "Nodes and
+ * Hierarchy"), among them the instance bomb: 9 levels of 10 nodes, each
+ * listing all 10 of the next level, which assimp expanded to 10^8 copies. */
+static void test_gltf_node_graphs(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *nodes, *roots, *message[2];
+    } cases[] = {
+        {"[{\"name\": \"a\", \"children\": [2]}, {\"name\": \"b\", \"children\": [2]}, "
+         "{\"name\": \"c\", \"mesh\": 0}]",
+         "[0, 1]", {"node 'c' (2) is a child of both node 'a' (0) and node 'b' (1)", NULL}},
+        {"[{\"name\": \"a\", \"children\": [1]}, {\"name\": \"b\", \"children\": [0], "
+         "\"mesh\": 0}]",
+         "[0]", {"is its own ancestor (the nodes form a cycle)", NULL}},
+        {"[{\"name\": \"r\", \"mesh\": 0}, {\"children\": [2]}, {\"children\": [3]}, "
+         "{\"children\": [1], \"mesh\": 0}]",
+         "[0]", {"is its own ancestor", NULL}},
+        /* a cycle hung under a root: some node of it has two parents */
+        {"[{\"name\": \"r\", \"children\": [1]}, {\"children\": [2]}, {\"children\": [1], "
+         "\"mesh\": 0}]",
+         "[0]", {"node 1 is a child of both node 'r' (0) and node 2", NULL}},
+        {"[{\"name\": \"a\", \"children\": [0], \"mesh\": 0}]", "[0]",
+         {"node 'a' (0) is its own child", NULL}},
+        {"[{\"name\": \"a\", \"children\": [1, 1]}, {\"mesh\": 0}]", "[0]",
+         {"node 'a' (0) lists node 1 twice", NULL}},
+        {"[{\"name\": \"a\", \"children\": [1]}, {\"name\": \"b\", \"mesh\": 0}]", "[0, 1]",
+         {"scene 0 lists node 'b' (1), a child of node 'a' (0)", NULL}},
+        {"[{\"mesh\": 0}]", "[0, 0]", {"scene 0 lists node 0 twice", NULL}},
+        {"[{\"children\": [7], \"mesh\": 0}]", "[0]",
+         {"node 0: a child is not a node index", NULL}},
+        {"[{\"children\": [0.5], \"mesh\": 0}]", "[0]", {"a child is not a node index", NULL}},
+        {"[{\"children\": [-1], \"mesh\": 0}]", "[0]", {"a child is not a node index", NULL}},
+        {"[{\"mesh\": 3}]", "[0]", {"node 0 refers to no mesh (1 meshes)", NULL}},
+        {"[{\"mesh\": 0}]", "[4]", {"scene 0 lists something that is not a node index", NULL}},
+        {"[{\"mesh\": 0, \"scale\": [1, 1]}]", "[0]", {"scale must be 3 finite numbers", NULL}},
+        {"[{\"mesh\": 0, \"translation\": [0, 1e999, 0]}]", "[0]",
+         {"translation must be 3 finite numbers", NULL}},
+        {"[{\"mesh\": 0, \"rotation\": [0, 0, 0, 0]}]", "[0]", {"the zero quaternion", NULL}},
+        {"[{\"mesh\": 0, \"matrix\": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0]}]", "[0]",
+         {"matrix must be 16 finite numbers", NULL}},
+    };
+    gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, "");
+        rad_api_enter(ctx);
+        assert_gltf_refused(&t, RAD_ERROR_PARSE, cases[k].message[0], cases[k].message[1]);
+    }
+
+    /* The instance bomb (1.8 KB of nodes in the original). */
+    text nodes = {0}, roots = {0};
+    put(&nodes, "[");
+    for (int level = 0; level < 9; level++)
+        for (int i = 0; i < 10; i++) {
+            put(&nodes, "%s{\"name\": \"n%d_%d\"", level + i ? ", " : "", level, i);
+            if (level == 8)
+                put(&nodes, ", \"mesh\": 0}");
+            else {
+                put(&nodes, ", \"children\": [");
+                for (int k = 0; k < 10; k++)
+                    put(&nodes, "%s%d", k ? ", " : "", 10 * (level + 1) + k);
+                put(&nodes, "]}");
+            }
+        }
+    put(&nodes, "]");
+    put(&roots, "[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]");
+    text t = gltf_text(nodes.data, roots.data, &quad, 1, "");
+    rad_api_enter(ctx);
+    assert_gltf_refused(&t, RAD_ERROR_PARSE,
+                        "node 'n1_0' (10) is a child of both node 'n0_0' (0) and node 'n0_1' (1)",
+                        "one parent at most");
+    free(nodes.data);
+    free(roots.data);
+}
+
+/* A zigzag triangle strip of `triangles` triangles of area 1/2 (vertex 2k
+ * at (0, k), 2k + 1 at (1, k)), all facing +z. */
+static float *zigzag(size_t triangles, size_t *vertices)
+{
+    *vertices = triangles + 2;
+    float *p = calloc(3 * *vertices, sizeof *p);
+    assert_non_null(p);
+    for (size_t v = 0; v < *vertices; v++) {
+        p[3 * v] = (float)(v % 2);
+        p[3 * v + 1] = (float)(v / 2);
+    }
+    return p;
+}
+
+/* Instances times triangles against the memory limit: 100 nodes each
+ * instancing one strip of 10,000 triangles would hold 10^6 triangles
+ * (about 130 MB) and are refused under a 64 MiB limit before assimp reads
+ * the file; 10 instances load, every triangle of every instance there.
+ * And an external buffer larger than the limit allows. */
+static void test_gltf_instances_memory(void **state)
+{
+    (void)state;
+    rad_context_options co = {.threads = 1, .max_memory_bytes = 64.0 * 1048576.0};
+    rad_context *limited = NULL;
+    assert_int_equal(rad_context_create(&co, &limited), RAD_OK);
+    size_t vertices;
+    float *strip = zigzag(10000, &vertices);
+    gltf_mesh mesh = {strip, vertices, NULL, 0, 5, 0};
+    for (int instances = 10; instances <= 100; instances *= 10) {
+        text nodes = {0}, roots = {0};
+        put(&nodes, "[");
+        put(&roots, "[");
+        for (int i = 0; i < instances; i++) {
+            put(&nodes, "%s{\"mesh\": 0, \"translation\": [%d, 0, 0]}", i ? ", " : "", 2 * i);
+            put(&roots, "%s%d", i ? ", " : "", i);
+        }
+        put(&nodes, "]");
+        put(&roots, "]");
+        text t = gltf_text(nodes.data, roots.data, &mesh, 1, "");
+        rad_scene *scene = NULL;
+        rad_api_enter(limited);
+        rad_result r = rad_scene_load_memory(limited, "x.gltf", t.data, t.length, NULL, 0, &scene);
+        if (instances == 10) {
+            if (r != RAD_OK)
+                fail_msg("%s", rad_context_error(limited));
+            assert_int_equal(rad_scene_polygon_count(scene), 100000);
+            assert_int_equal(rad_scene_surface_count(scene), 10); /* one per node */
+            for (size_t i = 0; i < 10; i++)
+                assert_close(rad_scene_surface_area(scene, i), 5000.0, 1e-9);
+            rad_scene_destroy(scene);
+        } else {
+            assert_int_equal(r, RAD_ERROR_OUT_OF_MEMORY);
+            assert_null(scene);
+            assert_contains(rad_context_error(limited), "x.gltf: importing it needs about");
+            assert_contains(rad_context_error(limited), "100 instances holding 1e+06 triangles");
+            assert_contains(rad_context_error(limited),
+                            "above the memory limit of 64.0 MiB "
+                            "(rad_context_options.max_memory_bytes)");
+        }
+        free(t.data);
+        free(nodes.data);
+        free(roots.data);
+    }
+    free(strip);
+
+    /* An external buffer of 1 MiB under a 1 MiB limit: assimp would hold it
+     * and copy out of it; refused before a byte of it is read. */
+    char bin_path[512];
+    snprintf(bin_path, sizeof bin_path, "%s/big.bin", temp_dir);
+    FILE *bin = fopen(bin_path, "wb");
+    assert_non_null(bin);
+    assert_int_equal(fseek(bin, 1048575, SEEK_SET), 0);
+    assert_int_equal(fputc(0, bin), 0);
+    fclose(bin);
+    rad_context *small = NULL;
+    co.max_memory_bytes = 1048576.0;
+    assert_int_equal(rad_context_create(&co, &small), RAD_OK);
+    const char *path = write_temp(
+        "big.gltf",
+        "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": "
+        "[{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}], "
+        "\"buffers\": [{\"byteLength\": 1048576, \"uri\": \"big.bin\"}], \"bufferViews\": "
+        "[{\"buffer\": 0, \"byteLength\": 36}], \"accessors\": [{\"bufferView\": 0, "
+        "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\"}]}");
+    rad_scene *scene = NULL;
+    rad_api_enter(small);
+    assert_int_equal(rad_scene_load_file(small, path, &scene), RAD_ERROR_OUT_OF_MEMORY);
+    assert_null(scene);
+    assert_contains(rad_context_error(small), "big.gltf: its buffers need about 2.0 MiB to import");
+    assert_contains(rad_context_error(small), "above the memory limit of 1.0 MiB");
+    remove(bin_path);
+    remove(path);
+    rad_context_destroy(small);
+    rad_context_destroy(limited);
+}
+
+/* ---- mirrored nodes: the floor's radiosity under a lamp ---- */
+
+/* Radiosity of the floor ([-1, 1]^2 at z = 0, reflectance 0.5) lit by the
+ * lamp of `lamp` (a black emitter of E = pi at z = 1 over [0.25, 0.75]^2
+ * when placed right), and the lamp's polygon normals checked to face the
+ * floor. */
+static double floor_radiosity(const char *lamp_nodes, const float *lamp_positions,
+                              const uint32_t *lamp_indices)
+{
+    gltf_mesh meshes[2] = {{unit_quad, 4, unit_quad_indices, 6, 4, 0},
+                           {lamp_positions, 4, lamp_indices, 6, 4, 1}};
+    text nodes = {0};
+    put(&nodes, "[{\"name\": \"floor\", \"mesh\": 0, \"translation\": [-1, -1, 0], "
+                "\"scale\": [2, 2, 1]}, %s]",
+        lamp_nodes);
+    text t = gltf_text(nodes.data, "[0, 1]", meshes, 2, "");
+    rad_scene *scene = NULL;
+    if (load_gltf(&t, &scene) != RAD_OK)
+        fail_msg("%s", rad_context_error(ctx));
+    size_t lamp = surface_index(scene, "lamp"), floor = surface_index(scene, "floor");
+    assert_close(rad_scene_surface_area(scene, lamp), 0.25, 1e-12);
+    for (size_t p = 0; p < scene->polygon_count; p++)
+        if (scene->polygons[p].surface == lamp) {
+            assert_close(scene->polygons[p].normal.z, -1.0, 1e-12);
+            for (uint32_t k = 0; k < scene->polygons[p].vertex_count; k++) {
+                vec3 v = scene->positions[scene->indices[scene->polygons[p].first_index + k]];
+                assert_true(v.x >= 0.25 - 1e-12 && v.x <= 0.75 + 1e-12 && fabs(v.z - 1.0) < 1e-12);
+            }
+        }
+    rad_options o = {0};
+    o.mesh_size = 0.25;
+    o.tolerance = 1e-12;
+    rad_solution *solution = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &solution), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, solution), RAD_OK);
+    double B[3];
+    rad_solution_surface_radiosity(solution, floor, B);
+    rad_solution_destroy(solution);
+    rad_scene_destroy(scene);
+    free(nodes.data);
+    free(t.data);
+    return B[0];
+}
+
+/* A node whose world transform mirrors (negative determinant) flips the
+ * winding (glTF 2.0, "Instantiation"): a lamp modelled facing down and
+ * mirrored lights the floor exactly as the same lamp placed there without
+ * a mirror (it used to face away: the floor got 0).  Neighbours: a mirror
+ * given as a matrix, a mirror in z, a mirror on the parent only, two
+ * mirrors that cancel (parent and child) and a half turn (-1, -1, 1)
+ * (determinant positive: no flip). */
+static void test_gltf_mirrored(void **state)
+{
+    (void)state;
+    /* The lamp where it belongs, facing down: the reference. */
+    static const float lamp[] = {0.25f, 0.25f, 1,     0.25f, 0.75f, 1,
+                                 0.75f, 0.75f, 1,     0.75f, 0.25f, 1};
+    static const uint32_t order[] = {0, 1, 2, 0, 2, 3}, reversed[] = {0, 2, 1, 0, 3, 2};
+    float mirror_x[12], mirror_z[12], half_turn[12];
+    for (int v = 0; v < 4; v++) {
+        for (int k = 0; k < 3; k++)
+            mirror_x[3 * v + k] = mirror_z[3 * v + k] = half_turn[3 * v + k] = lamp[3 * v + k];
+        mirror_x[3 * v] = -lamp[3 * v];
+        mirror_z[3 * v + 2] = -lamp[3 * v + 2];
+        half_turn[3 * v] = -lamp[3 * v];
+        half_turn[3 * v + 1] = -lamp[3 * v + 1];
+    }
+    double reference = floor_radiosity("{\"name\": \"lamp\", \"mesh\": 1}", lamp, order);
+    /* E F rho with F < 0.25 / (pi 1^2): well above 0, below its bound */
+    assert_true(reference > 0.02 && reference < 0.5 * M_PI * 0.25 / M_PI);
+    static const struct {
+        const char *nodes;
+        int positions; /* modelled: 0 in place, 1 mirrored in x, 2 in z, 3 turned */
+    } cases[] = {
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"scale\": [-1, 1, 1]}", 1},
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"matrix\": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, "
+         "0, 0, 0, 1]}",
+         1},
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"scale\": [1, 1, -1]}", 2},
+        /* the mirror on the parent, the mesh on an unmirrored child */
+        {"{\"scale\": [-1, 1, 1], \"children\": [2]}, {\"name\": \"lamp\", \"mesh\": 1, "
+         "\"translation\": [0, 0, 0]}",
+         1},
+        /* two mirrors that cancel: no flip */
+        {"{\"scale\": [-1, 1, 1], \"children\": [2]}, {\"name\": \"lamp\", \"mesh\": 1, "
+         "\"scale\": [-1, 1, 1]}",
+         0},
+        /* a half turn about z: determinant +1, no flip */
+        {"{\"name\": \"lamp\", \"mesh\": 1, \"scale\": [-1, -1, 1]}", 3},
+    };
+    const float *positions[4] = {lamp, mirror_x, mirror_z, half_turn};
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        /* Modelled mirrored, a lamp that faces the floor once placed has
+         * the reference's vertex order reversed (a mirror turns the
+         * orientation of its vertex order; glTF's rule turns it back). */
+        bool mirrored = cases[k].positions == 1 || cases[k].positions == 2;
+        double B = floor_radiosity(cases[k].nodes, positions[cases[k].positions],
+                                   mirrored ? reversed : order);
+        if (!(fabs(B - reference) <= 1e-9 * reference))
+            fail_msg("case %zu: floor radiosity %.17g, expected %.17g", k, B, reference);
+    }
+}
+
+/* ---- primitives: indices, accessors, buffers, topologies ---- */
+
+/* The unit quad file with `old` patched to `new_text` (NULL: as it is),
+ * topology `mode`, indices `indices` (NULL: the quad's), positions
+ * `positions` (NULL: the quad's). */
+static text quad_patched(const float *positions, const uint32_t *indices, size_t index_count,
+                         int mode, const char *old, const char *new_text)
+{
+    gltf_mesh mesh = {positions ? positions : unit_quad, 4,
+                      indices ? indices : unit_quad_indices, indices ? index_count : 6, mode, 0};
+    text t = gltf_text("[{\"mesh\": 0}]", "[0]", &mesh, 1, "");
+    if (old)
+        patch(&t, old, new_text);
+    return t;
+}
+
+/* Every primitive assimp would misread, or drop part of without a word,
+ * or crash on, is refused before assimp sees it, naming the file, mesh,
+ * primitive and accessor (and, for an index out of range, the index and
+ * the vertex count). */
+static void test_gltf_bad_primitives(void **state)
+{
+    (void)state;
+    static const uint32_t out_of_range[] = {0, 1, 2, 0, 2, 7}, strip_out[] = {0, 1, 9, 3},
+                          four[] = {0, 1, 2, 3}, one[] = {0};
+    static const float nan_quad[] = {0, 0, 0, 1, 0, 0, NAN, 1, 0, 0, 1, 0};
+    static const float inf_quad[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, -INFINITY};
+    const char *sparse_without_view =
+        "\"type\": \"VEC3\", \"sparse\": {\"count\": 1, \"indices\": {\"componentType\": 5125}, "
+        "\"values\": {\"bufferView\": 0}}}";
+    const char *sparse_decreasing =
+        "\"type\": \"VEC3\", \"sparse\": {\"count\": 4, \"indices\": {\"bufferView\": 1, "
+        "\"componentType\": 5125}, \"values\": {\"bufferView\": 0}}}";
+    const struct {
+        text t;
+        rad_result expected;
+        const char *message[2];
+    } cases[] = {
+        /* assimp dropped the triangle silently */
+        {quad_patched(NULL, out_of_range, 6, 4, NULL, NULL), RAD_ERROR_PARSE,
+         {"x.gltf: mesh 'm0' (0) primitive 0: index 5 refers to vertex 7 of 4", NULL}},
+        {quad_patched(NULL, strip_out, 4, 5, NULL, NULL), RAD_ERROR_PARSE,
+         {"primitive 0: index 2 refers to vertex 9 of 4", NULL}},
+        /* assimp read a float index accessor as integers */
+        {quad_patched(NULL, NULL, 0, 4, "\"componentType\": 5125", "\"componentType\": 5126"),
+         RAD_ERROR_PARSE, {"indices (accessor 1) must be SCALAR unsigned integers", "5126"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"componentType\": 5125", "\"componentType\": 5122"),
+         RAD_ERROR_PARSE, {"unsigned integers", "not componentType 5122"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"count\": 6, \"type\": \"SCALAR\"",
+                      "\"count\": 3, \"type\": \"VEC2\""),
+         RAD_ERROR_PARSE, {"indices (accessor 1) must be SCALAR", NULL}},
+        /* a view past its buffer, an accessor past its view, no vertices */
+        {quad_patched(NULL, NULL, 0, 4, "\"byteLength\": 48", "\"byteLength\": 4800"),
+         RAD_ERROR_PARSE, {"bufferView 0 (bytes 0 to 4800) lies outside buffer 0 of 72 bytes",
+                           NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"count\": 6", "\"count\": 60"), RAD_ERROR_PARSE,
+         {"accessor 1 needs bytes 0 to 240 of bufferView 1, which has 24", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"count\": 4", "\"count\": 0"), RAD_ERROR_PARSE,
+         {"primitive 0: accessor 0 has count 0", "at least 1"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"byteLength\": 72, \"uri\"",
+                      "\"byteLength\": 720, \"uri\""),
+         RAD_ERROR_PARSE, {"buffer 0: byteLength is 720, but its data has 72 bytes", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "base64,", "base64,*"), RAD_ERROR_PARSE,
+         {"base64", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"uri\": \"data:application/octet-stream;base64,",
+                      "\"uri\": \"quad.bin\", \"x\": \""),
+         RAD_ERROR_IO, {"buffer 0: cannot open 'quad.bin'", NULL}},
+        /* positions: finite float triples, as OBJ's */
+        {quad_patched(nan_quad, NULL, 0, 4, NULL, NULL), RAD_ERROR_INVALID_SCENE,
+         {"x.gltf: mesh 'm0' (0) primitive 0: vertex 2 (nan, 1, 0) is not finite", NULL}},
+        {quad_patched(inf_quad, NULL, 0, 4, NULL, NULL), RAD_ERROR_INVALID_SCENE,
+         {"vertex 3 (0, 1, -inf) is not finite", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"componentType\": 5126", "\"componentType\": 5123"),
+         RAD_ERROR_PARSE, {"POSITION (accessor 0) must be VEC3 of float", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "{\"POSITION\": 0}", "{\"NORMAL\": 0}"), RAD_ERROR_PARSE,
+         {"primitive 0 has no POSITION attribute", NULL}},
+        /* counts for the topology; assimp allocated 2^32 faces for a
+         * one-index strip */
+        {quad_patched(NULL, four, 4, 4, NULL, NULL), RAD_ERROR_PARSE,
+         {"triangles (mode 4) of 4 indices, not a multiple of 3", NULL}},
+        {quad_patched(NULL, one, 1, 5, NULL, NULL), RAD_ERROR_PARSE,
+         {"a triangle strip (mode 5) of 1 index (3 or more are needed)", NULL}},
+        {quad_patched(NULL, one, 1, 6, NULL, NULL), RAD_ERROR_PARSE,
+         {"a triangle fan (mode 6) of 1 index", NULL}},
+        {quad_patched(NULL, one, 1, 1, NULL, NULL), RAD_ERROR_PARSE,
+         {"lines (mode 1) of 1 index (2 or more are needed)", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"mode\": 4", "\"mode\": 9"), RAD_ERROR_PARSE,
+         {"mode must be 0 to 6", NULL}},
+        /* sparse accessors: assimp 5.2 dereferenced the missing view */
+        {quad_patched(NULL, NULL, 0, 4, "\"type\": \"VEC3\"}", sparse_without_view),
+         RAD_ERROR_PARSE, {"accessor 0: sparse indices and values each need a bufferView", NULL}},
+        {quad_patched(NULL, NULL, 0, 4, "\"type\": \"VEC3\"}", sparse_decreasing),
+         RAD_ERROR_PARSE, {"accessor 0: sparse index 3 is 0", "must increase"}},
+        {quad_patched(NULL, NULL, 0, 4, "\"version\": \"2.0\"", "\"version\": \"1.0\""),
+         RAD_ERROR_PARSE, {"glTF version '1.0' is not read (2.0 is)", NULL}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        text t = cases[k].t;
+        rad_api_enter(ctx);
+        assert_gltf_refused(&t, cases[k].expected, cases[k].message[0], cases[k].message[1]);
+    }
+}
+
+/* Area and orientation of every polygon of surface 0: all face +z. */
+static void check_faces_up(const rad_scene *scene, size_t polygons, double area)
+{
+    assert_int_equal(rad_scene_polygon_count(scene), polygons);
+    for (size_t p = 0; p < scene->polygon_count; p++)
+        assert_close(scene->polygons[p].normal.z, 1.0, 1e-12);
+    assert_close(rad_scene_surface_area(scene, 0), area, 1e-12);
+}
+
+/* Triangle strips and fans (glTF 2.0, "Meshes": strip triangle i is
+ * (i, i + 1 + i % 2, i + 2 - i % 2), fan triangle i is (i + 1, i + 2, 0))
+ * keep their winding; a triangle whose indices repeat (the stitches that
+ * join strips, a repeated fan vertex) has no area and is dropped (it used
+ * to fail the whole file).  Points and lines carry no area: ignored. */
+static void test_gltf_strips_and_fans(void **state)
+{
+    (void)state;
+    /* Two strips of 2 triangles, x in [0, 1] and [3, 4], joined by the
+     * stitches 3 3 4 4 (4 triangles of no area). */
+    static const float two_strips[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0,
+                                       3, 0, 0, 4, 0, 0, 3, 1, 0, 4, 1, 0};
+    static const uint32_t stitched[] = {0, 1, 2, 3, 3, 4, 4, 5, 6, 7};
+    gltf_mesh strips = {two_strips, 8, stitched, 10, 5, 0};
+    text t = gltf_text("[{\"mesh\": 0}]", "[0]", &strips, 1, "");
+    rad_scene *scene = NULL;
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 4, 2.0);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* A strip without indices: consecutive vertices, nothing repeated. */
+    size_t vertices;
+    float *zigzag_positions = zigzag(4, &vertices);
+    gltf_mesh plain = {zigzag_positions, vertices, NULL, 0, 5, 0};
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &plain, 1, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 4, 2.0);
+    rad_scene_destroy(scene);
+    free(t.data);
+    free(zigzag_positions);
+
+    /* A fan around (0, 0) over (1, 0), (1, 1), (0, 1), (-1, 1), with its
+     * second vertex repeated: 3 triangles of 1/2. */
+    static const float fan[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, -1, 1, 0};
+    static const uint32_t fan_indices[] = {0, 1, 2, 2, 3, 4};
+    gltf_mesh fans = {fan, 5, fan_indices, 6, 6, 0};
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &fans, 1, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 3, 1.5);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* A triangle list with one triangle of a repeated index among two. */
+    static const uint32_t listed[] = {0, 1, 2, 0, 0, 2, 0, 2, 3};
+    gltf_mesh list = {unit_quad, 4, listed, 9, 4, 0};
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &list, 1, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    check_faces_up(scene, 2, 1.0);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* Points, lines, a line loop and a line strip beside one triangle:
+     * only the triangle has area. */
+    gltf_mesh mixed[5] = {{unit_quad, 4, unit_quad_indices, 3, 4, 0},
+                          {unit_quad, 4, unit_quad_indices, 1, 0, 0},
+                          {unit_quad, 4, unit_quad_indices, 6, 1, 0},
+                          {unit_quad, 4, unit_quad_indices, 4, 2, 0},
+                          {unit_quad, 4, NULL, 0, 3, 0}};
+    t = gltf_text("[{\"name\": \"t\", \"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}, {\"mesh\": 3}, "
+                  "{\"mesh\": 4}]",
+                  "[0, 1, 2, 3, 4]", mixed, 5, "");
+    assert_int_equal(load_gltf(&t, &scene), RAD_OK);
+    assert_int_equal(rad_scene_surface_count(scene), 1);
+    assert_string_equal(rad_scene_surface_name(scene, 0), "t");
+    check_faces_up(scene, 1, 0.5);
+    rad_scene_destroy(scene);
+    free(t.data);
+
+    /* Lines alone: nothing has area. */
+    t = gltf_text("[{\"mesh\": 0}]", "[0]", &mixed[2], 1, "");
+    rad_api_enter(ctx);
+    assert_gltf_refused(&t, RAD_ERROR_INVALID_SCENE, "scene is empty (no polygons)", NULL);
+}
+
+/* ---- cameras ---- */
+
+typedef struct warnings {
+    int count;
+    char last[1024];
+} warnings;
+
+static void note_warning(void *user, const char *message)
+{
+    warnings *w = user;
+    w->count++;
+    snprintf(w->last, sizeof w->last, "%s", message);
+}
+
+/* An orthographic camera (which the renderer does not draw) no longer
+ * fails the file: the scene's first perspective camera is used, or none
+ * (the view is framed automatically), with one warning naming the file
+ * and the camera.  The first camera node in depth-first order is the
+ * scene's camera. */
+static void test_gltf_orthographic_camera(void **state)
+{
+    (void)state;
+    warnings seen = {0};
+    rad_context_options co = {.threads = 1, .on_warning = note_warning, .warning_user = &seen};
+    rad_context *warned = NULL;
+    assert_int_equal(rad_context_create(&co, &warned), RAD_OK);
+    const char *cameras = ", \"cameras\": [{\"name\": \"top\", \"type\": \"orthographic\", "
+                          "\"orthographic\": {\"xmag\": 2, \"ymag\": 1.5, \"znear\": 0.1, "
+                          "\"zfar\": 100}},\n {\"name\": \"eye\", \"type\": \"perspective\", "
+                          "\"perspective\": {\"yfov\": 0.8, \"znear\": 0.1}}]";
+    gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
+    static const struct {
+        const char *nodes, *roots;
+        bool has_camera;
+        double z, vfov;  /* the camera's position z and field of view, degrees */
+        const char *warning[2];
+    } cases[] = {
+        {"[{\"mesh\": 0}, {\"name\": \"above\", \"camera\": 0, \"translation\": [0, 0, 5]}]",
+         "[0, 1]", false, 0, 0,
+         {"x.gltf: camera 'top' (0) of node 'above' (1) is orthographic",
+          "the view is framed automatically"}},
+        {"[{\"mesh\": 0, \"children\": [2]}, {\"name\": \"side\", \"camera\": 1, "
+         "\"translation\": [0, 0, 7]}, {\"name\": \"above\", \"camera\": 0}]",
+         "[0, 1]", true, 7, 0.8 * 180 / M_PI,
+         {"camera 'top' (0) of node 'above' (2) is orthographic",
+          "using the perspective camera of node 'side' (1)"}},
+        {"[{\"mesh\": 0, \"children\": [2]}, {\"name\": \"above\", \"camera\": 0}, "
+         "{\"name\": \"near\", \"camera\": 1, \"translation\": [0, 0, 3]}]",
+         "[0, 1]", true, 3, 0.8 * 180 / M_PI, {NULL, NULL}},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        seen.count = 0;
+        text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, cameras);
+        rad_scene *scene = NULL;
+        rad_api_enter(warned);
+        if (rad_scene_load_memory(warned, "x.gltf", t.data, t.length, NULL, 0, &scene) != RAD_OK)
+            fail_msg("case %zu: %s", k, rad_context_error(warned));
+        rad_camera camera;
+        assert_int_equal(rad_scene_camera(scene, &camera), cases[k].has_camera);
+        if (cases[k].has_camera) {
+            assert_close(camera.position[2], cases[k].z, 1e-12);
+            assert_close(camera.look_at[2], cases[k].z - 1.0, 1e-12);
+            assert_close(camera.vfov_degrees, cases[k].vfov, 1e-9);
+        }
+        assert_int_equal(seen.count, cases[k].warning[0] ? 1 : 0);
+        for (int i = 0; i < 2 && cases[k].warning[i]; i++)
+            assert_contains(seen.last, cases[k].warning[i]);
+        assert_null(strchr(seen.last, '\n'));
+        rad_scene_destroy(scene);
+        free(t.data);
+    }
+    rad_context_destroy(warned);
+}
+
 /* ---- the builder ---- */
 
 static void test_builder_surfaces_and_materials(void **state)
@@ -594,7 +1326,7 @@ static const bad_input bad_inputs[] = {
      {"empty.obj: scene is empty (no polygons)", NULL, NULL}},
     {"lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
      {"lines.obj: scene is empty (no polygons)", NULL, NULL}},
-    {"bad.gltf", "{ garbage", NULL, NULL, RAD_ERROR_PARSE, {"bad.gltf: ", NULL, NULL}},
+    {"bad.gltf", "{\n garbage", NULL, NULL, RAD_ERROR_PARSE, {"bad.gltf:2:", "not JSON", NULL}},
     {"white.gltf",
      "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": "
      "[{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, "
@@ -704,6 +1436,13 @@ int main(void)
         cmocka_unit_test(test_obj_from_memory),
         cmocka_unit_test(test_obj_groups),
         cmocka_unit_test(test_gltf),
+        cmocka_unit_test(test_gltf_nesting),
+        cmocka_unit_test(test_gltf_node_graphs),
+        cmocka_unit_test(test_gltf_instances_memory),
+        cmocka_unit_test(test_gltf_mirrored),
+        cmocka_unit_test(test_gltf_bad_primitives),
+        cmocka_unit_test(test_gltf_strips_and_fans),
+        cmocka_unit_test(test_gltf_orthographic_camera),
         cmocka_unit_test(test_builder_surfaces_and_materials),
         cmocka_unit_test(test_builder_non_planar),
         cmocka_unit_test(test_builder_errors),

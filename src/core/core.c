@@ -74,6 +74,8 @@ rad_result rad_context_create(const rad_context_options *options, rad_context **
     ctx->on_error = options->on_error;
     ctx->read_outside_scene_folder = options->read_outside_scene_folder;
     ctx->error_user = options->error_user;
+    ctx->on_warning = options->on_warning;
+    ctx->warning_user = options->warning_user;
     atomic_init(&ctx->cancel, 0);
     *out = ctx;
     return RAD_OK;
@@ -124,6 +126,21 @@ rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
     if (ctx->on_error)
         ctx->on_error(ctx->error_user, result, ctx->error);
     return result;
+}
+
+void rad_warn(rad_context *ctx, const char *fmt, ...)
+{
+    if (!ctx || !ctx->on_warning)
+        return;
+    char message[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(message, sizeof message, fmt, ap);
+    va_end(ap);
+    for (char *c = message; *c; c++)
+        if (*c == '\n' || *c == '\r')
+            *c = ' ';
+    ctx->on_warning(ctx->warning_user, message);
 }
 
 void rad_progress(rad_context *ctx, const char *phase, uint64_t done, uint64_t total)

@@ -87,6 +87,8 @@ struct rad_context {
     void *progress_user;
     rad_error_fn on_error;
     void *error_user;
+    rad_warning_fn on_warning;
+    void *warning_user;
     bool read_outside_scene_folder; /* see rad_context_options */
     atomic_int cancel;          /* raised by rad_context_cancel, even from a signal handler */
     rad_result last_result;
@@ -106,6 +108,15 @@ struct rad_context {
 rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Tell the warning callback, if there is one, of input read differently
+ * from the file (one line, as rad_fail's).  Not a failure: nothing is
+ * latched.  ctx may be NULL. */
+void rad_warn(rad_context *ctx, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
 #endif
     ;
 

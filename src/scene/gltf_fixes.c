@@ -4,9 +4,9 @@
  * Before assimp: the framing of a GLB file is checked, because assimp
  * allocates what the header and chunk headers claim before comparing it
  * with the file's size.  After assimp: it ignores
- * KHR_materials_emissive_strength and turns the camera's yfov into an
- * approximate horizontal angle, so the glTF JSON (all of a .gltf, the
- * first chunk of a .glb) is read with cJSON for both.
+ * KHR_materials_emissive_strength, so the glTF JSON (all of a .gltf, the
+ * first chunk of a .glb) is read with cJSON for it (and for the checks of
+ * gltf_check.c).
  *
  *    GLB:  "glTF" version length | chunk length "JSON" text | chunk length "BIN\0" data
  *
@@ -25,19 +25,27 @@ static size_t le32(const unsigned char *p)
 }
 
 /* The JSON of a .gltf (all of it) or a .glb (its first chunk), parsed;
- * NULL if it is not JSON (assimp then reports the problem). */
-cJSON *import_gltf_json(const char *data, size_t size, bool binary)
+ * NULL if it is not JSON, with the offset in the file where parsing
+ * stopped. */
+cJSON *import_gltf_json(const char *data, size_t size, bool binary, size_t *error_offset)
 {
-    if (!binary)
-        return cJSON_ParseWithLength(data, size);
-    /* GLB: magic "glTF", version, length; then chunk length, "JSON", text. */
-    const unsigned char *bytes = (const unsigned char *)data;
-    if (size < 20 || memcmp(bytes, "glTF", 4) != 0 || memcmp(bytes + 16, "JSON", 4) != 0)
-        return NULL;
-    size_t length = le32(bytes + 12);
-    if (length > size - 20)
-        return NULL;
-    return cJSON_ParseWithLength(data + 20, length);
+    *error_offset = 0;
+    size_t start = 0, length = size;
+    if (binary) {
+        /* GLB: magic "glTF", version, length; then chunk length, "JSON", text. */
+        const unsigned char *bytes = (const unsigned char *)data;
+        if (size < 20 || memcmp(bytes, "glTF", 4) != 0 || memcmp(bytes + 16, "JSON", 4) != 0)
+            return NULL;
+        length = le32(bytes + 12);
+        if (length > size - 20)
+            return NULL;
+        start = 20;
+    }
+    const char *end = NULL;
+    cJSON *json = cJSON_ParseWithLengthOpts(data + start, length, &end, false);
+    if (!json)
+        *error_offset = start + (end && end >= data + start ? (size_t)(end - (data + start)) : 0);
+    return json;
 }
 
 /* Check the framing of a GLB file before assimp reads it: assimp 5.2
@@ -66,6 +74,12 @@ rad_result import_glb_check_framing(rad_context *ctx, const char *name, const ch
             return rad_fail(ctx, RAD_ERROR_PARSE,
                             "%s: GLB chunk %d claims %zu bytes, %zu are left in the file", name,
                             chunk, length, declared - offset - 8);
+        /* Chunks start and end on 4-byte boundaries; assimp rounds the
+         * JSON chunk up to one to find the next, so a JSON chunk of
+         * another length would hide its BIN chunk from the checks. */
+        if (chunk == 0 && length % 4 != 0)
+            return rad_fail(ctx, RAD_ERROR_PARSE,
+                            "%s: GLB JSON chunk of %zu bytes, not a multiple of 4", name, length);
         offset += 8 + length;
     }
     return RAD_OK;
@@ -93,14 +107,4 @@ double import_gltf_emissive_strength(const cJSON *materials, unsigned index, con
         cJSON_GetObjectItemCaseSensitive(extensions, "KHR_materials_emissive_strength");
     const cJSON *strength = cJSON_GetObjectItemCaseSensitive(extension, "emissiveStrength");
     return cJSON_IsNumber(strength) ? strength->valuedouble : 1.0;
-}
-
-/* The full vertical field of view (radians) of the first glTF camera, or 0. */
-double import_gltf_camera_yfov(const cJSON *root)
-{
-    const cJSON *cameras = cJSON_GetObjectItemCaseSensitive(root, "cameras");
-    const cJSON *perspective =
-        cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(cameras, 0), "perspective");
-    const cJSON *yfov = cJSON_GetObjectItemCaseSensitive(perspective, "yfov");
-    return cJSON_IsNumber(yfov) ? yfov->valuedouble : 0.0;
 }

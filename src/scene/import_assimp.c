@@ -20,9 +20,21 @@
  *  - it ignores KHR_materials_emissive_strength, turns the glTF camera's
  *    yfov into an approximate horizontal angle and copies the camera node's
  *    translation into aiCamera::mPosition (counting it twice): the glTF
- *    JSON is read with cJSON for the strength and yfov (gltf_fixes.c), and
- *    a glTF camera is placed as the glTF 2.0 spec says (at its node's
- *    origin, looking down -Z with +Y up).
+ *    JSON is read with cJSON for the strength (gltf_fixes.c), and the glTF
+ *    camera is placed from it as the spec says (gltf_check.c: at its node's
+ *    origin, looking down -Z with +Y up; an orthographic one, which the
+ *    renderer does not draw, is replaced, with a warning);
+ *  - it reads glTF node trees recursively (20,000 levels overflow the
+ *    stack), copies a subtree for each parent that lists it, drops a
+ *    triangle with an index out of range without a word and misreads
+ *    accessors of the wrong type: the JSON and the buffers are checked
+ *    before assimp sees them (gltf_check.c);
+ *  - it keeps the vertex order of a mirrored node: a node whose world
+ *    transform has a negative determinant has its polygons reversed here
+ *    (glTF 2.0, "Instantiation": the determinant's sign defines the
+ *    winding), and a triangle whose indices repeat (a triangle strip's
+ *    stitches) is dropped: it has no area by construction.
+ * The node tree is walked with an explicit stack: its depth is the file's.
  * MTL/glTF emissive colours are emitted RADIANCE: exitance E = pi * Ke.
  *
  * Memory: files are read through the context's allocator, in chunks when
@@ -177,6 +189,23 @@ static int convert_material(converter *cv, unsigned index)
     return cv->material_of[index];
 }
 
+/* The determinant of a transform's linear part: negative when it mirrors. */
+static double affine_determinant(const affine *t)
+{
+    const double(*m)[4] = t->m;
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+/* A face of three corners with a repeated vertex index: no area whatever
+ * the positions (a triangle strip's stitches, a fan's start). */
+static bool face_repeats_index(const struct aiFace *face)
+{
+    const unsigned *v = face->mIndices;
+    return face->mNumIndices == 3 && (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]);
+}
+
 static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigned mesh_index,
                                const affine *world)
 {
@@ -189,10 +218,11 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
                                : mesh->mName.length ? mesh->mName.data
                                                     : fallback;
     int surface = -1, material = -1; /* made on the first real polygon */
+    bool mirrored = affine_determinant(world) < 0.0;
     for (unsigned f = 0; f < mesh->mNumFaces; f++) {
         const struct aiFace *face = &mesh->mFaces[f];
-        if (face->mNumIndices < 3)
-            continue; /* points and lines */
+        if (face->mNumIndices < 3 || face_repeats_index(face))
+            continue; /* points and lines; stitches */
         if (surface < 0) {
             surface = rad_scene_builder_surface(cv->builder, surface_name);
             material = surface < 0 ? -1 : convert_material(cv, mesh->mMaterialIndex);
@@ -213,7 +243,8 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
                 return rad_fail(cv->ctx, RAD_ERROR_PARSE,
                                 "%s: mesh '%s': face references vertex %u of %u", cv->name,
                                 mesh->mName.data, v, mesh->mNumVertices);
-            cv->face[i] = affine_point(world, vec3_of(&mesh->mVertices[v]));
+            cv->face[mirrored ? face->mNumIndices - 1 - i : i] =
+                affine_point(world, vec3_of(&mesh->mVertices[v]));
         }
         rad_result r = rad_scene_builder_polygon(cv->builder, surface, material, cv->face,
                                                  face->mNumIndices, 0);
@@ -223,62 +254,107 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
     return RAD_OK;
 }
 
-static rad_result convert_node(converter *cv, const struct aiNode *node, const affine *parent)
+/* A node to visit and its parent's world transform. */
+typedef struct node_visit {
+    const struct aiNode *node;
+    affine parent;
+} node_visit;
+
+/* Push the children of `node` (world transform `world`) onto the stack,
+ * the last first so that the first is visited next: the order of a
+ * recursive walk, in memory the file cannot blow up (a tree 20,000 deep
+ * is 20,000 entries, not 20,000 frames). */
+static rad_result push_children(converter *cv, node_visit **stack, size_t *top, size_t *capacity,
+                                const struct aiNode *node, const affine *world)
 {
-    affine world = affine_then(parent, &node->mTransformation);
-    for (unsigned k = 0; k < node->mNumMeshes; k++) {
-        if (node->mMeshes[k] >= cv->ai->mNumMeshes)
-            return rad_fail(cv->ctx, RAD_ERROR_PARSE, "%s: node '%s' refers to mesh %u of %u",
-                            cv->name, node->mName.data, node->mMeshes[k], cv->ai->mNumMeshes);
-        rad_result r = convert_mesh(cv, node, node->mMeshes[k], &world);
-        if (r != RAD_OK)
-            return r;
+    if (node->mNumChildren > *capacity - *top) {
+        size_t grown = *capacity * 2 + node->mNumChildren;
+        node_visit *bigger = rad_realloc(cv->ctx, RAD_MEM_SCENE, *stack, grown, sizeof *bigger,
+                                         cv->name);
+        if (!bigger)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        *stack = bigger;
+        *capacity = grown;
     }
-    for (unsigned c = 0; c < node->mNumChildren; c++) {
-        rad_result r = convert_node(cv, node->mChildren[c], &world);
-        if (r != RAD_OK)
-            return r;
+    for (unsigned c = node->mNumChildren; c-- > 0;) {
+        (*stack)[*top].node = node->mChildren[c];
+        (*stack)[*top].parent = *world;
+        (*top)++;
     }
     return RAD_OK;
 }
 
-/* The world transform of the node called `name`; false if there is none. */
-static bool find_node(const struct aiNode *node, const char *name, const affine *parent,
-                      affine *world)
+/* Every node's meshes, placed by its world transform, depth first. */
+static rad_result convert_nodes(converter *cv, const struct aiNode *root)
 {
-    affine here = affine_then(parent, &node->mTransformation);
-    if (strcmp(node->mName.data, name) == 0) {
-        *world = here;
-        return true;
+    size_t top = 0, capacity = 0;
+    node_visit *stack = NULL;
+    affine identity = affine_identity();
+    const struct aiNode *node = root;
+    const affine *parent = &identity;
+    rad_result r = RAD_OK;
+    for (;;) {
+        affine world = affine_then(parent, &node->mTransformation);
+        for (unsigned k = 0; k < node->mNumMeshes && r == RAD_OK; k++) {
+            if (node->mMeshes[k] >= cv->ai->mNumMeshes)
+                r = rad_fail(cv->ctx, RAD_ERROR_PARSE, "%s: node '%s' refers to mesh %u of %u",
+                             cv->name, node->mName.data, node->mMeshes[k], cv->ai->mNumMeshes);
+            else
+                r = convert_mesh(cv, node, node->mMeshes[k], &world);
+        }
+        if (r == RAD_OK)
+            r = push_children(cv, &stack, &top, &capacity, node, &world);
+        if (r != RAD_OK || top == 0)
+            break;
+        top--;
+        node = stack[top].node;
+        parent = &stack[top].parent;
     }
-    for (unsigned c = 0; c < node->mNumChildren; c++)
-        if (find_node(node->mChildren[c], name, &here, world))
-            return true;
-    return false;
+    rad_free(stack);
+    return r;
 }
 
-/* The first camera, placed by its node.  `gltf_yfov` (radians, 0 if
- * unknown) overrides assimp's field of view for glTF. */
-static void convert_camera(converter *cv, bool gltf, double gltf_yfov)
+/* The world transform of the first node called `name`, depth first; false
+ * if there is none.  Cannot fail otherwise: out of memory, the search
+ * stops. */
+static bool find_node(converter *cv, const struct aiNode *root, const char *name, affine *world)
+{
+    size_t top = 0, capacity = 0;
+    node_visit *stack = NULL;
+    affine identity = affine_identity();
+    const struct aiNode *node = root;
+    const affine *parent = &identity;
+    bool found = false;
+    for (;;) {
+        affine here = affine_then(parent, &node->mTransformation);
+        if (strcmp(node->mName.data, name) == 0) {
+            *world = here;
+            found = true;
+            break;
+        }
+        if (push_children(cv, &stack, &top, &capacity, node, &here) != RAD_OK || top == 0)
+            break;
+        top--;
+        node = stack[top].node;
+        parent = &stack[top].parent;
+    }
+    rad_free(stack);
+    return found;
+}
+
+/* The first camera of a format other than glTF (whose camera
+ * gltf_check.c places), placed by its node. */
+static void convert_camera(converter *cv)
 {
     const struct aiCamera *camera = cv->ai->mCameras[0];
-    affine identity = affine_identity(), world = identity;
-    find_node(cv->ai->mRootNode, camera->mName.data, &identity, &world);
-    vec3 position = v3(0.0, 0.0, 0.0), direction = v3(0.0, 0.0, -1.0), up = v3(0.0, 1.0, 0.0);
-    if (!gltf) {
-        position = vec3_of(&camera->mPosition);
-        direction = vec3_of(&camera->mLookAt); /* a direction, not a point */
-        up = vec3_of(&camera->mUp);
-    }
-    position = affine_point(&world, position);
-    direction = affine_direction(&world, direction);
-    up = v3_normalize(affine_direction(&world, up));
-    double vfov = gltf_yfov;
-    if (!(vfov > 0.0)) {
-        /* Read as the full horizontal angle, as assimp's importers fill it. */
-        double aspect = camera->mAspect > 0.0f ? (double)camera->mAspect : 1.0;
-        vfov = 2.0 * atan(tan(0.5 * (double)camera->mHorizontalFOV) / aspect);
-    }
+    affine world = affine_identity();
+    find_node(cv, cv->ai->mRootNode, camera->mName.data, &world);
+    vec3 position = affine_point(&world, vec3_of(&camera->mPosition));
+    vec3 direction = affine_direction(&world, vec3_of(&camera->mLookAt)); /* a direction */
+    vec3 up = v3_normalize(affine_direction(&world, vec3_of(&camera->mUp)));
+    /* Read as the full horizontal angle, as assimp's importers fill it. */
+    double aspect = camera->mAspect > 0.0f ? (double)camera->mAspect : 1.0;
+    double vfov = 2.0 * atan(tan(0.5 * (double)camera->mHorizontalFOV) / aspect);
     rad_camera c = {
         .position = {position.x, position.y, position.z},
         .look_at = {position.x + direction.x, position.y + direction.y, position.z + direction.z},
@@ -286,6 +362,36 @@ static void convert_camera(converter *cv, bool gltf, double gltf_yfov)
         .vfov_degrees = vfov * 180.0 / M_PI,
     };
     rad_scene_builder_camera(cv->builder, &c);
+}
+
+/* The JSON of a glTF (the file's bytes `data`), parsed into *json (the
+ * caller's to cJSON_Delete) and checked (gltf_check.c) before assimp reads
+ * it; JSON that does not parse is refused here, naming the line. */
+static rad_result import_gltf_parse_and_check(rad_context *ctx, const char *name,
+                                              const char *data, size_t size, bool glb,
+                                              struct aiFileIO *io, cJSON **json,
+                                              import_gltf_facts *facts)
+{
+    size_t stop;
+    *json = import_gltf_json(data, size, glb, &stop);
+    if (!*json && glb)
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s: the JSON chunk is not JSON (byte %zu)", name,
+                        stop);
+    if (!*json) {
+        size_t line = 1, column = 1;
+        for (size_t i = 0; i < stop && i < size; i++, column++)
+            if (data[i] == '\n') {
+                line++;
+                column = 0;
+            }
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%zu:%zu: not JSON", name, line, column);
+    }
+    rad_result r = import_gltf_check(ctx, name, data, size, glb, *json, io, facts);
+    if (r != RAD_OK) {
+        cJSON_Delete(*json);
+        *json = NULL;
+    }
+    return r;
 }
 
 /* Import `name` with assimp (through `io`);
@@ -314,7 +420,14 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
                         "limit of %s (rad_context_options.max_memory_bytes)",
                         name, file_size, need, ASSIMP_PEAK_PER_BYTE, limit_text);
     }
-    cJSON *json = gltf && data ? import_gltf_json(data, size, glb) : NULL;
+    cJSON *json = NULL;
+    import_gltf_facts facts = {0};
+    if (gltf && data) {
+        rad_result checked = import_gltf_parse_and_check(ctx, name, data, size, glb, io, &json,
+                                                         &facts);
+        if (checked != RAD_OK)
+            return checked;
+    }
 
     struct aiPropertyStore *properties = aiCreatePropertyStore();
     if (!properties) {
@@ -352,12 +465,13 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
     }
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
         cv.material_of[i] = -1;
-    affine identity = affine_identity();
-    r = convert_node(&cv, ai->mRootNode, &identity);
+    r = convert_nodes(&cv, ai->mRootNode);
     if (r != RAD_OK)
         goto done;
-    if (ai->mNumCameras > 0 && ai->mCameras[0])
-        convert_camera(&cv, gltf, import_gltf_camera_yfov(json));
+    if (gltf && facts.has_camera)
+        rad_scene_builder_camera(cv.builder, &facts.camera);
+    else if (!gltf && ai->mNumCameras > 0 && ai->mCameras[0])
+        convert_camera(&cv);
     r = rad_scene_builder_finish(cv.builder, out);
     cv.builder = NULL;
 

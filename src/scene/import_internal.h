@@ -4,6 +4,8 @@
  *
  *    obj_prescan.c   OBJ/MTL text checked, with line numbers, before assimp
  *    gltf_fixes.c    GLB framing checked before assimp; glTF JSON read after
+ *    gltf_check.c    a glTF's nodes, meshes, buffers and memory checked before
+ *                    assimp; its camera
  *    assimp_io.c     a memory file system for assimp
  *    import_assimp.c aiScene -> rad_scene_builder, and the two entry points
  */
@@ -30,11 +32,13 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
 /* ---- gltf_fixes.c ---- */
 
 /* The parsed JSON of a .gltf (binary false) or a .glb (its JSON chunk),
- * owned by the caller (cJSON_Delete); NULL if there is none. */
-struct cJSON *import_gltf_json(const char *data, size_t size, bool binary);
+ * owned by the caller (cJSON_Delete); NULL if there is none, with
+ * *error_offset the byte of the file where the JSON stops parsing (0 when
+ * a .glb has no JSON chunk). */
+struct cJSON *import_gltf_json(const char *data, size_t size, bool binary, size_t *error_offset);
 
-/* Check that a GLB's header and chunks lie within its `size` bytes;
- * RAD_ERROR_PARSE naming `name` if not. */
+/* Check that a GLB's header and chunks lie within its `size` bytes, its
+ * JSON chunk 4-byte aligned; RAD_ERROR_PARSE naming `name` if not. */
 rad_result import_glb_check_framing(rad_context *ctx, const char *name, const char *data,
                                     size_t size);
 
@@ -43,8 +47,28 @@ rad_result import_glb_check_framing(rad_context *ctx, const char *name, const ch
 double import_gltf_emissive_strength(const struct cJSON *materials, unsigned index,
                                      const char *name);
 
-/* The first camera's full vertical field of view (radians), or 0. */
-double import_gltf_camera_yfov(const struct cJSON *root);
+/* ---- gltf_check.c ---- */
+
+/* What the check learnt for the import. */
+typedef struct import_gltf_facts {
+    bool has_camera;   /* the scene's first perspective camera, placed */
+    rad_camera camera;
+} import_gltf_facts;
+
+/* Check the glTF `json` (of the file `name`, `size` bytes at `data`; a .glb
+ * when `binary`) before assimp reads it: version 2.x; nodes in disjoint
+ * strict trees at most 1,000 deep; primitives with valid modes and counts,
+ * unsigned indices below their vertex count, finite float positions,
+ * accessors inside their buffers (read through `io`, which opens the
+ * external ones); what the import will take against the memory limit.
+ * Fills `facts` (the camera; an orthographic one is replaced, with a
+ * warning).  Fails with a one-line message naming the file and the node,
+ * mesh, primitive or accessor: RAD_ERROR_PARSE, RAD_ERROR_INVALID_SCENE
+ * (non-finite positions, a degenerate camera), RAD_ERROR_IO (a buffer that
+ * cannot be read), RAD_ERROR_OUT_OF_MEMORY. */
+rad_result import_gltf_check(rad_context *ctx, const char *name, const char *data, size_t size,
+                             bool binary, const struct cJSON *json, struct aiFileIO *io,
+                             import_gltf_facts *facts);
 
 /* ---- assimp_io.c ---- */
 
