@@ -32,7 +32,7 @@ const rad_solver *rad_solver_find(const char *name)
 void rad_residual_rows(const rad_system *sys, const double *B, double *row)
 {
     size_t n = sys->n;
-#pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
+#pragma omp parallel for schedule(static) num_threads(rad_pass_threads(sys))
     for (size_t i = 0; i < n; i++) {
         double g[3];
         rad_gather(sys->F + i * n, B, n, g);

@@ -157,7 +157,7 @@ static rad_result conjugate_gradient(rad_context *ctx, const rad_system *sys, co
 {
     size_t n = sys->n;
     int max_iterations = p->max_iterations > 0 ? p->max_iterations : 1000;
-    cg_state s = {sys, n, sys->threads > 0 ? sys->threads : 1, NULL, NULL, NULL, NULL, NULL, NULL,
+    cg_state s = {sys, n, rad_pass_threads(sys), NULL, NULL, NULL, NULL, NULL, NULL,
                   NULL, NULL, NULL, NULL, 0.0};
     double *work = rad_alloc(ctx, RAD_MEM_SOLVER, 27 * n + 1, sizeof *work, "solve: conjugate-gradient: vectors");
     s.row = rad_alloc(ctx, RAD_MEM_SOLVER, n + 1, sizeof *s.row, "solve: conjugate-gradient: row residuals");

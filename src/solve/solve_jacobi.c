@@ -45,7 +45,7 @@ static rad_result jacobi(rad_context *ctx, const rad_system *sys, const rad_solv
     rad_result result = RAD_OK;
     int sweep = 0;
     for (;;) {
-#pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
+#pragma omp parallel for schedule(static) num_threads(rad_pass_threads(sys))
         for (size_t i = 0; i < n; i++) {
             double g[3];
             const float *Fi = sys->F + i * n;
