@@ -871,6 +871,68 @@ static void test_signal_during_final_render(void **state)
     assert_no_temporaries(workdir);
 }
 
+/* A closed box of reflectance 0.999999 lit from its floor: no solver
+ * reaches 1e-15 on it (the iterative ones run to their bound of 10^4
+ * bounces), so each is in its solve when the signal comes. */
+static void write_bright_box(void)
+{
+    write_file("bright.mtl", "newmtl wall\nKd 0.999999 0.999999 0.999999\n"
+                             "newmtl lamp\nKd 0.999999 0.999999 0.999999\nKe 1 1 1\n");
+    write_file("bright.obj", "mtllib bright.mtl\n"
+                             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                             "usemtl lamp\no floor\nf 1 2 3 4\nusemtl wall\no ceiling\nf 5 8 7 6\n"
+                             "o front\nf 1 5 6 2\no back\nf 4 3 7 8\no left\nf 1 4 8 5\no right\nf 2 6 7 3\n");
+}
+
+/* SIGTERM while each solver solves: exit 143, the partial solution
+ * written and marked.  Those that show their steps are caught after their
+ * second frame; hierarchical (whose steps are not displayable) and direct
+ * (one step: its LU, polled between panels) when the progress names their
+ * phase. */
+static void test_signal_during_each_solver(void **state)
+{
+    (void)state;
+    write_bright_box();
+    static const char *framed[] = {"gauss-seidel", "jacobi", "conjugate-gradient", "southwell", "shooting"};
+    for (size_t k = 0; k < sizeof framed / sizeof framed[0] + 2; k++) {
+        const char *solver = k < 5 ? framed[k] : k == 5 ? "hierarchical" : "direct";
+        char args[1024], frame[128], stats_name[128], png[128];
+        snprintf(png, sizeof png, "sig_%s.png", solver);
+        snprintf(stats_name, sizeof stats_name, "sig_%s.json", solver);
+        if (k < 5)
+            snprintf(args, sizeof args,
+                     "render bright.obj --solver %s --elements 600 --tolerance 1e-15 --ff-samples 64 --width 16 "
+                     "--height 16 --progress-images frames_%s --every 1 -o %s --stats %s",
+                     solver, solver, png, stats_name);
+        else if (k == 5)
+            snprintf(args, sizeof args, "render bright.obj --solver hierarchical --tolerance 1e-15 --width 16 "
+                                        "--height 16 -o %s --stats %s", png, stats_name);
+        else /* an LU of 2904 unknowns: seconds, in 23 panels */
+            snprintf(args, sizeof args,
+                     "render bright.obj --solver direct --elements 3000 --form-factors hemicube --hemicube-res 16 "
+                     "--width 16 --height 16 -o %s --stats %s",
+                     png, stats_name);
+        watched w;
+        watch_start(&w, args);
+        if (k < 5) {
+            snprintf(frame, sizeof frame, "frames_%s/step_00000002.png", solver);
+            watch_for_file(&w, frame);
+        } else {
+            watch_for_text(&w, k == 5 ? "hierarchical" : "solve");
+        }
+        kill(w.pid, SIGTERM);
+        int status = watch_end(&w);
+        if (status != 143)
+            fail_msg("%s: exit %d after SIGTERM while solving; it printed: %s", solver, status, w.seen);
+        assert_true(exists(png));
+        const char *stats = text_of(stats_name);
+        if (!strstr(stats, "\"partial\":\ttrue") || !strstr(stats, "\"converged\":\tfalse"))
+            fail_msg("%s: the stats are not marked partial: %s", solver, stats);
+        assert_non_null(strstr(w.seen, "interrupted while solving; writing the partial solution"));
+        assert_no_temporaries(workdir);
+    }
+}
+
 /* Whether the process has a handler for SIGINT (Linux /proc). */
 static bool catches_sigint(pid_t pid)
 {
@@ -957,6 +1019,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_setup_teardown(test_second_signal_while_saving, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_final_render, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_generate, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_signal_during_each_solver, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

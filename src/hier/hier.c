@@ -302,11 +302,11 @@ static double push_pull(hr_state *st)
 }
 
 /* Sweeps until the residual is below `tol` (or `cap` sweeps). */
-static rad_result solve(hr_state *st, double tol, int cap, double *residual, bool *converged)
+static rad_result solve(hr_state *st, double tol, double cap, double *residual, bool *converged)
 {
     *converged = false;
     *residual = INFINITY;
-    for (int it = 0; it < cap; it++) {
+    for (double it = 0; it < cap; it++) {
         if (rad_cancelled(st->ctx))
             return RAD_ERROR_INTERRUPTED;
         gather(st);
@@ -749,8 +749,16 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     hs->initial_links = st.links.count;
     hs->seconds_refine += rad_seconds() - t0;
 
-    double residual = INFINITY;
+    /* How many sweeps a solve may take (solve.h): each leaf reflects at
+     * most rho_max of what it receives. */
+    double rho_max = 0.0;
+    for (size_t i = 0; i < base->element_count; i++)
+        for (int c = 0; c < 3; c++)
+            rho_max = fmax(rho_max, scene->materials[base->elements[i].material].reflectance[c]);
+    rad_solve_bound bound = {0};
+    double residual = INFINITY, tol = p->tolerance;
     bool converged = false;
+    int rounds_solved = 0, round_sweeps = 0;
     const int max_rounds = 24;
     for (int round = 0; round < max_rounds; round++) {
         rad_progress(ctx, "hierarchical", (uint64_t)round, (uint64_t)max_rounds);
@@ -800,11 +808,17 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                 goto done;
         }
         double t2 = rad_seconds();
-        double tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
-        int cap = p->max_iterations > 0 && last ? p->max_iterations : 10000;
-        r = solve(&st, tol, cap, &residual, &converged);
+        tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
+        bound = rad_solve_bound_make(last ? p->max_iterations : 0, rho_max, 1.0, tol, 1.0);
+        ss->iteration_limit = fmax(ss->iteration_limit, bound.limit);
+        int sweeps_before = st.sweeps;
+        r = solve(&st, tol, bound.limit, &residual, &converged);
+        rounds_solved = round + 1;
+        round_sweeps = st.sweeps - sweeps_before;
         hs->seconds_solve += rad_seconds() - t2;
-        if (r != RAD_OK || last)
+        /* A round that cannot reach its tolerance: refining against its B
+         * would not help the next one, which needs more. */
+        if (r != RAD_OK || last || !converged)
             break;
     }
     rad_progress(ctx, "hierarchical", (uint64_t)max_rounds, (uint64_t)max_rounds);
@@ -825,6 +839,12 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     ss->iterations = st.sweeps;
     ss->residual = residual;
     ss->converged = converged;
+    if (r == RAD_OK && !converged) {
+        char who[64];
+        snprintf(who, sizeof who, "hierarchical (refinement round %d)", rounds_solved);
+        rad_solve_warn(ss, who, &bound, round_sweeps, "sweeps", "residual", residual,
+                       tol, "");
+    }
     ss->rays = rs.rays;
     ss->absorbed = st.absorbed / 3.0;
     {

@@ -126,11 +126,14 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddBoolToObject(so, "solved", s->solved);
     cJSON_AddBoolToObject(so, "converged", s->solve->converged);
     cJSON_AddNumberToObject(so, "iterations", s->solve->iterations);
+    cJSON_AddNumberToObject(so, "iteration_limit", s->solve->iteration_limit);
     cJSON_AddNumberToObject(so, "residual", s->solve->residual);
     cJSON_AddNumberToObject(so, "tolerance", s->options->tolerance);
     cJSON_AddNumberToObject(so, "relaxation", s->options->relaxation);
     if (!isnan(s->solve->unshot))
         cJSON_AddNumberToObject(so, "unshot", s->solve->unshot);
+    if (s->solved && !s->solve->converged && s->solve->warning[0])
+        cJSON_AddStringToObject(so, "warning", s->solve->warning);
     cJSON_AddNumberToObject(so, "components", (double)s->solve->components);
     cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve->ambient));
     cJSON_AddNumberToObject(so, "seconds", s->solve->seconds);

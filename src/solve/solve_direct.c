@@ -213,6 +213,12 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
     if (result == RAD_OK)
         result = measured;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    stats->iteration_limit = 1.0;
+    if (result == RAD_OK && !stats->converged)
+        snprintf(stats->warning, sizeof stats->warning,
+                 "direct: the residual of the exact solve, %.3g, is above the tolerance %.3g: what the "
+                 "rounding of F and of the factorisation leaves",
+                 stats->residual, p->tolerance);
     if (result == RAD_OK && p->monitor) {
         rad_solve_step step = {1, rad_seconds() - t0, stats->residual, NAN};
         if (p->monitor(p->monitor_user, &step, B, NULL))
