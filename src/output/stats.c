@@ -115,6 +115,8 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddNumberToObject(ff, "reciprocity_max", s->ff->reciprocity_max);
     cJSON_AddNumberToObject(ff, "diagonal_max", s->ff->diagonal_max);
     cJSON_AddBoolToObject(ff, "closure_corrected", s->ff->closure_corrected);
+    if (s->options->closure_correction) /* the openness measured before correcting */
+        cJSON_AddNumberToObject(ff, "escaped", s->ff->escaped);
     if (s->F_variance)
         cJSON_AddNumberToObject(ff, "std_error_max", s->ff->std_error_max);
     if (s->ff->near_pairs)
