@@ -16,6 +16,7 @@
 #include "output/output.h"
 
 #include <cjson/cJSON.h>
+#include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -162,7 +163,11 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddBoolToObject(root, "partial", partial);
     rad_result r = add_text(ctx, root, "scene", s->scene->source);
     cJSON_AddNumberToObject(root, "threads", rad_context_threads(ctx));
-    cJSON_AddNumberToObject(root, "seed", (double)s->options->seed);
+    /* The seed as its exact digits: a JSON number is text, and a double
+     * rounds seeds above 2^53 (9007199254740993 was written ...992). */
+    char seed[24];
+    snprintf(seed, sizeof seed, "%" PRIu64, s->options->seed);
+    cJSON_AddRawToObject(root, "seed", seed);
 
     cJSON *mesh = cJSON_AddObjectToObject(root, "mesh");
     cJSON_AddNumberToObject(mesh, "elements", (double)n);
