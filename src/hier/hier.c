@@ -595,6 +595,25 @@ static rad_result correct_closure(hr_state *st, size_t *corrected)
     return r;
 }
 
+/* q of the links (solve.h): rho_max times the largest closure of a leaf
+ * (link_closure; its links may deliver more than it sends: 1.2 on a
+ * uniform box), at least rho_max.  Fails only for memory. */
+static rad_result links_contraction(hr_state *st, double rho_max, double *q)
+{
+    const hr_tree *t = &st->tree;
+    double *acc = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, t->count, sizeof *acc, "hierarchical: closure");
+    if (!acc)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_result r = link_closure(st, acc);
+    double most = 1.0;
+    for (size_t k = 0; r == RAD_OK && k < t->count; k++)
+        if (t->nodes[k].kind == HR_SURFACE && t->nodes[k].child[0] == 0)
+            most = fmax(most, acc[k]);
+    rad_free(acc);
+    *q = rho_max * most;
+    return r;
+}
+
 /* ---- the leaves as a mesh ---- */
 
 typedef struct leaf_builder {
@@ -750,7 +769,8 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     hs->seconds_refine += rad_seconds() - t0;
 
     /* How many sweeps a solve may take (solve.h): each leaf reflects at
-     * most rho_max of what it receives. */
+     * most rho_max of what it receives, and receives at most the largest
+     * closure of what is sent (links_contraction, each round). */
     double rho_max = 0.0;
     for (size_t i = 0; i < base->element_count; i++)
         for (int c = 0; c < 3; c++)
@@ -809,7 +829,10 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         }
         double t2 = rad_seconds();
         tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
-        bound = rad_solve_bound_make(last ? p->max_iterations : 0, rho_max, 1.0, tol, 1.0);
+        double q = rho_max;
+        if ((r = links_contraction(&st, rho_max, &q)) != RAD_OK)
+            goto done;
+        bound = rad_solve_bound_make(last ? p->max_iterations : 0, q, 1.0, tol, 1.0);
         ss->iteration_limit = fmax(ss->iteration_limit, bound.limit);
         int sweeps_before = st.sweeps;
         r = solve(&st, tol, bound.limit, &residual, &converged);

@@ -101,7 +101,8 @@ extern const rad_solver rad_solver_shooting;
  * must stop, unconverged and saying so, rather than run for days. */
 
 /* Bounces an automatic bound allows at most: enough for the default
- * tolerance 1e-6 up to q = 0.9986 (2 k + 10 = 10^4). */
+ * tolerance 1e-6 up to q = 0.9972, for shooting's 1e-3 up to q = 0.9986
+ * (2 k + 10 = 10^4). */
 #define RAD_SOLVE_BOUNCE_CAP 10000.0
 
 typedef enum rad_bound_reason {
@@ -137,7 +138,7 @@ rad_solve_bound rad_solve_bound_make(int max_iterations, double q, double relaxa
 void rad_solve_warn(rad_solve_stats *stats, const char *who, const rad_solve_bound *bound, double done,
                     const char *units, const char *measure, double value, double goal, const char *hint);
 
-/* The hint of the gathering and shooting solvers: conjugate gradients and
+/* The hint of Gauss-Seidel, Jacobi and Southwell: conjugate gradients and
  * LU do not slow down as rho_max nears 1. */
 #define RAD_SOLVE_FASTER_HINT "; conjugate-gradient or direct need far fewer iterations here"
 
