@@ -318,7 +318,10 @@ typedef struct rad_options {
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */
-    int max_iterations;           /* sweeps (gathering) or shots (shooting); 0 = automatic */
+    int max_iterations;           /* sweeps (gathering), shots (southwell) or batches of 32
+                                     shots (shooting); 0 = automatic: 2 ln(tolerance) /
+                                     ln(rho_max) + 10 bounces, at most 10^4; a cap above
+                                     that is lowered to it (rad_solution_warning) */
     double relaxation;            /* over-relaxation factor omega in (0, 2): SOR for jacobi
                                      and gauss-seidel, overshooting for southwell; 0 = 1 */
     /* Called after every solver iteration (sweep or shot) with the solution in its
