@@ -18,7 +18,7 @@ run cb_hier_classic render -o cb_hier_classic.png --solver hierarchical --oracle
 for ff in analytic contour hybrid hemicube hemisphere montecarlo; do
   run vf_$ff viewfactors -o vf_$ff.F.json --elements 400 --form-factors $ff
 done
-run vf_closure viewfactors -o vf_closure.F.json --elements 400 --closure-correction
+run vf_closure viewfactors office2.obj -o vf_closure.F.json --elements 400 --closure-correction  # closed: the correction refuses the open Cornell box
 run vf_elem viewfactors -o vf_elem.mtx --elements 200 --level element
 run office10_hier render office10.obj -o office10.png --solver hierarchical --width 64 --height 64
 run office10_hier_cc render office10.obj -o office10cc.png --solver hierarchical --closure-correction --width 64 --height 64

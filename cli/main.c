@@ -408,9 +408,16 @@ int main(int argc, char **argv)
     }
     if (partial)
         fprintf(stderr, "radiosity: interrupted while solving; writing the partial solution\n");
-    else if (!s.quiet && rad_solution_residual(sol) > (s.solve.tolerance > 0 ? s.solve.tolerance : 1e-6))
-        fprintf(stderr, "radiosity: warning: stopped at residual %.3g after %d iterations\n",
-                rad_solution_residual(sol), rad_solution_iterations(sol));
+    else if (!s.quiet && !rad_solution_converged(sol)) {
+        /* Every solver stops at its bound; the line says where and why. */
+        char line[1024];
+        const char *why = rad_solution_warning(sol);
+        if (why[0])
+            fprintf(stderr, "radiosity: warning: %s\n", cli_rewrite_message(why, line, sizeof line));
+        else
+            fprintf(stderr, "radiosity: warning: stopped unconverged after %d iterations\n",
+                    rad_solution_iterations(sol));
+    }
 
     /* 5. image, stats and history, into their temporaries, then all put in
      * place together.  Signals from here on are noted, not acted upon. */

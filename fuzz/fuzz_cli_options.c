@@ -2,7 +2,8 @@
  * fuzz_cli_options.c -- the command line (cli_parse_args in cli/options.c).
  * The input is argv[1..] separated by NUL bytes.  The parser must not
  * print, exit or read past argv; a usage error leaves one line of text;
- * accepted settings are within the ranges of the option table.
+ * accepted settings are within the ranges of the option table, and a seed
+ * other than 0 is exactly the decimal digits of some --seed value given.
  */
 #include "fuzz.h"
 #include "options.h"
@@ -10,6 +11,35 @@
 #include <string.h>
 
 enum { MAX_ARGS = 64, MAX_TEXT = 4096 };
+
+/* `text` as decimal digits that fit a uint64_t exactly, into *value. */
+static bool exact_digits(const char *text, uint64_t *value)
+{
+    uint64_t v = 0;
+    if (!*text)
+        return false;
+    for (const char *c = text; *c; c++) {
+        if (*c < '0' || *c > '9' || v > (UINT64_MAX - (uint64_t)(*c - '0')) / 10)
+            return false;
+        v = 10 * v + (uint64_t)(*c - '0');
+    }
+    *value = v;
+    return true;
+}
+
+/* Some "--seed V" or "--seed=V" in argv has V exactly `seed`. */
+static bool seed_given(int argc, char **argv, uint64_t seed)
+{
+    for (int k = 1; k < argc; k++) {
+        const char *value = strncmp(argv[k], "--seed=", 7) == 0                ? argv[k] + 7
+                            : strcmp(argv[k], "--seed") == 0 && k + 1 < argc ? argv[k + 1]
+                                                                               : NULL;
+        uint64_t v;
+        if (value && exact_digits(value, &v) && v == seed)
+            return true;
+    }
+    return false;
+}
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
@@ -63,6 +93,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             FUZZ_CHECK(v == 0.0 || rad_option_in_range(o, v));
         }
         FUZZ_CHECK(s.every == 0 || s.progress_dir != NULL);
+        FUZZ_CHECK(s.solve.seed == 0 || seed_given(argc, argv, s.solve.seed));
+        FUZZ_CHECK(s.office.seed == 0 || seed_given(argc, argv, s.office.seed));
         break;
     case CLI_HELP: case CLI_VERSION: case CLI_LIST_METHODS: case CLI_MAN: break;
     case CLI_NO_ARGUMENTS: FUZZ_CHECK(0); break; /* argc >= 2 here */

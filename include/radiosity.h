@@ -328,7 +328,10 @@ typedef struct rad_options {
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */
-    int max_iterations;           /* sweeps (gathering) or shots (shooting); 0 = automatic */
+    int max_iterations;           /* sweeps (gathering), shots (southwell) or batches of 32
+                                     shots (shooting); 0 = automatic: 2 ln(tolerance) /
+                                     ln(rho_max) + 10 bounces, at most 10^4; a cap above
+                                     that is lowered to it (rad_solution_warning) */
     double relaxation;            /* over-relaxation factor omega in (0, 2): SOR for jacobi
                                      and gauss-seidel, overshooting for southwell; 0 = 1 */
     /* Called after every solver iteration (sweep or shot) with the solution in its
@@ -395,6 +398,20 @@ RAD_API double rad_solution_residual(const rad_solution *solution);
 /* Iterations (sweeps or shots) the last solve took; 0 before the first.
  * NULL solution: 0. */
 RAD_API int rad_solution_iterations(const rad_solution *solution);
+/* Whether the last solve reached its tolerance: the residual below
+ * rad_options.tolerance, or for shooting (whose measure is the unshot power)
+ * the unshot power below rad_options.unshot_tolerance (0 = 1e-3).  Every
+ * iterative solver stops at a bound however the scene converges (about
+ * 2 ln(tolerance) / ln(rho_max) bounces of light, at most 10^4 unless
+ * max_iterations asks for more), so a solve can end unconverged: then
+ * rad_solution_warning says why.  False before the first solve, after an
+ * interruption, and for a NULL solution. */
+RAD_API bool rad_solution_converged(const rad_solution *solution);
+/* One line on why the last solve stopped short of its tolerance ("gauss-seidel
+ * did not converge in 10000 sweeps (the cap; ...): residual 0.83, tolerance
+ * 1e-06"), owned by the solution until its next solve; "" when it converged,
+ * was interrupted or has not run.  NULL solution: "". */
+RAD_API const char *rad_solution_warning(const rad_solution *solution);
 
 /* The convergence history of the last solve: *count steps, owned by the
  * solution and valid until its next solve or destroy.  NULL solution or

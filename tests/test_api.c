@@ -216,6 +216,8 @@ static void test_null_solution(void **state)
     assert_int_equal(rad_solution_element_count(NULL), 0);
     assert_true(isnan(rad_solution_residual(NULL)));
     assert_int_equal(rad_solution_iterations(NULL), 0);
+    assert_false(rad_solution_converged(NULL));
+    assert_string_equal(rad_solution_warning(NULL), "");
     size_t count = 7;
     assert_null(rad_solution_history(NULL, &count));
     assert_int_equal(count, 0);

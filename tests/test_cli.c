@@ -591,6 +591,38 @@ static void test_interrupt_during_form_factors(void **state)
     assert_non_null(strstr(text, "interrupted while computing form factors; wrote partial stats"));
 }
 
+/* --seed is one parser in every command: an unsigned 64-bit integer in
+ * decimal digits, exact (no double on the way), and the same one-line
+ * refusal of anything else, exit 2; the stats carry the seed's exact
+ * digits (they went through a double: 9007199254740993 was written as
+ * ...992). */
+static void test_seed(void **state)
+{
+    (void)state;
+    const char *good[] = {"0", "9007199254740993", "18446744073709551615"};
+    for (size_t k = 0; k < 3; k++) {
+        assert_int_equal(run("render --elements 24 --width 4 --height 4 -o seed.png --stats seed.json --seed %s",
+                             good[k]),
+                         0);
+        char path[600], text[16384], want[64];
+        snprintf(path, sizeof path, "%s/seed.json", workdir);
+        slurp(path, text, sizeof text);
+        snprintf(want, sizeof want, "\"seed\":\t%s,", good[k]);
+        if (!strstr(text, want))
+            fail_msg("the stats lack %s", want);
+    }
+    const char *bad[] = {"-1", "18446744073709551616", "0x10", "1e3", "1.5", "+1", "' 1'", "seven", "''"};
+    const char *commands[] = {"render -o seed.png", "viewfactors -o seed.json", "generate office -o seed.obj"};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++)
+        for (size_t c = 0; c < 3; c++) {
+            assert_int_equal(run("%s --seed %s", commands[c], bad[k]), 2);
+            if (strcmp(bad[k], "''") == 0)
+                assert_one_line_error("--seed needs a value", NULL);
+            else
+                assert_one_line_error("--seed: expected an integer in [0, 18446744073709551615], got '", NULL);
+        }
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -629,6 +661,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_gltf_refused),
         cmocka_unit_test(test_unknown_method_names),
         cmocka_unit_test(test_usage_errors),
+        cmocka_unit_test(test_seed),
         cmocka_unit_test(test_unwritable_output),
         cmocka_unit_test(test_render_reports_output),
         cmocka_unit_test(test_help_version_methods),

@@ -37,6 +37,7 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -387,17 +388,173 @@ static void test_closure_closed_cube(void **state)
     cJSON_Delete(closed);
 }
 
-/* An open scene: the correction still rescales every row that sees
- * anything to 1 (two facing squares then "see" only each other), which is
- * why it is documented for closed scenes only. */
+/* A unit box, normals inward, lit from its floor: without its ceiling, or
+ * with a square hole in the ceiling through which `escape` of the light
+ * leaving a uniformly bright box goes out (hole area over the surfaces'
+ * area, by reciprocity), or closed (escape 0); `block`: a 0.3 m cube,
+ * open at the bottom, resting on the floor (a contact the floor's row sums
+ * read as 9% open, the rays as closed). */
+static void write_box(cli_scene_writer *w, const char *name, bool ceiling, double escape, bool block)
+{
+    static const double faces[5][4][3] = {
+        {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}}, {{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}},
+        {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}},
+        {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}},
+    };
+    static const char *names[5] = {"x0", "x1", "y0", "y1", "floor"};
+    cli_scene_begin(w, name);
+    cli_scene_material(w, "grey", 0.5, 0.0);
+    cli_scene_material(w, "lamp", 0.5, 1.0);
+    for (int f = 0; f < 5; f++)
+        cli_scene_polygon(w, names[f], f == 4 ? "lamp" : "grey", faces[f], 4);
+    if (ceiling) {
+        /* Around a centred square hole of side h: h^2 / (6 - h^2) = escape. */
+        double h = sqrt(6.0 * escape / (1.0 + escape)), a = (1.0 - h) / 2.0, b = a + h;
+        double q[4][4][3] = {
+            {{0, 0, 1}, {0, a, 1}, {1, a, 1}, {1, 0, 1}}, {{0, b, 1}, {0, 1, 1}, {1, 1, 1}, {1, b, 1}},
+            {{0, a, 1}, {0, b, 1}, {a, b, 1}, {a, a, 1}}, {{b, a, 1}, {b, b, 1}, {1, b, 1}, {1, a, 1}},
+        };
+        for (int k = 0; k < (h > 0.0 ? 4 : 1); k++) {
+            if (h == 0.0) /* closed: one quad */
+                q[0][1][1] = q[0][2][1] = 1.0;
+            char piece[32];
+            snprintf(piece, sizeof piece, "ceiling%d", k);
+            cli_scene_polygon(w, piece, "grey", (const double(*)[3])q[k], 4);
+        }
+    }
+    if (block) {
+        static const double c[5][4][3] = { /* normals out of the block */
+            {{0.35, 0, 0.35}, {0.35, 0, 0.65}, {0.35, 0.3, 0.65}, {0.35, 0.3, 0.35}},
+            {{0.65, 0, 0.35}, {0.65, 0.3, 0.35}, {0.65, 0.3, 0.65}, {0.65, 0, 0.65}},
+            {{0.35, 0, 0.35}, {0.35, 0.3, 0.35}, {0.65, 0.3, 0.35}, {0.65, 0, 0.35}},
+            {{0.35, 0, 0.65}, {0.65, 0, 0.65}, {0.65, 0.3, 0.65}, {0.35, 0.3, 0.65}},
+            {{0.35, 0.3, 0.35}, {0.35, 0.3, 0.65}, {0.65, 0.3, 0.65}, {0.65, 0.3, 0.35}},
+        };
+        /* The box's y is up in the block's frame: map (x, y, z) -> (x, z, y). */
+        for (int f = 0; f < 5; f++) {
+            double v[4][3];
+            for (int k = 0; k < 4; k++) {
+                v[k][0] = c[f][k][0];
+                v[k][1] = c[f][k][2];
+                v[k][2] = c[f][k][1];
+            }
+            /* The swap of two axes mirrors: reverse the order to keep normals out. */
+            double r[4][3];
+            for (int k = 0; k < 4; k++)
+                memcpy(r[k], v[3 - k], sizeof r[k]);
+            char piece[32];
+            snprintf(piece, sizeof piece, "block%d", f);
+            cli_scene_polygon(w, piece, "grey", (const double(*)[3])r, 4);
+        }
+    }
+    cli_scene_end(w);
+}
+
+/* Run radiosity on a written scene with --closure-correction; the exit
+ * status, and the stderr line in `line`. */
+static int run_closure(const cli_scene_writer *w, const char *command, const char *extra, char *line, size_t size)
+{
+    char errors[700], out[700];
+    snprintf(errors, sizeof errors, "%s.closure.err", w->obj_path);
+    snprintf(out, sizeof out, "%s.closure.%s", w->obj_path, strcmp(command, "render") == 0 ? "png" : "json");
+    unlink(out);
+    int status = cli_run_capture(errors, "%s '%s' -o '%s' --closure-correction %s", command, w->obj_path, out, extra);
+    char *text = cli_read_text(errors);
+    assert_non_null(text);
+    snprintf(line, size, "%s", text);
+    free(text);
+    if (status != 0)
+        assert_true(access(out, F_OK) != 0); /* refused: nothing written */
+    return status;
+}
+
+/* A refusal: one line naming the scene and the option, with the escaped
+ * percentage within `tol` points of `percent`. */
+static void assert_refused(const char *line, const cli_scene_writer *w, double percent, double tol)
+{
+    const char *newline = strchr(line, '\n');
+    if (!newline || newline[1] != '\0' || !strstr(line, w->obj_path) ||
+        !strstr(line, "--closure-correction is for closed scenes, and "))
+        fail_msg("expected one line refusing --closure-correction on %s, got: %s", w->obj_path, line);
+    double got = strtod(strstr(line, "scenes, and ") + strlen("scenes, and "), NULL);
+    if (!(fabs(got - percent) <= tol))
+        fail_msg("%s: %.1f%% escaping, expected %.1f%%: %s", w->obj_path, got, percent, line);
+}
+
+/* An open scene is refused by the correction, which would put the light
+ * that escapes back on the surfaces (two facing unit squares a metre apart:
+ * F_12 = 0.2 became 1; 100 m apart, 3e-5 became 1); dense and hierarchical
+ * alike.  The line is 1% of
+ * the light escaping, measured by rays: a box without its ceiling (20%),
+ * with a hole of 3% is refused; a hole of 0.5% (a crack) is corrected, as
+ * are a closed box and one with a block resting on its floor, whose floor
+ * row sums read it as 9% open.  --help says "closed scenes only". */
 static void test_closure_open_scene(void **state)
 {
     (void)state;
-    cli_scene_writer w;
-    write_two_surface_case(&w, "par_rect_1x1_d1");
-    cJSON *vf = view_factors(&w, "analytic", "--mesh-size 2 --closure-correction");
-    cli_assert_relative(cli_vf_get(vf, "A1", "A2"), 1.0, 1e-6, "open scene, closed rows");
-    cli_assert_relative(cli_vf_get(vf, "A2", "A1"), 1.0, 1e-6, "open scene, closed rows");
+    char line[2048];
+    cli_scene_writer squares;
+    write_two_surface_case(&squares, "par_rect_1x1_d1");
+    assert_int_equal(run_closure(&squares, "viewfactors", "--mesh-size 2", line, sizeof line), 1);
+    assert_refused(line, &squares, 80.0, 1.0);
+
+    /* 100 m apart (F = 3e-5): no ray meets anything, only F shows they see
+     * each other; the rows would be scaled from 3e-5 to 1. */
+    cli_scene_writer far;
+    cli_scene_begin(&far, "far_squares");
+    cli_scene_material(&far, "grey", 0.5, 1.0);
+    const double a1[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    const double a2[4][3] = {{0, 0, 100}, {0, 1, 100}, {1, 1, 100}, {1, 0, 100}};
+    cli_scene_polygon(&far, "A1", "grey", a1, 4);
+    cli_scene_polygon(&far, "A2", "grey", a2, 4);
+    cli_scene_end(&far);
+    assert_int_equal(run_closure(&far, "viewfactors", "--mesh-size 2", line, sizeof line), 1);
+    assert_refused(line, &far, 100.0, 0.1);
+
+    cli_scene_writer open, hole3, hole05, closed, block;
+    write_box(&open, "box_open", false, 0.0, false);
+    write_box(&hole3, "box_hole3", true, 0.03, false);
+    write_box(&hole05, "box_hole05", true, 0.005, false);
+    write_box(&closed, "box_closed", true, 0.0, false);
+    write_box(&block, "box_block", true, 0.0, true);
+    const char *runs[2][2] = {{"viewfactors", "--elements 400"},
+                              {"render", "--solver hierarchical --epsilon 1e-3 --width 8 --height 8"}};
+    for (int r = 0; r < 2; r++) {
+        assert_int_equal(run_closure(&open, runs[r][0], runs[r][1], line, sizeof line), 1);
+        assert_refused(line, &open, 20.0, 1.0);
+        assert_int_equal(run_closure(&hole3, runs[r][0], runs[r][1], line, sizeof line), 1);
+        assert_refused(line, &hole3, 3.0, 0.3);
+        assert_int_equal(run_closure(&hole05, runs[r][0], runs[r][1], line, sizeof line), 0);
+        assert_string_equal(line, "");
+        assert_int_equal(run_closure(&closed, runs[r][0], runs[r][1], line, sizeof line), 0);
+        assert_int_equal(run_closure(&block, runs[r][0], runs[r][1], line, sizeof line), 0);
+    }
+    /* What the stats record: the escape measured, the rows corrected. */
+    cJSON *vf = cli_view_factors(&hole05, "--elements 400 --closure-correction");
+    assert_true(cJSON_IsTrue(cJSON_GetObjectItem(vf, "closure_corrected")));
+    cli_assert_relative(vf_row_sum(vf, "floor"), 1.0, 1e-7, "hole of 0.5%: corrected row");
+    cJSON_Delete(vf);
+    char stats[700];
+    snprintf(stats, sizeof stats, "%s.stats.json", hole05.obj_path);
+    assert_int_equal(cli_run("viewfactors '%s' -o '%s.vf.json' --elements 400 --closure-correction --stats '%s'",
+                             hole05.obj_path, hole05.obj_path, stats),
+                     0);
+    cJSON *st = cli_read_json(stats);
+    assert_non_null(st);
+    double escaped = cli_stats_number(st, "form_factors", "escaped");
+    if (!(fabs(escaped - 0.005) < 0.001))
+        fail_msg("hole of 0.5%%: escaped %g", escaped);
+    cJSON_Delete(st);
+    snprintf(stats, sizeof stats, "%s.stats.json", block.obj_path);
+    assert_int_equal(cli_run("viewfactors '%s' -o '%s.vf.json' --elements 400 --closure-correction --stats '%s'",
+                             block.obj_path, block.obj_path, stats),
+                     0);
+    st = cli_read_json(stats);
+    assert_non_null(st);
+    assert_true(cli_stats_number(st, "form_factors", "escaped") < 1e-3);
+    cJSON_Delete(st);
+    vf = cli_view_factors(&block, "--elements 400");
+    assert_true(vf_row_sum(vf, "floor") < 0.95); /* rows would have called it open */
     cJSON_Delete(vf);
 
     char help[600];

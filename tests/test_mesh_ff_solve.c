@@ -404,6 +404,155 @@ static void test_residual_definition(void **state)
     assert_true(fabs(residual - 0.25) < 1e-15);
 }
 
+/* ---- how long a solver may run (solve.h) ---- */
+
+static void test_bound_arithmetic(void **state)
+{
+    (void)state;
+    /* q = 0.5: 0.5^20 < 1e-6 <= 0.5^19, so k = 20 and 2 k + 10 = 50 sweeps. */
+    rad_solve_bound b = rad_solve_bound_make(0, 0.5, 1.0, 1e-6, 1.0);
+    assert_true(b.bounces == 20.0 && b.limit == 50.0 && b.reason == RAD_BOUND_PHYSICS);
+    /* A shot is 1/24 of a bounce in a system of 24 elements. */
+    assert_true(rad_solve_bound_make(0, 0.5, 1.0, 1e-6, 24.0).limit == 50.0 * 24.0);
+    /* rho = 0.999999 needs 1.4e7 bounces: the cap. */
+    b = rad_solve_bound_make(0, 0.999999, 1.0, 1e-6, 1.0);
+    assert_true(b.bounces > 1.38e7 && b.bounces < 1.39e7);
+    assert_true(b.limit == RAD_SOLVE_BOUNCE_CAP && b.reason == RAD_BOUND_CAP);
+    /* Row sums above 1 / rho bound nothing: the cap. */
+    b = rad_solve_bound_make(0, 1.00001, 1.0, 1e-6, 1.0);
+    assert_true(isinf(b.bounces) && b.limit == RAD_SOLVE_BOUNCE_CAP && b.reason == RAD_BOUND_CAP);
+    /* The user's cap: kept below the physics, lowered to it above, and
+     * allowed past the automatic cap (the user asked for the time). */
+    b = rad_solve_bound_make(7, 0.5, 1.0, 1e-6, 1.0);
+    assert_true(b.limit == 7.0 && b.reason == RAD_BOUND_USER);
+    b = rad_solve_bound_make(1000, 0.5, 1.0, 1e-6, 1.0);
+    assert_true(b.limit == 50.0 && b.reason == RAD_BOUND_PHYSICS);
+    b = rad_solve_bound_make(20000, 0.999, 1.0, 1e-6, 1.0);
+    assert_true(b.limit == 20000.0 && b.reason == RAD_BOUND_USER);
+    /* Relaxation: weighted Jacobi contracts by |1 - w| + w q. */
+    b = rad_solve_bound_make(0, 0.5, 0.5, 1e-6, 1.0); /* 0.75 per sweep: k = 49 */
+    assert_true(b.bounces == 49.0 && b.limit == 108.0);
+    b = rad_solve_bound_make(0, 0.9, 1.5, 1e-6, 1.0); /* 1.85: no bound */
+    assert_true(b.reason == RAD_BOUND_CAP);
+    /* Nothing reflected: one bounce. */
+    assert_true(rad_solve_bound_make(0, 0.0, 1.0, 1e-6, 1.0).bounces == 1.0);
+}
+
+/* Two facing planes that see only each other (F = [0 1; 1 0], rows exactly
+ * 1 in float): both emit E = 1 and reflect rho, so B = E / (1 - rho). */
+static rad_system plates(double rho, double *reflectance, double *emission)
+{
+    static const float F[4] = {0.0f, 1.0f, 1.0f, 0.0f};
+    static const double area[2] = {1.0, 1.0};
+    for (int k = 0; k < 6; k++) {
+        reflectance[k] = rho;
+        emission[k] = 1.0;
+    }
+    return (rad_system){.n = 2, .F = F, .area = area, .reflectance = reflectance, .emission = emission, .threads = 2};
+}
+
+static bool is_solver(size_t k, const char *name) { return strcmp(rad_solvers[k]->name, name) == 0; }
+
+/* Every solver on rho = 0.99 converges to B = 100; on rho = 0.999999 the
+ * gathering and Southwell solvers stop at the cap, unconverged, saying so,
+ * and report the true residual of what they stopped at (Gauss-Seidel used
+ * to report the estimate its sweeps make: 1.99 where the residual was
+ * 0.95); conjugate gradients and LU reach B = 10^6.  A user's cap stops a
+ * solve where it says, with the same honesty. */
+static void test_solvers_stop(void **state)
+{
+    (void)state;
+    double rho[6], E[6];
+    for (size_t k = 0; rad_solvers[k]; k++) {
+        const char *name = rad_solvers[k]->name;
+        /* 0.99: converged, 100 to what the tolerance leaves. */
+        rad_system sys = plates(0.99, rho, E);
+        double B[6];
+        memcpy(B, E, sizeof B);
+        rad_solve_params p = {.tolerance = 1e-6};
+        rad_solve_stats st;
+        memset(&st, 0, sizeof st);
+        assert_int_equal(rad_solvers[k]->solve(ctx, &sys, &p, B, &st), RAD_OK);
+        assert_true(st.converged && st.warning[0] == '\0');
+        for (int c = 0; c < 6; c++)
+            if (!(fabs(B[c] - 100.0) < 1e-4 * 100.0))
+                fail_msg("%s: rho 0.99: B = %.9g, not 100", name, B[c]);
+        assert_true(st.iterations <= st.iteration_limit);
+
+        /* 0.999999 */
+        sys = plates(0.999999, rho, E);
+        memcpy(B, E, sizeof B);
+        memset(&st, 0, sizeof st);
+        assert_int_equal(rad_solvers[k]->solve(ctx, &sys, &p, B, &st), RAD_OK);
+        double residual;
+        assert_int_equal(rad_residual(ctx, &sys, B, &residual), RAD_OK);
+        if (is_solver(k, "direct") || is_solver(k, "conjugate-gradient")) {
+            assert_true(st.converged);
+            for (int c = 0; c < 6; c++)
+                if (!(fabs(B[c] - 1e6) < 1e-6 * 1e6))
+                    fail_msg("%s: rho 0.999999: B = %.9g, not 10^6", name, B[c]);
+        } else {
+            double per_bounce = is_solver(k, "southwell") ? 2.0 : 1.0;
+            assert_false(st.converged);
+            assert_true(st.iteration_limit == RAD_SOLVE_BOUNCE_CAP * per_bounce);
+            assert_true(st.iterations == st.iteration_limit);
+            if (!strstr(st.warning, "did not converge") || !strstr(st.warning, "(the cap; reflectance x row sum 0.999999") ||
+                !strstr(st.warning, name) || !strstr(st.warning, "conjugate-gradient or direct"))
+                fail_msg("%s: warning '%s'", name, st.warning);
+            /* What it reports is the residual of what it stopped at. */
+            if (!(st.residual == residual))
+                fail_msg("%s: reports residual %.17g, its B has %.17g", name, st.residual, residual);
+            /* B rose from E but is far from 10^6: 10^4 bounces of 10^6. */
+            for (int c = 0; c < 6; c++)
+                assert_true(B[c] > 1e3 && B[c] < 2e4);
+        }
+
+        /* A user's cap of 3 iterations (shots for Southwell). */
+        sys = plates(0.99, rho, E);
+        memcpy(B, E, sizeof B);
+        memset(&st, 0, sizeof st);
+        p.max_iterations = 3;
+        assert_int_equal(rad_solvers[k]->solve(ctx, &sys, &p, B, &st), RAD_OK);
+        p.max_iterations = 0;
+        assert_int_equal(rad_residual(ctx, &sys, B, &residual), RAD_OK);
+        if (is_solver(k, "direct") || is_solver(k, "conjugate-gradient"))
+            continue; /* exact, or exact at once on this system */
+        assert_true(st.iterations == 3 && st.iteration_limit == 3.0 && !st.converged);
+        assert_non_null(strstr(st.warning, "(rad_options.max_iterations)"));
+        if (!(st.residual == residual))
+            fail_msg("%s: capped at 3: reports residual %.17g, its B has %.17g", name, st.residual, residual);
+    }
+}
+
+/* A raised cancel flag interrupts every solver, direct (between the
+ * panels of its factorisation) included, and leaves a finite iterate. */
+static void test_solvers_cancel(void **state)
+{
+    (void)state;
+    rad_context_options o = {0};
+    o.threads = 2;
+    rad_context *c = NULL;
+    assert_int_equal(rad_context_create(&o, &c), RAD_OK);
+    rad_context_cancel(c, true);
+    double rho[6], E[6];
+    for (size_t k = 0; rad_solvers[k]; k++) {
+        rad_system sys = plates(0.999999, rho, E);
+        double B[6];
+        memcpy(B, E, sizeof B);
+        rad_solve_params p = {.tolerance = 1e-6};
+        rad_solve_stats st;
+        memset(&st, 0, sizeof st);
+        rad_api_enter(c);
+        if (rad_solvers[k]->solve(c, &sys, &p, B, &st) != RAD_ERROR_INTERRUPTED)
+            fail_msg("%s: not interrupted by the cancel flag", rad_solvers[k]->name);
+        assert_false(st.converged);
+        assert_true(st.warning[0] == '\0');
+        for (int i = 0; i < 6; i++)
+            assert_true(isfinite(B[i]) && B[i] >= 1.0);
+    }
+    rad_context_destroy(c);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -431,6 +580,9 @@ int main(void)
         cmocka_unit_test(test_ff_loop),
         cmocka_unit_test(test_solvers_two_patch),
         cmocka_unit_test(test_residual_definition),
+        cmocka_unit_test(test_bound_arithmetic),
+        cmocka_unit_test(test_solvers_stop),
+        cmocka_unit_test(test_solvers_cancel),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -31,6 +31,8 @@
 
 #include "core/core.h"
 
+#include <cjson/cJSON.h>
+
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -697,6 +699,289 @@ static void test_all_or_none(void **state)
 }
 
 /* ======================================================================
+ * Names in the outputs: any byte but NUL can reach a surface's name
+ * ==================================================================== */
+
+/* Four unit quads (floor, lamp above, two walls) in a data URI, one glTF
+ * node each, named as a hostile file would. */
+static const char quads_base64[] =
+    "AAAAAAAAAAAAAAAAAAAAAAAAAAAAAIA/AACAPwAAAAAAAIA/AACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAACAPwAAgD8AAAAAAACAPwAAgD8AAIA/"
+    "AAAAAAAAgD8AAIA/AAAAAAAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAgD8AAIA/AAAAAAAAAAAAAIA/AACAPwAAAAAAAAAAAACAPwAAAAAAAIA/"
+    "AACAPwAAgD8AAIA/AACAPwAAgD8AAAAAAAABAAIAAAACAAMABAAFAAYABAAGAAcACAAJAAoACAAKAAsADAANAA4ADAAOAA8A";
+
+#define FFFD "\xef\xbf\xbd"
+/* The name in the glTF (JSON text; raw bytes as they are), and the name
+ * every output must carry: valid UTF-8, U+FFFD for each byte that does not
+ * begin a well-formed sequence (0xff, 0xfe; 0xc3 before '('; a surrogate
+ * 0xed 0xa0 0x80; 0xf4 0x90 0x80 0x80 past U+10FFFF; overlong 0xc0 0xaf),
+ * and cut at NUL (a C string cannot hold one; assimp stops there). */
+static const char *const odd_names[4][2] = {
+    {"floor \xff\xfe \xc3\x28 \xed\xa0\x80 \xf4\x90\x80\x80 \xc0\xaf \xc3\xa9",
+     "floor " FFFD FFFD " " FFFD "( " FFFD FFFD FFFD " " FFFD FFFD FFFD FFFD " " FFFD FFFD " \xc3\xa9"},
+    {"lamp\\n3 3 9\\r\\\"x\\\",%\\t", "lamp\n3 3 9\r\"x\",%\t"},
+    {" wall, \\\"a\\\"\\\\ ", " wall, \"a\"\\ "},
+    {"nul\\u0000hidden", "nul"},
+};
+#define ODD_SCENE "sc\xe9ne\n%.gltf"
+#define ODD_SCENE_CLEAN "sc" FFFD "ne\n%.gltf"
+
+static void write_odd_scene(void)
+{
+    char text[8192];
+    snprintf(text, sizeof text,
+             "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1, 2, 3]}],"
+             "\"nodes\": [{\"name\": \"%s\", \"mesh\": 0}, {\"name\": \"%s\", \"mesh\": 1}, "
+             "{\"name\": \"%s\", \"mesh\": 2}, {\"name\": \"%s\", \"mesh\": 3}],"
+             "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 0}]},"
+             "{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 2, \"material\": 1}]},"
+             "{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 3, \"material\": 0}]},"
+             "{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 4, \"material\": 0}]}],"
+             "\"materials\": [{\"name\": \"white\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}}, "
+             "{\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}, "
+             "\"emissiveFactor\": [1, 1, 1]}],"
+             "\"buffers\": [{\"byteLength\": 240, \"uri\": \"data:application/octet-stream;base64,%s\"}],"
+             "\"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 192}, "
+             "{\"buffer\": 0, \"byteOffset\": 192, \"byteLength\": 48}],"
+             "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 16, \"type\": \"VEC3\", "
+             "\"min\": [0, 0, 0], \"max\": [1, 1, 1]}, "
+             "{\"bufferView\": 1, \"byteOffset\": 0, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
+             "{\"bufferView\": 1, \"byteOffset\": 12, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
+             "{\"bufferView\": 1, \"byteOffset\": 24, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
+             "{\"bufferView\": 1, \"byteOffset\": 36, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}",
+             odd_names[0][0], odd_names[1][0], odd_names[2][0], odd_names[3][0], quads_base64);
+    write_file(ODD_SCENE, text);
+}
+
+/* Well-formed UTF-8 (RFC 3629), decoded by code point. */
+static bool valid_utf8(const char *text, size_t size)
+{
+    const unsigned char *p = (const unsigned char *)text, *end = p + size;
+    while (p < end) {
+        unsigned cp, len;
+        if (*p < 0x80) {
+            p++;
+            continue;
+        } else if ((*p & 0xe0) == 0xc0) {
+            cp = *p & 0x1f, len = 2;
+        } else if ((*p & 0xf0) == 0xe0) {
+            cp = *p & 0x0f, len = 3;
+        } else if ((*p & 0xf8) == 0xf0) {
+            cp = *p & 0x07, len = 4;
+        } else {
+            return false;
+        }
+        if ((size_t)(end - p) < len)
+            return false;
+        for (unsigned k = 1; k < len; k++) {
+            if ((p[k] & 0xc0) != 0x80)
+                return false;
+            cp = cp << 6 | (p[k] & 0x3f);
+        }
+        unsigned least = len == 2 ? 0x80 : len == 3 ? 0x800 : 0x10000;
+        if (cp < least || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff))
+            return false;
+        p += len;
+    }
+    return true;
+}
+
+/* A whole work file (caller frees), its size in *size. */
+static char *read_work(const char *name, size_t *size)
+{
+    FILE *f = fopen(in_work(name), "rb");
+    assert_non_null(f);
+    char *text = malloc(1 << 20);
+    assert_non_null(text);
+    *size = fread(text, 1, (1 << 20) - 1, f);
+    text[*size] = '\0';
+    fclose(f);
+    return text;
+}
+
+/* The name the outputs give element k of surface `surface`. */
+static void element_name(char *out, size_t size, int surface, int k)
+{
+    snprintf(out, size, "%s#%d", odd_names[surface][1], k);
+}
+
+/* One RFC 4180 field from *p (quoted or not) into out; *p moves past it
+ * and its comma; returns the character that ended it (',', '\n' or 0). */
+static char csv_next(const char **p, char *out, size_t size)
+{
+    size_t n = 0;
+    const char *c = *p;
+    if (*c == '"') {
+        for (c++;; c++) {
+            assert_true(*c != '\0');
+            if (*c == '"' && c[1] == '"')
+                c++;
+            else if (*c == '"')
+                break;
+            if (n + 1 < size)
+                out[n++] = *c;
+        }
+        c++;
+    } else {
+        for (; *c && *c != ',' && *c != '\n'; c++) {
+            assert_true(*c != '"' && *c != '\r');
+            if (n + 1 < size)
+                out[n++] = *c;
+        }
+    }
+    out[n] = '\0';
+    char end = *c;
+    assert_true(end == ',' || end == '\n' || end == '\0');
+    *p = end ? c + 1 : c;
+    return end;
+}
+
+/* Every output that carries names: the view factors as JSON, CSV and
+ * Matrix Market at surface and element level, and the stats.  Each file is
+ * valid UTF-8; the JSON parses (cJSON) and gives back every name; the CSV
+ * parses (RFC 4180) into N + 1 records of N + 2 fields with the names in
+ * its header; in the Matrix Market file every line before the size line is
+ * a comment, one per row, whose JSON string is the name (before, a name
+ * holding "\n3 3 9" forged a size line, and bytes 0x80-0xff made the stats
+ * invalid JSON). */
+static void test_names_in_every_output(void **state)
+{
+    (void)state;
+    write_odd_scene();
+    for (int level = 0; level < 2; level++) {
+        const char *flag = level ? "--level element --mesh-size 0.5" : "";
+        int per_surface = level ? 4 : 1, N = 4 * per_surface;
+        char expected[16][256];
+        for (int s = 0; s < 4; s++)
+            for (int k = 0; k < per_surface; k++) {
+                if (level)
+                    element_name(expected[s * per_surface + k], sizeof expected[0], s, k);
+                else
+                    snprintf(expected[s], sizeof expected[0], "%s", odd_names[s][1]);
+            }
+        const char *formats[3] = {"json", "csv", "mtx"};
+        for (int f = 0; f < 3; f++) {
+            char out[64];
+            snprintf(out, sizeof out, "vf%d.%s", level, formats[f]);
+            assert_int_equal(run("viewfactors '%s' %s -o %s --stats vf%d_stats.json", ODD_SCENE, flag, out, level), 0);
+            size_t size;
+            char *text = read_work(out, &size);
+            if (!valid_utf8(text, size))
+                fail_msg("%s is not valid UTF-8", out);
+            if (f == 0) {
+                cJSON *vf = cJSON_Parse(text);
+                assert_non_null(vf);
+                assert_string_equal(cJSON_GetObjectItem(vf, "scene")->valuestring, ODD_SCENE_CLEAN);
+                const cJSON *list = cJSON_GetObjectItem(vf, level ? "elements_list" : "surfaces");
+                assert_int_equal(cJSON_GetArraySize(list), N);
+                for (int r = 0; r < N; r++) {
+                    const cJSON *row = cJSON_GetArrayItem(list, r);
+                    assert_string_equal(cJSON_GetObjectItem(row, "name")->valuestring, expected[r]);
+                    if (level)
+                        assert_string_equal(cJSON_GetObjectItem(row, "surface")->valuestring,
+                                            odd_names[r / per_surface][1]);
+                }
+                cJSON_Delete(vf);
+            } else if (f == 1) {
+                const char *p = text;
+                char field[512];
+                assert_true(csv_next(&p, field, sizeof field) == ',' && strcmp(field, "from") == 0);
+                assert_true(csv_next(&p, field, sizeof field) == ',' && strcmp(field, "area_m2") == 0);
+                for (int c = 0; c < N; c++) {
+                    char end = csv_next(&p, field, sizeof field);
+                    assert_string_equal(field, expected[c]);
+                    assert_true(end == (c + 1 < N ? ',' : '\n'));
+                }
+                for (int r = 0; r < N; r++) {
+                    assert_true(csv_next(&p, field, sizeof field) == ',');
+                    assert_string_equal(field, expected[r]);
+                    for (int c = 0; c <= N; c++) {
+                        char end = csv_next(&p, field, sizeof field);
+                        assert_true(end == (c < N ? ',' : '\n'));
+                        char *stop;
+                        strtod(field, &stop);
+                        assert_true(stop != field && *stop == '\0'); /* a number */
+                    }
+                }
+                assert_true(*p == '\0');
+            } else {
+                char *save = NULL, *line = strtok_r(text, "\n", &save);
+                assert_string_equal(line, "%%MatrixMarket matrix coordinate real general");
+                line = strtok_r(NULL, "\n", &save);
+                assert_true(line[0] == '%' && !strstr(line, "\"")); /* the description */
+                for (int r = 0; r < N; r++) {
+                    line = strtok_r(NULL, "\n", &save);
+                    char prefix[16];
+                    snprintf(prefix, sizeof prefix, "%% %d \"", r + 1);
+                    assert_true(strncmp(line, prefix, strlen(prefix)) == 0);
+                    char *tail = strstr(line, "\" area_m2 ");
+                    assert_non_null(tail);
+                    tail[1] = '\0';
+                    cJSON *name = cJSON_Parse(line + strlen(prefix) - 1);
+                    assert_true(cJSON_IsString(name));
+                    assert_string_equal(name->valuestring, expected[r]);
+                    cJSON_Delete(name);
+                }
+                line = strtok_r(NULL, "\n", &save);
+                int rows = 0, cols = 0, nnz = 0;
+                char rest;
+                assert_int_equal(sscanf(line, "%d %d %d%c", &rows, &cols, &nnz, &rest), 3);
+                assert_true(rows == N && cols == N && nnz > 0);
+            }
+            free(text);
+        }
+        char stats_name[64];
+        snprintf(stats_name, sizeof stats_name, "vf%d_stats.json", level);
+        size_t size;
+        char *text = read_work(stats_name, &size);
+        assert_true(valid_utf8(text, size));
+        cJSON *stats = cJSON_Parse(text);
+        assert_non_null(stats);
+        assert_string_equal(cJSON_GetObjectItem(stats, "scene")->valuestring, ODD_SCENE_CLEAN);
+        const cJSON *surfaces = cJSON_GetObjectItem(stats, "surfaces");
+        assert_int_equal(cJSON_GetArraySize(surfaces), 4);
+        for (int k = 0; k < 4; k++)
+            assert_string_equal(cJSON_GetObjectItem(cJSON_GetArrayItem(surfaces, k), "name")->valuestring,
+                                odd_names[k][1]);
+        cJSON_Delete(stats);
+        free(text);
+    }
+
+    /* The OBJ writer: names are made statements' words (blanks and controls
+     * to '_'), and the scene's path in its comments cannot end them (a scene
+     * read from a path holding "\nv 9 9 9" added a vertex to every OBJ
+     * written from it).  An output whose MTL name mtllib cannot hold (a
+     * blank, a line break, '#') is refused, nothing written.  Read back:
+     * the same scene. */
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    rad_scene *scene = NULL, *back = NULL;
+    write_file("odd\nv 9 9 9\nf 1 2 3.gltf", text_of(ODD_SCENE));
+    assert_int_equal(rad_scene_load_file(ctx, in_work("odd\nv 9 9 9\nf 1 2 3.gltf"), &scene), RAD_OK);
+    const char *refused[] = {"odd\nv 9 9 9.obj", "two words.obj", "hash#.obj", "tab\t.obj"};
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
+        char path[600];
+        snprintf(path, sizeof path, "%s", in_work(refused[k]));
+        assert_int_equal(rad_scene_write_obj(ctx, scene, path), RAD_ERROR_INVALID_ARGUMENT);
+        assert_non_null(strstr(rad_context_error(ctx), "an OBJ cannot name its MTL"));
+        assert_false(exists(refused[k]));
+    }
+    char obj[600];
+    snprintf(obj, sizeof obj, "%s", in_work("odd_written.obj"));
+    if (rad_scene_write_obj(ctx, scene, obj) != RAD_OK)
+        fail_msg("%s", rad_context_error(ctx));
+    const char *written = text_of("odd_written.obj");
+    assert_null(strstr(written, "\nv 9 9 9"));
+    assert_non_null(strstr(written, "odd?v 9 9 9?f 1 2 3.gltf: 4 surfaces"));
+    assert_non_null(strstr(text_of("odd_written.mtl"), "odd?v 9 9 9?f 1 2 3.gltf: materials"));
+    assert_int_equal(rad_scene_load_file(ctx, obj, &back), RAD_OK);
+    assert_int_equal(rad_scene_surface_count(back), 4);
+    assert_int_equal(rad_scene_polygon_count(back), rad_scene_polygon_count(scene));
+    rad_scene_destroy(back);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
+/* ======================================================================
  * The program: signals at each stage
  * ==================================================================== */
 
@@ -871,6 +1156,68 @@ static void test_signal_during_final_render(void **state)
     assert_no_temporaries(workdir);
 }
 
+/* A closed box of reflectance 0.999999 lit from its floor: no solver
+ * reaches 1e-15 on it (the iterative ones run to their bound of 10^4
+ * bounces), so each is in its solve when the signal comes. */
+static void write_bright_box(void)
+{
+    write_file("bright.mtl", "newmtl wall\nKd 0.999999 0.999999 0.999999\n"
+                             "newmtl lamp\nKd 0.999999 0.999999 0.999999\nKe 1 1 1\n");
+    write_file("bright.obj", "mtllib bright.mtl\n"
+                             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                             "usemtl lamp\no floor\nf 1 2 3 4\nusemtl wall\no ceiling\nf 5 8 7 6\n"
+                             "o front\nf 1 5 6 2\no back\nf 4 3 7 8\no left\nf 1 4 8 5\no right\nf 2 6 7 3\n");
+}
+
+/* SIGTERM while each solver solves: exit 143, the partial solution
+ * written and marked.  Those that show their steps are caught after their
+ * second frame; hierarchical (whose steps are not displayable) and direct
+ * (one step: its LU, polled between panels) when the progress names their
+ * phase. */
+static void test_signal_during_each_solver(void **state)
+{
+    (void)state;
+    write_bright_box();
+    static const char *framed[] = {"gauss-seidel", "jacobi", "conjugate-gradient", "southwell", "shooting"};
+    for (size_t k = 0; k < sizeof framed / sizeof framed[0] + 2; k++) {
+        const char *solver = k < 5 ? framed[k] : k == 5 ? "hierarchical" : "direct";
+        char args[1024], frame[128], stats_name[128], png[128];
+        snprintf(png, sizeof png, "sig_%s.png", solver);
+        snprintf(stats_name, sizeof stats_name, "sig_%s.json", solver);
+        if (k < 5)
+            snprintf(args, sizeof args,
+                     "render bright.obj --solver %s --elements 600 --tolerance 1e-15 --ff-samples 64 --width 16 "
+                     "--height 16 --progress-images frames_%s --every 1 -o %s --stats %s",
+                     solver, solver, png, stats_name);
+        else if (k == 5)
+            snprintf(args, sizeof args, "render bright.obj --solver hierarchical --tolerance 1e-15 --width 16 "
+                                        "--height 16 -o %s --stats %s", png, stats_name);
+        else /* an LU of 2904 unknowns: seconds, in 23 panels */
+            snprintf(args, sizeof args,
+                     "render bright.obj --solver direct --elements 3000 --form-factors hemicube --hemicube-res 16 "
+                     "--width 16 --height 16 -o %s --stats %s",
+                     png, stats_name);
+        watched w;
+        watch_start(&w, args);
+        if (k < 5) {
+            snprintf(frame, sizeof frame, "frames_%s/step_00000002.png", solver);
+            watch_for_file(&w, frame);
+        } else {
+            watch_for_text(&w, k == 5 ? "hierarchical" : "solve");
+        }
+        kill(w.pid, SIGTERM);
+        int status = watch_end(&w);
+        if (status != 143)
+            fail_msg("%s: exit %d after SIGTERM while solving; it printed: %s", solver, status, w.seen);
+        assert_true(exists(png));
+        const char *stats = text_of(stats_name);
+        if (!strstr(stats, "\"partial\":\ttrue") || !strstr(stats, "\"converged\":\tfalse"))
+            fail_msg("%s: the stats are not marked partial: %s", solver, stats);
+        assert_non_null(strstr(w.seen, "interrupted while solving; writing the partial solution"));
+        assert_no_temporaries(workdir);
+    }
+}
+
 /* Whether the process has a handler for SIGINT (Linux /proc). */
 static bool catches_sigint(pid_t pid)
 {
@@ -952,11 +1299,13 @@ int main(int argc, char **argv)
         cmocka_unit_test_setup_teardown(test_outputs_aliasing_inputs, setup, teardown),
         cmocka_unit_test_setup_teardown(test_outputs_aliasing_each_other, setup, teardown),
         cmocka_unit_test_setup_teardown(test_all_or_none, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_names_in_every_output, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_form_factors, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_solve_with_progress_images, setup, teardown),
         cmocka_unit_test_setup_teardown(test_second_signal_while_saving, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_final_render, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_generate, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_signal_during_each_solver, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -263,6 +263,36 @@ static void test_first_error_kept_and_reported_once(void **state)
     rad_scene_destroy(scene);
 }
 
+/* A solve that stops short of its tolerance says so: converged false and
+ * one line naming the solver, the count and the limit, for every strategy
+ * (the user's cap of 2 sweeps, shots or batches). */
+static void test_unconverged_is_reported(void **state)
+{
+    (void)state;
+    rad_scene *scene = furnace();
+    const char *names[] = {"gauss-seidel", "shooting", "hierarchical"};
+    const char *units[] = {"2 sweeps", "2 batches", "2 sweeps"};
+    for (int k = 0; k < 3; k++) {
+        rad_options o = {0};
+        o.solver = names[k];
+        o.target_elements = 600;
+        o.max_iterations = 2;
+        rad_solution *s = NULL;
+        assert_false(rad_solution_converged(s));
+        assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+        assert_false(rad_solution_converged(s)); /* not solved yet */
+        assert_string_equal(rad_solution_warning(s), "");
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+        assert_false(rad_solution_converged(s));
+        const char *w = rad_solution_warning(s);
+        if (!strstr(w, names[k]) || !strstr(w, units[k]) || !strstr(w, "(rad_options.max_iterations)") ||
+            strchr(w, '\n'))
+            fail_msg("%s: warning '%s'", names[k], w);
+        rad_solution_destroy(s);
+    }
+    rad_scene_destroy(scene);
+}
+
 static void test_cancellation_flag(void **state)
 {
     (void)state;
@@ -281,8 +311,12 @@ static void test_cancellation_flag(void **state)
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     rad_context_cancel(ctx, true);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_INTERRUPTED);
+    assert_false(rad_solution_converged(s));
+    assert_string_equal(rad_solution_warning(s), ""); /* interrupted: no warning to give */
     rad_context_cancel(ctx, false);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+    assert_true(rad_solution_converged(s));
+    assert_string_equal(rad_solution_warning(s), "");
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
     rad_context_cancel(NULL, true); /* no-op */
@@ -365,6 +399,7 @@ int main(void)
         cmocka_unit_test(test_strategies_furnace_and_accessors),
         cmocka_unit_test(test_hierarchical_elements_are_leaves),
         cmocka_unit_test(test_first_error_kept_and_reported_once),
+        cmocka_unit_test(test_unconverged_is_reported),
         cmocka_unit_test(test_cancellation_flag),
         cmocka_unit_test(test_diverged_solution_refused),
     };

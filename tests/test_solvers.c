@@ -445,28 +445,269 @@ static void test_direct_memory_limit(void **state)
 
 /* ---- results do not depend on the thread count ---- */
 
+/* Run `radiosity render` (Cornell box, 600 elements) with `env` before it
+ * and `extra` after; the image as a PFM (caller frees) and the stats. */
+static char *render_image(const char *tag, const char *env, const char *extra, size_t *size, cJSON **stats)
+{
+    char pfm[600], json[600], cmd[4096];
+    snprintf(pfm, sizeof pfm, "%s/%s.pfm", cli_workdir(), tag);
+    snprintf(json, sizeof json, "%s/%s.json", cli_workdir(), tag);
+    snprintf(cmd, sizeof cmd, "%s '%s' render -o '%s' --stats '%s' --width 24 --height 24 --elements 600 %s -q",
+             env, cli_binary(), pfm, json, extra);
+    int status = system(cmd);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        fail_msg("%s: %s exited with %d", tag, cmd, status);
+    FILE *f = fopen(pfm, "rb");
+    assert_non_null(f);
+    char *bytes = malloc(1 << 16);
+    assert_non_null(bytes);
+    *size = fread(bytes, 1, 1 << 16, f);
+    fclose(f);
+    *stats = cli_read_json(json);
+    assert_non_null(*stats);
+    return bytes;
+}
+
+/* Every solver, dense and matrix-free: the image, every surface's
+ * radiosity, the residual and the iteration count are bit-identical on 1,
+ * 2 and 3 threads, set by --threads or by OMP_NUM_THREADS; direct also
+ * with OpenBLAS told to use 2 threads (its LU is ours, blocked the same
+ * on any thread count: it used to differ in the last bits, 4e-16). */
 static void test_thread_count(void **state)
 {
     (void)state;
-    for (int k = 0; k < solver_count; k++) {
+    static const char *runs[][2] = {
+        {"", "--threads 1"}, {"", "--threads 2"}, {"", "--threads 3"},
+        {"OMP_NUM_THREADS=2", ""}, {"OPENBLAS_NUM_THREADS=2 OMP_NUM_THREADS=2", ""},
+    };
+    const char *matrix_free[] = {"shooting", "hierarchical"};
+    for (int k = 0; k < solver_count + 2; k++) {
+        const char *solver = k < solver_count ? solvers[k] : matrix_free[k - solver_count];
         char extra[256], tag[128];
-        snprintf(extra, sizeof extra, "--elements 600 --solver %s --tolerance 1e-9 --threads 1", solvers[k]);
-        snprintf(tag, sizeof tag, "threads1_%s", solvers[k]);
-        cJSON *one = render_stats("", tag, extra);
-        snprintf(extra, sizeof extra, "--elements 600 --solver %s --tolerance 1e-9 --threads 3", solvers[k]);
-        snprintf(tag, sizeof tag, "threads3_%s", solvers[k]);
-        cJSON *three = render_stats("", tag, extra);
-        /* Bit for bit; but LU runs in OpenBLAS, whose partition of the
-         * factorisation among threads moves the last bit (~4e-16). */
-        bool lapack = strcmp(solvers[k], "direct") == 0;
-        assert_same_surfaces(three, one, lapack ? 1e-13 : 0.0, tag);
-        if (!lapack)
-            assert_true(cli_stats_number(one, "solver", "residual") ==
-                        cli_stats_number(three, "solver", "residual"));
-        assert_true(cli_stats_number(one, "solver", "iterations") ==
-                    cli_stats_number(three, "solver", "iterations"));
-        cJSON_Delete(one);
-        cJSON_Delete(three);
+        snprintf(extra, sizeof extra, "--solver %s --tolerance 1e-9%s", solver,
+                 k >= solver_count ? " --ff-samples 32 --epsilon 1e-3" : "");
+        size_t size0 = 0;
+        cJSON *stats0 = NULL;
+        snprintf(tag, sizeof tag, "threads0_%s", solver);
+        char *image0 = render_image(tag, runs[0][0], extra, &size0, &stats0);
+        assert_true(size0 > 24 * 24 * 12);
+        for (size_t r = 1; r < sizeof runs / sizeof runs[0]; r++) {
+            char more[512];
+            snprintf(more, sizeof more, "%s %s", extra, runs[r][1]);
+            snprintf(tag, sizeof tag, "threads%zu_%s", r, solver);
+            size_t size = 0;
+            cJSON *stats = NULL;
+            char *image = render_image(tag, runs[r][0], more, &size, &stats);
+            char label[128];
+            snprintf(label, sizeof label, "%.32s with %.48s%.16s", solver, runs[r][0], runs[r][1]);
+            if (size != size0 || memcmp(image, image0, size) != 0)
+                fail_msg("%s: the image differs from one thread's", label);
+            assert_same_surfaces(stats, stats0, 0.0, label);
+            double a = cli_stats_number(stats, "solver", "iterations"), b = cli_stats_number(stats0, "solver", "iterations");
+            if (a != b)
+                fail_msg("%s: %g iterations, %g on one thread", label, a, b);
+            const cJSON *ra = cJSON_GetObjectItem(cJSON_GetObjectItem(stats, "solver"), "residual");
+            const cJSON *rb = cJSON_GetObjectItem(cJSON_GetObjectItem(stats0, "solver"), "residual");
+            assert_true(cJSON_IsNull(ra) == cJSON_IsNull(rb));
+            if (!cJSON_IsNull(ra) && ra->valuedouble != rb->valuedouble)
+                fail_msg("%s: residual %.17g, %.17g on one thread", label, ra->valuedouble, rb->valuedouble);
+            free(image);
+            cJSON_Delete(stats);
+        }
+        free(image0);
+        cJSON_Delete(stats0);
+    }
+}
+
+/* ---- (h) bright closed boxes: every solver stops ---- */
+
+/* The furnace cube with reflectance rho on every face, each emitting E = 1:
+ * B = E / (1 - rho) everywhere (H = B in a closed box).  The matrix the
+ * solvers are given has element rows s_i in [s_min, s_max] (stats), and
+ * then (maximum principle: B_max = E + rho sum_j F_ij B_j <= E + rho s_max
+ * B_max, and the same for the minimum)
+ *
+ *     E / (1 - rho s_min) <= B_i <= E / (1 - rho s_max),
+ *
+ * the band the exact answer of that matrix lies in. */
+static void write_bright_cube(cli_scene_writer *w, const char *name, double rho)
+{
+    static const double zero[3] = {0, 0, 0};
+    const double r[3] = {rho, rho, rho};
+    cli_scene_begin(w, name);
+    write_cube_faces(w, "furnace_cube_rho0.5", "", zero, r, NULL, 0.0, NULL);
+    cli_scene_end(w);
+}
+
+/* Render without --quiet, for the warning; stderr into `errors`. */
+static cJSON *render_loud(const char *scene, const char *tag, const char *extra, char *errors, size_t size)
+{
+    char stats[600], png[600], err[600], cmd[4096];
+    snprintf(stats, sizeof stats, "%s/%s.stats.json", cli_workdir(), tag);
+    snprintf(png, sizeof png, "%s/%s.png", cli_workdir(), tag);
+    snprintf(err, sizeof err, "%s/%s.err", cli_workdir(), tag);
+    snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --stats '%s' --width 8 --height 8 %s >/dev/null 2>'%s'",
+             cli_binary(), scene, png, stats, extra, err);
+    int status = system(cmd);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        fail_msg("%s: radiosity render %s exited with %d", tag, extra, status);
+    char *text = cli_read_text(err);
+    assert_non_null(text);
+    snprintf(errors, size, "%s", text);
+    free(text);
+    cJSON *j = cli_read_json(stats);
+    assert_non_null(j);
+    return j;
+}
+
+static bool stats_flag(const cJSON *stats, const char *key)
+{
+    return cJSON_IsTrue(cJSON_GetObjectItem(cJSON_GetObjectItem(stats, "solver"), key));
+}
+
+/* The area-weighted mean radiosity over the six unit faces (channel 0). */
+static double cube_mean(const cJSON *stats)
+{
+    double sum = 0.0;
+    for (int f = 0; f < 6; f++) {
+        double B[3];
+        cli_stats_surface_radiosity(stats, cube_faces[f], B);
+        sum += B[0];
+    }
+    return sum / 6.0;
+}
+
+/* An unconverged stop: one warning line naming the solver, the count and
+ * why; the stats say the same. */
+static void assert_stopped(const cJSON *stats, const char *errors, const char *solver, double limit,
+                           const char *units)
+{
+    char expected[256];
+    snprintf(expected, sizeof expected, "radiosity: warning: %s did not converge in %.0f %s (the cap; reflectance x row sum 0.999999",
+             solver, limit, units);
+    const char *newline = strchr(errors, '\n');
+    if (strncmp(errors, expected, strlen(expected)) != 0 || !newline || newline[1] != '\0')
+        fail_msg("%s: expected one line '%s...', got '%s'", solver, expected, errors);
+    assert_false(stats_flag(stats, "converged"));
+    assert_true(cli_stats_number(stats, "solver", "iterations") == limit);
+    assert_true(cli_stats_number(stats, "solver", "iteration_limit") == limit);
+    const cJSON *warning = cJSON_GetObjectItem(cJSON_GetObjectItem(stats, "solver"), "warning");
+    assert_true(cJSON_IsString(warning) && strstr(errors, warning->valuestring));
+    /* Bounded time: 10^4 bounces of a 24-element box are seconds. */
+    assert_true(cli_stats_number(stats, "solver", "seconds") < 120.0);
+}
+
+static void test_bright_boxes_dense(void **state)
+{
+    (void)state;
+    cli_scene_writer w99, w6;
+    write_bright_cube(&w99, "bright99", 0.99);
+    write_bright_cube(&w6, "bright6", 0.999999);
+    for (int k = 0; k < solver_count; k++) {
+        char extra[256], tag[128], errors[2048];
+        /* 0.99: every solver converges, inside the band of its matrix, and
+         * the band is within 0.2% of the closed form E / (1 - rho) = 100. */
+        snprintf(extra, sizeof extra, "--solver %s --mesh-size 0.25", solvers[k]);
+        snprintf(tag, sizeof tag, "bright99_%s", solvers[k]);
+        cJSON *s = render_loud(w99.obj_path, tag, extra, errors, sizeof errors);
+        assert_true(stats_flag(s, "converged"));
+        assert_string_equal(errors, "");
+        double lo = 1.0 / (1.0 - 0.99 * cli_stats_number(s, "form_factors", "row_sum_min"));
+        double hi = 1.0 / (1.0 - 0.99 * cli_stats_number(s, "form_factors", "row_sum_max"));
+        for (int f = 0; f < 6; f++) {
+            double B[3];
+            cli_stats_surface_radiosity(s, cube_faces[f], B);
+            if (!(B[0] >= lo * (1.0 - 1e-6) && B[0] <= hi * (1.0 + 1e-6)))
+                fail_msg("%s: rho 0.99: B(%s) = %.9g outside [%.9g, %.9g]", solvers[k], cube_faces[f], B[0], lo, hi);
+            assert_relative(B[0], 100.0, 2e-3, tag);
+        }
+        cJSON_Delete(s);
+
+        /* 0.999999, closed up (rows 1 to float rounding): conjugate
+         * gradients and LU converge, to 10^6 within the band; gathering and
+         * Southwell stop at the cap of 10^4 bounces (24 elements: 10^4
+         * sweeps, 240,000 shots), with B between E and the band. */
+        snprintf(extra, sizeof extra, "--solver %s --mesh-size 0.5 --closure-correction", solvers[k]);
+        snprintf(tag, sizeof tag, "bright6_%s", solvers[k]);
+        s = render_loud(w6.obj_path, tag, extra, errors, sizeof errors);
+        assert_int_equal((int)cJSON_GetObjectItem(s, "elements")->valuedouble, 24);
+        lo = 1.0 / (1.0 - 0.999999 * cli_stats_number(s, "form_factors", "row_sum_min"));
+        hi = 1.0 / (1.0 - 0.999999 * cli_stats_number(s, "form_factors", "row_sum_max"));
+        bool exact = strcmp(solvers[k], "direct") == 0 || strcmp(solvers[k], "conjugate-gradient") == 0;
+        if (exact) {
+            assert_true(stats_flag(s, "converged"));
+            assert_string_equal(errors, "");
+            for (int f = 0; f < 6; f++) {
+                double B[3];
+                cli_stats_surface_radiosity(s, cube_faces[f], B);
+                if (!(B[0] >= lo * (1.0 - 1e-6) && B[0] <= hi * (1.0 + 1e-6)))
+                    fail_msg("%s: rho 0.999999: B(%s) = %.9g outside [%.9g, %.9g]", solvers[k], cube_faces[f], B[0],
+                             lo, hi);
+                assert_relative(B[0], 1e6, 0.02, tag);
+            }
+        } else {
+            bool southwell = strcmp(solvers[k], "southwell") == 0;
+            assert_stopped(s, errors, solvers[k], southwell ? 240000.0 : 10000.0, southwell ? "shots" : "sweeps");
+            double mean = cube_mean(s), residual = cli_stats_number(s, "solver", "residual");
+            assert_true(mean > 1.0 && mean < lo);
+            /* The residual reported is the iterate's: at least the power not
+             * yet accounted for, 1 - (1 - rho) B / E summed over the box. */
+            if (!(residual >= 1.0 - 1e-6 * mean - 1e-3 && residual <= 1.0))
+                fail_msg("%s: residual %g for a mean B of %g", solvers[k], residual, mean);
+        }
+        cJSON_Delete(s);
+    }
+}
+
+/* Shooting and hierarchical on the same boxes.  Shooting's own measure is
+ * the unshot power u (of the emitted): with nothing escaping, the power it
+ * has deposited is exact bookkeeping, sum A B = (emitted - rho U) / (1 - rho)
+ * and absorbed = emitted - U, converged or not. */
+static void test_bright_boxes_matrix_free(void **state)
+{
+    (void)state;
+    cli_scene_writer w99, w6;
+    write_bright_cube(&w99, "mf_bright99", 0.99);
+    write_bright_cube(&w6, "mf_bright6", 0.999999);
+    const double rho[2] = {0.99, 0.999999};
+    const char *scene[2] = {w99.obj_path, w6.obj_path};
+    for (int b = 0; b < 2; b++) {
+        char tag[64], errors[2048];
+        snprintf(tag, sizeof tag, "shoot_%d", b);
+        cJSON *s = render_loud(scene[b], tag, "--solver shooting --mesh-size 0.5 --ff-samples 64", errors, sizeof errors);
+        double u = cli_stats_number(s, "solver", "unshot");
+        double emitted = cli_stats_number(s, "power_W", "emitted");
+        /* E as read (Ke = E / pi goes through a float): the emitted power / 6 m^2. */
+        assert_relative(cube_mean(s), emitted / 6.0 * (1.0 - rho[b] * u) / (1.0 - rho[b]), 1e-9,
+                        "shooting: deposited power");
+        assert_relative(cli_stats_number(s, "power_W", "absorbed"), emitted * (1.0 - u), 1e-9, "shooting: absorbed");
+        if (b == 0) {
+            assert_true(stats_flag(s, "converged") && u <= 1e-3);
+            assert_string_equal(errors, "");
+        } else {
+            /* 24 elements: one batch a bounce. */
+            assert_stopped(s, errors, "shooting", 10000.0, "batches");
+            assert_true(u > 0.9);
+        }
+        cJSON_Delete(s);
+
+        /* Hierarchical: B = E / (1 - rho c), c its links' closure weighted by
+         * power (1 here: uniform leaves at this min-area), converged at 0.99;
+         * at 0.999999 its first round stops at the cap. */
+        snprintf(tag, sizeof tag, "hier_%d", b);
+        s = render_loud(scene[b], tag, "--solver hierarchical --epsilon 1e-3 --min-area 0.05", errors, sizeof errors);
+        if (b == 0) {
+            assert_true(stats_flag(s, "converged"));
+            assert_string_equal(errors, "");
+            const cJSON *closure = cJSON_GetObjectItem(
+                cJSON_GetObjectItem(cJSON_GetObjectItem(s, "solver"), "hierarchical"), "closure");
+            double c = cJSON_GetObjectItem(closure, "power_weighted")->valuedouble;
+            assert_relative(cube_mean(s), 1.0 / (1.0 - rho[b] * c), 1e-4, "hierarchical: B = E / (1 - rho c)");
+            assert_relative(cube_mean(s), 100.0, 1e-3, "hierarchical: closed form");
+        } else {
+            assert_stopped(s, errors, "hierarchical (refinement round 1)", 10000.0, "sweeps");
+        }
+        cJSON_Delete(s);
     }
 }
 
@@ -527,6 +768,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_conjugate_gradient_restarts),
         cmocka_unit_test(test_direct_memory_limit),
         cmocka_unit_test(test_thread_count),
+        cmocka_unit_test(test_bright_boxes_dense),
+        cmocka_unit_test(test_bright_boxes_matrix_free),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

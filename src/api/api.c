@@ -186,6 +186,11 @@ void rad_solution_destroy(rad_solution *s)
 size_t rad_solution_element_count(const rad_solution *s) { return s ? s->view.n : 0; }
 double rad_solution_residual(const rad_solution *s) { return s ? s->view.solve->residual : NAN; }
 int rad_solution_iterations(const rad_solution *s) { return s ? s->view.solve->iterations : 0; }
+bool rad_solution_converged(const rad_solution *s) { return s && s->view.solved && s->view.solve->converged; }
+const char *rad_solution_warning(const rad_solution *s)
+{
+    return s && s->view.solved && !s->view.solve->converged ? s->view.solve->warning : "";
+}
 
 void rad_solution_surface_radiosity(const rad_solution *s, size_t surface, double rgb[3])
 {

@@ -72,7 +72,9 @@ static const rad_option_info solution_rows[] = {
      .max_open = true, .default_value = NAN, .default_text = "not used",
      .help = "shooting: also stop when unshot power / emitted power falls below this"},
     {SOLUTION(max_iterations), .type = RAD_OPTION_INT, .min = 0.0, .max = INT_MAX, .default_value = NAN,
-     .default_text = "0 (automatic)", .help = "cap on sweeps (gathering) or shots (shooting)"},
+     .default_text = "0 (automatic: 2 ln(tolerance) / ln(rho_max) + 10 bounces of light, at most 10^4)",
+     .help = "cap on sweeps (gathering), shots (southwell) or batches of 32 shots (shooting); above what "
+             "the reflectances need it is lowered to that"},
     {SOLUTION(relaxation), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 2.0, .max_open = true,
      .default_value = 1.0, .default_text = "1",
      .help = "over-relaxation: SOR for jacobi and gauss-seidel, overshooting for southwell"},

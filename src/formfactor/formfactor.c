@@ -252,6 +252,94 @@ rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F)
     return RAD_OK;
 }
 
+rad_result rad_ff_escape_rays(rad_context *ctx, const rad_mesh *mesh, const rad_vis *vis, uint64_t seed,
+                              double *fraction)
+{
+    enum { BLOCK = 64 };
+    size_t n = mesh->element_count;
+    if (n == 0 || !vis) {
+        for (size_t i = 0; i < n; i++)
+            fraction[i] = 0.0;
+        return RAD_OK;
+    }
+    double per = ceil(262144.0 / (double)n);
+    int rays = per < 16.0 ? 16 : per > 4096.0 ? 4096 : (int)per, side = (int)sqrt((double)rays);
+    double eps = rad_vis_epsilon(mesh);
+    volatile int stop = 0;
+#pragma omp parallel for schedule(dynamic, 16) num_threads(ctx->threads > 0 ? ctx->threads : 1)
+    for (size_t i = 0; i < n; i++) {
+        fraction[i] = 0.0;
+        if (stop)
+            continue;
+        const rad_element *e = &mesh->elements[i];
+        /* Lifted as shooting lifts its rays, by the bend of a quad too. */
+        double lift = eps;
+        if (e->vertex_count == 4)
+            for (int k = 1; k < 4; k++)
+                lift += fabs(v3_dot(e->normal, v3_sub(mesh->vertices[e->vertex[k]], mesh->vertices[e->vertex[0]])));
+        vec3 nrm = e->normal;
+        vec3 t = v3_normalize(fabs(nrm.x) > 0.9 ? v3_cross(nrm, v3(0, 1, 0)) : v3_cross(nrm, v3(1, 0, 0)));
+        vec3 b = v3_cross(nrm, t);
+        rad_rng rng = rad_rng_keyed(seed ^ 0x436c6f736564ULL, i, 0); /* "Closed" */
+        rad_ray ray[BLOCK];
+        rad_hit hit[BLOCK];
+        int missed = 0;
+        for (int first = 0; first < rays; first += BLOCK) {
+            int count = rays - first < BLOCK ? rays - first : BLOCK;
+            for (int k = 0; k < count; k++) {
+                /* Directions stratified over the disk (Malley), points uniform. */
+                int cell = (first + k) % (side * side);
+                double u = ((cell % side) + rad_rng_uniform(&rng)) / side;
+                double v = ((cell / side) + rad_rng_uniform(&rng)) / side;
+                double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
+                double r = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
+                ray[k].origin = v3_mad(rad_element_sample(mesh, e, pu, pv), nrm, lift);
+                ray[k].direction = v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(nrm, z));
+                ray[k].tnear = 0.0;
+                ray[k].tfar = INFINITY;
+            }
+            vis->backend->intersect(vis->state, ray, (size_t)count, hit);
+            for (int k = 0; k < count; k++)
+                missed += !isfinite(hit[k].t);
+        }
+        fraction[i] = (double)missed / rays;
+        if (rad_cancelled(ctx))
+            stop = 1;
+    }
+    if (stop)
+        return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "closure: interrupted");
+    return RAD_OK;
+}
+
+double rad_ff_escaped(const rad_mesh *mesh, const double *fraction, const float *F)
+{
+    size_t n = mesh->element_count;
+    double area = 0.0, lost = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        bool sees = fraction[i] < 1.0;
+        if (F) {
+            double row = 0.0;
+            for (size_t j = 0; j < n; j++)
+                row += F[i * n + j];
+            sees = row > 0.0;
+        }
+        if (!sees)
+            continue;
+        area += mesh->elements[i].area;
+        lost += mesh->elements[i].area * fraction[i];
+    }
+    return area > 0.0 ? lost / area : 0.0;
+}
+
+rad_result rad_ff_refuse_open(rad_context *ctx, const char *source, double escaped)
+{
+    return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                    "%s: rad_options.closure_correction is for closed scenes, and %.1f%% of the light leaving "
+                    "this one's surfaces escapes it (rays from every element that meet nothing; up to %g%% is "
+                    "taken as the cracks of a closed model): refused, it would put that light back",
+                    source ? source : "scene", 100.0 * escaped, 100.0 * RAD_FF_OPEN_SCENE_ESCAPE);
+}
+
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
                             double max_memory, bool close, float **F_out, float **variance_out,
                             rad_ff_stats *stats)
@@ -286,6 +374,13 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     if (r == RAD_OK)
         r = run_method(ctx, method, req, shared, F, var, stats);
     rad_free(shared);
+    if (r == RAD_OK && close && req->escape) {
+        /* Now that F says which elements see something (what sees
+         * nothing keeps its zero row): is the scene closed? */
+        stats->escaped = rad_ff_escaped(req->mesh, req->escape, F);
+        if (stats->escaped > RAD_FF_OPEN_SCENE_ESCAPE)
+            r = rad_ff_refuse_open(ctx, req->source, stats->escaped);
+    }
     if (r == RAD_OK && close) {
         r = rad_ff_close(ctx, req->mesh, F);
         stats->closure_corrected = r == RAD_OK;

@@ -306,11 +306,11 @@ static double push_pull(hr_state *st)
 }
 
 /* Sweeps until the residual is below `tol` (or `cap` sweeps). */
-static rad_result solve(hr_state *st, double tol, int cap, double *residual, bool *converged)
+static rad_result solve(hr_state *st, double tol, double cap, double *residual, bool *converged)
 {
     *converged = false;
     *residual = INFINITY;
-    for (int it = 0; it < cap; it++) {
+    for (double it = 0; it < cap; it++) {
         if (rad_cancelled(st->ctx))
             return RAD_ERROR_INTERRUPTED;
         gather(st);
@@ -614,6 +614,25 @@ static rad_result correct_closure(hr_state *st, size_t *corrected)
     return r;
 }
 
+/* q of the links (solve.h): rho_max times the largest closure of a leaf
+ * (link_closure; its links may deliver more than it sends: 1.2 on a
+ * uniform box), at least rho_max.  Fails only for memory. */
+static rad_result links_contraction(hr_state *st, double rho_max, double *q)
+{
+    const hr_tree *t = &st->tree;
+    double *acc = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, t->count, sizeof *acc, "hierarchical: closure");
+    if (!acc)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_result r = link_closure(st, acc);
+    double most = 1.0;
+    for (size_t k = 0; r == RAD_OK && k < t->count; k++)
+        if (t->nodes[k].kind == HR_SURFACE && t->nodes[k].child[0] == 0)
+            most = fmax(most, acc[k]);
+    rad_free(acc);
+    *q = rho_max * most;
+    return r;
+}
+
 /* ---- the leaves as a mesh ---- */
 
 typedef struct leaf_builder {
@@ -771,8 +790,17 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     hs->initial_links = st.links.count;
     hs->seconds_refine += rad_seconds() - t0;
 
-    double residual = INFINITY;
+    /* How many sweeps a solve may take (solve.h): each leaf reflects at
+     * most rho_max of what it receives, and receives at most the largest
+     * closure of what is sent (links_contraction, each round). */
+    double rho_max = 0.0;
+    for (size_t i = 0; i < base->element_count; i++)
+        for (int c = 0; c < 3; c++)
+            rho_max = fmax(rho_max, scene->materials[base->elements[i].material].reflectance[c]);
+    rad_solve_bound bound = {0};
+    double residual = INFINITY, tol = p->tolerance;
     bool converged = false;
+    int rounds_solved = 0, round_sweeps = 0;
     const int max_rounds = 24;
     for (int round = 0; round < max_rounds; round++) {
         rad_progress(ctx, "hierarchical", (uint64_t)round, (uint64_t)max_rounds);
@@ -822,11 +850,20 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                 goto done;
         }
         double t2 = rad_seconds();
-        double tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
-        int cap = p->max_iterations > 0 && last ? p->max_iterations : 10000;
-        r = solve(&st, tol, cap, &residual, &converged);
+        tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
+        double q = rho_max;
+        if ((r = links_contraction(&st, rho_max, &q)) != RAD_OK)
+            goto done;
+        bound = rad_solve_bound_make(last ? p->max_iterations : 0, q, 1.0, tol, 1.0);
+        ss->iteration_limit = fmax(ss->iteration_limit, bound.limit);
+        int sweeps_before = st.sweeps;
+        r = solve(&st, tol, bound.limit, &residual, &converged);
+        rounds_solved = round + 1;
+        round_sweeps = st.sweeps - sweeps_before;
         hs->seconds_solve += rad_seconds() - t2;
-        if (r != RAD_OK || last)
+        /* A round that cannot reach its tolerance: refining against its B
+         * would not help the next one, which needs more. */
+        if (r != RAD_OK || last || !converged)
             break;
     }
     rad_progress(ctx, "hierarchical", (uint64_t)max_rounds, (uint64_t)max_rounds);
@@ -847,6 +884,12 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     ss->iterations = st.sweeps;
     ss->residual = residual;
     ss->converged = converged;
+    if (r == RAD_OK && !converged) {
+        char who[64];
+        snprintf(who, sizeof who, "hierarchical (refinement round %d)", rounds_solved);
+        rad_solve_warn(ss, who, &bound, round_sweeps, "sweeps", "residual", residual,
+                       tol, "");
+    }
     ss->rays = rs.rays;
     ss->absorbed = st.absorbed / 3.0;
     {

@@ -1,13 +1,82 @@
 /*
  * stats.c -- machine-readable results: the stats JSON (schema in
- * docs/stats.md) and surface-level view factors (JSON or CSV; docs/formats.md).
- * Both are written atomically (temporary file, then rename).
+ * docs/stats.md) and view factors (JSON, CSV or Matrix Market;
+ * docs/formats.md).  All are written atomically (temporary file, then
+ * rename).
+ *
+ * Names (surfaces, the scene's path) come from the user's files and may
+ * hold any byte but NUL.  Every writer carries them as valid UTF-8, each
+ * byte that does not begin a well-formed sequence (RFC 3629: no overlong
+ * forms, no surrogates, nothing above U+10FFFF) replaced by U+FFFD, and
+ * then in its own syntax: JSON strings escaped by cJSON (quotes,
+ * backslashes, control characters), CSV fields quoted per RFC 4180, Matrix
+ * Market comments holding the name as a JSON string, so that no name can
+ * end a line or forge one.
  */
 #include "output/output.h"
 
 #include <cjson/cJSON.h>
+#include <inttypes.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Length of the well-formed UTF-8 sequence at p (1-4), or 0 (RFC 3629,
+ * table 3-7 of the Unicode standard). */
+static int utf8_sequence(const unsigned char *p)
+{
+    unsigned char c = p[0];
+    if (c < 0x80)
+        return 1;
+    int len = c >= 0xc2 && c <= 0xdf ? 2 : c >= 0xe0 && c <= 0xef ? 3 : c >= 0xf0 && c <= 0xf4 ? 4 : 0;
+    if (len == 0)
+        return 0;
+    /* The second byte's range depends on the first (overlongs, surrogates, > U+10FFFF). */
+    unsigned char lo = c == 0xe0 ? 0xa0 : c == 0xf0 ? 0x90 : 0x80;
+    unsigned char hi = c == 0xed ? 0x9f : c == 0xf4 ? 0x8f : 0xbf;
+    if (p[1] < lo || p[1] > hi)
+        return 0;
+    for (int k = 2; k < len; k++)
+        if (p[k] < 0x80 || p[k] > 0xbf)
+            return 0;
+    return len;
+}
+
+/* `text` as valid UTF-8 (above), a new string in the output's memory; NULL
+ * when out of memory (the allocator's message is set). */
+static char *utf8_clean(rad_context *ctx, const char *text)
+{
+    size_t len = strlen(text);
+    char *out = rad_alloc(ctx, RAD_MEM_OUTPUT, 3 * len + 1, 1, "outputs: names");
+    if (!out)
+        return NULL;
+    const unsigned char *p = (const unsigned char *)text;
+    char *q = out;
+    while (*p) {
+        int k = utf8_sequence(p);
+        if (k > 0) {
+            memcpy(q, p, (size_t)k);
+            q += k;
+            p += k;
+        } else {
+            memcpy(q, "\xef\xbf\xbd", 3); /* U+FFFD for the one byte */
+            q += 3;
+            p++;
+        }
+    }
+    *q = '\0';
+    return out;
+}
+
+/* Add `text` to a JSON object as valid UTF-8.  Fails only for memory. */
+static rad_result add_text(rad_context *ctx, cJSON *object, const char *key, const char *text)
+{
+    char *clean = utf8_clean(ctx, text ? text : "");
+    if (!clean)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    cJSON_AddStringToObject(object, key, clean);
+    rad_free(clean);
+    return RAD_OK;
+}
 
 static cJSON *rgb_array(const double v[3])
 {
@@ -74,11 +143,12 @@ rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *
     cJSON_AddBoolToObject(root, "partial", 1);
     cJSON_AddStringToObject(root, "interrupted", phase);
     cJSON_AddBoolToObject(root, "converged", 0);
-    cJSON_AddStringToObject(root, "scene", scene->source);
+    rad_result r = add_text(ctx, root, "scene", scene->source);
     cJSON_AddNumberToObject(root, "surfaces", (double)scene->surface_count);
     cJSON *sec = cJSON_AddObjectToObject(root, "seconds");
     cJSON_AddNumberToObject(sec, "total", seconds);
-    rad_result r = write_json(ctx, root, path);
+    if (r == RAD_OK)
+        r = write_json(ctx, root, path);
     cJSON_Delete(root);
     return r;
 }
@@ -91,9 +161,13 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     size_t n = s->n;
     cJSON_AddStringToObject(root, "version", RAD_VERSION_STRING);
     cJSON_AddBoolToObject(root, "partial", partial);
-    cJSON_AddStringToObject(root, "scene", s->scene->source);
+    rad_result r = add_text(ctx, root, "scene", s->scene->source);
     cJSON_AddNumberToObject(root, "threads", rad_context_threads(ctx));
-    cJSON_AddNumberToObject(root, "seed", (double)s->options->seed);
+    /* The seed as its exact digits: a JSON number is text, and a double
+     * rounds seeds above 2^53 (9007199254740993 was written ...992). */
+    char seed[24];
+    snprintf(seed, sizeof seed, "%" PRIu64, s->options->seed);
+    cJSON_AddRawToObject(root, "seed", seed);
 
     cJSON *mesh = cJSON_AddObjectToObject(root, "mesh");
     cJSON_AddNumberToObject(mesh, "elements", (double)n);
@@ -115,6 +189,8 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddNumberToObject(ff, "reciprocity_max", s->ff->reciprocity_max);
     cJSON_AddNumberToObject(ff, "diagonal_max", s->ff->diagonal_max);
     cJSON_AddBoolToObject(ff, "closure_corrected", s->ff->closure_corrected);
+    if (s->options->closure_correction) /* the openness measured before correcting */
+        cJSON_AddNumberToObject(ff, "escaped", s->ff->escaped);
     if (s->F_variance)
         cJSON_AddNumberToObject(ff, "std_error_max", s->ff->std_error_max);
     if (s->ff->near_pairs)
@@ -126,11 +202,14 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddBoolToObject(so, "solved", s->solved);
     cJSON_AddBoolToObject(so, "converged", s->solve->converged);
     cJSON_AddNumberToObject(so, "iterations", s->solve->iterations);
+    cJSON_AddNumberToObject(so, "iteration_limit", s->solve->iteration_limit);
     cJSON_AddNumberToObject(so, "residual", s->solve->residual);
     cJSON_AddNumberToObject(so, "tolerance", s->options->tolerance);
     cJSON_AddNumberToObject(so, "relaxation", s->options->relaxation);
     if (!isnan(s->solve->unshot))
         cJSON_AddNumberToObject(so, "unshot", s->solve->unshot);
+    if (s->solved && !s->solve->converged && s->solve->warning[0])
+        cJSON_AddStringToObject(so, "warning", s->solve->warning);
     cJSON_AddNumberToObject(so, "components", (double)s->solve->components);
     cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve->ambient));
     cJSON_AddNumberToObject(so, "seconds", s->solve->seconds);
@@ -188,9 +267,9 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
         cJSON_Delete(root);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    for (size_t k = 0; k < s->scene->surface_count; k++) {
+    for (size_t k = 0; k < s->scene->surface_count && r == RAD_OK; k++) {
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", s->scene->surfaces[k].name);
+        r = add_text(ctx, o, "name", s->scene->surfaces[k].name);
         cJSON_AddNumberToObject(o, "area", s->scene->surfaces[k].area);
         cJSON_AddItemToObject(o, "reflectance", rgb_array(&means[9 * k]));
         cJSON_AddItemToObject(o, "emission", rgb_array(&means[9 * k + 3]));
@@ -224,7 +303,8 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
         cJSON_AddNumberToObject(by_category, rad_memory_category_name((rad_memory_category)c),
                                 (double)rad_memory_peak(ctx, (rad_memory_category)c));
 
-    rad_result r = write_json(ctx, root, path);
+    if (r == RAD_OK)
+        r = write_json(ctx, root, path);
     cJSON_Delete(root);
     return r;
 }
@@ -254,10 +334,13 @@ static rad_result surface_std_errors(rad_context *ctx, const rad_solution_view *
 }
 
 /* A CSV field: quoted (with doubled quotes) when it holds a comma, quote or
- * line break (RFC 4180). */
+ * line break (RFC 4180), or begins or ends with a blank (which readers
+ * that trim would lose). */
 static void csv_field(FILE *f, const char *text)
 {
-    if (!strpbrk(text, ",\"\r\n")) {
+    size_t len = strlen(text);
+    bool blank_edge = len > 0 && (strchr(" \t", text[0]) || strchr(" \t", text[len - 1]));
+    if (!strpbrk(text, ",\"\r\n") && !blank_edge) {
         fputs(text, f);
         return;
     }
@@ -270,8 +353,32 @@ static void csv_field(FILE *f, const char *text)
     fputc('"', f);
 }
 
-/* Names and areas of the rows of the matrix being written: surfaces, or
- * elements ("surface#k", k counting the surface's elements). */
+/* A JSON string literal, for the Matrix Market comments: quotes,
+ * backslashes and control characters escaped (RFC 8259, sec. 7); `text`
+ * is valid UTF-8, written as is otherwise. */
+static void json_string(FILE *f, const char *text)
+{
+    fputc('"', f);
+    for (const unsigned char *c = (const unsigned char *)text; *c; c++) {
+        switch (*c) {
+        case '"': fputs("\\\"", f); break;
+        case '\\': fputs("\\\\", f); break;
+        case '\n': fputs("\\n", f); break;
+        case '\r': fputs("\\r", f); break;
+        case '\t': fputs("\\t", f); break;
+        default:
+            if (*c < 0x20 || *c == 0x7f)
+                fprintf(f, "\\u%04x", *c);
+            else
+                fputc(*c, f);
+        }
+    }
+    fputc('"', f);
+}
+
+/* Names (valid UTF-8, utf8_clean) and areas of the rows of the matrix being
+ * written: surfaces, or elements ("surface#k", k counting the surface's
+ * elements). */
 typedef struct vf_rows {
     size_t count;
     char **names;
@@ -321,7 +428,7 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
         if (result == RAD_OK && with_err)
             result = surface_std_errors(ctx, s, r->err);
         for (size_t k = 0; k < S && result == RAD_OK; k++) {
-            r->names[k] = rad_strdup(ctx, RAD_MEM_OUTPUT, s->scene->surfaces[k].name, "view factors: names");
+            r->names[k] = utf8_clean(ctx, s->scene->surfaces[k].name);
             r->area[k] = s->scene->surfaces[k].area;
             if (!r->names[k])
                 result = RAD_ERROR_OUT_OF_MEMORY;
@@ -332,11 +439,14 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
             result = RAD_ERROR_OUT_OF_MEMORY;
         for (size_t i = 0; i < n && result == RAD_OK; i++) {
             uint32_t si = s->mesh->elements[i].surface;
-            char name[512];
-            snprintf(name, sizeof name, "%s#%zu", s->scene->surfaces[si].name, seen[si]++);
-            r->names[i] = rad_strdup(ctx, RAD_MEM_OUTPUT, name, "view factors: names");
-            if (!r->names[i])
+            char *surface = utf8_clean(ctx, s->scene->surfaces[si].name);
+            size_t size = surface ? strlen(surface) + 24 : 0;
+            r->names[i] = surface ? rad_alloc(ctx, RAD_MEM_OUTPUT, size, 1, "view factors: names") : NULL;
+            if (r->names[i])
+                snprintf(r->names[i], size, "%s#%zu", surface, seen[si]++);
+            else
                 result = RAD_ERROR_OUT_OF_MEMORY;
+            rad_free(surface);
             r->area[i] = s->area[i];
             for (size_t j = 0; j < n; j++) {
                 r->F[i * n + j] = s->F[i * n + j];
@@ -370,7 +480,7 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
     size_t N = rows.count;
     if (strcmp(ext, "json") == 0) {
         cJSON *root = cJSON_CreateObject();
-        cJSON_AddStringToObject(root, "scene", s->scene->source);
+        r = add_text(ctx, root, "scene", s->scene->source);
         cJSON_AddStringToObject(root, "method", s->options->form_factors);
         cJSON_AddStringToObject(root, "level", elements ? "element" : "surface");
         cJSON_AddNumberToObject(root, "elements", (double)s->n);
@@ -378,15 +488,14 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
         cJSON *list = cJSON_AddArrayToObject(root, elements ? "elements_list" : "surfaces");
         cJSON *F = cJSON_AddArrayToObject(root, "F");
         cJSON *E = rows.err ? cJSON_AddArrayToObject(root, "F_std_error") : NULL;
-        for (size_t a = 0; a < N; a++) {
+        for (size_t a = 0; a < N && r == RAD_OK; a++) {
             double sum = 0.0;
             for (size_t b = 0; b < N; b++)
                 sum += rows.F[a * N + b];
             cJSON *o = cJSON_CreateObject();
             cJSON_AddStringToObject(o, "name", rows.names[a]);
             if (elements)
-                cJSON_AddStringToObject(o, "surface",
-                                        s->scene->surfaces[s->mesh->elements[a].surface].name);
+                r = add_text(ctx, o, "surface", s->scene->surfaces[s->mesh->elements[a].surface].name);
             cJSON_AddNumberToObject(o, "area", rows.area[a]);
             cJSON_AddNumberToObject(o, "row_sum", sum);
             cJSON_AddItemToArray(list, o);
@@ -394,7 +503,8 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
             if (E)
                 cJSON_AddItemToArray(E, cJSON_CreateDoubleArray(rows.err + a * N, (int)N));
         }
-        r = write_json(ctx, root, path);
+        if (r == RAD_OK)
+            r = write_json(ctx, root, path);
         cJSON_Delete(root);
     } else {
         rad_atomic_file f;
@@ -423,8 +533,11 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
             fprintf(f.file, "%%%%MatrixMarket matrix coordinate real general\n");
             fprintf(f.file, "%% view factors F[i][j] from row i to column j (radiosity %s, %s level)\n",
                     RAD_VERSION_STRING, elements ? "element" : "surface");
-            for (size_t a = 0; a < N; a++)
-                fprintf(f.file, "%% %zu %s area_m2 %.17g\n", a + 1, rows.names[a], rows.area[a]);
+            for (size_t a = 0; a < N; a++) {
+                fprintf(f.file, "%% %zu ", a + 1);
+                json_string(f.file, rows.names[a]);
+                fprintf(f.file, " area_m2 %.17g\n", rows.area[a]);
+            }
             fprintf(f.file, "%zu %zu %zu\n", N, N, nnz);
             for (size_t a = 0; a < N; a++)
                 for (size_t b = 0; b < N; b++)

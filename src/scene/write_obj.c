@@ -58,6 +58,15 @@ static void write_name(FILE *file, const char *name, const char *fallback, size_
         fputc((unsigned char)*c <= ' ' || *c == '#' || *c == 0x7f ? '_' : *c, file);
 }
 
+/* The scene's path in a comment line: a control character (a newline in
+ * a file name) would end the comment and start a statement, so it becomes
+ * '?'. */
+static void write_comment_text(FILE *file, const char *text)
+{
+    for (const char *c = text ? text : "scene"; *c; c++)
+        fputc((unsigned char)*c < ' ' || *c == 0x7f ? '?' : *c, file);
+}
+
 /* Material i's name in the MTL, made unique by its index when an earlier
  * material has the same name (the builder does not require unique names).
  * O(materials^2), once per material: scenes have few materials. */
@@ -74,8 +83,9 @@ static void write_material_name(FILE *file, const rad_scene *scene, size_t i)
 
 static rad_result write_mtl(const rad_scene *scene, FILE *mtl)
 {
-    fprintf(mtl, "# %s: materials (Kd = reflectance, Ke = emitted radiance = exitance / pi)\n",
-            scene->source ? scene->source : "scene");
+    fputs("# ", mtl);
+    write_comment_text(mtl, scene->source);
+    fputs(": materials (Kd = reflectance, Ke = emitted radiance = exitance / pi)\n", mtl);
     for (size_t i = 0; i < scene->material_count; i++) {
         const rad_material *m = &scene->materials[i];
         char v[3][32];
@@ -117,8 +127,9 @@ static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE 
         start[s] = start[s - 1];
     start[0] = 0;
 
-    fprintf(obj, "# %s: %zu surfaces, %zu polygons; metres, y up\n",
-            scene->source ? scene->source : "scene", surfaces, polygons);
+    fputs("# ", obj);
+    write_comment_text(obj, scene->source);
+    fprintf(obj, ": %zu surfaces, %zu polygons; metres, y up\n", surfaces, polygons);
     fprintf(obj, "mtllib %s\n", mtl_name);
     size_t written = 0; /* vertices so far: OBJ indices are 1 + this */
     for (size_t s = 0; s < surfaces; s++) {
@@ -173,6 +184,20 @@ rad_result rad_scene_write_obj(rad_context *ctx, const rad_scene *scene, const c
     memcpy(mtl_path + stem, ".mtl", 5);
     const char *slash = strrchr(mtl_path, '/');
     const char *mtl_name = slash ? slash + 1 : mtl_path;
+    /* The OBJ names its MTL in an `mtllib` statement, where a blank
+     * separates file names and a line break or '#' ends the statement (a
+     * name holding "\nv 9 9 9" would add a vertex): such a name cannot be
+     * written, and is refused before anything is. */
+    for (const char *c = mtl_name; *c; c++)
+        if ((unsigned char)*c <= ' ' || *c == '#' || *c == 0x7f) {
+            rad_result bad = rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                                      "%s: an OBJ cannot name its MTL when the file name holds a blank, a "
+                                      "control character or '#' (mtllib separates names by blanks): choose "
+                                      "another name",
+                                      path);
+            rad_free(mtl_path);
+            return bad;
+        }
 
     /* Both written in full before either is put in place; a write error
      * (full disk) or an interruption leaves neither. */

@@ -301,6 +301,10 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
         g.residual[k] = sub_stats.residual * g.emitted[k];
         steps += sub_stats.iterations;
         most_iterations = sub_stats.iterations > most_iterations ? sub_stats.iterations : most_iterations;
+        stats->iteration_limit = fmax(stats->iteration_limit, sub_stats.iteration_limit);
+        if (!stats->warning[0] && sub_stats.warning[0]) /* the first group that fell short */
+            snprintf(stats->warning, sizeof stats->warning, "group %zu of %zu: %.260s", k + 1, g.count,
+                     sub_stats.warning);
         if (!isnan(sub_stats.unshot)) {
             any_unshot = true;
             unshot += sub_stats.unshot * g.emitted[k];
@@ -315,6 +319,12 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
     rad_free(vectors);
     rad_free(row);
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    if (stats->converged || result != RAD_OK)
+        stats->warning[0] = '\0';
+    else if (!stats->warning[0]) /* every group converged; their sum did not */
+        snprintf(stats->warning, sizeof stats->warning,
+                 "%s: the groups converged, but the whole system's residual is %.3g, above the tolerance %.3g",
+                 solver->name, stats->residual, p->tolerance);
     memcpy(stats->ambient, ambient, sizeof ambient);
     if (any_unshot)
         stats->unshot = unshot / emitted_total;

@@ -156,8 +156,18 @@ static rad_result conjugate_gradient(rad_context *ctx, const rad_system *sys, co
                                      double *B, rad_solve_stats *stats)
 {
     size_t n = sys->n;
-    int max_iterations = p->max_iterations > 0 ? p->max_iterations : 1000;
-    cg_state s = {sys, n, sys->threads > 0 ? sys->threads : 1, NULL, NULL, NULL, NULL, NULL, NULL,
+    /* The bound of solve.h at CG's rate: with Jacobi preconditioning the
+     * symmetrised system's eigenvalues lie in [1 - q, 1 + q], so the error
+     * shrinks by (sqrt(kappa) - 1) / (sqrt(kappa) + 1) per iteration,
+     * kappa = (1 + q) / (1 - q) (Saad 2003, sec. 6.11.3). */
+    double q = rad_system_contraction(sys);
+    double cg_rate = q < 1.0 ? (sqrt((1.0 + q) / (1.0 - q)) - 1.0) / (sqrt((1.0 + q) / (1.0 - q)) + 1.0) : 1.0;
+    rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, cg_rate, 1.0, p->tolerance, 1.0);
+    bound.contraction = q; /* what the warning names */
+    bound.k_units = "iterations at CG's rate";
+    int max_iterations = (int)bound.limit;
+    stats->iteration_limit = bound.limit;
+    cg_state s = {sys, n, rad_pass_threads(sys), NULL, NULL, NULL, NULL, NULL, NULL,
                   NULL, NULL, NULL, NULL, 0.0};
     double *work = rad_alloc(ctx, RAD_MEM_SOLVER, 27 * n + 1, sizeof *work, "solve: conjugate-gradient: vectors");
     s.row = rad_alloc(ctx, RAD_MEM_SOLVER, n + 1, sizeof *s.row, "solve: conjugate-gradient: row residuals");
@@ -275,6 +285,9 @@ static rad_result conjugate_gradient(rad_context *ctx, const rad_system *sys, co
     }
     stats->iterations = it;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    if (result == RAD_OK && !stats->converged)
+        rad_solve_warn(stats, "conjugate-gradient", &bound, it, "iterations", "residual", stats->residual,
+                       p->tolerance, "");
     rad_free(work);
     rad_free(s.row);
     return result;

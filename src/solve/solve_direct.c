@@ -13,6 +13,26 @@
  * keeps it, so LAPACKE makes no transposed copy of its own.  Above the
  * memory limit (rad_system.max_memory) the solver refuses rather than
  * swap; the iterative solvers need O(n) beside F.
+ *
+ * The factorisation is our own blocking of LAPACK's (Golub & Van Loan,
+ * "Matrix Computations", 4th ed., sec. 3.4.7: right-looking blocked LU
+ * with partial pivoting), so that its answer does not depend on the thread
+ * count:
+ *
+ *           k0  k0 + PANEL
+ *     [ L\U |  U12  |      ]     for each panel of PANEL columns:
+ *     [     |-------+----- ]       1. dgetrf on the panel K[k0:, k0:k0+nb]
+ *     [     |  L11  |  A12 ]       2. every other block of PANEL columns, in
+ *     [     |  L21  |  A22 ]          parallel: the panel's row swaps, and
+ *                                     right of it U12 = L11^-1 A12,
+ *                                     A22 -= L21 U12 (dtrsm, dgemm)
+ *
+ * The blocks are PANEL wide on any number of threads and each is one
+ * thread's, with OpenBLAS itself held to one thread: every number comes
+ * from the same operations in the same order, so B is bit-identical on 1
+ * or 16 threads.  (OpenBLAS's threaded dgesv splits its work by the
+ * thread count, and moved the last bits of B, 4e-16, between 1 and 2.)
+ * Cancellation is polled between panels.
  */
 #include "solve/solve.h"
 
@@ -24,12 +44,18 @@
 /* 64 x 64 doubles: one tile of K and of F stay in L1/L2 during the transposition. */
 enum { TILE = 64 };
 
+/* Columns per panel and per block of the update: wide enough for dgemm to
+ * run near its peak (a 128-column update is 2 x 128 flops per element of
+ * A22 read), narrow enough for a 2,000-element system to split into 16
+ * blocks among the threads. */
+enum { PANEL = 128 };
+
 /* K = I - diag(rho) F in column-major order, by tiles (F is row-major). */
 static void build_matrix(const rad_system *sys, const double *rho, size_t stride, double *K)
 {
     size_t n = sys->n;
     size_t tiles = (n + TILE - 1) / TILE;
-#pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
+#pragma omp parallel for schedule(static) num_threads(rad_pass_threads(sys))
     for (size_t jt = 0; jt < tiles; jt++) {
         size_t j0 = jt * TILE, j1 = j0 + TILE < n ? j0 + TILE : n;
         for (size_t i0 = 0; i0 < n; i0 += TILE) {
@@ -42,6 +68,52 @@ static void build_matrix(const rad_system *sys, const double *rho, size_t stride
             }
         }
     }
+}
+
+/* LU with partial pivoting of the column-major n x n K in place (above);
+ * pivots 1-based, as LAPACK's.  RAD_ERROR_INTERNAL for an exactly zero
+ * pivot, RAD_ERROR_INTERRUPTED when cancelled between panels. */
+static rad_result factor(rad_context *ctx, const rad_system *sys, double *K, lapack_int *pivots, int channel)
+{
+    size_t n = sys->n, blocks = (n + PANEL - 1) / PANEL;
+    lapack_int ld = (lapack_int)n;
+    for (size_t k0 = 0; k0 < n; k0 += PANEL) {
+        size_t nb = n - k0 < PANEL ? n - k0 : PANEL;
+        double *panel = K + k0 + k0 * n;
+        lapack_int info = LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, (lapack_int)(n - k0), (lapack_int)nb, panel, ld,
+                                              pivots + k0);
+        if (info != 0)
+            /* rho_i sum_j F_ij < 1 makes K strictly diagonally dominant, so
+             * a zero pivot means F is broken (row sums far above 1). */
+            return rad_fail(ctx, RAD_ERROR_INTERNAL,
+                            "solve: direct: LAPACK dgetrf failed (info %d) on channel %d: the matrix is "
+                            "singular; are the form-factor row sums above 1?",
+                            (int)(info > 0 ? info + (lapack_int)k0 : info), channel);
+        for (size_t i = k0; i < k0 + nb; i++)
+            pivots[i] += (lapack_int)k0; /* the panel's rows count from k0 */
+#pragma omp parallel for schedule(dynamic, 1) num_threads(rad_pass_threads(sys))
+        for (size_t b = 0; b < blocks; b++) {
+            size_t j0 = b * PANEL, width = n - j0 < PANEL ? n - j0 : PANEL;
+            if (j0 == k0)
+                continue;
+            double *columns = K + j0 * n;
+            LAPACKE_dlaswp_work(LAPACK_COL_MAJOR, (lapack_int)width, columns, ld, (lapack_int)k0 + 1,
+                                (lapack_int)(k0 + nb), pivots, 1);
+            if (j0 < k0)
+                continue; /* left of the panel: L, only swapped */
+            cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasUnit, (blasint)nb,
+                        (blasint)width, 1.0, panel, (blasint)n, columns + k0, (blasint)n);
+            if (k0 + nb < n)
+                cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (blasint)(n - k0 - nb), (blasint)width,
+                            (blasint)nb, -1.0, panel + nb, (blasint)n, columns + k0, (blasint)n, 1.0,
+                            columns + k0 + nb, (blasint)n);
+        }
+        rad_progress(ctx, "solve", (uint64_t)(k0 + nb), (uint64_t)n);
+        if (rad_cancelled(ctx))
+            return rad_fail(ctx, RAD_ERROR_INTERRUPTED,
+                            "solve: direct: interrupted in the factorisation of channel %d", channel);
+    }
+    return RAD_OK;
 }
 
 static bool same_channel(const rad_system *sys, int a, int b)
@@ -93,10 +165,13 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
         rad_free(pivots);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    /* OpenBLAS keeps its thread count in a global: set it for the
-     * factorisation and give the caller's back afterwards. */
+    /* OpenBLAS keeps its thread count in a global: one thread for the
+     * factorisation (the parallelism is ours), the caller's back afterwards.
+     * Two direct solves at once in one process may restore it while the
+     * other runs; OpenBLAS's threaded dgemm and dtrsm then split columns,
+     * not sums, so even that changes no bit. */
     int blas_threads = openblas_get_num_threads();
-    openblas_set_num_threads(sys->threads > 0 ? sys->threads : 1);
+    openblas_set_num_threads(1);
 
     rad_result result = RAD_OK;
     bool solved[3] = {false, false, false};
@@ -111,15 +186,13 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
         for (int k = 0; k < m; k++)
             for (size_t i = 0; i < n; i++)
                 rhs[(size_t)k * n + i] = sys->emission[3 * i + channels[k]];
-        lapack_int info = LAPACKE_dgesv(LAPACK_COL_MAJOR, (lapack_int)n, m, K, (lapack_int)n, pivots,
-                                        rhs, (lapack_int)n);
+        result = factor(ctx, sys, K, pivots, c);
+        if (result != RAD_OK)
+            break;
+        lapack_int info = LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)n, m, K, (lapack_int)n, pivots,
+                                              rhs, (lapack_int)n);
         if (info != 0) {
-            /* rho_i sum_j F_ij < 1 makes K strictly diagonally dominant, so
-             * a zero pivot means F is broken (row sums far above 1). */
-            result = rad_fail(ctx, RAD_ERROR_INTERNAL,
-                              "solve: direct: LAPACK dgesv failed (info %d) on channel %d: the "
-                              "matrix is singular; are the form-factor row sums above 1?",
-                              (int)info, c);
+            result = rad_fail(ctx, RAD_ERROR_INTERNAL, "solve: direct: LAPACK dgetrs failed (info %d)", (int)info);
             break;
         }
         for (int k = 0; k < m; k++) {
@@ -127,7 +200,6 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
                 B[3 * i + channels[k]] = rhs[(size_t)k * n + i];
             solved[channels[k]] = true;
         }
-        rad_progress(ctx, "solve", (uint64_t)(c + 1), 3);
         if (rad_cancelled(ctx) && !(solved[0] && solved[1] && solved[2]))
             result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: direct: interrupted after channel %d", c);
     }
@@ -141,6 +213,12 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
     if (result == RAD_OK)
         result = measured;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    stats->iteration_limit = 1.0;
+    if (result == RAD_OK && !stats->converged)
+        snprintf(stats->warning, sizeof stats->warning,
+                 "direct: the residual of the exact solve, %.3g, is above the tolerance %.3g: what the "
+                 "rounding of F and of the factorisation leaves",
+                 stats->residual, p->tolerance);
     if (result == RAD_OK && p->monitor) {
         rad_solve_step step = {1, rad_seconds() - t0, stats->residual, NAN};
         if (p->monitor(p->monitor_user, &step, B, NULL))

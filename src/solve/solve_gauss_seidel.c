@@ -11,7 +11,9 @@
  * residual left behind it (r_i = rho_i sum_{j>i} F_ij (B_j' - B_j) for w = 1),
  * so unless every step is to be measured (a history or a monitor wants it)
  * the true residual (solve.h, an O(n^2) pass) is measured only once the
- * change falls below the tolerance; the sweeps stop when it does too.
+ * change falls below the tolerance; the sweeps stop when it does too, or
+ * at the bound of solve.h (then the residual is measured, so that what is
+ * reported is never the estimate).
  */
 #include "solve/solve.h"
 
@@ -19,8 +21,10 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
                                double *B, rad_solve_stats *stats)
 {
     size_t n = sys->n;
-    int max_sweeps = p->max_iterations > 0 ? p->max_iterations : 1000;
     double w = p->relaxation > 0.0 ? p->relaxation : 1.0;
+    rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, rad_system_contraction(sys), w, p->tolerance, 1.0);
+    double max_sweeps = bound.limit;
+    stats->iteration_limit = max_sweeps;
     double emitted = 0.0;
     for (size_t i = 0; i < n; i++)
         emitted += sys->area[i] * (sys->emission[3 * i] + sys->emission[3 * i + 1] + sys->emission[3 * i + 2]);
@@ -30,6 +34,7 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
     rad_result result = RAD_OK;
     double t0 = rad_seconds();
     stats->residual = rad_residual_in(sys, B, row);
+    bool measured = true; /* stats->residual is the true residual, not the estimate */
     for (int sweep = 0; sweep < max_sweeps && stats->residual > p->tolerance; sweep++) {
         double change = 0.0;
         for (size_t i = 0; i < n; i++) {
@@ -50,6 +55,7 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
         double estimate = emitted > 0.0 ? change / emitted : change;
         bool measure = p->monitor != NULL || estimate <= p->tolerance || w != 1.0;
         stats->residual = measure ? rad_residual_in(sys, B, row) : estimate;
+        measured = measure;
         if (p->monitor) {
             rad_solve_step step = {sweep + 1, rad_seconds() - t0, stats->residual, NAN};
             if (p->monitor(p->monitor_user, &step, B, NULL)) {
@@ -63,9 +69,15 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
             break;
         }
     }
+    if (!measured)
+        stats->residual = rad_residual_in(sys, B, row);
     rad_free(row);
-    if (result == RAD_OK)
+    if (result == RAD_OK) {
         stats->converged = stats->residual <= p->tolerance;
+        if (!stats->converged)
+            rad_solve_warn(stats, "gauss-seidel", &bound, stats->iterations, "sweeps", "residual", stats->residual,
+                           p->tolerance, RAD_SOLVE_FASTER_HINT);
+    }
     return result;
 }
 

@@ -28,8 +28,10 @@ static rad_result jacobi(rad_context *ctx, const rad_system *sys, const rad_solv
                          double *B, rad_solve_stats *stats)
 {
     size_t n = sys->n;
-    int max_sweeps = p->max_iterations > 0 ? p->max_iterations : 1000;
     double w = p->relaxation > 0.0 ? p->relaxation : 1.0;
+    rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, rad_system_contraction(sys), w, p->tolerance, 1.0);
+    int max_sweeps = (int)bound.limit; /* at most the user's int or the cap */
+    stats->iteration_limit = bound.limit;
     double *next = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n + 1, sizeof *next, "solve: jacobi: next iterate");
     double *row = rad_alloc(ctx, RAD_MEM_SOLVER, n + 1, sizeof *row, "solve: jacobi: row residuals");
     if (!next || !row) {
@@ -45,7 +47,7 @@ static rad_result jacobi(rad_context *ctx, const rad_system *sys, const rad_solv
     rad_result result = RAD_OK;
     int sweep = 0;
     for (;;) {
-#pragma omp parallel for schedule(static) num_threads(sys->threads > 0 ? sys->threads : 1)
+#pragma omp parallel for schedule(static) num_threads(rad_pass_threads(sys))
         for (size_t i = 0; i < n; i++) {
             double g[3];
             const float *Fi = sys->F + i * n;
@@ -86,6 +88,9 @@ static rad_result jacobi(rad_context *ctx, const rad_system *sys, const rad_solv
     }
     stats->iterations = sweep;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    if (result == RAD_OK && !stats->converged)
+        rad_solve_warn(stats, "jacobi", &bound, sweep, "sweeps", "residual", stats->residual, p->tolerance,
+                       RAD_SOLVE_FASTER_HINT);
     rad_free(next);
     rad_free(row);
     return result;

@@ -25,7 +25,12 @@
  * Stopping: on unshot power / emitted power below the unshot tolerance
  * (default 1e-3: the answer is a Monte Carlo estimate whose noise, ~1/sqrt
  * of the rays an element receives, is far above what further shooting
- * would change).  The residual needs F, so it is not measured (NAN).
+ * would change), or at the bound of solve.h: a bounce of light is one
+ * batch per BATCH elements, and every bounce leaves at most rho_max of the
+ * unshot power (each ray carries its share to one element, which reflects
+ * rho of it).  The residual needs F, so it is not measured (NAN): the
+ * unshot power is shooting's own measure, and bounds it (r = rho F dB, so
+ * residual <= rho_max x unshot).
  */
 #include "solve/solve.h"
 #include "mesh/mesh.h"
@@ -195,7 +200,10 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
         heap_fix(&h, h.item[k]);
     double absorbed = 0.0, t0 = rad_seconds();
     double eps = rad_vis_epsilon(sys->mesh); /* O(vertices): once, not per shot */
-    long long max_batches = p->max_iterations > 0 ? p->max_iterations : 1000000000LL;
+    rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, rad_system_contraction(sys), 1.0, goal,
+                                                 ceil((double)n / BATCH));
+    long long max_batches = (long long)bound.limit;
+    stats->iteration_limit = bound.limit;
     uint64_t rays_cast = 0;
     long long batch = 0;
     double unshot = emitted > 0.0 ? (unshot_c[0] + unshot_c[1] + unshot_c[2]) / emitted : 0.0;
@@ -219,7 +227,10 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
         }
         if (K == 0)
             break;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads)
+        /* Small batches on one thread: a team costs more than a few
+         * thousand rays (the rays are keyed, so the answer is the same). */
+        int team = (double)K * N >= 4096.0 ? threads : 1;
+#pragma omp parallel for schedule(dynamic, 1) num_threads(team)
         for (int k = 0; k < K; k++) {
             int tid = 0;
 #ifdef _OPENMP
@@ -305,6 +316,9 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     stats->residual = NAN;
     stats->rays = rays_cast;
     stats->converged = result == RAD_OK && unshot <= goal;
+    if (result == RAD_OK && !stats->converged)
+        rad_solve_warn(stats, "shooting", &bound, (double)batch, "batches", "unshot power", unshot,
+                       goal, "");
 done:
     rad_free(dB);
     rad_free(h.item);

@@ -62,8 +62,11 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
      * rho F dB); shooting stops on unshot power below the residual tolerance,
      * or below unshot_tolerance when given, and the residual is then measured. */
     double unshot_goal = p->unshot_tolerance > 0.0 ? p->unshot_tolerance : p->tolerance;
-    long long max_shots = p->max_iterations > 0 ? (long long)p->max_iterations
-                                                : 1000LL * (long long)(n > 0 ? n : 1);
+    /* A bounce of light is about n shots (every element shoots once). */
+    rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, rad_system_contraction(sys), w, unshot_goal,
+                                                 (double)(n > 0 ? n : 1));
+    long long max_shots = (long long)bound.limit;
+    stats->iteration_limit = bound.limit;
     long long shot = 0;
     double t0 = rad_seconds(), unshot = 0.0;
     rad_result result = RAD_OK;
@@ -123,6 +126,11 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
         }
     }
     stats->iterations = shot > 2147483647LL ? 2147483647 : (int)shot;
+    /* What is left unshot after the last shot (the loop measured it before). */
+    unshot = 0.0;
+    for (size_t i = 0; i < n; i++)
+        unshot += sys->area[i] * (fabs(dB[3 * i]) + fabs(dB[3 * i + 1]) + fabs(dB[3 * i + 2]));
+    unshot = emitted > 0.0 ? unshot / emitted : unshot;
     stats->unshot = unshot;
     rad_southwell_ambient(sys, dB, stats->ambient);
     rad_free(dB);
@@ -130,6 +138,14 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
     if (result == RAD_OK)
         result = measured;
     stats->converged = result == RAD_OK && stats->residual <= p->tolerance;
+    if (result == RAD_OK && !stats->converged && unshot > unshot_goal)
+        rad_solve_warn(stats, "southwell", &bound, (double)shot, "shots", "unshot power", unshot, unshot_goal,
+                       RAD_SOLVE_FASTER_HINT);
+    else if (result == RAD_OK && !stats->converged)
+        snprintf(stats->warning, sizeof stats->warning,
+                 "southwell shot the unshot power down to %.3g of the emitted (goal %.3g), which leaves the "
+                 "residual at %.3g, above the tolerance %.3g",
+                 unshot, unshot_goal, stats->residual, p->tolerance);
     return result;
 }
 

@@ -81,14 +81,20 @@ static rad_result dense_create(rad_context *ctx, const rad_scene *scene, const r
         rad_free(st);
         return r;
     }
-    r = check_ff_scratch(ctx, o, m->mesh->element_count, m->threads);
+    /* An open scene is refused the closure correction before F where the
+     * rays show it, after F (rad_form_factors) where only F can. */
+    double *escape = NULL, escaped = 0.0;
+    r = rad_strategy_check_closed(ctx, scene, o, m->mesh, m->vis, &escape, &escaped);
+    if (r == RAD_OK)
+        r = check_ff_scratch(ctx, o, m->mesh->element_count, m->threads);
     if (r == RAD_OK) {
         rad_ff_request req = {m->mesh, m->vis, o->seed, o->shadow_rays, o->hemicube_resolution, o->samples,
-                              o->near_field};
+                              o->near_field, escape, scene->source};
         r = rad_form_factors(ctx, rad_ff_find(o->form_factors), &req, o->max_memory_bytes,
                              o->closure_correction != 0, &st->F, &st->F_variance, &m->ff_stats);
         m->seconds.form_factors = m->ff_stats.seconds;
     }
+    rad_free(escape);
     if (r != RAD_OK) {
         dense_destroy(st);
         return r;

@@ -63,6 +63,14 @@ static rad_result hierarchical_create(rad_context *ctx, const rad_scene *scene, 
     /* The patches are the roots: one element each; the solver splits them. */
     rad_mesh_options mo = {1e30, 0, o->crease_angle_degrees};
     rad_result r = rad_strategy_mesh_and_vis(ctx, scene, o, &mo, &st->patches, &st->vis, &st->seconds);
+    if (r == RAD_OK) {
+        /* The patches' rays decide: the correction leaves a patch whose
+         * closure is below 0.5 alone (hier.c), so what sees next to
+         * nothing does not need F's verdict. */
+        double *escape = NULL;
+        r = rad_strategy_check_closed(ctx, scene, o, st->patches, st->vis, &escape, &st->ff_stats.escaped);
+        rad_free(escape);
+    }
     if (r == RAD_OK)
         r = rad_elements_create(ctx, scene, st->patches, &st->patch_elements);
     if (r != RAD_OK) {

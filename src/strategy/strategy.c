@@ -112,6 +112,31 @@ rad_result rad_strategy_mesh_and_vis(rad_context *ctx, const rad_scene *scene, c
     return RAD_OK;
 }
 
+rad_result rad_strategy_check_closed(rad_context *ctx, const rad_scene *scene, const rad_options *o,
+                                     const rad_mesh *mesh, const rad_vis *vis, double **escape, double *escaped)
+{
+    *escape = NULL;
+    *escaped = 0.0;
+    if (!o->closure_correction)
+        return RAD_OK;
+    double *fraction = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, mesh->element_count + 1, sizeof *fraction,
+                                 "closure: escaping light");
+    if (!fraction)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_result r = rad_ff_escape_rays(ctx, mesh, vis, o->seed, fraction);
+    if (r == RAD_OK) {
+        *escaped = rad_ff_escaped(mesh, fraction, NULL);
+        if (*escaped > RAD_FF_OPEN_SCENE_ESCAPE)
+            r = rad_ff_refuse_open(ctx, scene->source, *escaped);
+    }
+    if (r != RAD_OK) {
+        rad_free(fraction);
+        return r;
+    }
+    *escape = fraction;
+    return RAD_OK;
+}
+
 rad_result rad_meshed_init(rad_context *ctx, const rad_scene *scene, const rad_options *o, rad_meshed *m)
 {
     memset(m, 0, sizeof *m);

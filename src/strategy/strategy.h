@@ -120,6 +120,16 @@ rad_result rad_strategy_mesh_and_vis(rad_context *ctx, const rad_scene *scene, c
                                      const rad_mesh_options *mesh_options, rad_mesh **mesh, rad_vis **vis,
                                      rad_phase_seconds *seconds);
 
+/* With rad_options.closure_correction, the scene must be closed: the light
+ * escaping it (rad_ff_escaped over the elements whose rays meet something)
+ * at most RAD_FF_OPEN_SCENE_ESCAPE, else RAD_ERROR_INVALID_ARGUMENT naming
+ * the scene and the fraction.  *escape receives the per-element fractions
+ * (the caller rad_frees them; dense checks again once F is known) and
+ * *escaped the light escaping.  Without the option: RAD_OK, *escape NULL,
+ * *escaped 0.  Fails otherwise for memory or when interrupted. */
+rad_result rad_strategy_check_closed(rad_context *ctx, const rad_scene *scene, const rad_options *options,
+                                     const rad_mesh *mesh, const rad_vis *vis, double **escape, double *escaped);
+
 /* The part of a strategy that meshes once and keeps its elements for life
  * (dense, matrix-free): a system of n elements solved in place. */
 typedef struct rad_meshed {
