@@ -134,7 +134,9 @@ typedef struct rad_context_options {
     double max_memory_bytes;     /* the memory limit: everything the engine allocates in
                                     this context (scenes while loading included) stays
                                     below it, else RAD_ERROR_OUT_OF_MEMORY with the limit
-                                    named; 0 = 80% of physical memory.  Memory that
+                                    named; 0 = half the memory the process may use (the
+                                    physical memory, or its cgroup's or RLIMIT_AS /
+                                    RLIMIT_DATA's limit where lower).  Memory that
                                     assimp, Embree, LAPACK and cJSON allocate themselves
                                     is not counted (loading refuses files that assimp
                                     would need more than the limit for: docs/robustness.md) */
@@ -670,7 +672,7 @@ typedef struct rad_option_info {
     double min, max;
     bool min_open, max_open;
     double default_value;          /* what 0 stands for; NAN where that is not a constant */
-    const char *default_text;      /* the default in words: "1e-06", "80% of physical memory" */
+    const char *default_text;      /* the default in words: "1e-06", "auto" */
     const rad_option_word *words;  /* FLAG (optional) and ENUM; ends with {NULL, 0} */
     rad_method_kind methods;       /* METHOD: the registry of its names */
     const char *help;              /* one line, lower case, no final full stop */

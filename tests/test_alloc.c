@@ -23,7 +23,9 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -462,6 +464,35 @@ static void test_loading_limit(void **state)
     rad_context_destroy(ctx);
 }
 
+/* With no limit given, the limit is half the memory the process may use:
+ * the physical memory, or less where RLIMIT_AS (ulimit -v) says so (here
+ * in a child, not to limit the tests). */
+static void test_default_limit(void **state)
+{
+    (void)state;
+    rad_context *ctx = limited_context(0.0);
+    double available = (double)rad_available_memory_bytes();
+    assert_true(available > 0.0 && available <= (double)rad_physical_memory_bytes());
+    assert_true(rad_memory_limit(ctx) == (double)(size_t)(0.5 * available));
+    rad_context_destroy(ctx);
+
+    pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        struct rlimit as = {(rlim_t)3 << 30, (rlim_t)3 << 30};
+        rad_context *limited = NULL;
+        int ok = setrlimit(RLIMIT_AS, &as) == 0 &&
+                 rad_available_memory_bytes() == (size_t)3 << 30 &&
+                 rad_context_create(NULL, &limited) == RAD_OK &&
+                 rad_memory_limit(limited) == 1.5 * 1073741824.0;
+        rad_context_destroy(limited);
+        _exit(ok ? 0 : 1);
+    }
+    int status = -1;
+    assert_int_equal(waitpid(child, &status, 0), child);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
 /* The stats report the allocator's peaks by category. */
 static void test_stats_by_category(void **state)
 {
@@ -548,6 +579,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_limit),
         cmocka_unit_test(test_context_outlived),
         cmocka_unit_test(test_loading_limit),
+        cmocka_unit_test(test_default_limit),
         cmocka_unit_test(test_stats_by_category),
         cmocka_unit_test(test_fail_each_allocation),
     };
