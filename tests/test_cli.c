@@ -220,6 +220,17 @@ static void test_scene_format_by_content(void **state)
     assert_non_null(strstr(text, "\"emission\":\t[3.14159265358979")); /* pi Ke, Ke = 1 */
 }
 
+/* A face of fewer than 3 vertices is an error with its line (before: it
+ * was dropped silently); a line is `l`, and is ignored. */
+static void test_face_vertex_count(void **state)
+{
+    (void)state;
+    bad_scene("twoverts.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", NULL, NULL,
+              "twoverts.obj:4: face needs 3 or more vertices, has 2 ('l' is for lines)", NULL);
+    bad_scene("samevert.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 2 2\n", NULL, NULL,
+              "samevert.obj:5: face needs 3 or more distinct vertices, has 1", NULL);
+}
+
 /* `mtllib walls.mtl lamps.mtl`: both libraries are read and their
  * materials used (before: "walls.mtl lamps.mtl" was taken for one file
  * name, which did not exist); a missing second one is the error a missing
@@ -632,6 +643,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_empty_scene),
         cmocka_unit_test(test_malformed_gltf),
         cmocka_unit_test(test_scene_format_by_content),
+        cmocka_unit_test(test_face_vertex_count),
         cmocka_unit_test(test_several_material_libraries),
         cmocka_unit_test(test_unknown_method_names),
         cmocka_unit_test(test_usage_errors),

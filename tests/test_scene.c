@@ -222,14 +222,14 @@ static void test_obj_groups(void **state)
     (void)state;
     static const char obj[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                               "f 1 2 3\n"
-                              "g wall\nf 1 3 4\nf 1 2\n";
+                              "g wall\nf 1 3 4\n";
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_memory(ctx, "groups.obj", obj, strlen(obj), NULL, 0, &scene),
                      RAD_OK);
     assert_int_equal(rad_scene_surface_count(scene), 2);
     assert_string_equal(rad_scene_surface_name(scene, 0), "defaultobject");
     assert_string_equal(rad_scene_surface_name(scene, 1), "wall");
-    assert_int_equal(rad_scene_polygon_count(scene), 2); /* the 2-vertex face is skipped */
+    assert_int_equal(rad_scene_polygon_count(scene), 2);
     assert_false(rad_scene_has_emitter(scene));
     rad_scene_destroy(scene);
 }
@@ -898,6 +898,41 @@ static const bad_input bad_inputs[] = {
      {"empty.obj: scene is empty (no polygons)", NULL, NULL}},
     {"lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
      {"lines.obj: scene is empty (no polygons)", NULL, NULL}},
+    {"tiny.obj", "v 0 0 0\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"tiny.obj: scene is empty (no polygons)", NULL, NULL}},
+    {"twoverts.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"twoverts.obj:5: face needs 3 or more vertices, has 2 ('l' is for lines)", NULL, NULL}},
+    {"onevert.obj", "v 0 0 0\nf 1\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"onevert.obj:2: face needs 3 or more vertices, has 1", NULL, NULL}},
+    {"noverts.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf\nf 1 2 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"noverts.obj:4: face needs 3 or more vertices, has 0", NULL, NULL}},
+    {"samevert.obj", "v 0 0 0\nv 1 0 0\nf 1 1 1\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"samevert.obj:3: face needs 3 or more distinct vertices, has 1", NULL, NULL}},
+    {"twodistinct.obj", "v 0 0 0\nv 1 0 0\nf 1 2 -1 -2 1\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"twodistinct.obj:3: face needs 3 or more distinct vertices, has 2", NULL, NULL}},
+    {"zeros.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 02 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"zeros.obj:4: face vertex '02' has an index with a leading zero", NULL, NULL}},
+    {"zerosvn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//01 2//1 3//1\n", NULL, NULL,
+     RAD_ERROR_PARSE, {"zerosvn.obj:5: face vertex '1//01' has an index with a leading zero",
+                       NULL, NULL}},
+    {"plus.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf +1 2 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"plus.obj:4: face has a malformed vertex '+1'", NULL, NULL}},
+    {"continued.obj", "v 0 0 0\nv 1 0 0\n# C:\\scenes\\\nv 0 1 0\nf 1 2 3\n", NULL, NULL,
+     RAD_ERROR_PARSE, {"continued.obj:3: line ends in '\\' (a continuation line)", NULL, NULL}},
+    {"freeform.obj", "v 0 0 0\ncstype bspline\nv 1 0 0\nend\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"freeform.obj:2: 'cstype': free-form geometry is not supported (polygons only)", NULL,
+      NULL}},
+    {"parm.obj", "v 0 0 0\nparm u 0 1\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"parm.obj:2: 'parm': free-form geometry", NULL, NULL}},
+    {"lod.obj", "v 0 0 0\nlod 1\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"lod.obj:2: 'lod': levels of detail are not supported", NULL, NULL}},
+    {"call.obj", "call other.obj\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"call.obj:1: 'call': reading another file is not supported", NULL, NULL}},
+    {"binary.obj", "\x89PNG\r\n\x1a\n\x1b[2J\x9b\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"binary.obj:1: unknown statement '?PNG' (read as OBJ: by its content the file is not glTF "
+      "JSON or binary glTF)", NULL, NULL}},
+    {"escape.obj", "v 0 0 0\n\x1b[2J\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"escape.obj:2: unknown statement '?[2J'", NULL, NULL}},
     {"noname.obj", "mtllib\nv 0 0 0\n", NULL, NULL, RAD_ERROR_PARSE,
      {"noname.obj:1: 'mtllib' names no material library", NULL, NULL}},
     {"unnamed.obj", "mtllib unnamed.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "unnamed.mtl",

@@ -1,9 +1,11 @@
 /*
  * obj_prescan.c -- a light pre-scan of OBJ and MTL text, for the errors
  * assimp 5.2 omits or gets wrong: its OBJ parser reads "nan", garbage and
- * out-of-range numbers leniently, drops vertices of unexpected arity,
- * skips indented statements, stops at a NUL byte, and reports no line
- * numbers.
+ * out-of-range numbers leniently, drops vertices of unexpected arity and
+ * faces of fewer than 3 vertices, skips indented statements, stops at a
+ * NUL byte, reads "f 012" or "f +1" as two indices, hides everything
+ * between `cstype` and `end`, joins a line ending in '\\' (a comment
+ * included) to the next, and reports no line numbers.
  *
  *    text --lines--> tokens --checks--> "scene.obj:12: face references vertex 40 of 32"
  *
@@ -54,10 +56,34 @@ static bool next_line(text_lines *t, const char **line, const char **line_end)
 
 enum { TOKEN_SIZE = 128 };
 
+/* Control characters and bytes that are not UTF-8 become '?', so that a
+ * message quoting a token of a binary file cannot drive the terminal it is
+ * printed on (a lone 0x9b is a control sequence to some). */
+static void make_printable(char *text)
+{
+    unsigned char *c = (unsigned char *)text;
+    while (*c) {
+        int length = *c < 0x80                  ? 1
+                     : *c >= 0xc2 && *c <= 0xdf ? 2
+                     : *c >= 0xe0 && *c <= 0xef ? 3
+                     : *c >= 0xf0 && *c <= 0xf4 ? 4
+                                                : 0;
+        int k = 1;
+        while (k < length && c[k] >= 0x80 && c[k] <= 0xbf)
+            k++;
+        if (length == 0 || k < length || *c < 0x20 || *c == 0x7f) {
+            *c = '?';
+            k = 1;
+        }
+        c += k;
+    }
+}
+
 static bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
 /* Copy the next blank-separated token of [*p, end) into `token` (cut to
- * TOKEN_SIZE - 1 characters) and return its full length; 0 at the end.  Blanks are spaces and tabs only, as assimp has them: a
+ * TOKEN_SIZE - 1 characters, made printable) and return its full length;
+ * 0 at the end.  Blanks are spaces and tabs only, as assimp has them: a
  * form feed or vertical tab is part of a token, so "v\v1 2 3" is no vertex
  * here either. */
 static size_t next_token(const char **p, const char *end, char *token)
@@ -72,6 +98,7 @@ static size_t next_token(const char **p, const char *end, char *token)
     size_t copied = length < TOKEN_SIZE - 1 ? length : TOKEN_SIZE - 1;
     memcpy(token, s, copied);
     token[copied] = '\0';
+    make_printable(token);
     *p = e;
     return length;
 }
@@ -112,13 +139,38 @@ static number_kind parse_number(const char *token, size_t length, double *value)
 /* ---- pre-scan of OBJ and MTL text: line-numbered errors assimp omits ---- */
 
 /* Statements of the OBJ format (Wavefront, "Object Files (.obj)", Appendix
- * B1 of the Advanced Visualizer manual); anything else means the text is
- * not an OBJ file. */
+ * B1 of the Advanced Visualizer manual) that assimp reads as what they
+ * are; anything else means the text is not an OBJ file, or uses what
+ * unsupported_statements lists. */
 static const char *const obj_statements[] = {
     "v", "vt", "vn", "vp", "f", "fo", "l", "p", "g", "o", "s", "mg", "mtllib", "usemtl",
-    "usemap", "maplib", "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm",
-    "trim", "hole", "scrv", "sp", "end", "con", "bevel", "c_interp", "d_interp", "lod",
-    "shadow_obj", "trace_obj", "ctech", "stech", "call", "csh",
+    "usemap", "maplib", "bevel", "c_interp", "d_interp", "shadow_obj", "trace_obj", "ctech",
+    "stech", "csh",
+};
+
+/* Statements the engine cannot honour and assimp 5.2 would get silently
+ * wrong: free-form geometry (`cstype` makes assimp skip every line up to
+ * `end`, vertices and faces included; `parm` is read as a point, `lod` as
+ * a line) and `call`, which would read another file. */
+static const struct {
+    const char *statement, *why;
+} unsupported_statements[] = {
+    {"cstype", "free-form geometry is not supported (polygons only)"},
+    {"deg", "free-form geometry is not supported (polygons only)"},
+    {"bmat", "free-form geometry is not supported (polygons only)"},
+    {"step", "free-form geometry is not supported (polygons only)"},
+    {"curv", "free-form geometry is not supported (polygons only)"},
+    {"curv2", "free-form geometry is not supported (polygons only)"},
+    {"surf", "free-form geometry is not supported (polygons only)"},
+    {"parm", "free-form geometry is not supported (polygons only)"},
+    {"trim", "free-form geometry is not supported (polygons only)"},
+    {"hole", "free-form geometry is not supported (polygons only)"},
+    {"scrv", "free-form geometry is not supported (polygons only)"},
+    {"sp", "free-form geometry is not supported (polygons only)"},
+    {"end", "free-form geometry is not supported (polygons only)"},
+    {"con", "free-form geometry is not supported (polygons only)"},
+    {"lod", "levels of detail are not supported"},
+    {"call", "reading another file is not supported"},
 };
 
 static bool is_obj_statement(const char *token)
@@ -127,6 +179,15 @@ static bool is_obj_statement(const char *token)
         if (strcmp(token, obj_statements[i]) == 0)
             return true;
     return false;
+}
+
+/* Why `token` is refused, or NULL when it is not one of those statements. */
+static const char *unsupported_statement(const char *token)
+{
+    for (size_t i = 0; i < sizeof unsupported_statements / sizeof unsupported_statements[0]; i++)
+        if (strcmp(token, unsupported_statements[i].statement) == 0)
+            return unsupported_statements[i].why;
+    return NULL;
 }
 
 /* A line holding a NUL byte: assimp stops reading there, so the rest of
@@ -153,10 +214,12 @@ static int face_slot_of(const char *statement)
 }
 
 /* Check one face vertex, "v", "v/vt", "v//vn" or "v/vt/vn": each index
- * in 1..total, or relative (-1 = the latest seen so far). */
+ * in 1..total, or relative (-1 = the latest seen so far), written without
+ * a '+' or leading zeros (assimp reads "012" as 12 and then 2, "+1" as 1
+ * twice).  Writes the vertex's absolute index (0-based). */
 static rad_result check_face_vertex(rad_context *ctx, const char *path, int line,
                                     const char *token, const size_t total[3],
-                                    const size_t seen[3])
+                                    const size_t seen[3], size_t *vertex)
 {
     const char *part = token;
     for (int slot = 0; slot < 3; slot++) {
@@ -166,9 +229,14 @@ static rad_result check_face_vertex(rad_context *ctx, const char *path, int line
             char *after;
             errno = 0;
             long index = strtol(part, &after, 10);
-            if (length == 0 || !strchr("0123456789+-", part[0]) || after != part + length)
+            if (length == 0 || !strchr("0123456789-", part[0]) || after != part + length)
                 return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: face has a malformed vertex '%s'",
                                 path, line, token);
+            const char *digits = part[0] == '-' ? part + 1 : part;
+            if (digits[0] == '0' && digits + 1 < part + length)
+                return rad_fail(ctx, RAD_ERROR_PARSE,
+                                "%s:%d: face vertex '%s' has an index with a leading zero", path,
+                                line, token);
             size_t available = index < 0 ? seen[slot] : total[slot];
             bool in_range = errno == 0 && index != 0 &&
                             (index > 0 ? (unsigned long)index <= available
@@ -176,6 +244,8 @@ static rad_result check_face_vertex(rad_context *ctx, const char *path, int line
             if (!in_range)
                 return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: face references %s %ld of %zu",
                                 path, line, face_slot_names[slot], index, available);
+            if (slot == 0)
+                *vertex = index > 0 ? (size_t)index - 1 : seen[0] - (size_t)(-index);
         }
         if (!slash)
             return RAD_OK;
@@ -221,9 +291,10 @@ void import_obj_scan_free(import_obj_scan *scan)
 
 /* Check an OBJ where assimp would silently misread it or fail without a
  * line number: text without NUL bytes, known statements, none indented,
- * vertices of 3, 4 or 6 finite numbers (assimp drops other vertices and
- * divides by the 4th), face, line and point indices in range.  Lists the
- * `mtllib` statements in `scan`.  Not a parser: assimp reads the file
+ * no line continued with '\\', vertices of 3, 4 or 6 finite numbers
+ * (assimp drops other vertices and divides by the 4th), face, line and
+ * point indices in range, faces of 3 or more distinct vertices.  Lists
+ * the `mtllib` statements in `scan`.  Not a parser: assimp reads the file
  * afterwards. */
 rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
                               import_obj_scan *scan)
@@ -237,10 +308,14 @@ rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *te
     bool seen_statement = false;
     while (r == RAD_OK && next_line(&lines, &p, &end)) {
         const char *line = p;
-        if (has_nul(p, end)) {
+        if (has_nul(p, end))
             r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: NUL byte in the text", path, lines.number);
+        else if (end > p && end[-1] == '\\') /* assimp joins the next line to it, comments too */
+            r = rad_fail(ctx, RAD_ERROR_PARSE,
+                         "%s:%d: line ends in '\\' (a continuation line): not supported, join "
+                         "the lines", path, lines.number);
+        if (r != RAD_OK)
             break;
-        }
         bool indented = p < end && is_blank(*p);
         if (next_token(&p, end, token) == 0 || token[0] == '#')
             continue;
@@ -254,6 +329,7 @@ rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *te
         int slot = face_slot_of(token);
         if (slot >= 0)
             total[slot]++;
+        const char *unsupported = unsupported_statement(token);
         if (slot == 0) {
             size_t length;
             int coordinates = 0;
@@ -280,6 +356,9 @@ rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *te
                              path, lines.number);
         } else if (strcmp(token, "mtllib") == 0) {
             r = add_mtllib(ctx, path, scan, p, end, lines.number, (size_t)(line - text));
+        } else if (unsupported) {
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: '%s': %s", path, lines.number, token,
+                         unsupported);
         } else if (!is_obj_statement(token)) {
             r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: unknown statement '%s'%s", path,
                          lines.number, token,
@@ -291,20 +370,43 @@ rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *te
 
     /* Second pass: faces may name vertices defined later in the file;
      * relative (negative) indices count back from the latest one. */
-    size_t seen[3] = {0, 0, 0};
+    size_t seen[3] = {0, 0, 0}, faces = 0;
     lines = text_lines_of(text, size);
     while (r == RAD_OK && next_line(&lines, &p, &end)) {
         next_token(&p, end, token);
         int slot = face_slot_of(token);
         if (slot >= 0)
             seen[slot]++;
-        /* assimp reads points and lines with the face code: check them too */
-        if (strcmp(token, "f") != 0 && strcmp(token, "fo") != 0 && strcmp(token, "l") != 0 &&
-            strcmp(token, "p") != 0)
+        /* assimp reads points and lines with the face code: check them
+         * too; they have no area, and the loader ignores them */
+        bool face = strcmp(token, "f") == 0 || strcmp(token, "fo") == 0;
+        if (!face && strcmp(token, "l") != 0 && strcmp(token, "p") != 0)
             continue;
-        while (r == RAD_OK && next_token(&p, end, token) > 0)
-            r = check_face_vertex(ctx, path, lines.number, token, total, seen);
+        faces += face;
+        size_t count = 0, distinct[3], vertex = 0;
+        int kinds = 0; /* distinct vertices up to 3 */
+        while (r == RAD_OK && next_token(&p, end, token) > 0) {
+            r = check_face_vertex(ctx, path, lines.number, token, total, seen, &vertex);
+            count++;
+            bool repeat = false;
+            for (int k = 0; k < kinds; k++)
+                repeat = repeat || distinct[k] == vertex;
+            if (!repeat && kinds < 3)
+                distinct[kinds++] = vertex;
+        }
+        if (r == RAD_OK && face && count < 3)
+            r = rad_fail(ctx, RAD_ERROR_PARSE,
+                         "%s:%d: face needs 3 or more vertices, has %zu ('l' is for lines)",
+                         path, lines.number, count);
+        else if (r == RAD_OK && face && kinds < 3)
+            r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
+                         "%s:%d: face needs 3 or more distinct vertices, has %d", path,
+                         lines.number, kinds);
     }
+    /* Said here, as for any scene without polygons: assimp 5.2 would say
+     * "OBJ-file is too small" below 16 bytes. */
+    if (r == RAD_OK && faces == 0)
+        r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE, "%s: scene is empty (no polygons)", path);
     if (r != RAD_OK)
         import_obj_scan_free(scan);
     return r;
@@ -384,6 +486,7 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
                                 lines.number);
             }
             snprintf(material, sizeof material, "%s", name);
+            make_printable(material);
             rad_result r = add_material_name(ctx, names, path, lines.number, name);
             if (r != RAD_OK) {
                 rad_free(name);
@@ -446,6 +549,7 @@ rad_result import_material_names_check(rad_context *ctx, import_material_names *
         if (strcmp(first->name, again->name) == 0) {
             char name[64];
             snprintf(name, sizeof name, "%s", again->name);
+            make_printable(name);
             return rad_fail(ctx, RAD_ERROR_PARSE,
                             "%s:%d: material '%s' is defined again (first at %s:%d)",
                             names->libraries[again->library], again->line, name,
@@ -480,6 +584,7 @@ rad_result import_obj_check_usemtl(rad_context *ctx, const char *path, const cha
         if (!known) {
             char quoted[64];
             snprintf(quoted, sizeof quoted, "%s", name);
+            make_printable(quoted);
             rad_free(name);
             size_t more = names->library_count > 0 ? names->library_count - 1 : 0;
             char others[48] = "";
