@@ -1,11 +1,13 @@
 /*
  * fuzz_mtl.c -- a material library from memory beside a fixed OBJ that
- * names it and uses three of its materials (by the names the seeds use):
- * the MTL pre-scan, assimp's MTL reader and material validation.
+ * names it in two `mtllib` statements (the buffer holds every library's
+ * materials) and uses three of its materials (by the names the seeds
+ * use): the MTL pre-scan, the material names (each defined once, each
+ * used one defined), assimp's MTL reader and material validation.
  */
 #include "fuzz_scene.h"
 
-static const char obj[] = "mtllib x.mtl\n"
+static const char obj[] = "mtllib x.mtl\nmtllib y.mtl\n"
                           "o floor\nusemtl white\n"
                           "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
                           "o lamp\nusemtl light\n"

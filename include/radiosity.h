@@ -142,7 +142,9 @@ typedef struct rad_context_options {
     double max_memory_bytes;     /* the memory limit: everything the engine allocates in
                                     this context (scenes while loading included) stays
                                     below it, else RAD_ERROR_OUT_OF_MEMORY with the limit
-                                    named; 0 = 80% of physical memory.  Memory that
+                                    named; 0 = half the memory the process may use (the
+                                    physical memory, or its cgroup's or RLIMIT_AS /
+                                    RLIMIT_DATA's limit where lower).  Memory that
                                     assimp, Embree, LAPACK and cJSON allocate themselves
                                     is not counted (loading refuses files that assimp
                                     would need more than the limit for: docs/robustness.md) */
@@ -186,19 +188,22 @@ RAD_API int rad_context_threads(const rad_context *ctx);
 typedef struct rad_scene rad_scene;
 
 /* Load OBJ(+MTL) or glTF 2.0 (.gltf/.glb) through assimp, coordinates in
- * metres.  The scene is validated: finite coordinates, polygons of non-zero
- * area, reflectance in [0, 1).  A scene without an emitter loads; solving
- * it is an error.  On success *out is a new scene the caller destroys with
+ * metres.  The format is told by the content, not the name: binary glTF by
+ * its magic, glTF by its JSON, anything else is read as OBJ.  The file and
+ * its material libraries are read once, within the memory limit (an
+ * import may take 20x their size).  The scene is validated: finite
+ * coordinates, polygons of non-zero area, reflectance in [0, 1).  A scene
+ * without an emitter loads; solving it is an error.  On success *out is a new scene the caller destroys with
  * rad_scene_destroy; it does not refer to `path` or the file afterwards.
  * Fails with RAD_ERROR_IO (unreadable), RAD_ERROR_PARSE (malformed, with
  * file:line), RAD_ERROR_INVALID_SCENE, RAD_ERROR_OUT_OF_MEMORY; NULL ctx,
  * path or out: RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out);
 
-/* Load from memory, as rad_scene_load_file.  `name` is used in messages and
- * to guess the format from its extension (".obj", ".gltf", ".glb").  `mtl`,
- * if not NULL, is the text of the material library an OBJ names in
- * `mtllib`.  The buffers are read during the call only (the scene copies
+/* Load from memory, as rad_scene_load_file.  `name` is used in messages
+ * (the format is the content's).  `mtl`, if not NULL, is the text of the
+ * material libraries an OBJ names in its `mtllib` statements, all of them
+ * in one buffer.  The buffers are read during the call only (the scene copies
  * what it needs).  NULL ctx, name or out, or NULL data (mtl) with a
  * non-zero size: RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void *data,
@@ -697,7 +702,7 @@ typedef struct rad_option_info {
     double min, max;
     bool min_open, max_open;
     double default_value;          /* what 0 stands for; NAN where that is not a constant */
-    const char *default_text;      /* the default in words: "1e-06", "80% of physical memory" */
+    const char *default_text;      /* the default in words: "1e-06", "auto" */
     const rad_option_word *words;  /* FLAG (optional) and ENUM; ends with {NULL, 0} */
     rad_method_kind methods;       /* METHOD: the registry of its names */
     const char *help;              /* one line, lower case, no final full stop */

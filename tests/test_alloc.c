@@ -23,7 +23,11 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -413,26 +417,85 @@ static void test_context_outlived(void **state)
 
 /* ---- loading within the limit ---- */
 
-/* Files with no size (a FIFO, /dev/zero under an OBJ name) are read in
- * growing blocks and stopped at the limit; a regular file larger than the
- * limit is refused before it is read; one whose import would need more
- * than the limit is refused before assimp sees it. */
+/* Fill the FIFO at `path` with `line` over and over until its reader
+ * leaves (the writer then dies of SIGPIPE); returns the writer's pid. */
+static pid_t endless_writer(const char *path, const char *line)
+{
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        signal(SIGPIPE, SIG_DFL);
+        alarm(60); /* should the reader never come */
+        char block[65536];
+        size_t n = strlen(line), used = 0;
+        while (used + n <= sizeof block) {
+            memcpy(block + used, line, n);
+            used += n;
+        }
+        int fd = open(path, O_WRONLY);
+        while (fd >= 0 && write(fd, block, used) > 0)
+            ;
+        _exit(0);
+    }
+    return pid;
+}
+
+/* A load that must fail with `expected` and a message holding `part`,
+ * in a fresh context of `limit` bytes (0: the default), reading no more
+ * than `most_scene_bytes` into scene memory. */
+static void load_fails(const char *path, double limit, rad_result expected, const char *part,
+                       double most_scene_bytes)
+{
+    rad_context *ctx = limited_context(limit);
+    rad_scene *scene = (rad_scene *)&ctx;
+    double t0 = rad_seconds();
+    rad_result r = rad_scene_load_file(ctx, path, &scene);
+    if (r != expected || !strstr(rad_context_error(ctx), part))
+        fail_msg("%s: %s '%s', expected %s '...%s...'", path, rad_result_string(r),
+                 rad_context_error(ctx), rad_result_string(expected), part);
+    assert_null(scene);
+    assert_null(strchr(rad_context_error(ctx), '\n'));
+    assert_true(rad_seconds() - t0 < 10.0);
+    /* + 4 KiB: the file names and the folder the load keeps */
+    if ((double)rad_memory_peak(ctx, RAD_MEM_SCENE) > most_scene_bytes + 4096.0)
+        fail_msg("%s: %zu bytes of scene memory at most, expected <= %.0f", path,
+                 rad_memory_peak(ctx, RAD_MEM_SCENE), most_scene_bytes + 4096.0);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+    rad_context_destroy(ctx);
+}
+
+/* Reading stops where the import could pass the limit: at limit / 20
+ * bytes of scene text (assimp takes up to 20x), the file and its
+ * libraries together.  A regular file is refused by its size, unread; a
+ * stream when it has given that much; text with a NUL byte at once. */
 static void test_loading_limit(void **state)
 {
     (void)state;
-    rad_context *ctx = limited_context(8.0 * 1048576.0);
+    const double limit = 8.0 * 1048576.0, budget = limit / 20.0; /* 409.6 KiB */
     char path[512];
-    rad_scene *scene = (rad_scene *)&path;
 
+    /* /dev/zero and /dev/urandom under an OBJ name: a NUL in the first
+     * piece read (before: /dev/zero was read up to the limit). */
     snprintf(path, sizeof path, "%s/zero.obj", input_dir);
     remove(path);
     assert_int_equal(symlink("/dev/zero", path), 0);
-    assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_ERROR_OUT_OF_MEMORY);
-    assert_null(scene);
-    assert_contains(rad_context_error(ctx), "zero.obj");
-    assert_contains(rad_context_error(ctx), "the memory limit of 8.0 MiB");
-    assert_null(strchr(rad_context_error(ctx), '\n'));
-    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+    load_fails(path, limit, RAD_ERROR_PARSE, "zero.obj:1: NUL byte in the text", 65536.0);
+    load_fails(path, 0.0, RAD_ERROR_PARSE, "zero.obj:1: NUL byte in the text", 65536.0);
+    remove(path);
+    load_fails("/dev/urandom", 0.0, RAD_ERROR_PARSE, "NUL byte in the text", 65536.0);
+
+    /* Endless text from a FIFO: stopped at the budget.  The doubling
+     * block and its copy stay under twice the budget. */
+    snprintf(path, sizeof path, "%s/endless.obj", input_dir);
+    remove(path);
+    assert_int_equal(mkfifo(path, 0600), 0);
+    pid_t writer = endless_writer(path, "v 0 0 0\n");
+    load_fails(path, limit, RAD_ERROR_OUT_OF_MEMORY,
+               "endless.obj: a file of more than 409.6 KiB may need more than 8.0 MiB to import "
+               "(20x its size), above the memory limit of 8.0 MiB "
+               "(rad_context_options.max_memory_bytes)",
+               2.0 * budget + 2.0);
+    waitpid(writer, NULL, 0);
     remove(path);
 
     /* A sparse file of 1 GiB: refused by its size, without reading it. */
@@ -441,15 +504,41 @@ static void test_loading_limit(void **state)
     assert_non_null(f);
     fclose(f);
     assert_int_equal(truncate(path, (off_t)1 << 30), 0);
-    double t0 = rad_seconds();
-    assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_ERROR_OUT_OF_MEMORY);
-    assert_true(rad_seconds() - t0 < 1.0);
-    assert_contains(rad_context_error(ctx), "huge.obj: a file of 1.00 GiB, larger than the memory limit of 8.0 MiB");
+    load_fails(path, limit, RAD_ERROR_OUT_OF_MEMORY,
+               "huge.obj: a file of 1.00 GiB may need 20.00 GiB to import (20x its size), above "
+               "the memory limit of 8.0 MiB", 0.0);
+    /* ... and with no limit given, a NUL byte in its first MiB at the latest. */
+    assert_int_equal(truncate(path, (off_t)16 << 20), 0);
+    load_fails(path, 0.0, RAD_ERROR_PARSE, "huge.obj:1: NUL byte in the text",
+               16.0 * 1048576.0 + 1.0);
     remove(path);
 
+    /* An OBJ of 300 KiB fits; with its 200 KiB library it does not. */
+    char *text = malloc(300 * 1024 + 1);
+    assert_non_null(text);
+    snprintf(text, 64, "mtllib big.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    for (size_t i = strlen(text); i < 300 * 1024; i++)
+        text[i] = i % 64 == 63 ? '\n' : '#';
+    text[300 * 1024] = '\0';
+    write_text(input_dir, "big.obj", text);
+    text[200 * 1024] = '\0';
+    memcpy(text, "newmtl m\n", 9);
+    write_text(input_dir, "big.mtl", text);
+    snprintf(path, sizeof path, "%s/big.obj", input_dir);
+    load_fails(path, limit, RAD_ERROR_OUT_OF_MEMORY,
+               "big.obj:1: material library 'big.mtl': with it the scene's files come to 500.0 "
+               "KiB, which may need 9.8 MiB to import (20x their size), above the memory limit "
+               "of 8.0 MiB", 300.0 * 1024 + 1);
+    remove(path);
+    snprintf(path, sizeof path, "%s/big.mtl", input_dir);
+    remove(path);
+    free(text);
+
     /* 1 MiB of text fits in 8 MiB, but not the 20 MiB assimp may need. */
+    rad_context *ctx = limited_context(limit);
+    rad_scene *scene = (rad_scene *)&path;
     size_t size = 1048576;
-    char *text = malloc(size);
+    text = malloc(size);
     assert_non_null(text);
     for (size_t i = 0; i < size; i++)
         text[i] = i % 64 == 63 ? '\n' : '#';
@@ -460,6 +549,35 @@ static void test_loading_limit(void **state)
     free(text);
     assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
     rad_context_destroy(ctx);
+}
+
+/* With no limit given, the limit is half the memory the process may use:
+ * the physical memory, or less where RLIMIT_AS (ulimit -v) says so (here
+ * in a child, not to limit the tests). */
+static void test_default_limit(void **state)
+{
+    (void)state;
+    rad_context *ctx = limited_context(0.0);
+    double available = (double)rad_available_memory_bytes();
+    assert_true(available > 0.0 && available <= (double)rad_physical_memory_bytes());
+    assert_true(rad_memory_limit(ctx) == (double)(size_t)(0.5 * available));
+    rad_context_destroy(ctx);
+
+    pid_t child = fork();
+    assert_true(child >= 0);
+    if (child == 0) {
+        struct rlimit as = {(rlim_t)3 << 30, (rlim_t)3 << 30};
+        rad_context *limited = NULL;
+        int ok = setrlimit(RLIMIT_AS, &as) == 0 &&
+                 rad_available_memory_bytes() == (size_t)3 << 30 &&
+                 rad_context_create(NULL, &limited) == RAD_OK &&
+                 rad_memory_limit(limited) == 1.5 * 1073741824.0;
+        rad_context_destroy(limited);
+        _exit(ok ? 0 : 1);
+    }
+    int status = -1;
+    assert_int_equal(waitpid(child, &status, 0), child);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
 }
 
 /* The stats report the allocator's peaks by category. */
@@ -548,6 +666,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_limit),
         cmocka_unit_test(test_context_outlived),
         cmocka_unit_test(test_loading_limit),
+        cmocka_unit_test(test_default_limit),
         cmocka_unit_test(test_stats_by_category),
         cmocka_unit_test(test_fail_each_allocation),
     };

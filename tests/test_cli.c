@@ -290,6 +290,68 @@ static void test_gltf_refused(void **state)
     assert_no_output("bad_out");
 }
 
+/* The reader is the content's: an OBJ named `noext`, `s.gltf` or `s.txt`
+ * is pre-scanned like any OBJ (before: it reached assimp, which read its
+ * NaN coordinate), and a good one renders whatever its name. */
+static void test_scene_format_by_content(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"noext", "s.gltf", "s.txt"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        char needle[64];
+        snprintf(needle, sizeof needle, "%s:2: vertex coordinate 'nan' is not a finite number",
+                 names[i]);
+        bad_scene(names[i], "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", NULL, NULL, needle, NULL);
+    }
+    write_file("good.mtl", good_mtl);
+    write_file("room", good_obj);
+    assert_int_equal(run("render room -o room.png --width 16 --height 16 --elements 50 "
+                         "--stats room.json"),
+                     0);
+    char path[600], text[16384];
+    snprintf(path, sizeof path, "%s/room.json", workdir);
+    slurp(path, text, sizeof text);
+    assert_non_null(strstr(text, "\"name\":\t\"lamp\""));
+    assert_non_null(strstr(text, "\"emission\":\t[3.14159265358979")); /* pi Ke, Ke = 1 */
+}
+
+/* A face of fewer than 3 vertices is an error with its line (before: it
+ * was dropped silently); a line is `l`, and is ignored. */
+static void test_face_vertex_count(void **state)
+{
+    (void)state;
+    bad_scene("twoverts.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", NULL, NULL,
+              "twoverts.obj:4: face needs 3 or more vertices, has 2 ('l' is for lines)", NULL);
+    bad_scene("samevert.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 2 2 2\n", NULL, NULL,
+              "samevert.obj:5: face needs 3 or more distinct vertices, has 1", NULL);
+}
+
+/* `mtllib walls.mtl lamps.mtl`: both libraries are read and their
+ * materials used (before: "walls.mtl lamps.mtl" was taken for one file
+ * name, which did not exist); a missing second one is the error a missing
+ * first one is. */
+static void test_several_material_libraries(void **state)
+{
+    (void)state;
+    const char *body = good_obj + strlen("mtllib good.mtl\n");
+    char obj[1024];
+    write_file("walls.mtl", "newmtl white\nKd 0.5 0.5 0.5\n");
+    write_file("lamps.mtl", "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+    snprintf(obj, sizeof obj, "mtllib walls.mtl lamps.mtl\n%s", body);
+    write_file("libs.obj", obj);
+    assert_int_equal(run("render libs.obj -o libs.png --width 16 --height 16 --elements 50 "
+                         "--stats libs.json"),
+                     0);
+    char path[600], text[16384];
+    snprintf(path, sizeof path, "%s/libs.json", workdir);
+    slurp(path, text, sizeof text);
+    assert_non_null(strstr(text, "\"emission\":\t[3.14159265358979"));
+    snprintf(obj, sizeof obj, "mtllib walls.mtl missing.mtl\n%s", body);
+    bad_scene("libs2.obj", obj, NULL, NULL,
+              "libs2.obj:1: material library 'missing.mtl': cannot open: No such file or directory",
+              NULL);
+}
+
 /* ---- bad input: the command line ---- */
 
 /* A method name is checked against the library's registry while parsing:
@@ -531,32 +593,82 @@ static void test_limits(void **state)
 static void test_loading_limits(void **state)
 {
     (void)state;
-    char path[600];
+    char path[600], cmd[4096];
+    /* /dev/zero under an OBJ name, with and without a limit: a NUL byte
+     * in the first piece read, at once (before: with no --max-memory it
+     * grew to 24 GB until the kernel killed it). */
     snprintf(path, sizeof path, "%s/zero.obj", workdir);
     remove(path);
     assert_int_equal(symlink("/dev/zero", path), 0);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     assert_int_equal(run("render zero.obj -o zout.png --max-memory 64M"), 1);
+    assert_one_line_error("zero.obj:1: NUL byte in the text", NULL);
+    assert_int_equal(run("render zero.obj -o zout.png"), 1);
+    assert_one_line_error("zero.obj:1: NUL byte in the text", NULL);
     clock_gettime(CLOCK_MONOTONIC, &t1);
-    assert_one_line_error("zero.obj: ", "memory limit of 64.0 MiB");
     assert_true((double)(t1.tv_sec - t0.tv_sec) < 20.0);
     assert_no_output("zout");
     remove(path);
+    assert_int_equal(run("render /dev/zero -o zout.png"), 1);
+    assert_one_line_error("/dev/zero:1: NUL byte in the text", NULL);
+    assert_int_equal(run("render /dev/urandom -o zout.png"), 1);
+    assert_one_line_error("/dev/urandom:", "NUL byte in the text");
 
+    /* A FIFO that never ends: read up to what the import could take
+     * within the limit (1/20 of it), then refused.  With no --max-memory
+     * the limit is half of what the process may use: here ulimit -v 2 GiB
+     * (where the program can run so: not under AddressSanitizer, which
+     * reserves terabytes of address space). */
+    snprintf(path, sizeof path, "%s/endless.obj", workdir);
+    remove(path);
+    assert_int_equal(mkfifo(path, 0600), 0);
+    snprintf(cmd, sizeof cmd, "(ulimit -v 2097152; '%s' --version) >/dev/null 2>&1", radiosity_bin);
+    int runs = system(cmd) == 0 ? 2 : 1;
+    const char *limits[2] = {"--max-memory 64M", ""};
+    const char *ulimits[2] = {"", "ulimit -v 2097152; "};
+    const char *expected[2] = {
+        "endless.obj: a file of more than 3.2 MiB may need more than 64.0 MiB to import (20x its "
+        "size), above the memory limit of 64.0 MiB (--max-memory)",
+        "endless.obj: a file of more than 51.2 MiB may need more than 1.00 GiB to import (20x its "
+        "size), above the memory limit of 1.00 GiB (--max-memory)"};
+    for (int k = 0; k < runs; k++) {
+        /* The writer opens the FIFO under `timeout`: it waits for a reader. */
+        snprintf(cmd, sizeof cmd,
+                 "cd '%s' && (timeout 60 sh -c \"yes 'v 0 0 0' > endless.obj\" >/dev/null 2>&1 &) "
+                 "&& (%s'%s' render endless.obj -o zout.png %s >stdout.txt 2>stderr.txt "
+                 "</dev/null)",
+                 workdir, ulimits[k], radiosity_bin, limits[k]);
+        int status = system(cmd);
+        snprintf(path, sizeof path, "%s/stderr.txt", workdir);
+        slurp(path, err_text, sizeof err_text);
+        assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 1);
+        assert_one_line_error(expected[k], NULL);
+        assert_no_output("zout");
+    }
+    snprintf(path, sizeof path, "%s/endless.obj", workdir);
+    remove(path);
+
+    /* Sparse files: refused by their size, unread; or, with room for them,
+     * stopped by the NUL byte at their start. */
     snprintf(path, sizeof path, "%s/sparse.obj", workdir);
     FILE *f = fopen(path, "wb");
     assert_non_null(f);
     fclose(f);
     assert_int_equal(truncate(path, (off_t)100 << 30), 0); /* 100 GiB, no blocks */
     assert_int_equal(run("render sparse.obj -o zout.png --max-memory 64M"), 1);
-    assert_one_line_error("sparse.obj: a file of 100.00 GiB, larger than the memory limit of 64.0 MiB", NULL);
+    assert_one_line_error("sparse.obj: a file of 100.00 GiB may need 2000.00 GiB to import (20x "
+                          "its size), above the memory limit of 64.0 MiB (--max-memory)",
+                          NULL);
+    assert_int_equal(truncate(path, (off_t)2 << 30), 0); /* 2 GiB */
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    assert_int_equal(run("render sparse.obj -o zout.png"), 1);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    assert_true((double)(t1.tv_sec - t0.tv_sec) < 20.0);
+    if (!strstr(err_text, "sparse.obj:1: NUL byte in the text"))
+        assert_one_line_error("sparse.obj: a file of 2.00 GiB may need 40.00 GiB to import", NULL);
     assert_no_output("zout");
     remove(path);
-
-    assert_int_equal(run("render /dev/zero -o zout.png --max-memory 64M"), 1);
-    assert_one_line_error("/dev/zero", NULL);
-    assert_no_output("zout");
 }
 
 /* SIGTERM while the form factors are computed (the dense analytic matrix
@@ -659,6 +771,9 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_malformed_gltf),
         cmocka_unit_test(test_gltf_orthographic_camera),
         cmocka_unit_test(test_gltf_refused),
+        cmocka_unit_test(test_scene_format_by_content),
+        cmocka_unit_test(test_face_vertex_count),
+        cmocka_unit_test(test_several_material_libraries),
         cmocka_unit_test(test_unknown_method_names),
         cmocka_unit_test(test_usage_errors),
         cmocka_unit_test(test_seed),

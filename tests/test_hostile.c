@@ -369,7 +369,7 @@ static void test_repeated_and_collinear_vertices(void **state)
     static const char *const bad[2] = {"o dot\nv 1 2 3\nf -1 -1 -1\n",
                                        "o stick\nv 0 0 0\nv 1 0 0\nv 3 0 0\nf -3 -2 -1\n"};
     static const char *const message[2] = {
-        "hostile.obj: polygon in surface 'dot' has 1 distinct vertices (3 or more needed)",
+        "hostile.obj:4: face needs 3 or more distinct vertices, has 1",
         "hostile.obj: polygon in surface 'stick' has zero area"};
     for (int k = 0; k < 2; k++) {
         text t = {0};

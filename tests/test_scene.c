@@ -11,6 +11,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "scene/import_internal.h"
 #include "scene/scene.h"
 
 #include <stdio.h>
@@ -179,13 +180,10 @@ static const char lamp_obj[] = "mtllib lamp.mtl\n"
 static const char lamp_mtl[] = "newmtl grey\nKd 0.5 0.25 0.125\n"
                                "newmtl glow\nKd 0.1 0.1 0.1\nKe 2 1 0.5\n";
 
-static void test_obj_from_memory(void **state)
+/* The scene of lamp_obj and lamp_mtl, however it was read. */
+static void check_lamp(rad_scene *scene)
 {
-    (void)state;
-    rad_scene *scene = NULL;
-    assert_int_equal(rad_scene_load_memory(ctx, "lamp.obj", lamp_obj, strlen(lamp_obj),
-                                           lamp_mtl, strlen(lamp_mtl), &scene),
-                     RAD_OK);
+    assert_non_null(scene);
     assert_int_equal(rad_scene_surface_count(scene), 2);
     size_t panel = surface_index(scene, "panel"), lamp = surface_index(scene, "lamp");
     assert_close(rad_scene_surface_area(scene, panel), 2.0, 1e-15);
@@ -209,22 +207,79 @@ static void test_obj_from_memory(void **state)
     rad_scene_destroy(scene);
 }
 
+static void test_obj_from_memory(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "lamp.obj", lamp_obj, strlen(lamp_obj),
+                                           lamp_mtl, strlen(lamp_mtl), &scene),
+                     RAD_OK);
+    check_lamp(scene);
+}
+
 /* `g` names a surface like `o`; with no name at all assimp says "defaultobject". */
 static void test_obj_groups(void **state)
 {
     (void)state;
     static const char obj[] = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
                               "f 1 2 3\n"
-                              "g wall\nf 1 3 4\nf 1 2\n";
+                              "g wall\nf 1 3 4\n";
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_memory(ctx, "groups.obj", obj, strlen(obj), NULL, 0, &scene),
                      RAD_OK);
     assert_int_equal(rad_scene_surface_count(scene), 2);
     assert_string_equal(rad_scene_surface_name(scene, 0), "defaultobject");
     assert_string_equal(rad_scene_surface_name(scene, 1), "wall");
-    assert_int_equal(rad_scene_polygon_count(scene), 2); /* the 2-vertex face is skipped */
+    assert_int_equal(rad_scene_polygon_count(scene), 2);
     assert_false(rad_scene_has_emitter(scene));
     rad_scene_destroy(scene);
+}
+
+static void remove_temp(const char *name);
+
+/* The scene of test_obj_face_forms. */
+static void check_face_forms(rad_scene *scene)
+{
+    assert_int_equal(rad_scene_surface_count(scene), 3); /* "lines" has no polygon */
+    assert_close(rad_scene_surface_area(scene, surface_index(scene, "mixed")), 2.0, 1e-15);
+    assert_close(rad_scene_surface_area(scene, surface_index(scene, "old")), 1.0, 1e-15);
+    assert_close(rad_scene_surface_area(scene, surface_index(scene, "repeat")), 1.0, 1e-15);
+    assert_int_equal(rad_scene_polygon_count(scene), 3);
+    for (size_t p = 0; p < scene->polygon_count; p++) {
+        const rad_polygon *polygon = &scene->polygons[p];
+        if (polygon->surface == surface_index(scene, "repeat"))
+            assert_int_equal(polygon->vertex_count, 3);
+        /* every polygon starts at vertex 1 = (0, 0, 0), or 2 = (2, 0, 0) */
+        vec3 first = scene->positions[scene->indices[polygon->first_index]];
+        assert_true(first.y == 0.0 && first.z == 0.0 && (first.x == 0.0 || first.x == 2.0));
+    }
+    rad_scene_destroy(scene);
+}
+
+/* What loads besides plain faces: lines and points (no area: ignored, no
+ * error), `fo`, faces mixing the v, v/vt, v//vn and v/vt/vn forms, a
+ * vertex repeated next to itself (dropped), relative indices. */
+static void test_obj_face_forms(void **state)
+{
+    (void)state;
+    static const char obj[] = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
+                              "o lines\nl 1 2 3\nl 1 2\np 1 2 3 4\np 4\n"
+                              "o mixed\nf 1/1 2//1 3/1/1 4\n"
+                              "o old\nfo 1 2 3\n"
+                              "o repeat\nf -4 -3 -3 -2\n";
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "forms.obj", obj, strlen(obj), NULL, 0, &scene),
+                     RAD_OK);
+    check_face_forms(scene);
+
+    /* A UTF-8 byte order mark first is skipped (assimp 5.2 dropped the
+     * first vertex with it, and every face then named the wrong ones). */
+    char with_bom[sizeof obj + 3];
+    snprintf(with_bom, sizeof with_bom, "\xEF\xBB\xBF%s", obj);
+    scene = NULL;
+    assert_int_equal(rad_scene_load_file(ctx, write_temp("bom.obj", with_bom), &scene), RAD_OK);
+    check_face_forms(scene);
+    remove_temp("bom.obj");
 }
 
 /* ---- glTF 2.0 ---- */
@@ -1041,6 +1096,255 @@ static void test_gltf_orthographic_camera(void **state)
     rad_context_destroy(warned);
 }
 
+/* ---- the reader is chosen by content ---- */
+
+/* Write `size` bytes to temp_dir/name; returns the path (static). */
+static const char *write_temp_bytes(const char *name, const void *bytes, size_t size)
+{
+    static char path[512];
+    snprintf(path, sizeof path, "%s/%s", temp_dir, name);
+    FILE *file = fopen(path, "wb");
+    assert_non_null(file);
+    assert_int_equal(fwrite(bytes, 1, size, file), size);
+    assert_int_equal(fclose(file), 0);
+    return path;
+}
+
+static void put_le32(unsigned char *p, size_t value)
+{
+    for (int k = 0; k < 4; k++)
+        p[k] = (unsigned char)(value >> (8 * k));
+}
+
+/* quad_gltf as a binary glTF: the 12-byte header, the JSON chunk (its
+ * buffer's data URI dropped: the BIN chunk is buffer 0) padded with spaces
+ * and the BIN chunk with the same 60 bytes (Khronos, glTF 2.0, "Binary
+ * glTF Layout").  The caller frees it. */
+static unsigned char *quad_glb(size_t *size)
+{
+    char json[sizeof quad_gltf];
+    const char *uri = strstr(quad_gltf, ", \"uri\"");
+    assert_non_null(uri);
+    const char *after = strchr(strchr(uri + 9, '"') + 1, '"') + 1; /* past the URI's quotes */
+    snprintf(json, sizeof json, "%.*s%s", (int)(uri - quad_gltf), quad_gltf, after);
+    const float corners[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+    size_t n = strlen(json), padded = (n + 3) & ~(size_t)3, bin = 64;
+    *size = 20 + padded + 8 + bin;
+    unsigned char *glb = calloc(1, *size);
+    assert_non_null(glb);
+    memcpy(glb, "glTF", 4);
+    put_le32(glb + 4, 2);
+    put_le32(glb + 8, *size);
+    put_le32(glb + 12, padded);
+    memcpy(glb + 16, "JSON", 4);
+    memcpy(glb + 20, json, n);
+    memset(glb + 20 + n, ' ', padded - n);
+    unsigned char *chunk = glb + 20 + padded;
+    put_le32(chunk, bin);
+    memcpy(chunk + 4, "BIN", 4); /* and a 0 byte */
+    memcpy(chunk + 8, corners, sizeof corners); /* little-endian, as the machines this runs on */
+    memcpy(chunk + 8 + sizeof corners, indices, sizeof indices);
+    return glb;
+}
+
+/* The format is the content's, whatever the name says: an OBJ named
+ * `scene`, `s.gltf` or `s.txt` used to reach assimp without the pre-scan,
+ * which read its NaN; a glTF or GLB named `.obj` is read as what it is. */
+static void test_format_by_content(void **state)
+{
+    (void)state;
+    assert_int_equal(import_format_of("glTF\2\0\0\0", 8), IMPORT_GLB);
+    assert_int_equal(import_format_of("glT", 3), IMPORT_OBJ);
+    assert_int_equal(import_format_of("\xEF\xBB\xBF \r\n\t{\"asset\"", 15), IMPORT_GLTF);
+    assert_int_equal(import_format_of(" \n v 0 0 0", 11), IMPORT_OBJ);
+    assert_int_equal(import_format_of("", 0), IMPORT_OBJ);
+    assert_int_equal(import_format_of("\0{", 2), IMPORT_OBJ);
+
+    static const char nan_obj[] = "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n";
+    static const char *const names[] = {"scene", "s.gltf", "s.txt", "s.OBJ", "s.glb", "s.obj.bak"};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        rad_scene sentinel, *scene = &sentinel;
+        const char *path = write_temp(names[i], nan_obj);
+        char expected[600];
+        snprintf(expected, sizeof expected, "%s:2: vertex coordinate 'nan' is not a finite number",
+                 path);
+        assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_ERROR_INVALID_SCENE);
+        assert_null(scene);
+        assert_string_equal(rad_context_error(ctx), expected);
+        scene = &sentinel;
+        assert_int_equal(rad_scene_load_memory(ctx, names[i], nan_obj, strlen(nan_obj), NULL, 0,
+                                               &scene),
+                         RAD_ERROR_INVALID_SCENE);
+        assert_null(scene);
+        snprintf(expected, sizeof expected, "%s:2: vertex coordinate 'nan' is not a finite number",
+                 names[i]);
+        assert_string_equal(rad_context_error(ctx), expected);
+        remove_temp(names[i]);
+    }
+
+    /* A good OBJ without an extension, with its library. */
+    write_temp("lamp.mtl", lamp_mtl);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_file(ctx, write_temp("room", lamp_obj), &scene), RAD_OK);
+    check_lamp(scene);
+
+    /* glTF JSON and binary glTF under OBJ, other and no names. */
+    size_t glb_size;
+    unsigned char *glb = quad_glb(&glb_size);
+    static const char *const gltf_names[] = {"quad.obj", "quad"};
+    static const char *const glb_names[] = {"quadb.obj", "quadb.gltf", "quadb"};
+    for (size_t i = 0; i < 2; i++) {
+        scene = NULL;
+        assert_int_equal(rad_scene_load_file(ctx, write_temp(gltf_names[i], quad_gltf), &scene),
+                         RAD_OK);
+        check_quad_gltf(scene);
+        rad_scene_destroy(scene);
+        remove_temp(gltf_names[i]);
+    }
+    for (size_t i = 0; i < 3; i++) {
+        scene = NULL;
+        const char *path = write_temp_bytes(glb_names[i], glb, glb_size);
+        rad_result r = rad_scene_load_file(ctx, path, &scene);
+        if (r != RAD_OK)
+            print_error("%s\n", rad_context_error(ctx));
+        assert_int_equal(r, RAD_OK);
+        check_quad_gltf(scene);
+        rad_scene_destroy(scene);
+        remove_temp(glb_names[i]);
+        scene = NULL;
+        assert_int_equal(rad_scene_load_memory(ctx, glb_names[i], glb, glb_size, NULL, 0, &scene),
+                         RAD_OK);
+        check_quad_gltf(scene);
+        rad_scene_destroy(scene);
+    }
+    scene = NULL;
+    assert_int_equal(
+        rad_scene_load_memory(ctx, "x.obj", quad_gltf, strlen(quad_gltf), NULL, 0, &scene),
+        RAD_OK);
+    check_quad_gltf(scene);
+    rad_scene_destroy(scene);
+    free(glb);
+    remove_temp("room");
+    remove_temp("lamp.mtl");
+}
+
+/* ---- several material libraries ---- */
+
+static const char grey_mtl[] = "newmtl grey\nKd 0.5 0.25 0.125\n";
+static const char glow_mtl[] = "newmtl glow\nKd 0.1 0.1 0.1\nKe 2 1 0.5\n";
+static const char lamp_body[] = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\n"
+                                "v 0 0 1\nv 1 0 1\nv 0 1 1\n"
+                                "o panel\nusemtl grey\nf 1 2 3 4\n"
+                                "o lamp\nusemtl glow\nf -3 -2 -1\n";
+
+/* Load temp_dir/libs.obj made of `head` and lamp_body. */
+static rad_result load_libs(const char *head, rad_scene **scene)
+{
+    char obj[1024];
+    snprintf(obj, sizeof obj, "%s%s", head, lamp_body);
+    *scene = NULL;
+    return rad_scene_load_file(ctx, write_temp("libs.obj", obj), scene);
+}
+
+/* `mtllib a.mtl b.mtl` names two libraries, as several `mtllib` lines do:
+ * every one is read and pre-scanned, and the materials of all of them are
+ * there (before: assimp looked for one file "grey.mtl glow.mtl", found
+ * none, and gave every polygon its default grey).  A library named twice
+ * is read once; a line whose whole text names a file is that file. */
+static void test_material_libraries(void **state)
+{
+    (void)state;
+    write_temp("grey.mtl", grey_mtl);
+    write_temp("glow.mtl", glow_mtl);
+    char both[256];
+    snprintf(both, sizeof both, "%s%s", grey_mtl, glow_mtl);
+    write_temp("my lamp.mtl", both);
+    char bom[256];
+    snprintf(bom, sizeof bom, "\xEF\xBB\xBF%s", glow_mtl);
+    write_temp("bom.mtl", bom);
+    write_temp("materials.txt", both);
+    static const struct {
+        const char *head;
+        size_t inputs; /* the OBJ and its libraries, each once */
+    } good[] = {
+        {"mtllib grey.mtl glow.mtl\n", 3},
+        {"mtllib grey.mtl\nmtllib glow.mtl\n", 3},
+        {"mtllib grey.mtl\tglow.mtl grey.mtl ./grey.mtl\nmtllib glow.mtl\n", 3},
+        {"mtllib my lamp.mtl\n", 2},
+        {"# libraries\nmtllib    grey.mtl   \n# and\nmtllib glow.mtl\n", 3},
+        {"\xEF\xBB\xBFmtllib grey.mtl bom.mtl\n", 3}, /* byte order marks, each skipped */
+        {"mtllib materials.txt\n", 2}, /* a library of any name is pre-scanned as MTL */
+    };
+    for (size_t i = 0; i < sizeof good / sizeof good[0]; i++) {
+        rad_scene *scene;
+        rad_result r = load_libs(good[i].head, &scene);
+        if (r != RAD_OK)
+            print_error("'%s': %s\n", good[i].head, rad_context_error(ctx));
+        assert_int_equal(r, RAD_OK);
+        assert_int_equal(rad_scene_input_count(scene), good[i].inputs);
+        assert_contains(rad_scene_input_path(scene, 1), i == 3   ? "my lamp.mtl"
+                                                        : i == 6 ? "materials.txt"
+                                                                 : "grey.mtl");
+        check_lamp(scene);
+    }
+
+    /* From memory the one buffer holds every library's materials. */
+    rad_scene *scene = NULL;
+    char obj[1024];
+    snprintf(obj, sizeof obj, "mtllib grey.mtl\nmtllib glow.mtl\n%s", lamp_body);
+    assert_int_equal(rad_scene_load_memory(ctx, "libs.obj", obj, strlen(obj), both, strlen(both),
+                                           &scene),
+                     RAD_OK);
+    check_lamp(scene);
+
+    /* A missing library is the same error whichever it is. */
+    write_temp("bad.mtl", "newmtl glow\nKd 1.5 0 0\n");
+    write_temp("grey2.mtl", "newmtl glow\nKd 0.1 0.1 0.1\nKe 1 1 1\nnewmtl grey\nKd 0.3 0.3 0.3\n");
+    char outside[600];
+    snprintf(outside, sizeof outside, "%s/outside.mtl", temp_dir);
+    remove(outside);
+    assert_int_equal(symlink("/etc/passwd", outside), 0);
+    static const struct {
+        const char *head;
+        rad_result expected;
+        const char *message[2];
+    } bad[] = {
+        {"mtllib grey.mtl nowhere.mtl\n", RAD_ERROR_IO,
+         {"libs.obj:1: material library 'nowhere.mtl': cannot open: No such file or directory",
+          NULL}},
+        {"mtllib nowhere.mtl grey.mtl\n", RAD_ERROR_IO,
+         {"libs.obj:1: material library 'nowhere.mtl': cannot open: No such file or directory",
+          NULL}},
+        {"mtllib grey.mtl\n\nmtllib nowhere.mtl\n", RAD_ERROR_IO,
+         {"libs.obj:3: material library 'nowhere.mtl': cannot open: No such file or directory",
+          NULL}},
+        {"mtllib grey.mtl bad.mtl\n", RAD_ERROR_INVALID_SCENE,
+         {"bad.mtl:2: material 'glow': reflectance (Kd) 1.5 is outside [0, 1)", NULL}},
+        {"mtllib grey.mtl grey2.mtl\n", RAD_ERROR_PARSE,
+         {"grey2.mtl:4: material 'grey' is defined again (first at ", "grey.mtl:1)"}},
+        {"mtllib grey.mtl\n", RAD_ERROR_PARSE,
+         {"libs.obj:13: usemtl 'glow': no material of that name in ", "grey.mtl"}},
+        {"mtllib grey.mtl outside.mtl\n", RAD_ERROR_IO,
+         {"outside the scene's folder", "/etc/passwd"}},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        rad_result r = load_libs(bad[i].head, &scene);
+        if (r != bad[i].expected)
+            print_error("'%s': %s\n", bad[i].head, rad_context_error(ctx));
+        assert_int_equal(r, bad[i].expected);
+        assert_null(scene);
+        assert_null(strchr(rad_context_error(ctx), '\n'));
+        for (int k = 0; k < 2 && bad[i].message[k]; k++)
+            assert_contains(rad_context_error(ctx), bad[i].message[k]);
+    }
+    static const char *const files[] = {"libs.obj", "grey.mtl",  "glow.mtl",   "my lamp.mtl",
+                                        "bom.mtl",  "bad.mtl",   "grey2.mtl", "outside.mtl",
+                                        "materials.txt"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++)
+        remove_temp(files[i]);
+}
+
 /* ---- the builder ---- */
 
 static void test_builder_surfaces_and_materials(void **state)
@@ -1327,6 +1631,53 @@ static const bad_input bad_inputs[] = {
     {"lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
      {"lines.obj: scene is empty (no polygons)", NULL, NULL}},
     {"bad.gltf", "{\n garbage", NULL, NULL, RAD_ERROR_PARSE, {"bad.gltf:2:", "not JSON", NULL}},
+    {"tiny.obj", "v 0 0 0\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"tiny.obj: scene is empty (no polygons)", NULL, NULL}},
+    {"twoverts.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"twoverts.obj:5: face needs 3 or more vertices, has 2 ('l' is for lines)", NULL, NULL}},
+    {"onevert.obj", "v 0 0 0\nf 1\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"onevert.obj:2: face needs 3 or more vertices, has 1", NULL, NULL}},
+    {"noverts.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf\nf 1 2 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"noverts.obj:4: face needs 3 or more vertices, has 0", NULL, NULL}},
+    {"samevert.obj", "v 0 0 0\nv 1 0 0\nf 1 1 1\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"samevert.obj:3: face needs 3 or more distinct vertices, has 1", NULL, NULL}},
+    {"twodistinct.obj", "v 0 0 0\nv 1 0 0\nf 1 2 -1 -2 1\n", NULL, NULL, RAD_ERROR_INVALID_SCENE,
+     {"twodistinct.obj:3: face needs 3 or more distinct vertices, has 2", NULL, NULL}},
+    {"zeros.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 02 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"zeros.obj:4: face vertex '02' has an index with a leading zero", NULL, NULL}},
+    {"zerosvn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//01 2//1 3//1\n", NULL, NULL,
+     RAD_ERROR_PARSE, {"zerosvn.obj:5: face vertex '1//01' has an index with a leading zero",
+                       NULL, NULL}},
+    {"plus.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf +1 2 3\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"plus.obj:4: face has a malformed vertex '+1'", NULL, NULL}},
+    {"continued.obj", "v 0 0 0\nv 1 0 0\n# C:\\scenes\\\nv 0 1 0\nf 1 2 3\n", NULL, NULL,
+     RAD_ERROR_PARSE, {"continued.obj:3: line ends in '\\' (a continuation line)", NULL, NULL}},
+    {"freeform.obj", "v 0 0 0\ncstype bspline\nv 1 0 0\nend\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"freeform.obj:2: 'cstype': free-form geometry is not supported (polygons only)", NULL,
+      NULL}},
+    {"parm.obj", "v 0 0 0\nparm u 0 1\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"parm.obj:2: 'parm': free-form geometry", NULL, NULL}},
+    {"lod.obj", "v 0 0 0\nlod 1\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"lod.obj:2: 'lod': levels of detail are not supported", NULL, NULL}},
+    {"call.obj", "call other.obj\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"call.obj:1: 'call': reading another file is not supported", NULL, NULL}},
+    {"binary.obj", "\x89PNG\r\n\x1a\n\x1b[2J\x9b\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"binary.obj:1: unknown statement '?PNG' (read as OBJ: by its content the file is not glTF "
+      "JSON or binary glTF)", NULL, NULL}},
+    {"escape.obj", "v 0 0 0\n\x1b[2J\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"escape.obj:2: unknown statement '?[2J'", NULL, NULL}},
+    {"noname.obj", "mtllib\nv 0 0 0\n", NULL, NULL, RAD_ERROR_PARSE,
+     {"noname.obj:1: 'mtllib' names no material library", NULL, NULL}},
+    {"unnamed.obj", "mtllib unnamed.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "unnamed.mtl",
+     "newmtl a\nKd 0.5 0.5 0.5\nnewmtl \nKd 0.1 0.1 0.1\n", RAD_ERROR_PARSE,
+     {"unnamed.mtl:3: 'newmtl' names no material", NULL, NULL}},
+    {"usemtl.obj", "mtllib usemtl.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl white\nf 1 2 3\n"
+     "usemtl lamp\n", "usemtl.mtl", "newmtl white\nKd 0.5 0.5 0.5\n", RAD_ERROR_PARSE,
+     {"usemtl.obj:7: usemtl 'lamp': no material of that name in ", "usemtl.mtl", NULL}},
+    {"twice.obj", "mtllib twice.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl white\nf 1 2 3\n",
+     "twice.mtl", "newmtl white\nKd 0.5 0.5 0.5\n# again\nnewmtl white\nKd 0.1 0.1 0.1\n",
+     RAD_ERROR_PARSE, {"twice.mtl:4: material 'white' is defined again (first at ",
+                       "twice.mtl:1)", NULL}},
     {"white.gltf",
      "{\"asset\": {\"version\": \"2.0\"}, \"scenes\": [{\"nodes\": [0]}], \"nodes\": "
      "[{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, "
@@ -1435,6 +1786,9 @@ int main(void)
         cmocka_unit_test(test_cornell_box_file),
         cmocka_unit_test(test_obj_from_memory),
         cmocka_unit_test(test_obj_groups),
+        cmocka_unit_test(test_obj_face_forms),
+        cmocka_unit_test(test_format_by_content),
+        cmocka_unit_test(test_material_libraries),
         cmocka_unit_test(test_gltf),
         cmocka_unit_test(test_gltf_nesting),
         cmocka_unit_test(test_gltf_node_graphs),

@@ -98,7 +98,8 @@ static const rad_option_info solution_rows[] = {
     {SOLUTION(seed), .type = RAD_OPTION_UINT64, UINT64_RANGE, .default_value = 0.0, .default_text = "0",
      .help = "seed of all sampling; results do not depend on the thread count"},
     {SOLUTION(max_memory_bytes), .type = RAD_OPTION_BYTES, .min = 0.0, .min_open = true, .max = INFINITY,
-     .default_value = NAN, .default_text = "80% of physical memory",
+     .default_value = NAN,
+     .default_text = "half the memory available (physical, or a lower cgroup or ulimit limit)",
      .help = "refuse to allocate more memory than this"},
 };
 

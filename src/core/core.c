@@ -65,7 +65,7 @@ rad_result rad_context_create(const rad_context_options *options, rad_context **
         return RAD_ERROR_INVALID_ARGUMENT;
     }
     double limit = options->max_memory_bytes > 0.0 ? options->max_memory_bytes
-                                                   : 0.8 * (double)rad_physical_memory_bytes();
+                                                   : rad_default_memory_limit();
     ctx->memory.limit = limit >= (double)SIZE_MAX ? SIZE_MAX : (size_t)limit;
     atomic_init(&ctx->memory.references, 1);
     ctx->memory.call_limit = ctx->memory.limit;
@@ -170,6 +170,83 @@ size_t rad_physical_memory_bytes(void)
     if (pages <= 0 || page <= 0)
         return (size_t)1 << 32;
     return (size_t)pages * (size_t)page;
+}
+
+/* The number in a cgroup file ("max" and anything unreadable: no limit). */
+static size_t cgroup_file_bytes(const char *path)
+{
+    FILE *file = fopen(path, "r");
+    if (!file)
+        return SIZE_MAX;
+    unsigned long long bytes;
+    int read = fscanf(file, "%llu", &bytes);
+    fclose(file);
+    return read == 1 && bytes < SIZE_MAX ? (size_t)bytes : SIZE_MAX;
+}
+
+/* The lowest memory limit of this process's cgroups and their ancestors:
+ * memory.max (cgroup v2, line "0::/path" of /proc/self/cgroup) or
+ * memory.limit_in_bytes (v1, the line listing "memory").  SIZE_MAX when
+ * there is none; a container's limit is usually its root's. */
+static size_t cgroup_memory_bytes(void)
+{
+    FILE *file = fopen("/proc/self/cgroup", "r");
+    if (!file)
+        return SIZE_MAX;
+    size_t lowest = SIZE_MAX;
+    char line[1024];
+    while (fgets(line, sizeof line, file)) {
+        char *controllers = strchr(line, ':');
+        char *path = controllers ? strchr(controllers + 1, ':') : NULL;
+        if (!path || path[1] != '/')
+            continue;
+        *path++ = '\0';
+        controllers++;
+        path[strcspn(path, "\n")] = '\0';
+        bool v1 = false; /* "memory" among the comma-separated controllers */
+        for (const char *word = controllers; *word;) {
+            v1 = v1 || (strncmp(word, "memory", 6) == 0 && (word[6] == ',' || word[6] == '\0'));
+            word += strcspn(word, ",");
+            if (*word == ',')
+                word++;
+        }
+        if (!v1 && controllers[0] != '\0')
+            continue;
+        for (size_t length = strlen(path);;) {
+            char limit_file[1200];
+            snprintf(limit_file, sizeof limit_file, "/sys/fs/cgroup%s%.*s/%s", v1 ? "/memory" : "",
+                     (int)length, path, v1 ? "memory.limit_in_bytes" : "memory.max");
+            size_t bytes = cgroup_file_bytes(limit_file);
+            lowest = bytes < lowest ? bytes : lowest;
+            if (length <= 1)
+                break;
+            while (length > 1 && path[length - 1] != '/')
+                length--; /* up to the parent: "/a/b" -> "/a/" -> "/a" */
+            if (length > 1)
+                length--;
+        }
+    }
+    fclose(file);
+    return lowest;
+}
+
+size_t rad_available_memory_bytes(void)
+{
+    size_t bytes = rad_physical_memory_bytes(), cgroup = cgroup_memory_bytes();
+    bytes = cgroup < bytes ? cgroup : bytes;
+    const int resources[] = {RLIMIT_AS, RLIMIT_DATA};
+    for (size_t i = 0; i < sizeof resources / sizeof resources[0]; i++) {
+        struct rlimit limit;
+        if (getrlimit(resources[i], &limit) == 0 && limit.rlim_cur != RLIM_INFINITY &&
+            limit.rlim_cur < bytes)
+            bytes = (size_t)limit.rlim_cur;
+    }
+    return bytes;
+}
+
+double rad_default_memory_limit(void)
+{
+    return RAD_DEFAULT_MEMORY_SHARE * (double)rad_available_memory_bytes();
 }
 
 /* ---- the allocator ---- */
@@ -357,7 +434,7 @@ char *rad_strdup(rad_context *ctx, rad_memory_category category, const char *s, 
 
 double rad_memory_limit(const rad_context *ctx)
 {
-    return ctx ? (double)ctx->memory.call_limit : 0.8 * (double)rad_physical_memory_bytes();
+    return ctx ? (double)ctx->memory.call_limit : rad_default_memory_limit();
 }
 
 void rad_memory_limit_call(rad_context *ctx, double bytes)

@@ -152,6 +152,19 @@ void rad_progress(rad_context *ctx, const char *phase, uint64_t done, uint64_t t
 double rad_seconds(void);              /* monotonic wall clock, seconds */
 size_t rad_peak_memory_bytes(void);    /* peak resident set of the process */
 size_t rad_physical_memory_bytes(void);
+/* The memory this process may use: the physical memory, or less where its
+ * cgroup (a container's limit) or RLIMIT_AS / RLIMIT_DATA (ulimit -v, -d)
+ * allows less. */
+size_t rad_available_memory_bytes(void);
+
+/* The default memory limit (rad_context_options.max_memory_bytes = 0) is
+ * this share of rad_available_memory_bytes().  Half: the limit counts only
+ * the engine's own blocks, and assimp while importing, Embree's BVH, LAPACK
+ * and the other processes of the machine need the rest (at 80% of the
+ * physical memory, the engine's blocks alone could take the machine). */
+#define RAD_DEFAULT_MEMORY_SHARE 0.5
+/* RAD_DEFAULT_MEMORY_SHARE x rad_available_memory_bytes(), bytes. */
+double rad_default_memory_limit(void);
 
 /* ---- the allocator: every block the engine owns comes from here ----
  *

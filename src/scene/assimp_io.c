@@ -1,20 +1,23 @@
 /*
- * assimp_io.c -- a read-only, one-file (plus MTL) file system for assimp,
- * so that scenes load from memory (the Cornell box, the fuzzers, the API's
- * rad_scene_load_memory).
+ * assimp_io.c -- the read-only file system assimp imports through.  The
+ * scene's bytes were read and checked before (import_input.c); assimp
+ * gets those very bytes from memory, under a name whose extension makes
+ * it pick the reader the content calls for:
  *
- *    aiImportFileEx(name, io)
- *       open(name)        -> the buffer            (matched by base name)
- *       open("any.mtl")   -> the MTL text, if any  (an OBJ's mtllib)
- *       open(other)       -> NULL: not found
+ *    aiImportFileEx(alias, io)
+ *       open(alias)        -> the input, from memory
+ *       open(other), OBJ   -> every material library's text, from memory
+ *       open(other), glTF  -> the file on disk, confined and logged (file
+ *                             loads); not found (memory loads)
  *
- * Reads, seeks and sizes behave like assimp's own MemoryIOStream.
+ * Reads, seeks and sizes behave like assimp's own MemoryIOStream.  So a
+ * FIFO is read once, a file changed on disk after the pre-scan changes
+ * nothing, and an OBJ's libraries are the ones the pre-scan read.
  *
- * And a file system for file imports that reads files as assimp's default
- * one does (stdio) and logs every file it opens, so that a scene can say
- * which files it was read from (rad_scene_input_path).  It reads nothing
- * outside the scene file's folder (symbolic links resolved) unless the
- * context allows it: a glTF buffer "../../etc/passwd" is refused, named.
+ * The log notes every file a load read, so that a scene can say which
+ * files it came from (rad_scene_input_path).  Nothing is read outside the
+ * scene file's folder (symbolic links resolved) unless the context allows
+ * it: a glTF buffer "../../etc/passwd" is refused, named.
  */
 /* realpath is an X/Open (XSI) addition to POSIX. */
 #define _XOPEN_SOURCE 700
@@ -82,35 +85,13 @@ static enum aiReturn memory_seek(struct aiFile *file, size_t offset, enum aiOrig
 
 static void memory_flush(struct aiFile *file) { (void)file; }
 
-static const char *base_name(const char *path)
+static struct aiFile *memory_file_open(import_files *files, const char *path, const char *data,
+                                       size_t size)
 {
-    const char *slash = strrchr(path, '/'), *backslash = strrchr(path, '\\');
-    if (backslash && (!slash || backslash > slash))
-        slash = backslash;
-    return slash ? slash + 1 : path;
-}
-
-static struct aiFile *memory_open(struct aiFileIO *io, const char *path, const char *mode)
-{
-    import_memory_fs *fs = (import_memory_fs *)(void *)io->UserData;
-    if (!path || !mode || strpbrk(mode, "wa+"))
-        return NULL;
-    char extension[16];
-    rad_path_extension(path, extension, sizeof extension);
-    const char *data;
-    size_t size;
-    if (strcmp(base_name(path), base_name(fs->name)) == 0) {
-        data = fs->data;
-        size = fs->size;
-    } else if (fs->mtl && strcmp(extension, "mtl") == 0) {
-        data = fs->mtl;
-        size = fs->mtl_size;
-    } else {
-        return NULL;
-    }
-    memory_file *m = rad_alloc(fs->ctx, RAD_MEM_SCENE, 1, sizeof *m, path);
+    memory_file *m = rad_alloc(files->ctx, RAD_MEM_SCENE, 1, sizeof *m, path);
     if (!m) {
-        fs->out_of_memory = true; /* assimp may take it for a missing file: the import fails anyway */
+        /* assimp may take it for a missing file: the import fails anyway */
+        files->out_of_memory = true;
         return NULL;
     }
     m->data = data;
@@ -125,18 +106,40 @@ static struct aiFile *memory_open(struct aiFileIO *io, const char *path, const c
     return &m->file;
 }
 
-static void memory_close(struct aiFileIO *io, struct aiFile *file)
+static struct aiFile *disk_open(import_file_log *log, const char *path);
+
+static struct aiFile *import_open(struct aiFileIO *io, const char *path, const char *mode)
 {
-    (void)io;
-    if (file)
-        rad_free(memory_file_of(file));
+    import_files *files = (import_files *)(void *)io->UserData;
+    if (!path || !mode || strpbrk(mode, "wa+"))
+        return NULL; /* an import only reads */
+    const import_input *in = files->in;
+    if (strcmp(path, in->alias) == 0)
+        return memory_file_open(files, path, in->data, in->size);
+    if (in->format == IMPORT_OBJ)
+        return in->materials ? memory_file_open(files, path, in->materials, in->materials_size)
+                             : NULL;
+    return files->log ? disk_open(files->log, path) : NULL;
 }
 
-void import_memory_io(struct aiFileIO *io, import_memory_fs *fs)
+static void import_close(struct aiFileIO *io, struct aiFile *file)
 {
-    io->OpenProc = memory_open;
-    io->CloseProc = memory_close;
-    io->UserData = (aiUserData)(void *)fs;
+    (void)io;
+    if (!file)
+        return;
+    if (file->ReadProc == memory_read) {
+        rad_free(memory_file_of(file));
+        return;
+    }
+    fclose((FILE *)(void *)file->UserData);
+    rad_free(file);
+}
+
+void import_io(struct aiFileIO *io, import_files *files)
+{
+    io->OpenProc = import_open;
+    io->CloseProc = import_close;
+    io->UserData = (aiUserData)(void *)files;
 }
 
 /* ---- the logging file system ---- */
@@ -248,11 +251,9 @@ static enum aiReturn stdio_seek(struct aiFile *file, size_t offset, enum aiOrigi
 
 static void stdio_flush(struct aiFile *file) { fflush(stdio_of(file)); }
 
-static struct aiFile *logged_open(struct aiFileIO *io, const char *path, const char *mode)
+/* A file a glTF refers to, from the disk: confined, and logged. */
+static struct aiFile *disk_open(import_file_log *log, const char *path)
 {
-    if (!path || !mode || strpbrk(mode, "wa+"))
-        return NULL; /* an import only reads */
-    import_file_log *log = (import_file_log *)(void *)io->UserData;
     if (!import_file_allowed(log, path))
         return NULL;
     struct aiFile *file = rad_alloc(NULL, RAD_MEM_SCENE, 1, sizeof *file, "input file");
@@ -270,20 +271,4 @@ static struct aiFile *logged_open(struct aiFileIO *io, const char *path, const c
     file->FlushProc = stdio_flush;
     file->UserData = (aiUserData)(void *)f;
     return file;
-}
-
-static void logged_close(struct aiFileIO *io, struct aiFile *file)
-{
-    (void)io;
-    if (!file)
-        return;
-    fclose(stdio_of(file));
-    rad_free(file);
-}
-
-void import_file_io(struct aiFileIO *io, import_file_log *log)
-{
-    io->OpenProc = logged_open;
-    io->CloseProc = logged_close;
-    io->UserData = (aiUserData)(void *)log;
 }

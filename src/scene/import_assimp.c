@@ -1,10 +1,12 @@
 /*
- * import_assimp.c -- OBJ(+MTL) and glTF 2.0 (and whatever else assimp
- * reads) into a rad_scene, from a file or from memory.
+ * import_assimp.c -- OBJ(+MTL) and glTF 2.0 (JSON or binary) into a
+ * rad_scene, from a file or from memory, through assimp.
  *
- *   bytes --pre-scan (OBJ, MTL: obj_prescan.c; GLB framing: gltf_fixes.c)-->
- *         assimp (no post-processing; from memory through assimp_io.c)
- *         --node tree, transforms applied--> rad_scene_builder --> rad_scene
+ *   bytes, read once (import_input.c) --format by content: OBJ, glTF, GLB-->
+ *         pre-scan (OBJ, MTL: obj_prescan.c; GLB framing: gltf_fixes.c)-->
+ *         assimp (no post-processing; the same bytes, from memory, through
+ *         assimp_io.c) --node tree, transforms applied--> rad_scene_builder
+ *         --> rad_scene
  *
  * A surface is a node (OBJ `o`/`g`, glTF node): its name, else its mesh's,
  * else "surface_N".  Polygons keep their vertex count (no
@@ -37,11 +39,10 @@
  * The node tree is walked with an explicit stack: its depth is the file's.
  * MTL/glTF emissive colours are emitted RADIANCE: exitance E = pi * Ke.
  *
- * Memory: files are read through the context's allocator, in chunks when
- * they have no size (a FIFO, /dev/zero), so reading stops at the memory
- * limit; and a file is refused before assimp sees it when its size times
- * ASSIMP_PEAK_PER_BYTE passes the limit (assimp's own memory is not the
- * allocator's to count).
+ * Memory: files are read through the context's allocator, and no more of
+ * them than the limit allows assimp to import (IMPORT_ASSIMP_PEAK_PER_BYTE:
+ * assimp's own memory is not the allocator's to count), so a stream
+ * (a FIFO, /dev/zero) stops there (import_input.c).
  */
 #include "scene/import_internal.h"
 
@@ -51,20 +52,8 @@
 #include <assimp/scene.h>
 #include <cjson/cJSON.h>
 
-#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-
-/* Bytes assimp's import may take per byte of the file: 20.  Measured with
- * assimp 5.2 (peak resident set less the engine's own blocks): about 4x for
- * generated offices and grids of quads (30-40 MB files), 18x for a file of
- * nothing but the shortest face lines ("f 1 2 3", 8 bytes a face, each
- * becoming a face, its indices and a copy of its corners).  A file whose
- * size times this passes the memory limit is refused before assimp
- * allocates anything; what assimp then takes is not counted (the engine's
- * own scene is, by the allocator). */
-#define ASSIMP_PEAK_PER_BYTE 20.0
 
 /* ---- from assimp's float to double ---- */
 
@@ -394,35 +383,21 @@ static rad_result import_gltf_parse_and_check(rad_context *ctx, const char *name
     return r;
 }
 
-/* Import `name` with assimp (through `io`);
- * `data` holds the file's bytes when the caller has them (glTF needs them
- * for the JSON), else NULL. */
-static rad_result import_scene(rad_context *ctx, const char *name, const char *data, size_t size,
+/* Import `in`, read from `name`, with assimp (through `io`). */
+static rad_result import_scene(rad_context *ctx, const char *name, const import_input *in,
                                struct aiFileIO *io, rad_scene **out)
 {
-    char extension[16];
-    rad_path_extension(name, extension, sizeof extension);
-    bool gltf = strcmp(extension, "gltf") == 0 || strcmp(extension, "glb") == 0;
-    bool glb = strcmp(extension, "glb") == 0;
-    if (glb && data) {
+    bool gltf = in->format != IMPORT_OBJ, glb = in->format == IMPORT_GLB;
+    const char *data = in->data;
+    size_t size = in->size;
+    if (glb) {
         rad_result framing = import_glb_check_framing(ctx, name, data, size);
         if (framing != RAD_OK)
             return framing;
     }
-    double peak = ASSIMP_PEAK_PER_BYTE * (double)size, limit = rad_memory_limit(ctx);
-    if (peak > limit) {
-        char file_size[32], need[32], limit_text[32];
-        rad_format_bytes((double)size, file_size, sizeof file_size);
-        rad_format_bytes(peak, need, sizeof need);
-        rad_format_bytes(limit, limit_text, sizeof limit_text);
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "%s: a file of %s may need %s to import (%.0fx its size), above the memory "
-                        "limit of %s (rad_context_options.max_memory_bytes)",
-                        name, file_size, need, ASSIMP_PEAK_PER_BYTE, limit_text);
-    }
     cJSON *json = NULL;
     import_gltf_facts facts = {0};
-    if (gltf && data) {
+    if (gltf) {
         rad_result checked = import_gltf_parse_and_check(ctx, name, data, size, glb, io, &json,
                                                          &facts);
         if (checked != RAD_OK)
@@ -440,7 +415,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, const char *d
      * drops meshes (aiProcess_ValidateDataStructure even rejects OBJ
      * files with a 2-vertex face beside polygons; the walk below checks
      * every index itself). */
-    const struct aiScene *ai = aiImportFileExWithProperties(name, 0, io, properties);
+    const struct aiScene *ai = aiImportFileExWithProperties(in->alias, 0, io, properties);
     aiReleasePropertyStore(properties);
     if (!ai) {
         const char *why = aiGetErrorString();
@@ -486,142 +461,27 @@ done:
 
 /* ---- from a file ---- */
 
-/* Read a whole file into a block of the context (rad_free it); RAD_ERROR_IO
- * naming `what` (the path, or "PATH:LINE: material library 'NAME'") when
- * it cannot be read.  A regular file is read in one block of its size, and
- * refused when that passes the memory limit; anything else (a FIFO,
- * /dev/zero) in blocks that double from 64 KiB, so the allocator stops it
- * at the limit. */
-static rad_result read_file(rad_context *ctx, const char *path, const char *what, char **text,
-                            size_t *size)
-{
-    *text = NULL;
-    *size = 0;
-    FILE *file = fopen(path, "rb");
-    if (!file)
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", what, strerror(errno));
-    size_t capacity = 1 << 16, length = 0;
-    struct stat st;
-    if (fstat(fileno(file), &st) == 0 && S_ISREG(st.st_mode)) {
-        double limit = rad_memory_limit(ctx);
-        if ((double)st.st_size >= limit) {
-            fclose(file);
-            char file_size[32], limit_text[32];
-            rad_format_bytes((double)st.st_size, file_size, sizeof file_size);
-            rad_format_bytes(limit, limit_text, sizeof limit_text);
-            return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                            "%s: a file of %s, larger than the memory limit of %s "
-                            "(rad_context_options.max_memory_bytes)",
-                            what, file_size, limit_text);
-        }
-        capacity = (size_t)st.st_size + 1; /* + 1: the read that finds the end needs no growth */
-    }
-    char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, what);
-    while (buffer) {
-        length += fread(buffer + length, 1, capacity - length, file);
-        if (length < capacity)
-            break;
-        char *grown = rad_realloc(ctx, RAD_MEM_SCENE, buffer, capacity, 2, what);
-        if (!grown) {
-            rad_free(buffer);
-            buffer = NULL;
-            break;
-        }
-        buffer = grown;
-        capacity *= 2;
-    }
-    if (!buffer) {
-        fclose(file);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    int failed = ferror(file), error = errno;
-    fclose(file);
-    if (failed) {
-        rad_free(buffer);
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: %s", what, strerror(error));
-    }
-    *text = buffer;
-    *size = length;
-    return RAD_OK;
-}
-
-/* Pre-scan the material library an OBJ file names, relative to its folder. */
-static rad_result prescan_mtl_file(rad_context *ctx, const char *obj_path, const char *mtllib,
-                                   int line, import_file_log *log)
-{
-    const char *slash = strrchr(obj_path, '/');
-    size_t folder = mtllib[0] == '/' || !slash ? 0 : (size_t)(slash - obj_path) + 1;
-    size_t length = folder + strlen(mtllib) + 1;
-    char *path = rad_alloc(ctx, RAD_MEM_SCENE, length, 1, obj_path);
-    if (!path)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    memcpy(path, obj_path, folder);
-    memcpy(path + folder, mtllib, length - folder);
-
-    char what[512];
-    snprintf(what, sizeof what, "%s:%d: material library '%s'", obj_path, line, mtllib);
-    if (!import_file_allowed(log, path)) {
-        rad_free(path);
-        return RAD_ERROR_IO;
-    }
-    char *text = NULL;
-    size_t size;
-    rad_result r = read_file(ctx, path, what, &text, &size);
-    if (r == RAD_OK)
-        import_file_log_add(log, path);
-    if (r == RAD_OK)
-        r = import_mtl_prescan(ctx, path, text, size);
-    rad_free(text);
-    rad_free(path);
-    return r;
-}
-
 rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene **out)
 {
     *out = NULL;
-    char extension[16];
-    rad_path_extension(path, extension, sizeof extension);
-    bool is_obj = strcmp(extension, "obj") == 0;
-    bool wanted = is_obj || strcmp(extension, "gltf") == 0 || strcmp(extension, "glb") == 0;
-    char *text = NULL;
-    size_t size = 0;
-    rad_result r = RAD_OK;
     import_file_log log = {0};
     import_file_log_add(&log, path);
     if (import_file_log_confine(ctx, &log, path) != RAD_OK) {
         import_file_log_free(&log);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    if (wanted) {
-        r = read_file(ctx, path, path, &text, &size);
-    } else {
-        /* Open and read a byte for the errno text assimp does not give
-         * (a folder opens but cannot be read); the size, for the check
-         * against assimp's peak. */
-        FILE *file = fopen(path, "rb");
-        if (!file)
-            return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-        struct stat st;
-        if (fstat(fileno(file), &st) == 0 && S_ISREG(st.st_mode))
-            size = (size_t)st.st_size;
-        int unreadable = fgetc(file) == EOF && ferror(file), error = errno;
-        fclose(file);
-        if (unreadable) {
-            import_file_log_free(&log);
-            return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: %s", path, strerror(error));
-        }
-    }
-    if (r == RAD_OK && is_obj) {
-        char mtllib[256];
-        int mtllib_line;
-        r = import_obj_prescan(ctx, path, text, size, mtllib, sizeof mtllib, &mtllib_line);
-        if (r == RAD_OK && mtllib[0])
-            r = prescan_mtl_file(ctx, path, mtllib, mtllib_line, &log);
-    }
+    import_input in;
+    rad_result r = import_input_read_file(ctx, path, &log, &in);
+    import_files files = {ctx, &in, &log, false};
     struct aiFileIO io;
-    import_file_io(&io, &log);
+    import_io(&io, &files);
     if (r == RAD_OK)
-        r = import_scene(ctx, path, text, size, &io, out);
+        r = import_scene(ctx, path, &in, &io, out);
+    if (r == RAD_OK && files.out_of_memory) { /* the allocator named the file */
+        rad_scene_destroy(*out);
+        *out = NULL;
+        r = RAD_ERROR_OUT_OF_MEMORY;
+    }
     if (log.refused && (r == RAD_OK || r == RAD_ERROR_PARSE)) {
         /* The refusal is the cause (and the message kept); a scene that
          * loaded without the file is still refused: it asked for it. */
@@ -641,7 +501,7 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
         log.count = 0;
     }
     import_file_log_free(&log);
-    rad_free(text);
+    import_input_free(&in);
     return r;
 }
 
@@ -652,35 +512,19 @@ rad_result rad_import_assimp_memory(rad_context *ctx, const char *name, const vo
                                     rad_scene **out)
 {
     *out = NULL;
-    char extension[16];
-    rad_path_extension(name, extension, sizeof extension);
-    if (strcmp(extension, "obj") == 0) {
-        char mtllib[256];
-        int mtllib_line;
-        rad_result r =
-            import_obj_prescan(ctx, name, data, size, mtllib, sizeof mtllib, &mtllib_line);
-        if (r != RAD_OK)
-            return r;
-        if (mtl) {
-            /* Messages name the library as the OBJ does, else as NAME.mtl. */
-            char mtl_name[256];
-            if (mtllib[0])
-                snprintf(mtl_name, sizeof mtl_name, "%s", mtllib);
-            else
-                snprintf(mtl_name, sizeof mtl_name, "%.*s.mtl", (int)(strlen(name) - 4), name);
-            r = import_mtl_prescan(ctx, mtl_name, mtl, mtl_size);
-            if (r != RAD_OK)
-                return r;
-        }
-    }
-    import_memory_fs fs = {ctx, name, data, size, mtl, mtl_size, false};
+    import_input in;
+    rad_result r = import_input_from_memory(ctx, name, data, size, mtl, mtl_size, &in);
+    if (r != RAD_OK)
+        return r;
+    import_files files = {ctx, &in, NULL, false};
     struct aiFileIO io;
-    import_memory_io(&io, &fs);
-    rad_result r = import_scene(ctx, name, data, size, &io, out);
-    if (r == RAD_OK && fs.out_of_memory) { /* the allocator named the file */
+    import_io(&io, &files);
+    r = import_scene(ctx, name, &in, &io, out);
+    if (r == RAD_OK && files.out_of_memory) { /* the allocator named the file */
         rad_scene_destroy(*out);
         *out = NULL;
         r = RAD_ERROR_OUT_OF_MEMORY;
     }
+    import_input_free(&in);
     return r;
 }

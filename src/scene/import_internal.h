@@ -2,11 +2,14 @@
  * import_internal.h -- what the files of the assimp importer share, and
  * nothing outside scene/ uses:
  *
+ *    import_input.c  a scene's bytes read once, within the memory limit;
+ *                    its format by content; an OBJ's material libraries
  *    obj_prescan.c   OBJ/MTL text checked, with line numbers, before assimp
  *    gltf_fixes.c    GLB framing checked before assimp; glTF JSON read after
  *    gltf_check.c    a glTF's nodes, meshes, buffers and memory checked before
  *                    assimp; its camera
- *    assimp_io.c     a memory file system for assimp
+ *    assimp_io.c     the file system assimp reads through: the input from
+ *                    memory, a glTF's other files logged and confined
  *    import_assimp.c aiScene -> rad_scene_builder, and the two entry points
  */
 #ifndef RAD_SCENE_IMPORT_INTERNAL_H
@@ -16,18 +19,110 @@
 
 struct aiFileIO;
 struct cJSON;
+typedef struct import_file_log import_file_log; /* assimp_io.c */
 
 /* ---- obj_prescan.c ---- */
 
-/* Check the OBJ text [text, text + size) (`path` names it in messages);
- * writes the first `mtllib` name (or "", cut to mtllib_size - 1
- * characters) and its line.  Fails with a line-numbered RAD_ERROR_PARSE
- * or RAD_ERROR_INVALID_SCENE. */
-rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
-                              char *mtllib, size_t mtllib_size, int *mtllib_line);
+/* An `mtllib` statement of an OBJ: the rest of its line, which names one
+ * or more material libraries (the loader splits it). */
+typedef struct import_obj_mtllib {
+    char *names;   /* blanks trimmed (rad_alloc'd) */
+    int line;
+    size_t offset; /* of the statement in the text */
+} import_obj_mtllib;
 
-/* Check the MTL text [text, text + size), as import_obj_prescan. */
-rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *text, size_t size);
+typedef struct import_obj_scan {
+    import_obj_mtllib *mtllibs; /* every `mtllib` statement, in order (rad_alloc'd) */
+    size_t mtllib_count, mtllib_capacity;
+} import_obj_scan;
+
+/* Check the OBJ text [text, text + size) (`path` names it in messages) and
+ * list its `mtllib` statements in `scan` (import_obj_scan_free it).
+ * Fails with a line-numbered RAD_ERROR_PARSE or RAD_ERROR_INVALID_SCENE,
+ * or RAD_ERROR_OUT_OF_MEMORY; `scan` is then empty. */
+rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
+                              import_obj_scan *scan);
+void import_obj_scan_free(import_obj_scan *scan);
+
+/* The materials the libraries of one OBJ define: where each name is. */
+typedef struct import_material_name {
+    char *name;     /* as `newmtl` gives it, the rest of its line (rad_alloc'd) */
+    size_t library; /* index into import_material_names.libraries */
+    int line;
+    size_t order;   /* definition order */
+} import_material_name;
+
+typedef struct import_material_names {
+    import_material_name *entries; /* rad_alloc'd */
+    size_t count, capacity;
+    char **libraries;              /* the libraries' names for messages (rad_alloc'd) */
+    size_t library_count, library_capacity;
+    bool sorted;                   /* by name (import_material_names_check) */
+} import_material_names;
+
+/* Check the MTL text [text, text + size), as import_obj_prescan, and add
+ * its materials to `names`. */
+rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
+                              import_material_names *names);
+/* After the last library: a name defined twice (in one library or two)
+ * fails, naming both places (assimp would merge the two silently). */
+rad_result import_material_names_check(rad_context *ctx, import_material_names *names);
+/* Every `usemtl` of the OBJ text names a material of `names` (checked):
+ * RAD_ERROR_PARSE with the line otherwise (assimp would use its grey
+ * default material silently). */
+rad_result import_obj_check_usemtl(rad_context *ctx, const char *path, const char *text,
+                                   size_t size, const import_material_names *names);
+void import_material_names_free(import_material_names *names);
+
+/* ---- import_input.c ---- */
+
+/* What a scene's bytes are.  Chosen by content, never by the file's name:
+ * assimp 5.2 picks its reader by the extension when one reader claims
+ * it, and by content otherwise (an OBJ named `scene` or `s.txt` reached
+ * assimp without the pre-scan). */
+typedef enum import_format {
+    IMPORT_OBJ,  /* anything else: read as OBJ, so pre-scanned as OBJ */
+    IMPORT_GLTF, /* JSON: '{' first, after an optional UTF-8 byte order mark and blanks */
+    IMPORT_GLB   /* binary glTF: the magic "glTF" first */
+} import_format;
+
+import_format import_format_of(const char *data, size_t size);
+/* "obj", "gltf", "glb". */
+const char *import_format_extension(import_format format);
+
+/* Bytes of scene text (the file and its libraries) assimp may take per
+ * byte while importing; see import_input.c. */
+#define IMPORT_ASSIMP_PEAK_PER_BYTE 20.0
+
+/* A scene's input, read and checked: what assimp is then served, from
+ * memory, under a name that makes it pick the reader of `format`. */
+typedef struct import_input {
+    import_format format;
+    char *alias;           /* the scene's name with the format's extension, unless it has it */
+    const char *data;      /* the scene's bytes; an OBJ's `mtllib` statements after the
+                              first are made comments (the first serves every library) */
+    size_t size;
+    const char *materials; /* OBJ: every library's text, one after the other; NULL: none */
+    size_t materials_size;
+    char *owned[2];        /* the blocks above that are ours (rad_free) */
+} import_input;
+
+/* Read the scene file `path` once (within the memory limit: a file or
+ * stream whose import could pass it is refused before assimp sees it),
+ * find its format, pre-scan an OBJ and read and pre-scan every material
+ * library it names (each file passing `log`'s confinement and noted in
+ * it).  Fails with RAD_ERROR_IO, RAD_ERROR_PARSE, RAD_ERROR_INVALID_SCENE,
+ * RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INTERRUPTED; `in` is then empty. */
+rad_result import_input_read_file(rad_context *ctx, const char *path, import_file_log *log,
+                                  import_input *in);
+/* The same from memory: `mtl` (NULL: none) holds every library an OBJ
+ * names.  The buffers are borrowed, or copied where an OBJ's text is
+ * changed. */
+rad_result import_input_from_memory(rad_context *ctx, const char *name, const char *data,
+                                    size_t size, const char *mtl, size_t mtl_size,
+                                    import_input *in);
+/* Free what `in` owns.  Cannot fail. */
+void import_input_free(import_input *in);
 
 /* ---- gltf_fixes.c ---- */
 
@@ -72,25 +167,10 @@ rad_result import_gltf_check(rad_context *ctx, const char *name, const char *dat
 
 /* ---- assimp_io.c ---- */
 
-/* The files a memory import serves; the buffers are the caller's. */
-typedef struct import_memory_fs {
-    rad_context *ctx; /* the open files' handles are allocated in it */
-    const char *name; /* the main buffer's file name */
-    const char *data;
-    size_t size;
-    const char *mtl; /* served under any *.mtl name; NULL if none */
-    size_t mtl_size;
-    bool out_of_memory; /* an open failed for memory: assimp may carry on without the file */
-} import_memory_fs;
-
-/* Fill `io` so that assimp reads `fs` (which must outlive the import).
- * Cannot fail. */
-void import_memory_io(struct aiFileIO *io, import_memory_fs *fs);
-
-/* The files a file import opened: assimp reads through the file system as
- * its default would, and every file it opens for reading is named here (the
- * MTL of an OBJ, a glTF's buffers), so the scene can list its inputs. */
-typedef struct import_file_log {
+/* The files a file import opened: the scene file, an OBJ's libraries and
+ * every file assimp opens for reading (a glTF's buffers), so the scene can
+ * list its inputs. */
+struct import_file_log {
     char **paths;     /* rad_alloc'd, each rad_alloc'd; no repeats */
     size_t count, capacity;
     bool failed;      /* a name could not be kept (out of memory) */
@@ -99,7 +179,7 @@ typedef struct import_file_log {
     const char *scene;/* the scene file, for the message */
     char *root;       /* realpath of the scene's folder (rad_alloc'd), or NULL */
     bool refused;     /* a file was refused (the context has the message) */
-} import_file_log;
+};
 
 /* Confine `log` to the folder of `scene_path` unless the context allows
  * reading outside it.  Fails only for memory; a folder that cannot be
@@ -109,14 +189,25 @@ rad_result import_file_log_confine(rad_context *ctx, import_file_log *log, const
  * reported once to the context ("scene.gltf: refers to '../x.bin' outside
  * its folder ...") and sets log->refused. */
 bool import_file_allowed(import_file_log *log, const char *path);
-
-/* Fill `io` so that assimp reads files and logs them into `log` (which must
- * outlive the import).  Cannot fail. */
-void import_file_io(struct aiFileIO *io, import_file_log *log);
-/* Note a file read outside assimp (the pre-scans); sets log->failed when
- * out of memory. */
+/* Note a file read outside assimp (the scene, an OBJ's libraries); sets
+ * log->failed when out of memory. */
 void import_file_log_add(import_file_log *log, const char *path);
 /* Free the names.  Cannot fail. */
 void import_file_log_free(import_file_log *log);
+
+/* What assimp reads through import_io: the input from memory under its
+ * alias; for an OBJ, the libraries' text under any other name (assimp
+ * opens only the `mtllib` it sees, the first); for glTF, other files from
+ * the disk through `log` (NULL: none, as for a memory load). */
+typedef struct import_files {
+    rad_context *ctx;        /* the open files' handles are allocated in it */
+    const import_input *in;
+    import_file_log *log;
+    bool out_of_memory;      /* an open failed for memory: assimp may carry on without the file */
+} import_files;
+
+/* Fill `io` so that assimp reads `files` (which must outlive the import).
+ * Cannot fail. */
+void import_io(struct aiFileIO *io, import_files *files);
 
 #endif /* RAD_SCENE_IMPORT_INTERNAL_H */

@@ -1,16 +1,20 @@
 /*
  * obj_prescan.c -- a light pre-scan of OBJ and MTL text, for the errors
  * assimp 5.2 omits or gets wrong: its OBJ parser reads "nan", garbage and
- * out-of-range numbers leniently, drops vertices of unexpected arity, skips
- * indented statements, stops at a NUL byte, and reports no line numbers.
+ * out-of-range numbers leniently, drops vertices of unexpected arity and
+ * faces of fewer than 3 vertices, skips indented statements, stops at a
+ * NUL byte, reads "f 012" or "f +1" as two indices, hides everything
+ * between `cstype` and `end`, joins a line ending in '\\' (a comment
+ * included) to the next, and reports no line numbers.
  *
  *    text --lines--> tokens --checks--> "scene.obj:12: face references vertex 40 of 32"
  *
- * Not a parser: it checks vertex coordinates, face/line/point indices and
- * Kd/Ke, and finds the first `mtllib`; assimp reads the text afterwards.
- * The statements are those of Wavefront's "Object Files (.obj)", Appendix
- * B1 of the Advanced Visualizer manual.  Works on buffers (which need not
- * end in NUL), so the fuzzers drive it from memory.
+ * Not a parser: it checks vertex coordinates, face/line/point indices,
+ * Kd/Ke and material names, and lists the `mtllib` statements; assimp
+ * reads the text afterwards.  The statements are those of Wavefront's
+ * "Object Files (.obj)" and "Material Library Files (.mtl)", Appendices B1
+ * and B2 of the Advanced Visualizer manual.  Works on buffers (which need
+ * not end in NUL), so the fuzzers drive it from memory.
  */
 #include "scene/import_internal.h"
 
@@ -50,14 +54,38 @@ static bool next_line(text_lines *t, const char **line, const char **line_end)
     return true;
 }
 
-/* Copy the next blank-separated token of [*p, end) into `token` (cut to
- * TOKEN_SIZE - 1 characters) and return its full length; 0 at the end.
- * Blanks are spaces and tabs only, as assimp has them: a form feed or
- * vertical tab is part of a token, so "v\v1 2 3" is no vertex here either. */
 enum { TOKEN_SIZE = 128 };
+
+/* Control characters and bytes that are not UTF-8 become '?', so that a
+ * message quoting a token of a binary file cannot drive the terminal it is
+ * printed on (a lone 0x9b is a control sequence to some). */
+static void make_printable(char *text)
+{
+    unsigned char *c = (unsigned char *)text;
+    while (*c) {
+        int length = *c < 0x80                  ? 1
+                     : *c >= 0xc2 && *c <= 0xdf ? 2
+                     : *c >= 0xe0 && *c <= 0xef ? 3
+                     : *c >= 0xf0 && *c <= 0xf4 ? 4
+                                                : 0;
+        int k = 1;
+        while (k < length && c[k] >= 0x80 && c[k] <= 0xbf)
+            k++;
+        if (length == 0 || k < length || *c < 0x20 || *c == 0x7f) {
+            *c = '?';
+            k = 1;
+        }
+        c += k;
+    }
+}
 
 static bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
+/* Copy the next blank-separated token of [*p, end) into `token` (cut to
+ * TOKEN_SIZE - 1 characters, made printable) and return its full length;
+ * 0 at the end.  Blanks are spaces and tabs only, as assimp has them: a
+ * form feed or vertical tab is part of a token, so "v\v1 2 3" is no vertex
+ * here either. */
 static size_t next_token(const char **p, const char *end, char *token)
 {
     const char *s = *p;
@@ -70,20 +98,23 @@ static size_t next_token(const char **p, const char *end, char *token)
     size_t copied = length < TOKEN_SIZE - 1 ? length : TOKEN_SIZE - 1;
     memcpy(token, s, copied);
     token[copied] = '\0';
+    make_printable(token);
     *p = e;
     return length;
 }
 
-/* The rest of the line, blanks trimmed, cut to `size` - 1 characters. */
-static void rest_of_line(const char *p, const char *end, char *out, size_t size)
+/* The rest of the line, blanks trimmed, whole, in a block of the context
+ * (rad_free it); NULL when out of memory. */
+static char *rest_of_line_copy(rad_context *ctx, const char *p, const char *end, const char *what)
 {
     while (p < end && isspace((unsigned char)*p))
         p++;
     while (end > p && isspace((unsigned char)end[-1]))
         end--;
-    size_t length = (size_t)(end - p) < size - 1 ? (size_t)(end - p) : size - 1;
-    memcpy(out, p, length);
-    out[length] = '\0';
+    char *copy = rad_alloc(ctx, RAD_MEM_SCENE, (size_t)(end - p) + 1, 1, what);
+    if (copy)
+        memcpy(copy, p, (size_t)(end - p));
+    return copy;
 }
 
 typedef enum number_kind { NUMBER_FINITE, NUMBER_NOT_FINITE, NUMBER_GARBAGE } number_kind;
@@ -108,13 +139,38 @@ static number_kind parse_number(const char *token, size_t length, double *value)
 /* ---- pre-scan of OBJ and MTL text: line-numbered errors assimp omits ---- */
 
 /* Statements of the OBJ format (Wavefront, "Object Files (.obj)", Appendix
- * B1 of the Advanced Visualizer manual); anything else means the text is
- * not an OBJ file. */
+ * B1 of the Advanced Visualizer manual) that assimp reads as what they
+ * are; anything else means the text is not an OBJ file, or uses what
+ * unsupported_statements lists. */
 static const char *const obj_statements[] = {
     "v", "vt", "vn", "vp", "f", "fo", "l", "p", "g", "o", "s", "mg", "mtllib", "usemtl",
-    "usemap", "maplib", "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm",
-    "trim", "hole", "scrv", "sp", "end", "con", "bevel", "c_interp", "d_interp", "lod",
-    "shadow_obj", "trace_obj", "ctech", "stech", "call", "csh",
+    "usemap", "maplib", "bevel", "c_interp", "d_interp", "shadow_obj", "trace_obj", "ctech",
+    "stech", "csh",
+};
+
+/* Statements the engine cannot honour and assimp 5.2 would get silently
+ * wrong: free-form geometry (`cstype` makes assimp skip every line up to
+ * `end`, vertices and faces included; `parm` is read as a point, `lod` as
+ * a line) and `call`, which would read another file. */
+static const struct {
+    const char *statement, *why;
+} unsupported_statements[] = {
+    {"cstype", "free-form geometry is not supported (polygons only)"},
+    {"deg", "free-form geometry is not supported (polygons only)"},
+    {"bmat", "free-form geometry is not supported (polygons only)"},
+    {"step", "free-form geometry is not supported (polygons only)"},
+    {"curv", "free-form geometry is not supported (polygons only)"},
+    {"curv2", "free-form geometry is not supported (polygons only)"},
+    {"surf", "free-form geometry is not supported (polygons only)"},
+    {"parm", "free-form geometry is not supported (polygons only)"},
+    {"trim", "free-form geometry is not supported (polygons only)"},
+    {"hole", "free-form geometry is not supported (polygons only)"},
+    {"scrv", "free-form geometry is not supported (polygons only)"},
+    {"sp", "free-form geometry is not supported (polygons only)"},
+    {"end", "free-form geometry is not supported (polygons only)"},
+    {"con", "free-form geometry is not supported (polygons only)"},
+    {"lod", "levels of detail are not supported"},
+    {"call", "reading another file is not supported"},
 };
 
 static bool is_obj_statement(const char *token)
@@ -123,6 +179,15 @@ static bool is_obj_statement(const char *token)
         if (strcmp(token, obj_statements[i]) == 0)
             return true;
     return false;
+}
+
+/* Why `token` is refused, or NULL when it is not one of those statements. */
+static const char *unsupported_statement(const char *token)
+{
+    for (size_t i = 0; i < sizeof unsupported_statements / sizeof unsupported_statements[0]; i++)
+        if (strcmp(token, unsupported_statements[i].statement) == 0)
+            return unsupported_statements[i].why;
+    return NULL;
 }
 
 /* A line holding a NUL byte: assimp stops reading there, so the rest of
@@ -149,10 +214,12 @@ static int face_slot_of(const char *statement)
 }
 
 /* Check one face vertex, "v", "v/vt", "v//vn" or "v/vt/vn": each index
- * in 1..total, or relative (-1 = the latest seen so far). */
+ * in 1..total, or relative (-1 = the latest seen so far), written without
+ * a '+' or leading zeros (assimp reads "012" as 12 and then 2, "+1" as 1
+ * twice).  Writes the vertex's absolute index (0-based). */
 static rad_result check_face_vertex(rad_context *ctx, const char *path, int line,
                                     const char *token, const size_t total[3],
-                                    const size_t seen[3])
+                                    const size_t seen[3], size_t *vertex)
 {
     const char *part = token;
     for (int slot = 0; slot < 3; slot++) {
@@ -162,9 +229,14 @@ static rad_result check_face_vertex(rad_context *ctx, const char *path, int line
             char *after;
             errno = 0;
             long index = strtol(part, &after, 10);
-            if (length == 0 || !strchr("0123456789+-", part[0]) || after != part + length)
+            if (length == 0 || !strchr("0123456789-", part[0]) || after != part + length)
                 return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: face has a malformed vertex '%s'",
                                 path, line, token);
+            const char *digits = part[0] == '-' ? part + 1 : part;
+            if (digits[0] == '0' && digits + 1 < part + length)
+                return rad_fail(ctx, RAD_ERROR_PARSE,
+                                "%s:%d: face vertex '%s' has an index with a leading zero", path,
+                                line, token);
             size_t available = index < 0 ? seen[slot] : total[slot];
             bool in_range = errno == 0 && index != 0 &&
                             (index > 0 ? (unsigned long)index <= available
@@ -172,6 +244,8 @@ static rad_result check_face_vertex(rad_context *ctx, const char *path, int line
             if (!in_range)
                 return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: face references %s %ld of %zu",
                                 path, line, face_slot_names[slot], index, available);
+            if (slot == 0)
+                *vertex = index > 0 ? (size_t)index - 1 : seen[0] - (size_t)(-index);
         }
         if (!slash)
             return RAD_OK;
@@ -181,97 +255,218 @@ static rad_result check_face_vertex(rad_context *ctx, const char *path, int line
                     token);
 }
 
+/* Note an `mtllib` statement: the rest of its line, whole (the loader
+ * splits it into names). */
+static rad_result add_mtllib(rad_context *ctx, const char *path, import_obj_scan *scan,
+                             const char *p, const char *end, int line, size_t offset)
+{
+    if (scan->mtllib_count == scan->mtllib_capacity) {
+        size_t grown = scan->mtllib_capacity ? 2 * scan->mtllib_capacity : 4;
+        import_obj_mtllib *mtllibs = rad_realloc(ctx, RAD_MEM_SCENE, scan->mtllibs, grown,
+                                                 sizeof *mtllibs, path);
+        if (!mtllibs)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        scan->mtllibs = mtllibs;
+        scan->mtllib_capacity = grown;
+    }
+    char *names = rest_of_line_copy(ctx, p, end, path);
+    if (!names)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    if (!names[0]) {
+        rad_free(names);
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: 'mtllib' names no material library", path,
+                        line);
+    }
+    scan->mtllibs[scan->mtllib_count++] = (import_obj_mtllib){names, line, offset};
+    return RAD_OK;
+}
+
+void import_obj_scan_free(import_obj_scan *scan)
+{
+    for (size_t i = 0; i < scan->mtllib_count; i++)
+        rad_free(scan->mtllibs[i].names);
+    rad_free(scan->mtllibs);
+    memset(scan, 0, sizeof *scan);
+}
+
 /* Check an OBJ where assimp would silently misread it or fail without a
  * line number: text without NUL bytes, known statements, none indented,
- * vertices of 3, 4 or 6 finite numbers (assimp drops other vertices and
- * divides by the 4th), face, line and point indices in range.  Writes
- * the first `mtllib` name (or "") and its line.  Not a parser: assimp
- * reads the file afterwards. */
+ * no line continued with '\\', vertices of 3, 4 or 6 finite numbers
+ * (assimp drops other vertices and divides by the 4th), face, line and
+ * point indices in range, faces of 3 or more distinct vertices.  Lists
+ * the `mtllib` statements in `scan`.  Not a parser: assimp reads the file
+ * afterwards. */
 rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
-                              char *mtllib, size_t mtllib_size, int *mtllib_line)
+                              import_obj_scan *scan)
 {
     char token[TOKEN_SIZE];
     const char *p, *end;
     size_t total[3] = {0, 0, 0}; /* v, vt, vn in the whole file */
-    mtllib[0] = '\0';
-    *mtllib_line = 0;
+    memset(scan, 0, sizeof *scan);
     text_lines lines = text_lines_of(text, size);
-    while (next_line(&lines, &p, &end)) {
+    rad_result r = RAD_OK;
+    bool seen_statement = false;
+    while (r == RAD_OK && next_line(&lines, &p, &end)) {
+        const char *line = p;
         if (has_nul(p, end))
-            return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: NUL byte in the text", path,
-                            lines.number);
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: NUL byte in the text", path, lines.number);
+        else if (end > p && end[-1] == '\\') /* assimp joins the next line to it, comments too */
+            r = rad_fail(ctx, RAD_ERROR_PARSE,
+                         "%s:%d: line ends in '\\' (a continuation line): not supported, join "
+                         "the lines", path, lines.number);
+        if (r != RAD_OK)
+            break;
         bool indented = p < end && is_blank(*p);
         if (next_token(&p, end, token) == 0 || token[0] == '#')
             continue;
-        if (indented) /* assimp skips such a line without a word */
-            return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: statement '%s' is indented", path,
-                            lines.number, token);
+        bool first_statement = !seen_statement;
+        seen_statement = true;
+        if (indented) { /* assimp skips such a line without a word */
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: statement '%s' is indented", path,
+                         lines.number, token);
+            break;
+        }
         int slot = face_slot_of(token);
         if (slot >= 0)
             total[slot]++;
+        const char *unsupported = unsupported_statement(token);
         if (slot == 0) {
             size_t length;
             int coordinates = 0;
             double value = 1.0;
-            while ((length = next_token(&p, end, token)) > 0) {
+            while (r == RAD_OK && (length = next_token(&p, end, token)) > 0) {
                 number_kind kind = parse_number(token, length, &value);
                 if (token[0] == '.') /* assimp does not count ".5" as a coordinate */
                     kind = NUMBER_GARBAGE;
                 if (kind != NUMBER_FINITE)
-                    return rad_fail(ctx,
-                                    kind == NUMBER_GARBAGE ? RAD_ERROR_PARSE
-                                                           : RAD_ERROR_INVALID_SCENE,
-                                    "%s:%d: vertex coordinate '%s' is not a finite number", path,
-                                    lines.number, token);
+                    r = rad_fail(ctx,
+                                 kind == NUMBER_GARBAGE ? RAD_ERROR_PARSE : RAD_ERROR_INVALID_SCENE,
+                                 "%s:%d: vertex coordinate '%s' is not a finite number", path,
+                                 lines.number, token);
                 coordinates++;
             }
+            if (r != RAD_OK)
+                break;
             if (coordinates != 3 && coordinates != 4 && coordinates != 6)
-                return rad_fail(ctx, RAD_ERROR_PARSE,
-                                "%s:%d: vertex has %d numbers (3, 4 or 6 expected)", path,
-                                lines.number, coordinates);
-            if (coordinates == 4 && value == 0.0) /* x y z w: assimp divides by w */
-                return rad_fail(ctx, RAD_ERROR_INVALID_SCENE, "%s:%d: vertex has weight w = 0",
-                                path, lines.number);
+                r = rad_fail(ctx, RAD_ERROR_PARSE,
+                             "%s:%d: vertex has %d numbers (3, 4 or 6 expected)", path,
+                             lines.number, coordinates);
+            else if (coordinates == 4 && value == 0.0) /* x y z w: assimp divides by w */
+                r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE, "%s:%d: vertex has weight w = 0",
+                             path, lines.number);
         } else if (strcmp(token, "mtllib") == 0) {
-            if (!mtllib[0]) {
-                rest_of_line(p, end, mtllib, mtllib_size);
-                *mtllib_line = lines.number;
-            }
+            r = add_mtllib(ctx, path, scan, p, end, lines.number, (size_t)(line - text));
+        } else if (unsupported) {
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: '%s': %s", path, lines.number, token,
+                         unsupported);
         } else if (!is_obj_statement(token)) {
-            return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: unknown statement '%s'", path,
-                            lines.number, token);
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: unknown statement '%s'%s", path,
+                         lines.number, token,
+                         first_statement ? " (read as OBJ: by its content the file is not "
+                                           "glTF JSON or binary glTF)"
+                                         : "");
         }
     }
 
     /* Second pass: faces may name vertices defined later in the file;
      * relative (negative) indices count back from the latest one. */
-    size_t seen[3] = {0, 0, 0};
+    size_t seen[3] = {0, 0, 0}, faces = 0;
     lines = text_lines_of(text, size);
-    while (next_line(&lines, &p, &end)) {
+    while (r == RAD_OK && next_line(&lines, &p, &end)) {
         next_token(&p, end, token);
         int slot = face_slot_of(token);
         if (slot >= 0)
             seen[slot]++;
-        /* assimp reads points and lines with the face code: check them too */
-        if (strcmp(token, "f") != 0 && strcmp(token, "fo") != 0 && strcmp(token, "l") != 0 &&
-            strcmp(token, "p") != 0)
+        /* assimp reads points and lines with the face code: check them
+         * too; they have no area, and the loader ignores them */
+        bool face = strcmp(token, "f") == 0 || strcmp(token, "fo") == 0;
+        if (!face && strcmp(token, "l") != 0 && strcmp(token, "p") != 0)
             continue;
-        while (next_token(&p, end, token) > 0) {
-            rad_result r = check_face_vertex(ctx, path, lines.number, token, total, seen);
-            if (r != RAD_OK)
-                return r;
+        faces += face;
+        size_t count = 0, distinct[3], vertex = 0;
+        int kinds = 0; /* distinct vertices up to 3 */
+        while (r == RAD_OK && next_token(&p, end, token) > 0) {
+            r = check_face_vertex(ctx, path, lines.number, token, total, seen, &vertex);
+            count++;
+            bool repeat = false;
+            for (int k = 0; k < kinds; k++)
+                repeat = repeat || distinct[k] == vertex;
+            if (!repeat && kinds < 3)
+                distinct[kinds++] = vertex;
         }
+        if (r == RAD_OK && face && count < 3)
+            r = rad_fail(ctx, RAD_ERROR_PARSE,
+                         "%s:%d: face needs 3 or more vertices, has %zu ('l' is for lines)",
+                         path, lines.number, count);
+        else if (r == RAD_OK && face && kinds < 3)
+            r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
+                         "%s:%d: face needs 3 or more distinct vertices, has %d", path,
+                         lines.number, kinds);
+    }
+    /* Said here, as for any scene without polygons: assimp 5.2 would say
+     * "OBJ-file is too small" below 16 bytes. */
+    if (r == RAD_OK && faces == 0)
+        r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE, "%s: scene is empty (no polygons)", path);
+    if (r != RAD_OK)
+        import_obj_scan_free(scan);
+    return r;
+}
+
+/* Note library `path` (when it is not the latest already). */
+static rad_result add_library(rad_context *ctx, import_material_names *names, const char *path)
+{
+    if (names->library_count == 0 ||
+        strcmp(names->libraries[names->library_count - 1], path) != 0) {
+        if (names->library_count == names->library_capacity) {
+            size_t grown = names->library_capacity ? 2 * names->library_capacity : 4;
+            char **libraries = rad_realloc(ctx, RAD_MEM_SCENE, names->libraries, grown,
+                                           sizeof *libraries, path);
+            if (!libraries)
+                return RAD_ERROR_OUT_OF_MEMORY;
+            names->libraries = libraries;
+            names->library_capacity = grown;
+        }
+        char *copy = rad_strdup(ctx, RAD_MEM_SCENE, path, path);
+        if (!copy)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        names->libraries[names->library_count++] = copy;
     }
     return RAD_OK;
 }
 
-/* Check an MTL: nothing before the first newmtl; Kd (reflectance) and Ke
- * (emitted radiance) are 3 finite numbers, Kd in [0, 1) and Ke >= 0. */
-rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *text, size_t size)
+/* Note that `line` of the latest library defines material `name`. */
+static rad_result add_material_name(rad_context *ctx, import_material_names *names,
+                                    const char *path, int line, char *name)
+{
+    if (names->count == names->capacity) {
+        size_t grown = names->capacity ? 2 * names->capacity : 16;
+        import_material_name *entries = rad_realloc(ctx, RAD_MEM_SCENE, names->entries, grown,
+                                                    sizeof *entries, path);
+        if (!entries)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        names->entries = entries;
+        names->capacity = grown;
+    }
+    names->entries[names->count] =
+        (import_material_name){name, names->library_count - 1, line, names->count};
+    names->count++;
+    names->sorted = false;
+    return RAD_OK;
+}
+
+/* Check an MTL: nothing before the first newmtl, which names its
+ * material; Kd (reflectance) and Ke (emitted radiance) are 3 finite
+ * numbers, Kd in [0, 1) and Ke >= 0.  Every material is noted in `names`
+ * (import_material_names_check then finds names defined twice). */
+rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
+                              import_material_names *names)
 {
     char token[TOKEN_SIZE], material[64] = "";
     const char *p, *end;
     bool seen_newmtl = false;
+    rad_result added = add_library(ctx, names, path);
+    if (added != RAD_OK)
+        return added;
     text_lines lines = text_lines_of(text, size);
     while (next_line(&lines, &p, &end)) {
         if (has_nul(p, end))
@@ -280,7 +475,23 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
         if (next_token(&p, end, token) == 0 || token[0] == '#')
             continue;
         if (strcmp(token, "newmtl") == 0) {
-            rest_of_line(p, end, material, sizeof material);
+            /* The name is the rest of the line, as assimp reads it and
+             * `usemtl` names it: it may hold blanks. */
+            char *name = rest_of_line_copy(ctx, p, end, path);
+            if (!name)
+                return RAD_ERROR_OUT_OF_MEMORY;
+            if (!name[0]) {
+                rad_free(name);
+                return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: 'newmtl' names no material", path,
+                                lines.number);
+            }
+            snprintf(material, sizeof material, "%s", name);
+            make_printable(material);
+            rad_result r = add_material_name(ctx, names, path, lines.number, name);
+            if (r != RAD_OK) {
+                rad_free(name);
+                return r;
+            }
             seen_newmtl = true;
             continue;
         }
@@ -319,4 +530,84 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
         }
     }
     return RAD_OK;
+}
+
+static int compare_material_names(const void *a, const void *b)
+{
+    const import_material_name *x = a, *y = b;
+    int order = strcmp(x->name, y->name);
+    return order ? order : (x->order > y->order) - (x->order < y->order);
+}
+
+rad_result import_material_names_check(rad_context *ctx, import_material_names *names)
+{
+    if (!names->sorted && names->count > 1)
+        qsort(names->entries, names->count, sizeof *names->entries, compare_material_names);
+    names->sorted = true;
+    for (size_t i = 1; i < names->count; i++) {
+        const import_material_name *first = &names->entries[i - 1], *again = &names->entries[i];
+        if (strcmp(first->name, again->name) == 0) {
+            char name[64];
+            snprintf(name, sizeof name, "%s", again->name);
+            make_printable(name);
+            return rad_fail(ctx, RAD_ERROR_PARSE,
+                            "%s:%d: material '%s' is defined again (first at %s:%d)",
+                            names->libraries[again->library], again->line, name,
+                            names->libraries[first->library], first->line);
+        }
+    }
+    return RAD_OK;
+}
+
+static int compare_name_to_entry(const void *key, const void *entry)
+{
+    return strcmp((const char *)key, ((const import_material_name *)entry)->name);
+}
+
+rad_result import_obj_check_usemtl(rad_context *ctx, const char *path, const char *text,
+                                   size_t size, const import_material_names *names)
+{
+    char token[TOKEN_SIZE];
+    const char *p, *end;
+    text_lines lines = text_lines_of(text, size);
+    while (next_line(&lines, &p, &end)) {
+        next_token(&p, end, token);
+        if (strcmp(token, "usemtl") != 0)
+            continue;
+        char *name = rest_of_line_copy(ctx, p, end, path);
+        if (!name)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        bool known = !name[0] || /* assimp ignores a usemtl without a name */
+                     (names->count > 0 &&
+                      bsearch(name, names->entries, names->count, sizeof *names->entries,
+                              compare_name_to_entry) != NULL);
+        if (!known) {
+            char quoted[64];
+            snprintf(quoted, sizeof quoted, "%s", name);
+            make_printable(quoted);
+            rad_free(name);
+            size_t more = names->library_count > 0 ? names->library_count - 1 : 0;
+            char others[48] = "";
+            if (more > 0)
+                snprintf(others, sizeof others, " and %zu more", more);
+            return rad_fail(ctx, RAD_ERROR_PARSE,
+                            "%s:%d: usemtl '%s': no material of that name in %s%s", path,
+                            lines.number, quoted,
+                            names->library_count ? names->libraries[0] : "its material library",
+                            others);
+        }
+        rad_free(name);
+    }
+    return RAD_OK;
+}
+
+void import_material_names_free(import_material_names *names)
+{
+    for (size_t i = 0; i < names->count; i++)
+        rad_free(names->entries[i].name);
+    for (size_t i = 0; i < names->library_count; i++)
+        rad_free(names->libraries[i]);
+    rad_free(names->entries);
+    rad_free(names->libraries);
+    memset(names, 0, sizeof *names);
 }
