@@ -199,7 +199,9 @@ static int fail(rad_context *ctx, rad_result r)
     char msg[1024];
     cli_rewrite_message(rad_context_error(ctx), msg, sizeof msg);
     fprintf(stderr, "radiosity: %s\n", msg[0] ? msg : rad_result_string(r));
-    return 1;
+    /* A stage that fails once a signal has come (a load whose read or open
+     * the signal broke off) was interrupted: 130 / 143, like the rest. */
+    return cancel_signal ? interrupted_status() : 1;
 }
 
 /* The library's warnings (an orthographic glTF camera replaced): one line

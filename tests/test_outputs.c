@@ -1255,6 +1255,29 @@ static void test_signal_during_generate(void **state)
     unlink(in_work("gen.mtl"));
 }
 
+/* A scene that never comes (a FIFO nobody writes): the load blocks in
+ * open(), and SIGTERM breaks it off.  That is an interruption like any
+ * other, 143, not a failure (before: exit 1). */
+static void test_signal_during_load(void **state)
+{
+    (void)state;
+    assert_int_equal(mkfifo(in_work("never.obj"), 0600), 0);
+    watched w;
+    watch_start(&w, "render never.obj -o never.png");
+    time_t end = time(NULL) + WATCH_SECONDS;
+    while (!catches_sigint(w.pid)) {
+        if (time(NULL) > end)
+            fail_msg("render never set up its signal handlers");
+        pause_ms(1);
+    }
+    pause_ms(100);
+    kill(w.pid, SIGTERM);
+    assert_int_equal(watch_end(&w), 143);
+    assert_false(exists("never.png"));
+    assert_no_temporaries(workdir);
+    unlink(in_work("never.obj"));
+}
+
 /* ---- the work folder ---- */
 
 static int remove_tree(const char *path)
@@ -1305,6 +1328,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_setup_teardown(test_second_signal_while_saving, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_final_render, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_generate, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_signal_during_load, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_each_solver, setup, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
