@@ -658,6 +658,21 @@ static int teardown(void **state)
     return 0;
 }
 
+/* Every message is one line of text: line breaks and tabs become spaces,
+ * other control bytes (an escape sequence in a surface name) '?', UTF-8
+ * passes. */
+static void test_messages_one_line(void **state)
+{
+    (void)state;
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    rad_api_enter(ctx);
+    assert_int_equal(rad_fail(ctx, RAD_ERROR_PARSE, "surface '%s'", "a\nb\r\x1b[2J\tc\x7f\xc3\xa9"),
+                     RAD_ERROR_PARSE);
+    assert_string_equal(rad_context_error(ctx), "surface 'a b ?[2J c?\xc3\xa9'");
+    rad_context_destroy(ctx);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "--full") == 0)
@@ -668,6 +683,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_loading_limit),
         cmocka_unit_test(test_default_limit),
         cmocka_unit_test(test_stats_by_category),
+        cmocka_unit_test(test_messages_one_line),
         cmocka_unit_test(test_fail_each_allocation),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

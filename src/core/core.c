@@ -107,6 +107,19 @@ void rad_context_cancel(rad_context *ctx, bool cancel)
 
 bool rad_context_cancelled(const rad_context *ctx) { return rad_cancelled(ctx); }
 
+/* One line of text: a message never carries a line break into the terminal
+ * (a glTF name "a\nb" split it), nor an escape sequence (a name holding
+ * ESC [2J cleared the screen).  Blanks become spaces, other control bytes
+ * '?'; UTF-8 and every printable byte pass. */
+static void one_line(char *s)
+{
+    for (unsigned char *c = (unsigned char *)s; *c; c++)
+        if (*c == '\n' || *c == '\r' || *c == '\t')
+            *c = ' ';
+        else if (*c < 0x20 || *c == 0x7f)
+            *c = '?';
+}
+
 rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 {
     if (!ctx)
@@ -117,10 +130,7 @@ rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(ctx->error, sizeof ctx->error, fmt, ap);
     va_end(ap);
-    /* One line: a message never carries a newline into the terminal. */
-    for (char *c = ctx->error; *c; c++)
-        if (*c == '\n' || *c == '\r')
-            *c = ' ';
+    one_line(ctx->error);
     ctx->last_result = result;
     ctx->error_latched = true;
     if (ctx->on_error)
@@ -137,9 +147,7 @@ void rad_warn(rad_context *ctx, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(message, sizeof message, fmt, ap);
     va_end(ap);
-    for (char *c = message; *c; c++)
-        if (*c == '\n' || *c == '\r')
-            *c = ' ';
+    one_line(message);
     ctx->on_warning(ctx->warning_user, message);
 }
 
