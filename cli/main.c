@@ -335,6 +335,15 @@ int main(int argc, char **argv)
         }
         s.render.camera = &camera;
     }
+    /* A camera too far from the scene to draw it is refused now, not after
+     * the solve (the automatic one frames the scene). */
+    rad_camera chosen;
+    if (s.command == CLI_RENDER && (s.camera ? (chosen = camera, true) : rad_scene_camera(scene, &chosen)) &&
+        rad_scene_check_camera(ctx, scene, &chosen) != RAD_OK) {
+        fprintf(stderr, "radiosity: %s%s\n", s.camera ? "--" : "", rad_context_error(ctx));
+        status = s.camera ? EXIT_USAGE : 1;
+        goto done;
+    }
     if (s.command == CLI_RENDER && !s.quiet && !s.scene_path)
         printf("radiosity: no scene given, rendering the built-in Cornell box\n");
 

@@ -292,6 +292,16 @@ RAD_API rad_result rad_camera_from_string(rad_context *ctx, const char *text, ra
  * scene or camera is NULL. */
 RAD_API bool rad_scene_camera(const rad_scene *scene, rad_camera *camera);
 
+/* Check, before any work, that `camera` can draw `scene`: its position
+ * within 10^6 scene sizes (bounding-box diagonals) of the scene's centre.
+ * Farther, double rounding of the pixel directions would misplace the
+ * rays by more than the ray queries resolve, so rendering refuses such a
+ * camera too; this call lets a program say so before it solves.
+ * RAD_ERROR_INVALID_ARGUMENT with a message beginning "camera: " when it
+ * is too far, or when ctx, scene or camera is NULL. */
+RAD_API rad_result rad_scene_check_camera(rad_context *ctx, const rad_scene *scene,
+                                          const rad_camera *camera);
+
 /* ------------------------------------------------------------------------
  * Solution: mesh, form factors and radiosity for one scene.
  * ---------------------------------------------------------------------- */

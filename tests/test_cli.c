@@ -154,6 +154,46 @@ static void test_infinite_coordinates(void **state)
     bad_scene("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n", NULL, NULL, "inf.obj:3", NULL);
 }
 
+/* Coordinates beyond the engine's range (1e30 m) name their line; a scene
+ * of 1e18 m, whose rays Embree could not hold unscaled (an assertion
+ * aborted the run), renders as the same scene in metres does. */
+static void test_huge_coordinates(void **state)
+{
+    (void)state;
+    bad_scene("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 3e31 0\nf 1 2 3\n", NULL, NULL,
+              "huge.obj:3: vertex coordinate '3e31' is beyond the 1e+30 m", NULL);
+    write_file("good.mtl", good_mtl);
+    write_file("far.obj", "mtllib good.mtl\n"
+                          "o floor\nusemtl white\n"
+                          "v 0 0 0\nv 1e18 0 0\nv 1e18 0 1e18\nv 0 0 1e18\nf 1 4 3 2\n"
+                          "o lamp\nusemtl lamp\n"
+                          "v 0 1e18 0\nv 1e18 1e18 0\nv 1e18 1e18 1e18\nv 0 1e18 1e18\nf 5 6 7 8\n");
+    write_file("near.obj", good_obj);
+    assert_int_equal(run("render far.obj -q --elements 50 --width 32 --height 32 --exposure 1 -o far.png "
+                         "--camera 0.5e18,0.5e18,-2e18,0.5e18,0,0.5e18"), 0);
+    assert_int_equal(run("render near.obj -q --elements 50 --width 32 --height 32 --exposure 1 -o near.png "
+                         "--camera 0.5,0.5,-2,0.5,0,0.5"), 0);
+    /* The same picture, byte for byte. */
+    unsigned char bytes[2][16384];
+    size_t size[2];
+    const char *names[2] = {"far.png", "near.png"};
+    for (int k = 0; k < 2; k++) {
+        char path[600];
+        snprintf(path, sizeof path, "%s/%s", workdir, names[k]);
+        FILE *f = fopen(path, "rb");
+        assert_non_null(f);
+        size[k] = fread(bytes[k], 1, sizeof bytes[k], f);
+        fclose(f);
+    }
+    assert_true(size[0] > 100 && size[0] < sizeof bytes[0]);
+    assert_int_equal(size[0], size[1]);
+    assert_memory_equal(bytes[0], bytes[1], size[0]);
+    /* A camera 10^7 scene sizes away is refused before the work: exit 2. */
+    assert_int_equal(run("render near.obj -o cam.png --stats cam.json --camera 0.5,2e7,0.5,0.5,0,0.5,0,0,1"), 2);
+    assert_one_line_error("--camera: the position is", "at most 1e+06 times");
+    assert_no_output("cam.");
+}
+
 static void test_zero_area_polygon(void **state)
 {
     (void)state;
@@ -763,6 +803,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_face_index_out_of_range),
         cmocka_unit_test(test_nan_coordinates),
         cmocka_unit_test(test_infinite_coordinates),
+        cmocka_unit_test(test_huge_coordinates),
         cmocka_unit_test(test_zero_area_polygon),
         cmocka_unit_test(test_reflectance_too_high),
         cmocka_unit_test(test_reflectance_negative),

@@ -12,6 +12,10 @@
  *                                    a polygon with nothing left: a clear error
  *   very thin slivers                the irradiance of a wide strip there
  *   millimetres, metres, kilometres  the same radiosity per surface
+ *   1e-27 m to 1e27 m                the same, to round-off, for every strategy
+ *   beyond 1e30 m, below 1e-30 m     a clear error naming the polygon
+ *   a camera 10^6 scene sizes away   refused before the work; nearer, drawn
+ *   a 1 mm lamp over a 2 km floor    its power, and the floor's closed form
  *   two separate rooms               each as if solved alone
  *   an open scene                    emitted = absorbed + escaped
  *   10^6 tiny triangles (slow)       loads and meshes in bounded time
@@ -466,6 +470,229 @@ static void test_units_do_not_matter(void **state)
     }
 }
 
+/* ---- scale: the engine's range of lengths, and scale ratios ---- */
+
+/* The occluded room of room_at_scale, built with exact doubles (OBJ text
+ * goes through assimp's float parser, which rounds numbers with exponents
+ * differently at each scale), every coordinate times `scale`. */
+static rad_scene *scaled_room(double scale)
+{
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "scaled room");
+    const double white[3] = {0.5, 0.5, 0.5}, grey[3] = {0.3, 0.3, 0.3}, none[3] = {0, 0, 0};
+    const double glow[3] = {1, 1, 1};
+    int m_white = rad_scene_builder_material(b, "white", white, none);
+    int m_grey = rad_scene_builder_material(b, "grey", grey, none);
+    int m_lamp = rad_scene_builder_material(b, "glowing_white", white, glow);
+    /* Faces of the unit cube, counter-clockwise seen from inside. */
+    static const double faces[6][4][3] = {
+        {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}}, /* floor, y = 0 */
+        {{0, 1, 0}, {1, 1, 0}, {1, 1, 1}, {0, 1, 1}}, /* ceiling, y = 1 */
+        {{0, 0, 0}, {0, 1, 0}, {0, 1, 1}, {0, 0, 1}}, /* x = 0 */
+        {{1, 0, 0}, {1, 0, 1}, {1, 1, 1}, {1, 1, 0}}, /* x = 1 */
+        {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, /* z = 0 */
+        {{0, 0, 1}, {0, 1, 1}, {1, 1, 1}, {1, 0, 1}}, /* z = 1 */
+    };
+    static const char *const names[6] = {"room_floor", "room_ceiling", "room_x0",
+                                         "room_x1", "room_z0", "room_z1"};
+    for (int f = 0; f < 6; f++) {
+        vec3 q[4];
+        for (int k = 0; k < 4; k++)
+            q[k] = v3(scale * faces[f][k][0], scale * faces[f][k][1], scale * faces[f][k][2]);
+        int m = f == 1 ? m_lamp : m_white;
+        assert_int_equal(rad_scene_builder_polygon(b, rad_scene_builder_surface(b, names[f]), m, q, 4, 0),
+                         RAD_OK);
+    }
+    /* The blocker, facing down. */
+    const vec3 blocker[4] = {v3(0.31 * scale, 0.47 * scale, 0.33 * scale),
+                             v3(0.69 * scale, 0.47 * scale, 0.33 * scale),
+                             v3(0.69 * scale, 0.47 * scale, 0.71 * scale),
+                             v3(0.31 * scale, 0.47 * scale, 0.71 * scale)};
+    assert_int_equal(rad_scene_builder_polygon(b, rad_scene_builder_surface(b, "blocker"), m_grey,
+                                               blocker, 4, 0),
+                     RAD_OK);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_OK);
+    return scene;
+}
+
+/* Every surface's radiosity (channel 0) of the scaled room, solved by
+ * `solver` at about 300 elements. */
+static void scaled_room_radiosity(double scale, const char *solver, double B[7])
+{
+    rad_scene *scene = scaled_room(scale);
+    rad_options o = {0};
+    o.target_elements = 300;
+    o.solver = solver;
+    rad_solution *sol = NULL;
+    if (rad_solution_create(ctx, scene, &o, &sol) != RAD_OK || rad_solution_solve(ctx, sol) != RAD_OK)
+        fail_msg("scale %g, %s: %s", scale, solver, rad_context_error(ctx));
+    assert_int_equal(rad_scene_surface_count(scene), 7);
+    for (size_t i = 0; i < 7; i++) {
+        double rgb[3];
+        rad_solution_surface_radiosity(sol, i, rgb);
+        B[i] = rgb[0];
+        assert_true(B[i] > 0.01);
+    }
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+}
+
+/* Radiosity is power per area: a room of 1e-27 m or of 1e27 m is the same
+ * room.  Rays are traced in a frame scaled to the scene by a power of two
+ * (vis_embree.c), so at binary scales every float and double operation
+ * scales exactly and each strategy gives the answer it gives in metres, to
+ * round-off, far beyond what single-precision rays could hold unscaled
+ * (Embree asserts on origins past 1.8e18: a scene of 1e18 m aborted, and
+ * shooting at 1e19 m returned B = 0 everywhere but the lamp). */
+static void test_extreme_scales(void **state)
+{
+    (void)state;
+    static const char *const solvers[3] = {"gauss-seidel", "shooting", "hierarchical"};
+    const double scales[5] = {0x1p-90, 0x1p-40, 0x1p60, 0x1p64, 0x1p90};
+    for (int k = 0; k < 3; k++) {
+        double metres[7], other[7];
+        scaled_room_radiosity(1.0, solvers[k], metres);
+        for (int i = 0; i < 5; i++) {
+            scaled_room_radiosity(scales[i], solvers[k], other);
+            for (int n = 0; n < 7; n++) {
+                char what[96];
+                snprintf(what, sizeof what, "%s, surface %d, scale %g", solvers[k], n, scales[i]);
+                assert_relative(other[n], metres[n], 1e-9, what);
+            }
+        }
+    }
+}
+
+/* Beyond the engine's range of lengths (scene.h: RAD_MAX_COORDINATE,
+ * RAD_MIN_LENGTH) a polygon is refused, naming it and the limit; just
+ * inside, it loads.  Through OBJ text, with its line. */
+static void test_coordinate_limits(void **state)
+{
+    (void)state;
+    const struct {
+        double scale;
+        const char *error; /* NULL: loads */
+    } cases[] = {
+        {0.5e30, NULL},
+        {2e30, "hostile.obj:5: vertex coordinate '2e+30' is beyond the 1e+30 m"},
+        {-2e30, "hostile.obj:5: vertex coordinate '-2e+30' is beyond the 1e+30 m"},
+        {1e-30, NULL},
+        {1e-31, "hostile.obj: polygon in surface 'floor' is 1.41e-31 m across, below the 1e-30 m"},
+        {1e-35, "is 1.41e-35 m across"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        text t = {0};
+        flat(&t, "floor", "white", 0, 1, 0, 1, 0, 1, cases[i].scale);
+        rad_scene *scene = NULL;
+        rad_result r = load(&t, &scene);
+        if (!cases[i].error) {
+            if (r != RAD_OK)
+                fail_msg("scale %g: %s", cases[i].scale, rad_context_error(ctx));
+            assert_relative(rad_scene_surface_area(scene, 0), cases[i].scale * cases[i].scale, 1e-6,
+                            "area");
+        } else {
+            assert_int_equal(r, RAD_ERROR_INVALID_SCENE);
+            if (!strstr(rad_context_error(ctx), cases[i].error))
+                fail_msg("scale %g: '%s' lacks '%s'", cases[i].scale, rad_context_error(ctx),
+                         cases[i].error);
+        }
+        rad_scene_destroy(scene);
+        free(t.data);
+    }
+}
+
+/* A camera too far from the scene for its rays to land where it aims:
+ * refused before the work (rad_scene_check_camera) and by the renderer;
+ * one just inside the limit, aimed with a field of view that frames the
+ * scene, draws it. */
+static void test_camera_distance(void **state)
+{
+    (void)state;
+    text t = {0};
+    lamp(&t, 1.0);
+    flat(&t, "floor", "white", 0, 1, 0, 1, 0, 1, 1.0);
+    solved s = solve(&t, 0.25, 0);
+    double diagonal = sqrt(3.0); /* lamp and floor span [0, 1]^3 */
+    rad_camera far = {{0.5, 0.5 + 2e6 * diagonal, 0.5}, {0.5, 0.0, 0.5}, {0, 0, 1}, 1e-4};
+    assert_int_equal(rad_scene_check_camera(ctx, s.scene, &far), RAD_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rad_context_error(ctx), "camera: the position is"));
+    assert_non_null(strstr(rad_context_error(ctx), "at most 1e+06 times"));
+    rad_render_options ro = {0};
+    ro.width = ro.height = 8;
+    ro.samples = 1;
+    ro.camera = &far;
+    rad_image *image = NULL;
+    assert_int_equal(rad_solution_render(ctx, s.solution, &ro, &image), RAD_ERROR_INVALID_ARGUMENT);
+    assert_null(image);
+    /* 0.9e6 scene sizes up, looking down past the lamp at a corner of the
+     * floor, which fills the view: every pixel sees the lit floor. */
+    double distance = 0.9e6 * diagonal;
+    rad_camera near = {{0.1, distance, 0.1}, {0.1, 0.0, 0.1}, {0, 0, 1},
+                       2.0 * atan(0.05 / distance) * 180.0 / M_PI};
+    assert_int_equal(rad_scene_check_camera(ctx, s.scene, &near), RAD_OK);
+    ro.camera = &near;
+    if (rad_solution_render(ctx, s.solution, &ro, &image) != RAD_OK)
+        fail_msg("render: %s", rad_context_error(ctx));
+    double floor_radiance = radiosity_of(&s, "floor") / M_PI;
+    const float *pixels = rad_image_pixels(image);
+    for (int k = 0; k < 8 * 8; k++)
+        if (!(pixels[3 * k] > 0.5 * floor_radiance && pixels[3 * k] < 2.0 * floor_radiance))
+            fail_msg("pixel %d: radiance %g, the floor's %g", k, pixels[3 * k], floor_radiance);
+    rad_image_destroy(image);
+    assert_int_equal(rad_scene_check_camera(NULL, s.scene, &near), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_scene_check_camera(ctx, NULL, &near), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_scene_check_camera(ctx, s.scene, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    release(&s);
+    free(t.data);
+}
+
+/* A 1 mm lamp 3 m over a 2 km floor (a scale ratio of 2 x 10^6), open to
+ * the sky: every strategy emits its A E and lights the floor with it,
+ * B_floor = rho A_lamp E F / A_floor, F = 1 - 2.7e-6 for this square (the
+ * lamp sees all but a sliver of its hemisphere past the floor's edges).
+ * Before, the hierarchical solver welded the lamp's corners at 1e-6 of the
+ * scene's diagonal (2.8 mm) into one point: emitted power 0. */
+static void test_scale_ratio(void **state)
+{
+    (void)state;
+    text t = {0};
+    flat(&t, "floor", "white", -1000, 1000, -1000, 1000, 0, 1, 1.0);
+    flat(&t, "lamp", "lamp", -0.0005, 0.0005, -0.0005, 0.0005, 3, -1, 1.0);
+    rad_scene *scene = NULL;
+    if (load(&t, &scene) != RAD_OK)
+        fail_msg("load: %s", rad_context_error(ctx));
+    /* F from a small patch to a coaxial parallel square of half-side a at
+     * height h: the differential planar element to a parallel rectangle
+     * with a corner above it (Howell's catalogue of configuration
+     * factors), summed over the four a x a rectangles: with x = a / h,
+     * F = (4 / pi) q atan(q), q = x / sqrt(1 + x^2). */
+    double x = 1000.0 / 3.0, q = x / sqrt(1.0 + x * x);
+    double F = 4.0 / M_PI * q * atan(q);
+    double lamp_area = 1e-6, E = M_PI;
+    static const char *const solvers[3] = {"gauss-seidel", "shooting", "hierarchical"};
+    for (int k = 0; k < 3; k++) {
+        rad_options o = {0};
+        o.target_elements = 400;
+        o.solver = solvers[k];
+        rad_solution *sol = NULL;
+        if (rad_solution_create(ctx, scene, &o, &sol) != RAD_OK || rad_solution_solve(ctx, sol) != RAD_OK)
+            fail_msg("%s: %s", solvers[k], rad_context_error(ctx));
+        double emitted, absorbed, rgb[3];
+        rad_solution_power(sol, &emitted, &absorbed);
+        /* assimp reads the OBJ's numbers as floats: the lamp's area to 1e-7 */
+        assert_relative(emitted, E * lamp_area, 1e-6, solvers[k]);
+        for (size_t i = 0; i < rad_scene_surface_count(scene); i++)
+            if (strcmp(rad_scene_surface_name(scene, i), "floor") == 0) {
+                rad_solution_surface_radiosity(sol, i, rgb);
+                assert_relative(rgb[0], 0.5 * emitted * F / 4e6, 1e-3, solvers[k]);
+            }
+        assert_true(absorbed > 0.49 * emitted && absorbed < 0.51 * emitted);
+        rad_solution_destroy(sol);
+    }
+    rad_scene_destroy(scene);
+    free(t.data);
+}
+
 /* Two closed rooms 2 m apart, lit by their ceilings, with different
  * reflectances: together, each surface's radiosity is what that room gives
  * solved alone (F is block-diagonal). */
@@ -622,6 +849,10 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_repeated_and_collinear_vertices),
         cmocka_unit_test(test_thin_sliver),
         cmocka_unit_test(test_units_do_not_matter),
+        cmocka_unit_test(test_extreme_scales),
+        cmocka_unit_test(test_coordinate_limits),
+        cmocka_unit_test(test_camera_distance),
+        cmocka_unit_test(test_scale_ratio),
         cmocka_unit_test(test_two_separate_rooms),
         cmocka_unit_test(test_open_scene),
         cmocka_unit_test(test_allocation_overflow),

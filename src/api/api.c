@@ -392,6 +392,14 @@ rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera
     return rad_camera_parse(ctx, text, camera);
 }
 
+rad_result rad_scene_check_camera(rad_context *ctx, const rad_scene *scene, const rad_camera *camera)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !scene || !camera)
+        return rad_null_argument(ctx, __func__);
+    return rad_camera_check_distance(ctx, camera, scene->bounds_min, scene->bounds_max);
+}
+
 bool rad_method_info(rad_method_kind kind, size_t index, const char **name, const char **description)
 {
     size_t count = 0;

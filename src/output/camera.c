@@ -120,3 +120,27 @@ bad_count:
                     "camera: expected 6, 9 or 10 comma-separated numbers, got '%s'",
                     text ? text : "");
 }
+
+/* Pixel directions are exact to double rounding (1e-16), so a camera at
+ * distance D misplaces its rays by about 1e-16 D where they meet the
+ * scene.  Within RAD_CAMERA_MAX_DISTANCE scene diagonals that is 1e-10 of
+ * the scene, far below the float rounding of the ray queries (1e-7; the
+ * rays themselves are advanced to the scene in double, vis_embree.c): the
+ * image is what a nearer camera with a narrower field would see.  Farther,
+ * the rays would land wherever rounding puts them, so the camera is
+ * refused. */
+rad_result rad_camera_check_distance(rad_context *ctx, const rad_camera *camera, vec3 lo, vec3 hi)
+{
+    double diagonal = v3_length(v3_sub(hi, lo));
+    if (!(diagonal > 0.0) || !isfinite(diagonal))
+        return RAD_OK; /* nothing to place the camera against */
+    vec3 position = v3(camera->position[0], camera->position[1], camera->position[2]);
+    double distance = v3_length(v3_sub(position, v3_scale(v3_add(lo, hi), 0.5)));
+    if (distance <= RAD_CAMERA_MAX_DISTANCE * diagonal)
+        return RAD_OK;
+    return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                    "camera: the position is %.3g m from the scene's centre, %.3g times the "
+                    "scene's size of %.3g m; at most %g times is drawn (farther, rounding "
+                    "misplaces the rays)",
+                    distance, distance / diagonal, diagonal, RAD_CAMERA_MAX_DISTANCE);
+}

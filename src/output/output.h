@@ -36,6 +36,15 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
  * (a three-quarter view would hide the interior of open boxes). */
 rad_camera rad_camera_frame(vec3 bounds_min, vec3 bounds_max, double aspect);
 
+/* Farthest a camera may be from the centre of what it draws, in sizes
+ * (diagonals) of it. */
+#define RAD_CAMERA_MAX_DISTANCE 1e6
+
+/* RAD_ERROR_INVALID_ARGUMENT, with a message beginning "camera: ", when
+ * the camera is farther than RAD_CAMERA_MAX_DISTANCE diagonals from the
+ * centre of the box [lo, hi] (camera.c says why). */
+rad_result rad_camera_check_distance(rad_context *ctx, const rad_camera *camera, vec3 lo, vec3 hi);
+
 /* Parse "px,py,pz,lx,ly,lz[,ux,uy,uz[,vfov]]" (the CLI's --camera). */
 rad_result rad_camera_parse(rad_context *ctx, const char *text, rad_camera *camera);
 

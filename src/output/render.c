@@ -45,6 +45,19 @@ static rad_result check_size(rad_context *ctx, const char *what, int value)
     return RAD_OK;
 }
 
+/* The camera against the patches' bounding box (rad_camera_check_distance). */
+static rad_result check_camera_distance(rad_context *ctx, const rad_render_input *input)
+{
+    const rad_mesh *mesh = input->mesh;
+    vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (size_t i = 0; i < mesh->patch_count; i++)
+        for (uint32_t c = 0; c < mesh->patches[i].corner_count; c++) {
+            lo = v3_min(lo, mesh->patches[i].corner[c]);
+            hi = v3_max(hi, mesh->patches[i].corner[c]);
+        }
+    return rad_camera_check_distance(ctx, &input->camera, lo, hi);
+}
+
 static rad_result make_view(rad_context *ctx, const rad_camera *camera, int width, int height,
                             int samples, render_view *view)
 {
@@ -160,7 +173,8 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
         (r = check_size(ctx, "samples", samples)) != RAD_OK)
         return r;
     render_view view;
-    if ((r = make_view(ctx, &input->camera, width, height, samples, &view)) != RAD_OK)
+    if ((r = make_view(ctx, &input->camera, width, height, samples, &view)) != RAD_OK ||
+        (r = check_camera_distance(ctx, input)) != RAD_OK)
         return r;
 
     int threads = ctx && ctx->threads > 0 ? ctx->threads : 1;

@@ -343,6 +343,11 @@ rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *te
                                  kind == NUMBER_GARBAGE ? RAD_ERROR_PARSE : RAD_ERROR_INVALID_SCENE,
                                  "%s:%d: vertex coordinate '%s' is not a finite number", path,
                                  lines.number, token);
+                else if (coordinates < 3 && fabs(value) > RAD_MAX_COORDINATE)
+                    r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
+                                 "%s:%d: vertex coordinate '%s' is beyond the %g m the engine "
+                                 "works in (are the units right?)",
+                                 path, lines.number, token, RAD_MAX_COORDINATE);
                 coordinates++;
             }
             if (r != RAD_OK)

@@ -314,10 +314,19 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
         return rad_fail(b->ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: polygon refers to surface %d and material %d, of %zu and %zu",
                         b->source, surface, material, b->surface_count, b->material_count);
-    for (size_t i = 0; i < vertex_count; i++)
+    for (size_t i = 0; i < vertex_count; i++) {
         if (!v3_finite(vertices[i]))
             return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE,
                                  "has a non-finite coordinate");
+        double largest = fmax(fabs(vertices[i].x), fmax(fabs(vertices[i].y), fabs(vertices[i].z)));
+        if (largest > RAD_MAX_COORDINATE) {
+            char problem[128];
+            snprintf(problem, sizeof problem,
+                     "has a coordinate of %.3g m, beyond the %g m the engine works in "
+                     "(are the units right?)", largest, RAD_MAX_COORDINATE);
+            return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE, problem);
+        }
+    }
 
     vec3 *polygon = reserve(b, b->polygon_scratch, &b->polygon_scratch_capacity,
                             vertex_count + 1, sizeof *polygon, "polygon vertices");
@@ -349,9 +358,17 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
     vec3 newell = rad_polygon_newell(polygon, n);
     double area = 0.5 * v3_length(newell);
     /* 1e-12 x diameter^2: a polygon a million-millionth as wide as it is
-     * long is a line, and its normal is rounding noise.  1e-20 m^2 (a
-     * 0.1 nm square) catches polygons too small to have a normal at all. */
-    if (!(area >= 1e-12 * diameter * diameter) || area < 1e-20)
+     * long is a line, and its normal is rounding noise.  The test is
+     * relative, so it holds at every scale; below RAD_MIN_LENGTH across,
+     * a polygon is refused as too small for the engine's arithmetic. */
+    if (!(diameter >= RAD_MIN_LENGTH)) {
+        char problem[128];
+        snprintf(problem, sizeof problem,
+                 "is %.3g m across, below the %g m the engine works in (are the units right?)",
+                 diameter, RAD_MIN_LENGTH);
+        return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE, problem);
+    }
+    if (!(area >= 1e-12 * diameter * diameter))
         return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE, "has zero area");
     vec3 normal = v3_scale(newell, 0.5 / area);
 
@@ -418,8 +435,8 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
                             polygon[b->triangle_scratch[3 * t + 2]]};
         vec3 triangle_newell = rad_polygon_newell(triangle, 3);
         double triangle_area = 0.5 * v3_length(triangle_newell);
-        if (triangle_area < 1e-20)
-            continue; /* nothing to radiate or receive; ear clipping avoids these anyway */
+        if (!(triangle_area > 1e-15 * area))
+            continue; /* round-off: nothing to radiate or receive; ear clipping avoids these anyway */
         rad_result r = append_polygon(b, surface, material, triangle, 3,
                                       v3_scale(triangle_newell, 0.5 / triangle_area),
                                       triangle_area);

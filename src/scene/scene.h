@@ -94,6 +94,19 @@ rad_result rad_import_assimp_memory(rad_context *ctx, const char *name, const vo
 bool rad_scene_has_emitter(const rad_scene *scene);
 double rad_scene_diagonal(const rad_scene *scene); /* m */
 
+/* The lengths the engine works in, m.  Radiosity is scale-free, so any
+ * unit would do, but lengths are squared (areas), raised to the fourth
+ * power (the kernel's r^4 with cosines unnormalised) and summed over 10^8
+ * elements: within [1e-30, 1e30] m every such product stays inside
+ * double's range (1e-308 to 1e308) with a wide margin, whatever the scale.
+ * A coordinate beyond RAD_MAX_COORDINATE or a polygon smaller across than
+ * RAD_MIN_LENGTH is refused, naming it (the limits are 40 and 60 orders of
+ * magnitude from anything physical: a unit mix-up, or hostile input).
+ * Rays are traced in a frame scaled to the scene (vis_embree.c), so single
+ * precision does not narrow this range. */
+#define RAD_MAX_COORDINATE 1e30
+#define RAD_MIN_LENGTH 1e-30
+
 /* Bytes of working space rad_triangulate_polygon needs for n vertices. */
 #define RAD_TRIANGULATE_SCRATCH(n) ((size_t)(n) * (2 * sizeof(double) + 2 * sizeof(uint32_t)))
 

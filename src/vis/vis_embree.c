@@ -6,11 +6,20 @@
  * built from the primitive list (vis.h: flat patches whole, bent ones as
  * their elements): triangles (RTC_GEOMETRY_TYPE_TRIANGLE) and quads
  * (RTC_GEOMETRY_TYPE_QUAD); an array per geometry maps Embree's primID back
- * to the primitive, and so to its patch.  Embree works in float, so the scene is translated to
- * the centre of its bounding box first (rays are shifted the same way in
- * double), which keeps float rounding relative to the scene's size rather
- * than to its distance from the origin.  Closest hits are refined in double
- * against the hit patch's plane.
+ * to the primitive, and so to its patch.
+ *
+ * Embree works in float and asserts that ray origins and directions stay
+ * below 1.8e18 (its FLT_LARGE).  So the geometry is handed over in a frame
+ * of its own: translated to the centre of its bounding box and scaled by
+ * the power of two that brings its half-diagonal to [1, 2).  Rays are mapped
+ * the same way in double, with a unit direction and their parameters in
+ * that frame.  Float rounding is then relative to the scene's size, not to
+ * its distance from the origin nor to its unit, and a scene of 1e-20 m or
+ * of 1e25 m is traced exactly as the same scene in metres (a power of two
+ * scales every float exactly).  A ray that starts far outside (a camera a
+ * thousand scene sizes away) is first advanced, in double, to just before
+ * the scene's bounding sphere.  Closest hits are refined in double against
+ * the hit patch's plane.
  *
  * Embree runs its own TBB thread pool for the build; the device is created
  * with "threads=N" for the context's N so it does not oversubscribe the
@@ -31,6 +40,7 @@ typedef struct embree_state {
     RTCScene scene;
     const rad_mesh *mesh;
     vec3 shift;                  /* m: subtracted from geometry and ray origins */
+    double scale;                /* 1/m, a power of two: then multiplies them */
     unsigned triangle_geometry;  /* geomID, or RTC_INVALID_GEOMETRY_ID */
     unsigned quad_geometry;
     rad_vis_prim *prims;         /* the primitives (vis.h) */
@@ -95,7 +105,7 @@ static unsigned embree_add_prims(embree_state *s, uint32_t corners, size_t count
             continue;
         for (uint32_t c = 0; c < corners; c++) {
             size_t v = primitive * corners + c;
-            vec3 q = v3_sub(p->corner[c], s->shift);
+            vec3 q = v3_scale(v3_sub(p->corner[c], s->shift), s->scale);
             position[3 * v + 0] = (float)q.x;
             position[3 * v + 1] = (float)q.y;
             position[3 * v + 2] = (float)q.z;
@@ -143,6 +153,13 @@ static rad_result embree_create(rad_context *ctx, const rad_mesh *mesh, void **s
         }
     }
     s->shift = v3_scale(v3_add(lo, hi), 0.5);
+    /* 2^-e with half-diagonal = m 2^e, m in [0.5, 1): exact, and the
+     * scene then spans [-2, 2] at most.  A point scene keeps scale 1. */
+    double half = 0.5 * v3_length(v3_sub(hi, lo));
+    int e = 0;
+    if (half > 0.0 && isfinite(half))
+        frexp(half, &e);
+    s->scale = ldexp(1.0, 1 - e);
     s->triangle_prim = rad_alloc(ctx, RAD_MEM_VISIBILITY, triangles, sizeof(uint32_t), "Embree triangle map");
     s->quad_prim = rad_alloc(ctx, RAD_MEM_VISIBILITY, quads, sizeof(uint32_t), "Embree quad map");
     if (!s->triangle_prim || !s->quad_prim) {
@@ -181,23 +198,54 @@ static rad_result embree_create(rad_context *ctx, const rad_mesh *mesh, void **s
     return RAD_OK;
 }
 
-/* Our ray in Embree's float form; returns 0 for an empty segment.  Embree
- * needs tnear >= 0, so a negative tnear is taken as 0 (both backends). */
-static int embree_ray(const embree_state *s, const rad_ray *ray, struct RTCRay *out)
+/* Beyond this distance from the centre (in the scaled frame, where the
+ * scene lies within radius 2), a ray's origin is advanced along the ray
+ * before it is rounded to float. */
+#define EMBREE_FAR 64.0
+
+/* Our ray in Embree's float frame; returns 0 for an empty segment, else
+ * sets *t_offset and *t_scale so that our t = offset + scale * Embree's t.
+ * Embree needs tnear >= 0, so a negative tnear is taken as 0 (both
+ * backends). */
+static int embree_ray(const embree_state *s, const rad_ray *ray, struct RTCRay *out,
+                      double *t_offset, double *t_scale)
 {
-    double tnear = ray->tnear > 0.0 ? ray->tnear : 0.0;
-    if (!(ray->tfar > tnear))
+    double tnear = ray->tnear > 0.0 ? ray->tnear : 0.0, tfar = ray->tfar;
+    vec3 o = v3_scale(v3_sub(ray->origin, s->shift), s->scale);
+    vec3 d = v3_scale(ray->direction, s->scale);
+    double length = v3_length(d);
+    if (!(tfar > tnear) || !(length > 0.0) || !isfinite(length) || !v3_finite(o))
         return 0;
-    vec3 o = v3_sub(ray->origin, s->shift);
+    /* A far origin: start at the entry into the sphere of radius
+     * EMBREE_FAR instead (nothing lies before it), or give up on a ray
+     * that passes the sphere by. */
+    double offset = 0.0;
+    if (v3_length(o) > EMBREE_FAR) {
+        vec3 u = v3_scale(d, 1.0 / length);
+        double along = -v3_dot(o, u);                      /* to the point nearest the centre */
+        double miss2 = v3_dot(o, o) - along * along;       /* squared distance of that point */
+        if (!(along > 0.0) || miss2 >= EMBREE_FAR * EMBREE_FAR)
+            return 0;
+        double enter = (along - sqrt(EMBREE_FAR * EMBREE_FAR - miss2)) / length;
+        if (enter > tnear) {
+            offset = enter;
+            o = v3_mad(o, d, enter);
+        }
+    }
+    double near = (tnear - offset) * length, far = (tfar - offset) * length;
+    if (!(far > (near > 0.0 ? near : 0.0)))
+        return 0;
+    *t_offset = offset;
+    *t_scale = 1.0 / length;
     out->org_x = (float)o.x;
     out->org_y = (float)o.y;
     out->org_z = (float)o.z;
-    out->tnear = (float)tnear;
-    out->dir_x = (float)ray->direction.x;
-    out->dir_y = (float)ray->direction.y;
-    out->dir_z = (float)ray->direction.z;
+    out->tnear = near > 0.0 ? (float)near : 0.0f;
+    out->dir_x = (float)(d.x / length);
+    out->dir_y = (float)(d.y / length);
+    out->dir_z = (float)(d.z / length);
     out->time = 0.0f;
-    out->tfar = (float)ray->tfar;
+    out->tfar = far < 1e30 ? (float)far : INFINITY;
     out->mask = 0xFFFFFFFFu;
     out->id = 0;
     out->flags = 0;
@@ -217,7 +265,8 @@ static void embree_occluded(void *state, const rad_ray *rays, size_t count, uint
             /* Inactive lanes get an empty segment too, so nothing Embree
              * may load is uninitialised. */
             struct RTCRay ray = {0, 0, 0, 0.0f, 0, 0, 1.0f, 0.0f, -1.0f, 0, 0, 0};
-            valid[k] = k < n && embree_ray(s, &rays[first + k], &ray) ? -1 : 0;
+            double offset, scale;
+            valid[k] = k < n && embree_ray(s, &rays[first + k], &ray, &offset, &scale) ? -1 : 0;
             packet.org_x[k] = ray.org_x;
             packet.org_y[k] = ray.org_y;
             packet.org_z[k] = ray.org_z;
@@ -246,7 +295,8 @@ static void embree_intersect(void *state, const rad_ray *rays, size_t count, rad
         hits[k].t = INFINITY;
         hits[k].patch = 0;
         struct RTCRayHit rayhit;
-        if (!embree_ray(s, &rays[k], &rayhit.ray))
+        double offset, scale;
+        if (!embree_ray(s, &rays[k], &rayhit.ray, &offset, &scale))
             continue;
         rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         rayhit.hit.primID = RTC_INVALID_GEOMETRY_ID;
@@ -262,7 +312,7 @@ static void embree_intersect(void *state, const rad_ray *rays, size_t count, rad
          * to ~1e-7 of the scene size, the plane solve to ~1e-16.  Keep the
          * float t when the ray grazes the plane or the refined t leaves
          * the segment. */
-        double t = rayhit.ray.tfar;
+        double t = offset + scale * (double)rayhit.ray.tfar;
         vec3 normal = v3_normalize(
             v3_cross(v3_sub(p->corner[1], p->corner[0]), v3_sub(p->corner[2], p->corner[0])));
         double along = v3_dot(normal, rays[k].direction);
