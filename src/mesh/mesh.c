@@ -209,8 +209,18 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
             e->vertex[c] = (uint32_t)k++;
         }
     }
+    /* The rule of mesh_weld_tolerance, on the leaves themselves: 1e-6 of
+     * the scene, but under 1e-3 of the narrowest leaf, so a 1 mm lamp
+     * over a 2 km floor keeps its corners apart (they were welded into
+     * one point at 1e-6 x 2.8 km: the lamp had no area and emitted 0). */
     double diag = rad_scene_diagonal(scene);
     double tol = 1e-6 * (diag > 0.0 ? diag : 1.0);
+    for (size_t i = 0; i < leaf_count; i++) {
+        const rad_mesh_leaf *l = &leaves[i];
+        double width = mesh_corners_width(l->corner, l->corner_count);
+        if (width > 0.0 && 1e-3 * width < tol)
+            tol = 1e-3 * width;
+    }
     rad_result r = mesh_weld(ctx, mesh, raw, nraw, tol, cos(crease * M_PI / 180.0), weld_of,
                              &mesh->vertices, &mesh->vertex_count);
     if (r == RAD_OK) {

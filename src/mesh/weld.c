@@ -111,23 +111,28 @@ static void cell_index_free(cell_index *ix)
  * zero-area elements.  The narrowest element is estimated per patch as
  * its width (2 x area / longest edge) or its shortest edge, whichever is
  * less, over its cells along the longest side. */
+double mesh_corners_width(const vec3 *corner, uint32_t count)
+{
+    vec3 n = count == 4 ? v3_cross(v3_sub(corner[2], corner[0]), v3_sub(corner[3], corner[1]))
+                        : v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[2], corner[0]));
+    double area = 0.5 * v3_length(n), longest = 0.0, shortest = HUGE_VAL;
+    for (uint32_t k = 0; k < count; k++) {
+        double edge = v3_length(v3_sub(corner[(k + 1) % count], corner[k]));
+        longest = fmax(longest, edge);
+        shortest = fmin(shortest, edge);
+    }
+    return longest > 0.0 ? fmin(shortest, 2.0 * area / longest) : 0.0;
+}
+
 double mesh_weld_tolerance(const rad_mesh *mesh, double diag)
 {
     double narrowest = HUGE_VAL;
     for (size_t i = 0; i < mesh->patch_count; i++) {
         const rad_patch *p = &mesh->patches[i];
-        vec3 n = p->corner_count == 4
-                     ? v3_cross(v3_sub(p->corner[2], p->corner[0]), v3_sub(p->corner[3], p->corner[1]))
-                     : v3_cross(v3_sub(p->corner[1], p->corner[0]), v3_sub(p->corner[2], p->corner[0]));
-        double area = 0.5 * v3_length(n), longest = 0.0, shortest = HUGE_VAL;
-        for (uint32_t k = 0; k < p->corner_count; k++) {
-            double edge = v3_length(v3_sub(p->corner[(k + 1) % p->corner_count], p->corner[k]));
-            longest = fmax(longest, edge);
-            shortest = fmin(shortest, edge);
-        }
+        double width = mesh_corners_width(p->corner, p->corner_count);
         uint32_t cells = p->nu > p->nv ? p->nu : p->nv;
-        if (longest > 0.0)
-            narrowest = fmin(narrowest, fmin(shortest, 2.0 * area / longest) / (double)cells);
+        if (width > 0.0)
+            narrowest = fmin(narrowest, width / (double)cells);
     }
     double tol = 1e-6 * diag;
     if (narrowest > 0.0 && 1e-3 * narrowest < tol)
