@@ -1139,7 +1139,10 @@ static void test_second_signal_while_saving(void **state)
 
 /* Signals during the final render of a converged solution: the render and
  * the outputs are completed (not marked partial: the solution is whole),
- * then the run exits 143. */
+ * then the run exits 143, the status of the first signal.  The second is
+ * sent 0.2 s later: two signals pending at once are delivered in the
+ * order of their numbers (SIGINT first), whatever order they were sent
+ * in, so back to back the test would race. */
 static void test_signal_during_final_render(void **state)
 {
     (void)state;
@@ -1148,6 +1151,7 @@ static void test_signal_during_final_render(void **state)
                     "--stats final.json --history final.csv");
     watch_for_text(&w, "render");
     kill(w.pid, SIGTERM);
+    nanosleep(&(struct timespec){0, 200000000}, NULL);
     kill(w.pid, SIGINT);
     assert_int_equal(watch_end(&w), 143);
     assert_true(exists("final.png") && exists("final.csv"));
