@@ -124,8 +124,10 @@ typedef void (*rad_error_fn)(void *user, rad_result result, const char *message)
 
 /* Called when a call succeeds but reads its input differently from what the
  * file asks (a glTF orthographic camera, which the renderer does not draw,
- * replaced): one line naming the file, valid during the callback only; from
- * the thread that made the call. */
+ * replaced), or meets geometry finer than its rays resolve (a polygon
+ * narrower than the shadow rays' tolerance, 1e-5 of the scene's size):
+ * one line naming the file, valid during the callback only; from the
+ * thread that made the call. */
 typedef void (*rad_warning_fn)(void *user, const char *message);
 
 typedef struct rad_context_options {
@@ -148,7 +150,8 @@ typedef struct rad_context_options {
                                     assimp, Embree, LAPACK and cJSON allocate themselves
                                     is not counted (loading refuses files that assimp
                                     would need more than the limit for: docs/robustness.md) */
-    rad_warning_fn on_warning;   /* optional: told of input read differently from the file */
+    rad_warning_fn on_warning;   /* optional: told of input read differently from the file,
+                                    and of geometry finer than the rays resolve */
     void *warning_user;          /* passed to `on_warning` */
 } rad_context_options;
 

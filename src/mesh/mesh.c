@@ -217,7 +217,7 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
     double tol = 1e-6 * (diag > 0.0 ? diag : 1.0);
     for (size_t i = 0; i < leaf_count; i++) {
         const rad_mesh_leaf *l = &leaves[i];
-        double width = mesh_corners_width(l->corner, l->corner_count);
+        double width = rad_corners_width(l->corner, l->corner_count);
         if (width > 0.0 && 1e-3 * width < tol)
             tol = 1e-3 * width;
     }

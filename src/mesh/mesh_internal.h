@@ -55,10 +55,6 @@ void mesh_grid_fill(rad_mesh *mesh, raw_vertex *raw);
 
 /* ---- weld.c ---- */
 
-/* A polygon's width: its shortest edge or 2 x area / longest edge,
- * whichever is less (3 or 4 corners); 0 when it has no extent. */
-double mesh_corners_width(const vec3 *corner, uint32_t count);
-
 /* The weld distance (m) for the sized patches of `mesh` in a scene of
  * diagonal `diag` (m).  Cannot fail. */
 double mesh_weld_tolerance(const rad_mesh *mesh, double diag);

@@ -111,7 +111,7 @@ static void cell_index_free(cell_index *ix)
  * zero-area elements.  The narrowest element is estimated per patch as
  * its width (2 x area / longest edge) or its shortest edge, whichever is
  * less, over its cells along the longest side. */
-double mesh_corners_width(const vec3 *corner, uint32_t count)
+double rad_corners_width(const vec3 *corner, uint32_t count)
 {
     vec3 n = count == 4 ? v3_cross(v3_sub(corner[2], corner[0]), v3_sub(corner[3], corner[1]))
                         : v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[2], corner[0]));
@@ -129,7 +129,7 @@ double mesh_weld_tolerance(const rad_mesh *mesh, double diag)
     double narrowest = HUGE_VAL;
     for (size_t i = 0; i < mesh->patch_count; i++) {
         const rad_patch *p = &mesh->patches[i];
-        double width = mesh_corners_width(p->corner, p->corner_count);
+        double width = rad_corners_width(p->corner, p->corner_count);
         uint32_t cells = p->nu > p->nv ? p->nu : p->nv;
         if (width > 0.0)
             narrowest = fmin(narrowest, width / (double)cells);

@@ -109,6 +109,18 @@ rad_result rad_strategy_mesh_and_vis(rad_context *ctx, const rad_scene *scene, c
         return r;
     }
     seconds->visibility = (*vis)->build_seconds;
+    /* Scale ratios: what the shadow rays cannot resolve is said once. */
+    double narrowest;
+    uint32_t which;
+    size_t unresolved = rad_vis_unresolved(*mesh, &narrowest, &which);
+    if (unresolved > 0)
+        rad_warn(ctx,
+                 "%s: %zu polygon%s (the narrowest %.3g m across, in surface '%s') %s narrower than "
+                 "the shadow rays' tolerance of %.3g m, 1e-5 of the scene's size: an occluder "
+                 "nearer to %s than that is not seen",
+                 scene->source, unresolved, unresolved == 1 ? "" : "s", narrowest,
+                 scene->surfaces[(*mesh)->patches[which].surface].name, unresolved == 1 ? "is" : "are",
+                 rad_vis_epsilon(*mesh), unresolved == 1 ? "it" : "them");
     return RAD_OK;
 }
 

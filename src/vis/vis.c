@@ -77,6 +77,25 @@ double rad_vis_epsilon(const rad_mesh *mesh)
     return 1e-5 * diagonal;
 }
 
+size_t rad_vis_unresolved(const rad_mesh *mesh, double *narrowest, uint32_t *which)
+{
+    double eps = rad_vis_epsilon(mesh);
+    size_t count = 0;
+    *narrowest = INFINITY;
+    *which = 0;
+    for (size_t i = 0; i < mesh->patch_count; i++) {
+        double width = rad_corners_width(mesh->patches[i].corner, mesh->patches[i].corner_count);
+        if (width < eps) {
+            count++;
+            if (width < *narrowest) {
+                *narrowest = width;
+                *which = (uint32_t)i;
+            }
+        }
+    }
+    return count;
+}
+
 /* Largest distance of a quad's corners from the plane of its first three. */
 static double patch_bend(const rad_patch *p)
 {

@@ -68,4 +68,10 @@ void rad_vis_destroy(rad_vis *vis);
  * self-intersection yet far below any element size we mesh to. */
 double rad_vis_epsilon(const rad_mesh *mesh);
 
+/* Patches narrower than rad_vis_epsilon: shadow rays end that far off the
+ * surfaces, so an occluder nearer than it to such a patch is not seen.
+ * Returns their count; *narrowest (m) and *which (a patch) tell the
+ * narrowest of them. */
+size_t rad_vis_unresolved(const rad_mesh *mesh, double *narrowest, uint32_t *which);
+
 #endif /* RAD_VIS_H */
