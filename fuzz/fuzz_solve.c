@@ -20,7 +20,9 @@
  *    the rows of F sum to at most 1; 4x leaves room for the estimators'
  *    own errors, not for a blow-up;
  *  - the emitted power the solution reports is sum_i A_i E_i over its
- *    elements (the hierarchical bookkeeping once reported 0 here).
+ *    elements (the hierarchical bookkeeping once reported 0 here);
+ *  - an 8 x 8 picture from the automatic camera has finite radiance >= 0
+ *    at every scale the grid reaches (2^-128 to 2^127 m).
  */
 #include "fuzz.h"
 
@@ -138,6 +140,24 @@ static void check_solution(const rad_solution *s, const method *m)
     FUZZ_CHECK(fabs(emitted - emitted_sum) <= 1e-9 * emitted_sum);
 }
 
+/* An 8 x 8 picture from the automatic camera, which frames the scene at
+ * whatever scale (a 1e18 m scene once put it where Embree aborts):
+ * radiance finite and >= 0 everywhere, or a one-line refusal. */
+static void check_render(rad_context *ctx, rad_solution *s)
+{
+    rad_render_options ro = {.width = 8, .height = 8, .samples = 1};
+    rad_image *image = NULL;
+    if (rad_solution_render(ctx, s, &ro, &image) != RAD_OK) {
+        const char *msg = rad_context_error(ctx);
+        FUZZ_CHECK(image == NULL && msg[0] != '\0' && strchr(msg, '\n') == NULL);
+        return;
+    }
+    const float *pixels = rad_image_pixels(image);
+    for (int k = 0; k < 3 * 8 * 8; k++)
+        FUZZ_CHECK(isfinite(pixels[k]) && pixels[k] >= 0.0f);
+    rad_image_destroy(image);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     if (size < 2)
@@ -163,6 +183,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             r = rad_solution_solve(ctx, s);
             if (r == RAD_OK)
                 check_solution(s, m);
+            if (r == RAD_OK)
+                check_render(ctx, s);
         }
         if (r != RAD_OK) {
             const char *msg = rad_context_error(ctx);
