@@ -431,8 +431,15 @@ static size_t names_field(const char *p, const cli_flag *f)
 
 char *cli_rewrite_message(const char *message, char *out, size_t size)
 {
-    /* The context's memory limit is the one --max-memory sets too (main.c). */
-    static const char context_limit[] = "rad_context_options.max_memory_bytes";
+    /* The context's fields that flags set (main.c), which the option table
+     * does not hold: the library names them in its messages too. */
+    static const struct {
+        const char *field, *flag;
+    } context_fields[] = {
+        {"rad_context_options.max_memory_bytes", "max-memory"},
+        {"rad_context_options.read_outside_scene_folder", "read-outside-scene-folder"},
+        {"rad_context_options.threads", "threads"},
+    };
     size_t n = 0;
     if (!size)
         return out;
@@ -440,11 +447,15 @@ char *cli_rewrite_message(const char *message, char *out, size_t size)
         size_t skip = 0, k = 0;
         while (k < FLAG_COUNT && !(skip = names_field(p, &FLAGS[k])))
             k++;
-        if (!skip && strncmp(p, context_limit, sizeof context_limit - 1) == 0) {
-            skip = sizeof context_limit - 1;
-            k = 0;
-            while (k < FLAG_COUNT && strcmp(FLAGS[k].name, "max-memory") != 0)
-                k++;
+        for (size_t c = 0; !skip && c < sizeof context_fields / sizeof context_fields[0]; c++) {
+            size_t length = strlen(context_fields[c].field);
+            char next = p[length];
+            if (strncmp(p, context_fields[c].field, length) != 0 || next == '_' ||
+                isalnum((unsigned char)next))
+                continue;
+            for (k = 0; k < FLAG_COUNT && strcmp(FLAGS[k].name, context_fields[c].flag) != 0; k++)
+                ;
+            skip = k < FLAG_COUNT ? length : 0;
         }
         if (skip && k < FLAG_COUNT) {
             size_t wrote = (size_t)snprintf(out + n, size - n, "--%s", FLAGS[k].name);

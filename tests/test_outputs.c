@@ -489,6 +489,8 @@ static void test_scene_references_confined(void **state)
     if (status != 1)
         fail_msg("status %d: %s", status, text_of("stderr.txt"));
     assert_one_line_error("/../quad.bin'", "outside the scene's folder");
+    /* The message names the flag, not the library's field. */
+    assert_non_null(strstr(err_text, "(--read-outside-scene-folder allows it)"));
     assert_false(exists("out.png"));
     assert_int_equal(run("render scene/out.gltf --read-outside-scene-folder --elements 50 --width 16 "
                          "--height 16 --quiet -o out.png"),
