@@ -234,7 +234,9 @@ typedef struct run_outputs {
  * alias, an unknown format), 1 when it cannot be written. */
 static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
 {
-    rad_output_kind kind = s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS : RAD_OUTPUT_IMAGE;
+    rad_output_kind kind = s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS
+                           : s->command == CLI_SOLVE     ? RAD_OUTPUT_SOLUTION
+                                                         : RAD_OUTPUT_IMAGE;
     rad_result r = rad_output_set_create(ctx, &o->set);
     if (r == RAD_OK && s->scene_path)
         r = rad_output_set_add_input(ctx, o->set, s->scene_path);
@@ -242,7 +244,7 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
         r = rad_output_set_add(ctx, o->set, s->output, kind, &o->main);
     if (r == RAD_OK && s->stats)
         r = rad_output_set_add(ctx, o->set, s->stats, RAD_OUTPUT_FILE, &o->stats);
-    if (r == RAD_OK && s->history && s->command == CLI_RENDER)
+    if (r == RAD_OK && s->history && (s->command == CLI_RENDER || s->command == CLI_SOLVE))
         r = rad_output_set_add(ctx, o->set, s->history, RAD_OUTPUT_FILE, &o->history);
     if (r == RAD_OK)
         return -1;
@@ -261,6 +263,38 @@ static int check_scene_inputs(rad_context *ctx, const rad_scene *scene, run_outp
         }
     }
     return -1;
+}
+
+/* The solve command's outputs: the solution file with the stats and the
+ * history, put in place together; an interrupted solve is not a solution,
+ * so it leaves the partial stats only.  Returns the exit status. */
+static int write_solution(rad_context *ctx, const settings *s, rad_solution *sol, run_outputs *out,
+                          int partial, double t0)
+{
+    begin_saving(ctx);
+    if (partial)
+        rad_output_set_drop(out->set, s->output);
+    rad_result r = partial ? RAD_OK : rad_solution_save(ctx, sol, out->main);
+    if (r == RAD_OK && s->stats)
+        r = rad_solution_write_stats(ctx, sol, out->stats, partial);
+    if (r == RAD_OK && s->history)
+        r = rad_solution_write_history(ctx, sol, out->history);
+    if (r == RAD_OK) {
+        fflush(stdout);
+        r = rad_output_set_commit(ctx, out->set);
+    }
+    if (r != RAD_OK)
+        return fail(ctx, r);
+    if (partial) {
+        fprintf(stderr, "radiosity: interrupted while solving; no solution file written%s\n",
+                s->stats ? ", the partial stats only" : "");
+        return interrupted_status();
+    }
+    char full[PATH_MAX];
+    if (!s->quiet)
+        printf("wrote %s (%zu elements, residual %.2g, %.1f s)\n", where(s->output, full),
+               rad_solution_element_count(sol), rad_solution_residual(sol), now_seconds() - t0);
+    return cancel_signal ? interrupted_status() : 0;
 }
 
 int main(int argc, char **argv)
@@ -312,10 +346,27 @@ int main(int argc, char **argv)
         goto done;
     status = 1;
 
-    /* 1. load */
+    /* 1. load: a scene, or for render a solution file (by its signature),
+     * which is solved already */
     double t0 = now_seconds();
-    r = s.scene_path ? rad_scene_load_file(ctx, s.scene_path, &scene)
-                     : rad_scene_create_cornell_box(ctx, &scene);
+    bool saved = s.scene_path && rad_file_is_solution(s.scene_path);
+    if (saved && s.command != CLI_RENDER) {
+        fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it; %s needs the "
+                        "scene it was solved for\n", s.scene_path, cli_command_name(s.command));
+        status = EXIT_USAGE;
+        goto done;
+    }
+    if (saved && (s.history || s.progress_dir)) {
+        fprintf(stderr, "radiosity: --%s: %s is a solution file, solved already: there is no solve to "
+                        "follow\n", s.history ? "history" : "progress-images", s.scene_path);
+        status = EXIT_USAGE;
+        goto done;
+    }
+    if (saved)
+        r = rad_solution_load_file(ctx, s.scene_path, &scene, &sol);
+    else
+        r = s.scene_path ? rad_scene_load_file(ctx, s.scene_path, &scene)
+                         : rad_scene_create_cornell_box(ctx, &scene);
     if (r != RAD_OK) {
         status = fail(ctx, r);
         goto done;
@@ -362,8 +413,8 @@ int main(int argc, char **argv)
         s.solve.on_step_user = &prog;
     }
 
-    /* 2-3. mesh, visibility, form factors */
-    r = rad_solution_create(ctx, scene, &s.solve, &sol);
+    /* 2-3. mesh, visibility, form factors (a loaded solution has them) */
+    r = saved ? RAD_OK : rad_solution_create(ctx, scene, &s.solve, &sol);
     progress_end(&progress);
     if (r == RAD_ERROR_INTERRUPTED) {
         /* No radiosity yet, so no image: only the stats say what happened. */
@@ -405,8 +456,8 @@ int main(int argc, char **argv)
         goto done;
     }
 
-    /* 4. solve */
-    r = rad_solution_solve(ctx, sol);
+    /* 4. solve (a loaded solution is solved) */
+    r = saved ? RAD_OK : rad_solution_solve(ctx, sol);
     progress_end(&progress);
     if (prog.failed) {
         status = fail(ctx, RAD_ERROR_IO);
@@ -428,6 +479,11 @@ int main(int argc, char **argv)
         else
             fprintf(stderr, "radiosity: warning: stopped unconverged after %d iterations\n",
                     rad_solution_iterations(sol));
+    }
+
+    if (s.command == CLI_SOLVE) {
+        status = write_solution(ctx, &s, sol, &out, partial, t0);
+        goto done;
     }
 
     /* 5. image, stats and history, into their temporaries, then all put in

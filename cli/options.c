@@ -38,6 +38,8 @@ static const command_def COMMANDS[] = {
      "write the view factors between the scene's named surfaces"},
     {CLI_GENERATE, "generate", "generate office [options]",
      "write a procedural office floor as OBJ + MTL (docs/scenes.md)"},
+    {CLI_SOLVE, "solve", "solve [SCENE] [options]",
+     "solve the scene and write the solution file, to render from any camera without solving again"},
 };
 #define COMMAND_COUNT (sizeof COMMANDS / sizeof COMMANDS[0])
 
@@ -51,8 +53,9 @@ const char *cli_command_name(int command)
 
 /* ---- the flags ---- */
 
-#define RV (CLI_RENDER | CLI_VIEWFACTORS)
-#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_GENERATE)
+#define RS (CLI_RENDER | CLI_SOLVE)
+#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_SOLVE)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_GENERATE | CLI_SOLVE)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
 #define RENDER(field_) .target = CLI_TO_RENDER, .field = #field_
 #define OFFICE(field_) .target = CLI_TO_OFFICE, .field = #field_
@@ -71,12 +74,15 @@ static const cli_flag FLAGS[] = {
      .own.default_text = "viewfactors.json"},
     {"output", 'o', "FILE", CLI_GENERATE, OWN(output, RAD_OPTION_STRING),
      .own.help = "output OBJ; the MTL is written beside it", .own.default_text = "office.obj"},
+    {"output", 'o', "FILE", CLI_SOLVE, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output solution file, .radsol (docs/formats.md); `radiosity render FILE` draws it",
+     .own.default_text = "solution.radsol"},
     {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
     {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
     {"mesh-size", 0, "L", RV, SOLVE(mesh_size)},
     {"elements", 0, "N", RV, SOLVE(target_elements)},
     {"form-factors", 0, "NAME", RV, SOLVE(form_factors)},
-    {"solver", 0, "NAME", CLI_RENDER, SOLVE(solver)},
+    {"solver", 0, "NAME", RS, SOLVE(solver)},
     {"visibility", 0, "NAME", RV, SOLVE(visibility)},
     {"shadow-rays", 0, "N", RV, SOLVE(shadow_rays)},
     {"hemicube-res", 0, "N", RV, SOLVE(hemicube_resolution)},
@@ -85,15 +91,15 @@ static const cli_flag FLAGS[] = {
     {"closure-correction", 0, NULL, RV, SOLVE(closure_correction)},
     {"level", 0, "WHICH", CLI_VIEWFACTORS, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
      .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
-    {"epsilon", 0, "X", CLI_RENDER, SOLVE(epsilon)},
-    {"min-area", 0, "A", CLI_RENDER, SOLVE(min_area)},
-    {"clustering", 0, "WHEN", CLI_RENDER, SOLVE(clustering)},
-    {"oracle", 0, "WHICH", CLI_RENDER, SOLVE(classic_oracle)},
-    {"tolerance", 0, "X", CLI_RENDER, SOLVE(tolerance)},
-    {"max-iterations", 0, "N", CLI_RENDER, SOLVE(max_iterations)},
-    {"unshot-tolerance", 0, "X", CLI_RENDER, SOLVE(unshot_tolerance)},
-    {"relaxation", 0, "W", CLI_RENDER, SOLVE(relaxation)},
-    {"history", 0, "FILE.csv", CLI_RENDER, OWN(history, RAD_OPTION_STRING),
+    {"epsilon", 0, "X", RS, SOLVE(epsilon)},
+    {"min-area", 0, "A", RS, SOLVE(min_area)},
+    {"clustering", 0, "WHEN", RS, SOLVE(clustering)},
+    {"oracle", 0, "WHICH", RS, SOLVE(classic_oracle)},
+    {"tolerance", 0, "X", RS, SOLVE(tolerance)},
+    {"max-iterations", 0, "N", RS, SOLVE(max_iterations)},
+    {"unshot-tolerance", 0, "X", RS, SOLVE(unshot_tolerance)},
+    {"relaxation", 0, "W", RS, SOLVE(relaxation)},
+    {"history", 0, "FILE.csv", RS, OWN(history, RAD_OPTION_STRING),
      .own.help = "write the convergence history: iteration, seconds, residual, unshot power"},
     {"progress-images", 0, "DIR", CLI_RENDER, OWN(progress_dir, RAD_OPTION_STRING),
      .own.help = "write the image every --every iterations while solving (progressive display)"},

@@ -554,6 +554,42 @@ RAD_API double rad_image_auto_exposure(const rad_image *image);
 RAD_API rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image,
                                            const char *path, double exposure);
 
+/* ---- the solution file: solve once, render from any camera ---- */
+
+/* Write the solved solution to `path` (docs/formats.md, "Solution file"):
+ * its scene (polygons, surfaces, materials, camera, with a checksum), its
+ * mesh (patches, elements, welded vertices, T-vertices, quadtrees), each
+ * element's and vertex's radiosity in W/m^2 as doubles, the options and the
+ * solve's figures; atomically (a temporary, renamed).  The vertex values
+ * are the renderer's, so they are computed here if no render did.  Fails
+ * with RAD_ERROR_INVALID_ARGUMENT for a solution not solved (or NULL ctx,
+ * solution or path), RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY.  Not at the same
+ * time as other calls on the same solution. */
+RAD_API rad_result rad_solution_save(rad_context *ctx, rad_solution *solution, const char *path);
+
+/* Read a solution file: *scene is the scene it was solved for (rebuilt and
+ * checked against its checksum) and *solution the solved solution, which
+ * borrows *scene: destroy the solution, then the scene.  Everything in the
+ * file is validated (signature, version, counts, checksum, every index,
+ * every value); a file that is not a solution file or is damaged fails with
+ * RAD_ERROR_PARSE and one line naming the file and what is wrong; a scene
+ * that does not validate with RAD_ERROR_INVALID_SCENE; RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY (the file and what it holds count against the
+ * memory limit).  The loaded solution renders, answers every accessor and
+ * writes its stats; it is solved (rad_solution_solve does nothing) and
+ * holds no form factors (view factors are zero).  On failure both are NULL.
+ * NULL ctx, path, scene or solution: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_load_file(rad_context *ctx, const char *path, rad_scene **scene,
+                                          rad_solution **solution);
+/* The same from `size` bytes at `data`; `name` stands for the file in
+ * messages. */
+RAD_API rad_result rad_solution_load_memory(rad_context *ctx, const char *name, const void *data,
+                                            size_t size, rad_scene **scene, rad_solution **solution);
+/* True if `path` is a regular file that begins with the solution file's
+ * signature (the command line reads such a file as a solution, anything
+ * else as a scene).  Any thread; NULL: false. */
+RAD_API bool rad_file_is_solution(const char *path);
+
 /* Stats as JSON (schema in docs/stats.md), atomically.  `partial` marks an
  * interrupted run.  Fails with RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY; NULL
  * ctx, solution or path: RAD_ERROR_INVALID_ARGUMENT. */
@@ -610,7 +646,8 @@ typedef struct rad_output_set rad_output_set;
 typedef enum rad_output_kind {
     RAD_OUTPUT_FILE = 0,        /* any name: stats, history, OBJ */
     RAD_OUTPUT_IMAGE = 1,       /* .png, .hdr, .pfm (rad_image_write) */
-    RAD_OUTPUT_VIEW_FACTORS = 2 /* .json, .csv, .mtx (rad_solution_write_view_factors) */
+    RAD_OUTPUT_VIEW_FACTORS = 2, /* .json, .csv, .mtx (rad_solution_write_view_factors) */
+    RAD_OUTPUT_SOLUTION = 16     /* .radsol (rad_solution_save) */
 } rad_output_kind;
 
 /* An empty set.  Fails with RAD_ERROR_OUT_OF_MEMORY; NULL ctx or out:

@@ -7,9 +7,13 @@
  *     options --> strategy: mesh -> visibility -> couplings -> B --> view
  */
 #include "api/solution.h"
+#include "strategy/saved.h"
 
+#include <errno.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* The view downstream code reads, after the strategy changed its state. */
 static void refresh_view(rad_solution *s)
@@ -296,18 +300,12 @@ bool rad_solution_element_values(const rad_solution *s, size_t element, double r
     return true;
 }
 
-rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_render_options *options,
-                               rad_image **out)
+/* What is displayed: each element's radiosity (plus the ambient term of a
+ * partial shooting solution) in *display (3n, rad_free it), and the vertex
+ * values interpolated from it in s->vertex_radiosity. */
+static rad_result display_values(rad_context *ctx, rad_solution *s, double **display_out)
 {
-    rad_api_enter(ctx);
-    if (out)
-        *out = NULL;
-    if (!ctx || !s || !out)
-        return rad_null_argument(ctx, __func__);
-    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
-    rad_render_options o = options ? *options : (rad_render_options){0};
     size_t n = s->view.mesh->element_count;
-    /* Display values: a partial shooting solution gets the ambient term. */
     double *display = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *display, "render: element values");
     if (!display)
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -322,12 +320,30 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
         rad_free(display);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    double t = rad_seconds();
     rad_result r = rad_vertex_values(ctx, s->view.mesh, display, s->vertex_radiosity);
     if (r != RAD_OK) {
         rad_free(display);
         return r;
     }
+    *display_out = display;
+    return RAD_OK;
+}
+
+rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_render_options *options,
+                               rad_image **out)
+{
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !s || !out)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+    rad_render_options o = options ? *options : (rad_render_options){0};
+    double *display = NULL;
+    double t = rad_seconds();
+    rad_result r = display_values(ctx, s, &display);
+    if (r != RAD_OK)
+        return r;
     rad_render_input in;
     in.mesh = s->view.mesh;
     in.vis = s->view.vis;
@@ -354,6 +370,150 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     s->view.render_rays = (uint64_t)w * (uint64_t)h * (uint64_t)spp * (uint64_t)spp;
     rad_free(display);
     return r;
+}
+
+rad_result rad_solution_save(rad_context *ctx, rad_solution *s, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+    double *display = NULL;
+    rad_result r = display_values(ctx, s, &display);
+    if (r == RAD_OK)
+        r = rad_write_solution(ctx, &s->view, s->vertex_radiosity, path);
+    rad_free(display);
+    return r;
+}
+
+rad_result rad_solution_load_memory(rad_context *ctx, const char *name, const void *data, size_t size,
+                                    rad_scene **scene, rad_solution **out)
+{
+    rad_api_enter(ctx);
+    if (scene)
+        *scene = NULL;
+    if (out)
+        *out = NULL;
+    if (!ctx || !name || (!data && size) || !scene || !out)
+        return rad_null_argument(ctx, __func__);
+    rad_solution *s = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *s, "solution");
+    if (!s)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    s->ctx = ctx;
+    s->threads = rad_context_threads(ctx);
+    rad_scene *loaded = NULL;
+    double t = rad_seconds();
+    rad_result r = rad_saved_read(ctx, name, data, size, &loaded, &s->options, &s->names, &s->state);
+    if (r != RAD_OK) {
+        rad_free(s);
+        return r;
+    }
+    s->options.max_memory_bytes = rad_memory_limit(ctx);
+    loaded->load_seconds = rad_seconds() - t;
+    s->scene = loaded;
+    s->strategy = &rad_strategy_saved;
+    s->view.seconds.load = loaded->load_seconds;
+    refresh_view(s);
+    *scene = loaded;
+    *out = s;
+    return RAD_OK;
+}
+
+/* The whole file at `path` in a block of the context (rad_free it), within
+ * its memory limit: a regular file by its size, a stream as it comes. */
+static rad_result read_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size)
+{
+    *data = NULL;
+    *size = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    size_t capacity = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) ? (size_t)st.st_size + 1 : 65536;
+    if (S_ISDIR(st.st_mode)) {
+        fclose(f);
+        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: Is a directory", path);
+    }
+    unsigned char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, "solution file");
+    size_t used = 0;
+    while (buffer) {
+        size_t got = fread(buffer + used, 1, capacity - used, f);
+        used += got;
+        if (used < capacity) {
+            if (ferror(f)) {
+                rad_free(buffer);
+                fclose(f);
+                return rad_fail(ctx, rad_cancelled(ctx) ? RAD_ERROR_INTERRUPTED : RAD_ERROR_IO,
+                                "%s: cannot read: %s", path, strerror(errno));
+            }
+            break;
+        }
+        unsigned char *grown = rad_realloc(ctx, RAD_MEM_SCENE, buffer, 2 * capacity, 1, "solution file");
+        if (!grown)
+            rad_free(buffer);
+        buffer = grown;
+        capacity *= 2;
+    }
+    fclose(f);
+    if (!buffer)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    *data = buffer;
+    *size = used;
+    return RAD_OK;
+}
+
+rad_result rad_solution_load_file(rad_context *ctx, const char *path, rad_scene **scene, rad_solution **out)
+{
+    rad_api_enter(ctx);
+    if (scene)
+        *scene = NULL;
+    if (out)
+        *out = NULL;
+    if (!ctx || !path || !scene || !out)
+        return rad_null_argument(ctx, __func__);
+    unsigned char *data;
+    size_t size;
+    double t = rad_seconds();
+    rad_result r = read_file(ctx, path, &data, &size);
+    if (r != RAD_OK)
+        return r;
+    r = rad_solution_load_memory(ctx, path, data, size, scene, out);
+    rad_free(data);
+    if (r != RAD_OK)
+        return r;
+    /* The file is the scene's one input (an output must not overwrite it). */
+    char **inputs = rad_alloc(ctx, RAD_MEM_SCENE, 1, sizeof *inputs, "solution file: inputs");
+    char *copy = inputs ? rad_strdup(ctx, RAD_MEM_SCENE, path, "solution file: inputs") : NULL;
+    if (!copy) {
+        rad_free(inputs);
+        rad_solution_destroy(*out);
+        rad_scene_destroy(*scene);
+        *out = NULL;
+        *scene = NULL;
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    inputs[0] = copy;
+    rad_scene_set_inputs(*scene, inputs, 1);
+    (*scene)->load_seconds = rad_seconds() - t;
+    (*out)->view.seconds.load = (*scene)->load_seconds;
+    return RAD_OK;
+}
+
+bool rad_file_is_solution(const char *path)
+{
+    if (!path)
+        return false;
+    struct stat st;
+    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode))
+        return false;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    unsigned char magic[RAD_SAVED_MAGIC_SIZE];
+    bool is = fread(magic, 1, sizeof magic, f) == sizeof magic &&
+              memcmp(magic, RAD_SAVED_MAGIC, RAD_SAVED_MAGIC_SIZE) == 0;
+    fclose(f);
+    return is;
 }
 
 rad_result rad_solution_write_stats(rad_context *ctx, const rad_solution *s, const char *path, bool partial)

@@ -128,7 +128,11 @@ static rad_result check_format(rad_context *ctx, const char *path, rad_output_ki
         strcmp(ext, "mtx") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: unknown view-factor format (use .json, .csv or .mtx)", path);
-    if (kind != RAD_OUTPUT_FILE && kind != RAD_OUTPUT_IMAGE && kind != RAD_OUTPUT_VIEW_FACTORS)
+    if (kind == RAD_OUTPUT_SOLUTION && strcmp(ext, "radsol") != 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: a solution file is named .radsol (docs/formats.md)", path);
+    if (kind != RAD_OUTPUT_FILE && kind != RAD_OUTPUT_IMAGE && kind != RAD_OUTPUT_VIEW_FACTORS &&
+        kind != RAD_OUTPUT_SOLUTION)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown output kind %d", path,
                         (int)kind);
     return RAD_OK;

@@ -65,6 +65,12 @@ rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *
  * interrupted run. */
 rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *view, const char *path, bool partial);
 
+/* The solution file (strategy/saved.h): the view's scene, mesh and values
+ * with the vertex values the renderer uses (3 per mesh vertex), written
+ * atomically to `path`.  RAD_ERROR_INVALID_ARGUMENT when it is not solved. */
+rad_result rad_write_solution(rad_context *ctx, const rad_solution_view *view, const double *vertex_radiosity,
+                              const char *path);
+
 /* View factors by the path's extension (.json, .csv, .mtx; docs/formats.md),
  * surface-level or, with `elements`, element-level.  Fails without F. */
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *view, const char *path,

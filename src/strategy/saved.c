@@ -1,0 +1,818 @@
+/*
+ * saved.c -- a solution read back from its file (saved.h has the layout):
+ * the bytes are checked, the scene rebuilt and checked against its
+ * checksum, the mesh checked index by index, and the result is a strategy
+ * whose state is the solved mesh with its values.
+ *
+ *   bytes -> magic, header (JSON), payload checksum
+ *         -> scene: builder (validates each polygon) -> checksum
+ *         -> mesh: counts, indices, grids and quadtrees, geometry
+ *         -> values: finite, >= 0 -> ray structure -> strategy state
+ *
+ * The encoding helpers (FNV-1a, the byte buffer, the scene and mesh
+ * arrays) are here too, for the writer (output/solution_file.c) downstream.
+ */
+#include "strategy/saved.h"
+
+#include "api/options.h"
+
+#include <cjson/cJSON.h>
+#include <inttypes.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- encoding ---- */
+
+uint64_t rad_fnv1a(uint64_t hash, const void *data, size_t size)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < size; i++) {
+        hash ^= p[i];
+        hash *= 0x100000001b3ull;
+    }
+    return hash;
+}
+
+static void bytes_reserve(rad_bytes *b, size_t more)
+{
+    if (b->failed || b->size + more <= b->capacity)
+        return;
+    size_t capacity = b->capacity ? b->capacity : 4096;
+    while (capacity < b->size + more)
+        capacity *= 2;
+    unsigned char *grown = rad_realloc(b->ctx, RAD_MEM_OUTPUT, b->data, capacity, 1, "solution file");
+    if (!grown) {
+        b->failed = true;
+        return;
+    }
+    b->data = grown;
+    b->capacity = capacity;
+}
+
+void rad_bytes_raw(rad_bytes *b, const void *data, size_t size)
+{
+    bytes_reserve(b, size);
+    if (b->failed)
+        return;
+    memcpy(b->data + b->size, data, size);
+    b->size += size;
+}
+
+void rad_bytes_u32(rad_bytes *b, uint32_t v)
+{
+    unsigned char le[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16),
+                           (unsigned char)(v >> 24)};
+    rad_bytes_raw(b, le, 4);
+}
+
+void rad_bytes_f64(rad_bytes *b, double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, 8);
+    unsigned char le[8];
+    for (int k = 0; k < 8; k++)
+        le[k] = (unsigned char)(u >> (8 * k));
+    rad_bytes_raw(b, le, 8);
+}
+
+void rad_bytes_free(rad_bytes *b)
+{
+    rad_free(b->data);
+    b->data = NULL;
+    b->size = b->capacity = 0;
+}
+
+static void put_vec3(rad_bytes *b, vec3 v)
+{
+    rad_bytes_f64(b, v.x);
+    rad_bytes_f64(b, v.y);
+    rad_bytes_f64(b, v.z);
+}
+
+/* The hash of a value in its little-endian encoding. */
+static uint64_t hash_u32(uint64_t h, uint32_t v)
+{
+    unsigned char le[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16),
+                           (unsigned char)(v >> 24)};
+    return rad_fnv1a(h, le, 4);
+}
+
+static uint64_t hash_f64(uint64_t h, double v)
+{
+    uint64_t u;
+    memcpy(&u, &v, 8);
+    unsigned char le[8];
+    for (int k = 0; k < 8; k++)
+        le[k] = (unsigned char)(u >> (8 * k));
+    return rad_fnv1a(h, le, 8);
+}
+
+uint64_t rad_saved_scene_checksum(const rad_scene *scene)
+{
+    uint64_t h = RAD_FNV_OFFSET;
+    for (size_t i = 0; i < scene->polygon_count; i++) {
+        const rad_polygon *p = &scene->polygons[i];
+        h = hash_u32(h, p->vertex_count);
+        h = hash_u32(h, p->surface);
+        h = hash_u32(h, p->material);
+        for (uint32_t k = 0; k < p->vertex_count; k++) {
+            vec3 v = scene->positions[scene->indices[p->first_index + k]];
+            h = hash_f64(hash_f64(hash_f64(h, v.x), v.y), v.z);
+        }
+    }
+    for (size_t s = 0; s < scene->surface_count; s++)
+        h = rad_fnv1a(h, scene->surfaces[s].name, strlen(scene->surfaces[s].name) + 1);
+    for (size_t m = 0; m < scene->material_count; m++) {
+        const rad_material *mat = &scene->materials[m];
+        h = rad_fnv1a(h, mat->name, strlen(mat->name) + 1);
+        for (int c = 0; c < 3; c++)
+            h = hash_f64(hash_f64(h, mat->reflectance[c]), mat->emission[c]);
+    }
+    return h;
+}
+
+void rad_saved_put_scene_and_mesh(rad_bytes *b, const rad_scene *scene, const rad_mesh *mesh,
+                                  cJSON *counts)
+{
+    /* The scene: each polygon's own vertices, as the builder stores them. */
+    size_t corners = 0;
+    for (size_t i = 0; i < scene->polygon_count; i++)
+        corners += scene->polygons[i].vertex_count;
+    for (size_t i = 0; i < scene->polygon_count; i++) {
+        const rad_polygon *p = &scene->polygons[i];
+        for (uint32_t k = 0; k < p->vertex_count; k++)
+            put_vec3(b, scene->positions[scene->indices[p->first_index + k]]);
+    }
+    for (size_t i = 0; i < scene->polygon_count; i++) {
+        const rad_polygon *p = &scene->polygons[i];
+        rad_bytes_u32(b, p->vertex_count);
+        rad_bytes_u32(b, p->surface);
+        rad_bytes_u32(b, p->material);
+        rad_bytes_u32(b, 0);
+    }
+    /* Materials and camera as doubles here, not in the JSON: cJSON prints
+     * 15 digits where they read back within an ulp, and every bit counts
+     * (the scene's checksum, the same picture again). */
+    for (size_t m = 0; m < scene->material_count; m++)
+        for (int c = 0; c < 3; c++) {
+            rad_bytes_f64(b, scene->materials[m].reflectance[c]);
+            rad_bytes_f64(b, scene->materials[m].emission[c]);
+        }
+    rad_bytes_u32(b, scene->has_camera ? 1u : 0u);
+    rad_bytes_u32(b, 0);
+    const double *camera[3] = {scene->camera.position, scene->camera.look_at, scene->camera.up};
+    for (int k = 0; k < 3; k++)
+        for (int c = 0; c < 3; c++)
+            rad_bytes_f64(b, scene->has_camera ? camera[k][c] : 0.0);
+    rad_bytes_f64(b, scene->has_camera ? scene->camera.vfov_degrees : 0.0);
+    for (size_t i = 0; i < mesh->patch_count; i++) {
+        const rad_patch *p = &mesh->patches[i];
+        const uint32_t fields[9] = {p->polygon, p->surface, p->material, p->corner_count, p->nu,
+                                    p->nv, p->first_element, p->element_count, p->tree_root};
+        for (int k = 0; k < 9; k++)
+            rad_bytes_u32(b, fields[k]);
+        rad_bytes_u32(b, 0);
+        for (int c = 0; c < 4; c++)
+            put_vec3(b, p->corner[c]);
+        put_vec3(b, p->normal);
+    }
+    for (size_t i = 0; i < mesh->element_count; i++) {
+        const rad_element *e = &mesh->elements[i];
+        const uint32_t fields[8] = {e->patch, e->surface, e->material, e->vertex_count,
+                                    e->vertex[0], e->vertex[1], e->vertex[2], e->vertex[3]};
+        for (int k = 0; k < 8; k++)
+            rad_bytes_u32(b, fields[k]);
+        put_vec3(b, e->centroid);
+        put_vec3(b, e->normal);
+        rad_bytes_f64(b, e->area);
+    }
+    for (size_t i = 0; i < mesh->vertex_count; i++)
+        put_vec3(b, mesh->vertices[i]);
+    for (size_t i = 0; i < mesh->tvertex_count; i++) {
+        const rad_tvertex *t = &mesh->tvertices[i];
+        rad_bytes_u32(b, t->vertex);
+        rad_bytes_u32(b, t->a);
+        rad_bytes_u32(b, t->b);
+        rad_bytes_u32(b, 0);
+        rad_bytes_f64(b, t->t);
+    }
+    for (size_t i = 0; i < 4 * mesh->tree_count; i++)
+        rad_bytes_u32(b, mesh->tree[i]);
+    cJSON_AddNumberToObject(counts, "corners", (double)corners);
+    cJSON_AddNumberToObject(counts, "polygons", (double)scene->polygon_count);
+    cJSON_AddNumberToObject(counts, "materials", (double)scene->material_count);
+    cJSON_AddNumberToObject(counts, "patches", (double)mesh->patch_count);
+    cJSON_AddNumberToObject(counts, "elements", (double)mesh->element_count);
+    cJSON_AddNumberToObject(counts, "vertices", (double)mesh->vertex_count);
+    cJSON_AddNumberToObject(counts, "tvertices", (double)mesh->tvertex_count);
+    cJSON_AddNumberToObject(counts, "tree_nodes", (double)mesh->tree_count);
+}
+
+/* ---- decoding ---- */
+
+/* A bounds-checked reader over the payload. */
+typedef struct cursor {
+    const unsigned char *p, *end;
+} cursor;
+
+static uint32_t get_u32(cursor *c)
+{
+    const unsigned char *p = c->p;
+    c->p += 4;
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static double get_f64(cursor *c)
+{
+    uint64_t u = 0;
+    for (int k = 0; k < 8; k++)
+        u |= (uint64_t)c->p[k] << (8 * k);
+    c->p += 8;
+    double v;
+    memcpy(&v, &u, 8);
+    return v;
+}
+
+static vec3 get_vec3(cursor *c)
+{
+    double x = get_f64(c), y = get_f64(c);
+    return v3(x, y, get_f64(c));
+}
+
+typedef struct saved_state {
+    rad_mesh *mesh;
+    rad_mesh *patches;       /* hierarchical: the patches meshed whole, which the rays see */
+    rad_vis *vis;
+    rad_elements elements;
+    rad_ff_stats ff_stats;
+    rad_solve_stats solve_stats;
+    rad_phase_seconds seconds;
+    char ff_method[32], solve_method[32];
+} saved_state;
+
+static void saved_destroy(void *state)
+{
+    saved_state *st = state;
+    if (!st)
+        return;
+    rad_vis_destroy(st->vis);
+    rad_mesh_destroy(st->mesh);
+    rad_mesh_destroy(st->patches);
+    rad_elements_free(&st->elements);
+    rad_free(st);
+}
+
+static bool saved_solver_info(size_t index, const char **name, const char **description)
+{
+    (void)index, (void)name, (void)description;
+    return false; /* made from a file, never chosen by a solver's name */
+}
+
+static rad_result saved_create(rad_context *ctx, const rad_scene *scene, const rad_options *options,
+                               void **state)
+{
+    (void)scene, (void)options;
+    *state = NULL;
+    return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                    "a saved solution is made by rad_solution_load_file, not by a solver's name");
+}
+
+static rad_result saved_solve(rad_context *ctx, void *state, const rad_step_hook *hook)
+{
+    (void)ctx, (void)state, (void)hook;
+    return RAD_OK; /* solved when it was saved */
+}
+
+static void saved_view(const void *state, rad_solution_view *v)
+{
+    const saved_state *st = state;
+    rad_view_elements(v, st->mesh, &st->elements);
+    v->vis = st->vis;
+    v->F = NULL;
+    v->F_variance = NULL;
+    v->ff = &st->ff_stats;
+    v->solve = &st->solve_stats;
+    v->hier = NULL;
+    v->solved = true;
+    v->seconds = st->seconds;
+}
+
+const rad_strategy rad_strategy_saved = {
+    "saved",
+    "a solution read from its file: solved, rendered from any camera",
+    saved_solver_info,
+    saved_create,
+    saved_solve,
+    saved_view,
+    saved_destroy,
+};
+
+/* Every reader error names the file; RAD_ERROR_PARSE unless said. */
+#define BAD(...) (rad_fail(ctx, RAD_ERROR_PARSE, __VA_ARGS__))
+
+static double number_in(const cJSON *object, const char *key)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
+    return cJSON_IsNumber(item) ? item->valuedouble : NAN;
+}
+
+/* A count from the header: an integer in [0, most]. */
+static bool count_in(const cJSON *counts, const char *key, size_t most, size_t *out)
+{
+    double v = number_in(counts, key);
+    if (!(v >= 0.0 && v <= (double)most && v == floor(v)))
+        return false;
+    *out = (size_t)v;
+    return true;
+}
+
+/* The options as saved: each row of the option table by its type. */
+static rad_result read_options(rad_context *ctx, const char *name, const cJSON *json, rad_options *out,
+                               rad_method_names *names)
+{
+    rad_options o = {0};
+    char methods[3][32] = {"", "", ""};
+    int method_slot = 0;
+    for (size_t i = 0;; i++) {
+        const rad_option_info *row = rad_option_info_get(RAD_OPTION_SET_SOLUTION, i);
+        if (!row)
+            break;
+        const cJSON *item = cJSON_GetObjectItemCaseSensitive(json, row->name);
+        if (!item)
+            continue; /* 0: the default */
+        char *field = (char *)&o + row->offset;
+        switch (row->type) {
+        case RAD_OPTION_INT:
+        case RAD_OPTION_FLAG:
+        case RAD_OPTION_ENUM: {
+            if (!cJSON_IsNumber(item) || !(fabs(item->valuedouble) < 2147483647.0))
+                return BAD("%s: option '%s' is not an integer", name, row->name);
+            int v = (int)item->valuedouble;
+            memcpy(field, &v, sizeof v);
+            break;
+        }
+        case RAD_OPTION_SIZE: {
+            if (!cJSON_IsNumber(item) || !(item->valuedouble >= 0.0 && item->valuedouble < 9.0e15))
+                return BAD("%s: option '%s' is not a count", name, row->name);
+            size_t v = (size_t)item->valuedouble;
+            memcpy(field, &v, sizeof v);
+            break;
+        }
+        case RAD_OPTION_UINT64: {
+            /* Decimal digits, exactly (a double would round past 2^53). */
+            const char *text = cJSON_GetStringValue(item);
+            uint64_t v = 0;
+            bool ok = text && *text && strlen(text) <= 20;
+            for (const char *p = text; ok && *p; p++) {
+                ok = *p >= '0' && *p <= '9' && v <= (UINT64_MAX - (uint64_t)(*p - '0')) / 10;
+                v = ok ? 10 * v + (uint64_t)(*p - '0') : v;
+            }
+            if (!ok)
+                return BAD("%s: option '%s' is not an unsigned 64-bit integer", name, row->name);
+            memcpy(field, &v, sizeof v);
+            break;
+        }
+        case RAD_OPTION_DOUBLE:
+        case RAD_OPTION_BYTES: {
+            if (!cJSON_IsNumber(item) || !isfinite(item->valuedouble))
+                return BAD("%s: option '%s' is not a finite number", name, row->name);
+            double v = item->valuedouble;
+            memcpy(field, &v, sizeof v);
+            break;
+        }
+        case RAD_OPTION_METHOD: {
+            const char *text = cJSON_GetStringValue(item);
+            if (!text || strlen(text) >= sizeof methods[0] || method_slot == 3)
+                return BAD("%s: option '%s' is not a method name", name, row->name);
+            snprintf(methods[method_slot], sizeof methods[0], "%s", text);
+            const char *v = methods[method_slot++];
+            memcpy(field, &v, sizeof v);
+            break;
+        }
+        case RAD_OPTION_STRING:
+            break;
+        }
+    }
+    o.max_memory_bytes = 0.0; /* the reader's machine, not the writer's */
+    rad_result r = rad_options_resolve(ctx, &o, out, names);
+    if (r != RAD_OK)
+        return rad_fail(ctx, RAD_ERROR_PARSE, "%s: saved options: %s", name, rad_context_error(ctx));
+    return RAD_OK;
+}
+
+/* Rebuild the scene through the builder, which validates every polygon:
+ * surfaces and material names from the header; corners, polygons,
+ * material values and camera from the payload at *c. */
+static rad_result read_scene(rad_context *ctx, const char *name, const cJSON *header, cursor *c,
+                             size_t corners, size_t polygons, size_t material_count, rad_scene **out)
+{
+    const cJSON *scene = cJSON_GetObjectItemCaseSensitive(header, "scene");
+    const cJSON *surfaces = cJSON_GetObjectItemCaseSensitive(scene, "surfaces");
+    const cJSON *materials = cJSON_GetObjectItemCaseSensitive(scene, "materials");
+    const char *source = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(scene, "source"));
+    const char *checksum = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(scene, "checksum"));
+    if (!cJSON_IsArray(surfaces) || !cJSON_IsArray(materials) || !source || !checksum ||
+        cJSON_GetArraySize(materials) != (int)material_count)
+        return BAD("%s: the header has no scene (source, checksum, surfaces, %zu materials)", name,
+                   material_count);
+    cursor at = *c, table = {c->p + 24 * corners, c->end};
+    cursor values = {table.p + 16 * polygons, c->end};
+    cursor camera_at = {values.p + 48 * material_count, c->end};
+    c->p = camera_at.p + 88;
+    rad_scene_builder *b = rad_scene_builder_create(ctx, source);
+    if (!b)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    int surface_count = cJSON_GetArraySize(surfaces);
+    rad_result r = RAD_OK;
+    for (int i = 0; r == RAD_OK && i < surface_count; i++) {
+        const char *s = cJSON_GetStringValue(cJSON_GetArrayItem(surfaces, i));
+        if (!s)
+            r = BAD("%s: surface %d has no name", name, i);
+        else if (rad_scene_builder_surface(b, s) != i)
+            r = rad_context_error(ctx)[0] ? RAD_ERROR_OUT_OF_MEMORY
+                                          : BAD("%s: surface '%s' is named twice", name, s);
+    }
+    for (size_t i = 0; r == RAD_OK && i < material_count; i++) {
+        const cJSON *m = cJSON_GetArrayItem(materials, (int)i);
+        const char *mname = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(m, "name"));
+        double reflectance[3], emission[3];
+        bool ok = mname != NULL;
+        for (int k = 0; k < 3; k++) {
+            reflectance[k] = get_f64(&values);
+            emission[k] = get_f64(&values);
+            ok = ok && reflectance[k] >= 0.0 && reflectance[k] < 1.0 && emission[k] >= 0.0 &&
+                 isfinite(emission[k]);
+        }
+        if (!ok)
+            r = BAD("%s: material %zu: a name, 3 reflectances in [0, 1) and 3 finite emissions >= 0 "
+                    "are needed",
+                    name, i);
+        else if (rad_scene_builder_material(b, mname, reflectance, emission) != (int)i)
+            r = rad_context_error(ctx)[0] ? RAD_ERROR_OUT_OF_MEMORY
+                                          : BAD("%s: material '%s' is defined twice", name, mname);
+    }
+    vec3 *v = NULL;
+    size_t v_capacity = 0, used = 0;
+    for (size_t i = 0; r == RAD_OK && i < polygons; i++) {
+        uint32_t count = get_u32(&table), surface = get_u32(&table), material = get_u32(&table);
+        (void)get_u32(&table);
+        if (count < 3 || count > corners - used || surface >= (uint32_t)surface_count ||
+            material >= (uint32_t)material_count) {
+            r = BAD("%s: polygon %zu: %" PRIu32 " corners, surface %" PRIu32 ", material %" PRIu32
+                    " are out of range",
+                    name, i, count, surface, material);
+            break;
+        }
+        if (count > v_capacity) {
+            vec3 *grown = rad_realloc(ctx, RAD_MEM_SCENE, v, count, sizeof *v, "solution file: polygon");
+            if (!grown) {
+                r = RAD_ERROR_OUT_OF_MEMORY;
+                break;
+            }
+            v = grown;
+            v_capacity = count;
+        }
+        for (uint32_t k = 0; k < count; k++)
+            v[k] = get_vec3(&at);
+        used += count;
+        r = rad_scene_builder_polygon(b, (int)surface, (int)material, v, count, 0);
+    }
+    rad_free(v);
+    if (r == RAD_OK && used != corners)
+        r = BAD("%s: the polygons use %zu of %zu corners", name, used, corners);
+    if (r == RAD_OK) {
+        uint32_t has_camera = get_u32(&camera_at);
+        (void)get_u32(&camera_at);
+        rad_camera cam;
+        double *dest[3] = {cam.position, cam.look_at, cam.up};
+        for (int k = 0; k < 3; k++)
+            for (int j = 0; j < 3; j++)
+                dest[k][j] = get_f64(&camera_at);
+        cam.vfov_degrees = get_f64(&camera_at);
+        if (has_camera > 1)
+            r = BAD("%s: the camera flag is %" PRIu32 ", not 0 or 1", name, has_camera);
+        else if (has_camera)
+            rad_scene_builder_camera(b, &cam); /* the builder checks it */
+    }
+    rad_scene *built = NULL;
+    if (r == RAD_OK)
+        r = rad_scene_builder_finish(b, &built);
+    else
+        rad_scene_builder_destroy(b);
+    if (r != RAD_OK)
+        return r;
+    char hex[17];
+    snprintf(hex, sizeof hex, "%016" PRIx64, rad_saved_scene_checksum(built));
+    if (strcmp(hex, checksum) != 0 || built->surface_count != (size_t)surface_count ||
+        built->material_count != material_count) {
+        rad_scene_destroy(built);
+        return BAD("%s: the scene rebuilt from the file has checksum %s, not the %s it was saved with",
+                   name, hex, checksum);
+    }
+    *out = built;
+    return RAD_OK;
+}
+
+/* The quadtree below `entry` of patch p: every leaf an element of p, seen
+ * once (seen[]), children deeper than their parent (no cycle). */
+static bool check_tree(const rad_mesh *m, uint32_t entry, uint32_t parent, uint32_t p, unsigned char *seen)
+{
+    if (entry & RAD_TREE_LEAF) {
+        uint32_t e = entry & ~RAD_TREE_LEAF;
+        if (e >= m->element_count || m->elements[e].patch != p || seen[e])
+            return false;
+        seen[e] = 1;
+        return true;
+    }
+    if (entry >= m->tree_count || (parent != UINT32_MAX && entry <= parent))
+        return false;
+    for (int k = 0; k < 4; k++)
+        if (!check_tree(m, m->tree[4 * (size_t)entry + (size_t)k], entry, p, seen))
+            return false;
+    return true;
+}
+
+static bool unit(vec3 n) { return v3_finite(n) && fabs(v3_length(n) - 1.0) < 1e-6; }
+
+/* The mesh: read, then every index bounded and every structure whole. */
+static rad_result read_mesh(rad_context *ctx, const char *name, const rad_scene *scene, cursor *c,
+                            size_t patches, size_t elements, size_t vertices, size_t tvertices,
+                            size_t tree_nodes, rad_mesh **out)
+{
+    rad_mesh *m = rad_alloc(ctx, RAD_MEM_MESH, 1, sizeof *m, "solution file: mesh");
+    if (!m)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    m->patches = rad_alloc(ctx, RAD_MEM_MESH, patches ? patches : 1, sizeof *m->patches, "solution file: patches");
+    m->elements = rad_alloc(ctx, RAD_MEM_MESH, elements ? elements : 1, sizeof *m->elements, "solution file: elements");
+    m->vertices = rad_alloc(ctx, RAD_MEM_MESH, vertices ? vertices : 1, sizeof *m->vertices, "solution file: vertices");
+    m->tvertices = rad_alloc(ctx, RAD_MEM_MESH, tvertices ? tvertices : 1, sizeof *m->tvertices, "solution file: T-vertices");
+    m->tree = tree_nodes ? rad_alloc(ctx, RAD_MEM_MESH, 4 * tree_nodes, sizeof *m->tree, "solution file: quadtree")
+                         : NULL;
+    unsigned char *seen = rad_alloc(ctx, RAD_MEM_MESH, elements ? elements : 1, 1, "solution file: elements");
+    if (!m->patches || !m->elements || !m->vertices || !m->tvertices || (tree_nodes && !m->tree) || !seen) {
+        rad_free(seen);
+        rad_mesh_destroy(m);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    m->patch_count = patches;
+    m->element_count = elements;
+    m->vertex_count = vertices;
+    m->tvertex_count = tvertices;
+    m->tree_count = tree_nodes;
+    for (size_t i = 0; i < patches; i++) {
+        rad_patch *p = &m->patches[i];
+        p->polygon = get_u32(c);
+        p->surface = get_u32(c);
+        p->material = get_u32(c);
+        p->corner_count = get_u32(c);
+        p->nu = get_u32(c);
+        p->nv = get_u32(c);
+        p->first_element = get_u32(c);
+        p->element_count = get_u32(c);
+        p->tree_root = get_u32(c);
+        (void)get_u32(c);
+        for (int k = 0; k < 4; k++)
+            p->corner[k] = get_vec3(c);
+        p->normal = get_vec3(c);
+    }
+    for (size_t i = 0; i < elements; i++) {
+        rad_element *e = &m->elements[i];
+        e->patch = get_u32(c);
+        e->surface = get_u32(c);
+        e->material = get_u32(c);
+        e->vertex_count = get_u32(c);
+        for (int k = 0; k < 4; k++)
+            e->vertex[k] = get_u32(c);
+        e->centroid = get_vec3(c);
+        e->normal = get_vec3(c);
+        e->area = get_f64(c);
+    }
+    for (size_t i = 0; i < vertices; i++)
+        m->vertices[i] = get_vec3(c);
+    for (size_t i = 0; i < tvertices; i++) {
+        rad_tvertex *t = &m->tvertices[i];
+        t->vertex = get_u32(c);
+        t->a = get_u32(c);
+        t->b = get_u32(c);
+        (void)get_u32(c);
+        t->t = get_f64(c);
+    }
+    for (size_t i = 0; i < 4 * tree_nodes; i++)
+        m->tree[i] = get_u32(c);
+
+    rad_result r = RAD_OK;
+    double diag = rad_scene_diagonal(scene), area_sum = 0.0, scene_area = 0.0;
+    for (size_t s = 0; s < scene->surface_count; s++)
+        scene_area += scene->surfaces[s].area;
+    for (size_t i = 0; r == RAD_OK && i < elements; i++) {
+        const rad_element *e = &m->elements[i];
+        bool ok = e->patch < patches && (e->vertex_count == 3 || e->vertex_count == 4) &&
+                  unit(e->normal) && v3_finite(e->centroid) && isfinite(e->area) && e->area >= 0.0;
+        for (uint32_t k = 0; ok && k < e->vertex_count; k++)
+            ok = e->vertex[k] < vertices;
+        if (ok)
+            ok = e->surface == m->patches[e->patch].surface && e->material == m->patches[e->patch].material;
+        if (!ok)
+            r = BAD("%s: element %zu is malformed (patch, corners, vertex indices, normal or area)", name, i);
+        else
+            area_sum += e->area;
+    }
+    for (size_t i = 0; r == RAD_OK && i < patches; i++) {
+        const rad_patch *p = &m->patches[i];
+        bool ok = p->polygon < scene->polygon_count && (p->corner_count == 3 || p->corner_count == 4) &&
+                  p->surface == scene->polygons[p->polygon].surface &&
+                  p->material == scene->polygons[p->polygon].material && unit(p->normal) && p->nu >= 1 &&
+                  p->nv >= 1 && p->element_count >= 1 && p->first_element <= elements &&
+                  p->element_count <= elements - p->first_element;
+        for (uint32_t k = 0; ok && k < p->corner_count; k++)
+            ok = v3_finite(p->corner[k]);
+        if (ok && !m->tree) {
+            /* A grid: nu x nv cells of a quad, k^2 of a triangle, contiguous. */
+            uint64_t cells = p->corner_count == 4 ? (uint64_t)p->nu * p->nv : (uint64_t)p->nu * p->nu;
+            ok = (p->corner_count == 4 || p->nu == p->nv) && cells == p->element_count;
+            for (uint32_t k = 0; ok && k < p->element_count; k++) {
+                uint32_t e = p->first_element + k;
+                ok = m->elements[e].patch == i && !seen[e];
+                seen[e] = 1;
+            }
+        } else if (ok) {
+            ok = check_tree(m, p->tree_root, UINT32_MAX, (uint32_t)i, seen);
+        }
+        if (!ok)
+            r = BAD("%s: patch %zu is malformed (its polygon, corners, grid or quadtree)", name, i);
+    }
+    for (size_t i = 0; r == RAD_OK && i < elements; i++)
+        if (!seen[i])
+            r = BAD("%s: element %zu belongs to no patch's grid or quadtree", name, i);
+    for (size_t i = 0; r == RAD_OK && i < vertices; i++)
+        if (!v3_finite(m->vertices[i]))
+            r = BAD("%s: vertex %zu is not finite", name, i);
+    for (size_t i = 0; r == RAD_OK && i < tvertices; i++) {
+        const rad_tvertex *t = &m->tvertices[i];
+        if (!(t->vertex < vertices && t->a < vertices && t->b < vertices && t->t >= 0.0 && t->t <= 1.0))
+            r = BAD("%s: T-vertex %zu is malformed", name, i);
+    }
+    /* The elements cover the scene: their areas add up to its surfaces'. */
+    if (r == RAD_OK && !(fabs(area_sum - scene_area) <= 1e-3 * scene_area))
+        r = BAD("%s: the elements' areas add up to %.9g m^2, the scene's surfaces to %.9g m^2", name,
+                area_sum, scene_area);
+    (void)diag;
+    rad_free(seen);
+    if (r != RAD_OK) {
+        rad_mesh_destroy(m);
+        return r;
+    }
+    *out = m;
+    return RAD_OK;
+}
+
+rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned char *data, size_t size,
+                          rad_scene **scene_out, rad_options *options, rad_method_names *names,
+                          void **state)
+{
+    *scene_out = NULL;
+    *state = NULL;
+    if (size < RAD_SAVED_MAGIC_SIZE + 4 || memcmp(data, RAD_SAVED_MAGIC, RAD_SAVED_MAGIC_SIZE) != 0)
+        return BAD("%s: not a radiosity solution file (it does not begin with the solution "
+                   "file's signature)",
+                   name);
+    cursor c = {data + RAD_SAVED_MAGIC_SIZE, data + size};
+    size_t header_size = get_u32(&c);
+    if (header_size > size - RAD_SAVED_MAGIC_SIZE - 4)
+        return BAD("%s: the header claims %zu bytes, %zu are left in the file", name, header_size,
+                   size - RAD_SAVED_MAGIC_SIZE - 4);
+    cJSON *header = cJSON_ParseWithLength((const char *)c.p, header_size);
+    if (!header)
+        return BAD("%s: the header is not JSON", name);
+    size_t payload_at = (RAD_SAVED_MAGIC_SIZE + 4 + header_size + 7) / 8 * 8;
+    rad_result r = RAD_OK;
+    rad_scene *scene = NULL;
+    rad_mesh *mesh = NULL;
+    saved_state *st = NULL;
+    const cJSON *counts = cJSON_GetObjectItemCaseSensitive(header, "counts");
+    const cJSON *payload = cJSON_GetObjectItemCaseSensitive(header, "payload");
+    const cJSON *solution = cJSON_GetObjectItemCaseSensitive(header, "solution");
+    double version = number_in(header, "version");
+    size_t corners = 0, polygons = 0, material_count = 0, patches = 0, elements = 0, vertices = 0, tvertices = 0, tree_nodes = 0;
+    /* Counts are bounded by the bytes they need, so the sizes below cannot overflow. */
+    size_t most = size / 16;
+    if (version != RAD_SAVED_VERSION) {
+        r = BAD("%s: format version %g is not read (this is version %d)", name, version, RAD_SAVED_VERSION);
+        goto done;
+    }
+    if (!count_in(counts, "corners", most, &corners) || !count_in(counts, "polygons", most, &polygons) ||
+        !count_in(counts, "materials", most, &material_count) ||
+        !count_in(counts, "patches", most, &patches) || !count_in(counts, "elements", most, &elements) ||
+        !count_in(counts, "vertices", most, &vertices) || !count_in(counts, "tvertices", most, &tvertices) ||
+        !count_in(counts, "tree_nodes", most, &tree_nodes) || !cJSON_IsObject(solution)) {
+        r = BAD("%s: the header's counts or solution are missing or out of range", name);
+        goto done;
+    }
+    if (polygons > UINT32_MAX || patches > UINT32_MAX || elements >= RAD_TREE_LEAF ||
+        vertices > UINT32_MAX || tree_nodes >= RAD_TREE_LEAF) {
+        r = BAD("%s: the counts pass what the mesh can index", name);
+        goto done;
+    }
+    size_t expected = 24 * corners + 16 * polygons + 48 * material_count + 88 + 160 * patches + 88 * elements + 24 * vertices +
+                      24 * tvertices + 16 * tree_nodes + 24 * elements + 24 * vertices;
+    double payload_bytes = number_in(payload, "bytes");
+    const char *checksum = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(payload, "fnv1a64"));
+    if (payload_at > size || payload_bytes != (double)expected || expected != size - payload_at || !checksum) {
+        r = BAD("%s: the payload should hold %zu bytes for its counts, the file has %zu (truncated or "
+                "damaged)",
+                name, expected, payload_at <= size ? size - payload_at : 0);
+        goto done;
+    }
+    char hex[17];
+    snprintf(hex, sizeof hex, "%016" PRIx64, rad_fnv1a(RAD_FNV_OFFSET, data + payload_at, expected));
+    if (strcmp(hex, checksum) != 0) {
+        r = BAD("%s: the payload's checksum is %s, not the %s written (the file is damaged)", name, hex,
+                checksum);
+        goto done;
+    }
+    r = read_options(ctx, name, cJSON_GetObjectItemCaseSensitive(header, "options"), options, names);
+    if (r != RAD_OK)
+        goto done;
+    c.p = data + payload_at;
+    r = read_scene(ctx, name, header, &c, corners, polygons, material_count, &scene);
+    if (r == RAD_OK)
+        r = read_mesh(ctx, name, scene, &c, patches, elements, vertices, tvertices, tree_nodes, &mesh);
+    if (r != RAD_OK)
+        goto done;
+    st = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *st, "solution file: state");
+    if (!st || rad_elements_create(ctx, scene, mesh, &st->elements) != RAD_OK) {
+        r = RAD_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    st->mesh = mesh;
+    mesh = NULL;
+    /* The values: B finite, at least E (light only adds), per element;
+     * the vertex values are the renderer's and are made again from them. */
+    for (size_t i = 0; r == RAD_OK && i < 3 * elements; i++) {
+        double b = get_f64(&c);
+        if (!(isfinite(b) && b >= st->elements.emission[i] * (1.0 - 1e-9)))
+            r = BAD("%s: element %zu has radiosity %g W/m^2, below its emission %g or not finite", name,
+                    i / 3, b, st->elements.emission[i]);
+        st->elements.radiosity[i] = b;
+    }
+    for (size_t i = 0; r == RAD_OK && i < 3 * vertices; i++) {
+        double b = get_f64(&c);
+        if (!(isfinite(b) && b >= 0.0))
+            r = BAD("%s: vertex %zu has radiosity %g W/m^2", name, i / 3, b);
+    }
+    if (r != RAD_OK)
+        goto done;
+    /* The figures of the solve, for the stats and the display. */
+    rad_solve_stats *ss = &st->solve_stats;
+    rad_ff_stats *ff = &st->ff_stats;
+    const char *method = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(solution, "method"));
+    const char *ff_method = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(solution, "form_factors"));
+    snprintf(st->solve_method, sizeof st->solve_method, "%s", method ? method : "unknown");
+    snprintf(st->ff_method, sizeof st->ff_method, "%s", ff_method ? ff_method : "unknown");
+    ss->method = st->solve_method;
+    ff->method = st->ff_method;
+    double iterations = number_in(solution, "iterations");
+    ss->iterations = iterations >= 0.0 && iterations < 2147483647.0 ? (int)iterations : 0;
+    ss->residual = number_in(solution, "residual");
+    ss->converged = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(solution, "converged"));
+    ss->unshot = number_in(solution, "unshot");
+    ss->absorbed = number_in(solution, "absorbed_W");
+    ss->iteration_limit = number_in(solution, "iteration_limit");
+    const cJSON *ambient = cJSON_GetObjectItemCaseSensitive(solution, "ambient");
+    for (int k = 0; k < 3; k++) {
+        const cJSON *a = cJSON_GetArrayItem(ambient, k);
+        ss->ambient[k] = cJSON_IsNumber(a) && isfinite(a->valuedouble) && a->valuedouble >= 0.0 ? a->valuedouble : 0.0;
+    }
+    const char *warning = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(solution, "warning"));
+    snprintf(ss->warning, sizeof ss->warning, "%s", warning ? warning : "");
+    ff->row_sum_min = ff->row_sum_max = ff->row_sum_mean = NAN;
+    ff->reciprocity_max = ff->diagonal_max = ff->std_error_max = NAN;
+    if (!(isfinite(ss->absorbed) && ss->absorbed >= 0.0)) {
+        r = BAD("%s: the absorbed power is missing or not a finite number >= 0", name);
+        goto done;
+    }
+    /* The ray structure as the solve had it: a hierarchical solution
+     * traces against its patches meshed whole (hierarchical.c), whose bent
+     * patches are single primitives, not their leaves; so it is built over
+     * that mesh again, and the picture is the same to the last bit. */
+    double t = rad_seconds();
+    if (st->mesh->tree) {
+        rad_mesh_options mo = {1e30, 0, options->crease_angle_degrees};
+        r = rad_mesh_build(ctx, scene, &mo, &st->patches);
+    }
+    if (r == RAD_OK)
+        r = rad_vis_create(ctx, options->visibility, st->patches ? st->patches : st->mesh, &st->vis);
+    st->seconds.visibility = rad_seconds() - t;
+
+done:
+    cJSON_Delete(header);
+    rad_mesh_destroy(mesh);
+    if (r != RAD_OK) {
+        saved_destroy(st);
+        rad_scene_destroy(scene);
+        return r;
+    }
+    *scene_out = scene;
+    *state = st;
+    return RAD_OK;
+}
