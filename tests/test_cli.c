@@ -194,6 +194,59 @@ static void test_huge_coordinates(void **state)
     assert_no_output("cam.");
 }
 
+/* Files of any size, whole (PNG holds NUL bytes). */
+static size_t read_bytes(const char *name, unsigned char *buf, size_t size)
+{
+    char p[600];
+    snprintf(p, sizeof p, "%s/%s", workdir, name);
+    FILE *f = fopen(p, "rb");
+    if (!f)
+        return 0;
+    size_t n = fread(buf, 1, size, f);
+    fclose(f);
+    return n;
+}
+
+/* Solve once, render from the file: the picture of solving and rendering
+ * at once, byte for byte; from another camera too.  The file is refused
+ * where it cannot serve, and a damaged one is named. */
+static void test_solution_file(void **state)
+{
+    (void)state;
+    assert_int_equal(run("solve --elements 200 -q -o box.radsol --stats solve.json"), 0);
+    assert_true(exists("box.radsol") && exists("solve.json"));
+    const char *camera = "--camera 0.1,0.3,-0.5,0.3,0.25,0.3";
+    assert_int_equal(run("render box.radsol -q --width 64 --height 48 %s -o from_file.png", camera), 0);
+    assert_int_equal(run("render --elements 200 -q --width 64 --height 48 %s -o solved.png", camera), 0);
+    static unsigned char a[65536], b[65536];
+    size_t na = read_bytes("from_file.png", a, sizeof a), nb = read_bytes("solved.png", b, sizeof b);
+    assert_true(na > 100 && na < sizeof a);
+    assert_int_equal(na, nb);
+    assert_memory_equal(a, b, na);
+    /* Refused before any work: another extension, a solution where a
+     * scene is needed, a solve to follow. */
+    assert_int_equal(run("solve --elements 50 -o box.png"), 2);
+    assert_one_line_error("box.png: a solution file is named .radsol", NULL);
+    assert_no_output("box.png");
+    assert_int_equal(run("viewfactors box.radsol -o vf.json"), 2);
+    assert_one_line_error("box.radsol is a solution file", "needs the scene");
+    assert_int_equal(run("render box.radsol --history h.csv -o x.png"), 2);
+    assert_one_line_error("--history: box.radsol is a solution file", NULL);
+    assert_no_output("h.csv");
+    /* Damaged: cut short. */
+    size_t n = read_bytes("box.radsol", a, sizeof a);
+    assert_true(n > 1000);
+    char p[600];
+    snprintf(p, sizeof p, "%s/cut.radsol", workdir);
+    FILE *f = fopen(p, "wb");
+    assert_non_null(f);
+    fwrite(a, 1, n / 2, f);
+    fclose(f);
+    assert_int_equal(run("render cut.radsol -o cut.png"), 1);
+    assert_one_line_error("cut.radsol: the payload should hold", "truncated or damaged");
+    assert_no_output("cut.png");
+}
+
 static void test_zero_area_polygon(void **state)
 {
     (void)state;
@@ -804,6 +857,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_nan_coordinates),
         cmocka_unit_test(test_infinite_coordinates),
         cmocka_unit_test(test_huge_coordinates),
+        cmocka_unit_test(test_solution_file),
         cmocka_unit_test(test_zero_area_polygon),
         cmocka_unit_test(test_reflectance_too_high),
         cmocka_unit_test(test_reflectance_negative),
