@@ -395,7 +395,16 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
         if (!scratch)
             return RAD_ERROR_OUT_OF_MEMORY;
         b->triangulate_scratch = scratch;
-        triangle_count = rad_triangulate_polygon(polygon, n, normal, scratch, triangles);
+        triangle_count = rad_triangulate_polygon(b->ctx, polygon, n, normal, scratch, triangles);
+        if (triangle_count == RAD_TRIANGULATE_INTERRUPTED) {
+            char at[24] = "";
+            if (line > 0)
+                snprintf(at, sizeof at, ":%d", line);
+            return rad_fail(b->ctx, RAD_ERROR_INTERRUPTED,
+                            "%s%s: interrupted while triangulating a polygon of %zu vertices in "
+                            "surface '%s'",
+                            b->source, at, n, b->surfaces[surface].name);
+        }
         if (triangle_count == 0)
             return polygon_error(b, surface, line, RAD_ERROR_INVALID_SCENE,
                                  "intersects itself");
