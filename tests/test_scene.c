@@ -14,6 +14,7 @@
 #include "scene/import_internal.h"
 #include "scene/scene.h"
 
+#include <float.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1529,21 +1530,21 @@ static void test_triangulate_l_shape(void **state)
     /* An L: the 2 x 2 square without its top-right unit square; area 3. */
     const vec3 l_shape[] = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
     uint32_t t[12];
-    double scratch[32]; /* RAD_TRIANGULATE_SCRATCH(8) bytes and more */
-    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, 1), scratch, t), 4);
+    _Alignas(double) unsigned char scratch[RAD_TRIANGULATE_SCRATCH(8)];
+    assert_int_equal(rad_triangulate_polygon(NULL, l_shape, 6, v3(0, 0, 1), scratch, t), 4);
     assert_close(triangles_area(l_shape, t, 4, v3(0, 0, 1)), 3.0, 1e-15);
     assert_close(0.5 * v3_length(rad_polygon_newell(l_shape, 6)), 3.0, 1e-15);
 
     /* Seen from the other side (clockwise about the normal) the triangles
      * keep the polygon's own winding. */
-    assert_int_equal(rad_triangulate_polygon(l_shape, 6, v3(0, 0, -1), scratch, t), 4);
+    assert_int_equal(rad_triangulate_polygon(NULL, l_shape, 6, v3(0, 0, -1), scratch, t), 4);
     assert_close(triangles_area(l_shape, t, 4, v3(0, 0, 1)), 3.0, 1e-15);
 
     /* The same L standing in the x = 5 plane, tilted normal. */
     vec3 standing[6];
     for (int i = 0; i < 6; i++)
         standing[i] = v3(5.0, l_shape[i].x, l_shape[i].y);
-    assert_int_equal(rad_triangulate_polygon(standing, 6, v3(1, 0.01, 0), scratch, t), 4);
+    assert_int_equal(rad_triangulate_polygon(NULL, standing, 6, v3(1, 0.01, 0), scratch, t), 4);
     assert_close(triangles_area(standing, t, 4, v3(1, 0, 0)), 3.0, 1e-15);
 }
 
@@ -1554,8 +1555,8 @@ static void test_triangulate_collinear(void **state)
     const vec3 square[] = {{0, 0, 0},   {0.5, 0, 0}, {1, 0, 0},   {1, 0.5, 0},
                            {1, 1, 0},   {0.5, 1, 0}, {0, 1, 0},   {0, 0.5, 0}};
     uint32_t t[18];
-    double scratch[32]; /* RAD_TRIANGULATE_SCRATCH(8) bytes and more */
-    assert_int_equal(rad_triangulate_polygon(square, 8, v3(0, 0, 1), scratch, t), 6);
+    _Alignas(double) unsigned char scratch[RAD_TRIANGULATE_SCRATCH(8)];
+    assert_int_equal(rad_triangulate_polygon(NULL, square, 8, v3(0, 0, 1), scratch, t), 6);
     assert_close(triangles_area(square, t, 6, v3(0, 0, 1)), 1.0, 1e-15);
 }
 
@@ -1563,17 +1564,320 @@ static void test_triangulate_rejects(void **state)
 {
     (void)state;
     uint32_t t[12];
-    double scratch[32]; /* RAD_TRIANGULATE_SCRATCH(8) bytes and more */
+    _Alignas(double) unsigned char scratch[RAD_TRIANGULATE_SCRATCH(8)];
     /* A symmetric bowtie (area 0) and a lopsided one (area != 0). */
     const vec3 bowtie[] = {{0, 0, 0}, {1, 1, 0}, {1, 0, 0}, {0, 1, 0}};
     const vec3 lopsided[] = {{0, 0, 0}, {2, 1, 0}, {2, 0, 0}, {0, 2, 0}};
     const vec3 line[] = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
     const vec3 spike[] = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {2, 3, 0}, {2, 1, 0}, {0, 1, 0}};
-    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 1), scratch, t), 0);
-    assert_int_equal(rad_triangulate_polygon(lopsided, 4, v3(0, 0, 1), scratch, t), 0);
-    assert_int_equal(rad_triangulate_polygon(line, 3, v3(0, 0, 1), scratch, t), 0);
-    assert_int_equal(rad_triangulate_polygon(spike, 6, v3(0, 0, 1), scratch, t), 0);
-    assert_int_equal(rad_triangulate_polygon(bowtie, 4, v3(0, 0, 0), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(NULL, bowtie, 4, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(NULL, lopsided, 4, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(NULL, line, 3, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(NULL, spike, 6, v3(0, 0, 1), scratch, t), 0);
+    assert_int_equal(rad_triangulate_polygon(NULL, bowtie, 4, v3(0, 0, 0), scratch, t), 0);
+}
+
+/* ---- faces of 10^5 vertices: the sweep and the grid ---- */
+
+#define BIG 100000
+
+/* A deterministic generator for the test shapes (xorshift64*). */
+static double random_unit(uint64_t *state)
+{
+    *state ^= *state >> 12;
+    *state ^= *state << 25;
+    *state ^= *state >> 27;
+    return (double)((*state * 2685821657736338717ull) >> 11) / 9007199254740992.0;
+}
+
+/* Shapes in the z = 0 plane, counter-clockwise; each returns its count. */
+static size_t big_circle(vec3 *v)
+{
+    for (size_t i = 0; i < BIG; i++)
+        v[i] = v3(cos(2.0 * M_PI * (double)i / BIG), sin(2.0 * M_PI * (double)i / BIG), 0.0);
+    return BIG;
+}
+
+/* The square [-1, 1]^2 with 25,000 points per side, all but its corners
+ * collinear with their neighbours. */
+static size_t big_square(vec3 *v)
+{
+    const size_t side = BIG / 4;
+    for (size_t i = 0; i < side; i++) {
+        double t = -1.0 + 2.0 * (double)i / (double)side;
+        v[i] = v3(t, -1.0, 0.0);
+        v[side + i] = v3(1.0, t, 0.0);
+        v[2 * side + i] = v3(-t, 1.0, 0.0);
+        v[3 * side + i] = v3(-1.0, -t, 0.0);
+    }
+    return BIG;
+}
+
+/* A comb: a spine [-1, 1] x [-1, -0.9] and 25,000 teeth up to y = 1, half
+ * a period wide; area 0.2 + 1.9 = 2.1. */
+static size_t big_comb(vec3 *v)
+{
+    const size_t teeth = BIG / 4;
+    const double period = 2.0 / (double)teeth;
+    size_t n = 0;
+    v[n++] = v3(-1.0, -1.0, 0.0);
+    v[n++] = v3(1.0, -1.0, 0.0);
+    for (size_t t = 0; t < teeth; t++) {
+        double right = 1.0 - (double)t * period;
+        if (t > 0)
+            v[n++] = v3(right, -0.9, 0.0);
+        v[n++] = v3(right, 1.0, 0.0);
+        v[n++] = v3(right - 0.5 * period, 1.0, 0.0);
+        v[n++] = v3(right - 0.5 * period, -0.9, 0.0);
+    }
+    v[n++] = v3(-1.0, -0.9, 0.0);
+    return n;
+}
+
+/* A star: angles in order, radii random in [0.2, 1]. */
+static size_t big_star(vec3 *v)
+{
+    uint64_t state = 0x9e3779b97f4a7c15ull;
+    for (size_t i = 0; i < BIG; i++) {
+        double angle = 2.0 * M_PI * ((double)i + 0.5 * random_unit(&state)) / BIG;
+        double radius = 0.2 + 0.8 * random_unit(&state);
+        v[i] = v3(radius * cos(angle), radius * sin(angle), 0.0);
+    }
+    return BIG;
+}
+
+/* A strip 0.02 wide wound 20 times round the origin. */
+static size_t big_spiral(vec3 *v)
+{
+    const size_t half = BIG / 2;
+    for (size_t i = 0; i < half; i++) {
+        double angle = 20.0 * 2.0 * M_PI * (double)i / (double)(half - 1);
+        double radius = 0.05 + angle / (20.0 * 2.0 * M_PI);
+        v[i] = v3((radius + 0.01) * cos(angle), (radius + 0.01) * sin(angle), 0.0);
+        v[BIG - 1 - i] = v3((radius - 0.01) * cos(angle), (radius - 0.01) * sin(angle), 0.0);
+    }
+    return BIG;
+}
+
+/* Load one face through the builder; returns the scene (or NULL, the
+ * result in *result). */
+static rad_scene *build_face(const vec3 *v, size_t n, rad_result *result)
+{
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "big.obj");
+    assert_non_null(b);
+    const double grey[3] = {0.5, 0.5, 0.5}, black[3] = {0.0, 0.0, 0.0};
+    int material = rad_scene_builder_material(b, "grey", grey, black);
+    int surface = rad_scene_builder_surface(b, "big");
+    rad_scene *scene = NULL;
+    rad_api_enter(ctx);
+    *result = rad_scene_builder_polygon(b, surface, material, v, n, 3);
+    if (*result == RAD_OK)
+        *result = rad_scene_builder_finish(b, &scene); /* consumes the builder */
+    else
+        rad_scene_builder_destroy(b);
+    return scene;
+}
+
+/* The triangles' total area about `normal`, each one of positive area
+ * (the big shapes' slivers are far below triangles_area's 1e-9). */
+static double positive_triangles_area(const vec3 *v, const uint32_t *t, size_t count, vec3 normal)
+{
+    double area = 0.0;
+    for (size_t i = 0; i < count; i++) {
+        vec3 cross = v3_cross(v3_sub(v[t[3 * i + 1]], v[t[3 * i]]),
+                              v3_sub(v[t[3 * i + 2]], v[t[3 * i]]));
+        double signed_area = 0.5 * v3_dot(cross, normal);
+        assert_true(signed_area > 0.0);
+        area += signed_area;
+    }
+    return area;
+}
+
+static void test_triangulate_big_faces(void **state)
+{
+    (void)state;
+    size_t (*const shapes[])(vec3 *) = {big_circle, big_square, big_comb, big_star, big_spiral};
+    const char *const names[] = {"circle", "square", "comb", "star", "spiral"};
+    vec3 *v = malloc((BIG + 8) * sizeof *v);
+    uint32_t *t = malloc(3 * (BIG + 8) * sizeof *t);
+    void *scratch = malloc(RAD_TRIANGULATE_SCRATCH(BIG + 8));
+    assert_true(v && t && scratch);
+    for (size_t s = 0; s < sizeof shapes / sizeof shapes[0]; s++) {
+        size_t n = shapes[s](v);
+        double area = 0.5 * rad_polygon_newell(v, n).z;
+        print_message("%s: %zu vertices, area %.17g\n", names[s], n, area);
+        /* The triangles tile the polygon: n - 2 of them, the area to 1e-9. */
+        assert_int_equal(rad_triangulate_polygon(NULL, v, n, v3(0, 0, 1), scratch, t), n - 2);
+        assert_close_relative(positive_triangles_area(v, t, n - 2, v3(0, 0, 1)), area, 1e-9);
+        /* Seen from below, the same. */
+        assert_int_equal(rad_triangulate_polygon(NULL, v, n, v3(0, 0, -1), scratch, t), n - 2);
+        assert_close_relative(positive_triangles_area(v, t, n - 2, v3(0, 0, 1)), area, 1e-9);
+        /* Through the builder: one polygon of that area (the square's
+         * collinear points dropped, its corners kept). */
+        rad_result r;
+        rad_scene *scene = build_face(v, n, &r);
+        assert_int_equal(r, RAD_OK);
+        assert_int_equal(scene->polygon_count, 1);
+        assert_int_equal(scene->polygons[0].vertex_count, s == 1 ? 4 : n);
+        assert_close_relative(rad_scene_surface_area(scene, 0), area, 1e-9);
+        rad_scene_destroy(scene);
+    }
+    free(v);
+    free(t);
+    free(scratch);
+}
+
+static void test_triangulate_big_refusals(void **state)
+{
+    (void)state;
+    vec3 *v = malloc((BIG + 8) * sizeof *v);
+    uint32_t *t = malloc(3 * (BIG + 8) * sizeof *t);
+    void *scratch = malloc(RAD_TRIANGULATE_SCRATCH(BIG + 8));
+    assert_true(v && t && scratch);
+    /* The circle with two vertices near the end swapped: their chords
+     * cross, once. */
+    size_t n = big_circle(v);
+    vec3 swap = v[n - 3];
+    v[n - 3] = v[n - 2];
+    v[n - 2] = swap;
+    assert_int_equal(rad_triangulate_polygon(NULL, v, n, v3(0, 0, 1), scratch, t), 0);
+    rad_result r;
+    assert_null(build_face(v, n, &r));
+    assert_int_equal(r, RAD_ERROR_INVALID_SCENE);
+    assert_string_equal(rad_context_error(ctx), "big.obj:3: polygon in surface 'big' intersects itself");
+    /* The comb with the left tip of tooth 12,500 moved onto the right side
+     * of the next tooth: the two touch at a vertex, without crossing. */
+    n = big_comb(v);
+    size_t tip = 5 + 4 * 12499 + 2; /* tooth t > 0: (R, -0.9), (R, 1), tip, ... */
+    assert_close(v[tip].y, 1.0, 0.0);
+    v[tip] = v3(v[tip + 3].x, 0.5, 0.0); /* tip + 3: (R - period, 1), the next side's top */
+    assert_int_equal(rad_triangulate_polygon(NULL, v, n, v3(0, 0, 1), scratch, t), 0);
+    v[tip].x += 1e-9; /* just clear of it: simple */
+    assert_int_equal(rad_triangulate_polygon(NULL, v, n, v3(0, 0, 1), scratch, t), n - 2);
+    free(v);
+    free(t);
+    free(scratch);
+}
+
+/* The pair-by-pair test the sweep replaced: every two non-adjacent edges,
+ * through the same predicate (segments_meet in triangulate.c), here
+ * written again from its definition. */
+static double orient_xy(vec3 a, vec3 b, vec3 c)
+{
+    return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+static bool in_box(vec3 a, vec3 b, vec3 p)
+{
+    return p.x >= fmin(a.x, b.x) && p.x <= fmax(a.x, b.x) && p.y >= fmin(a.y, b.y) &&
+           p.y <= fmax(a.y, b.y);
+}
+static bool brute_force_simple(const vec3 *v, size_t n, double eps)
+{
+    for (size_t i = 0; i < n; i++) {
+        vec3 prev = v[(i + n - 1) % n], p = v[i], next = v[(i + 1) % n];
+        if (p.x == next.x && p.y == next.y)
+            return false;
+        double along = (p.x - prev.x) * (next.x - p.x) + (p.y - prev.y) * (next.y - p.y);
+        if (fabs(orient_xy(prev, p, next)) <= eps && along < 0.0)
+            return false;
+    }
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = i + 2; j < n; j++) {
+            if (i == 0 && j == n - 1)
+                continue;
+            vec3 a = v[i], b = v[i + 1], c = v[j], d = v[(j + 1) % n];
+            double d1 = orient_xy(c, d, a), d2 = orient_xy(c, d, b);
+            double d3 = orient_xy(a, b, c), d4 = orient_xy(a, b, d);
+            if (((d1 > eps && d2 < -eps) || (d1 < -eps && d2 > eps)) &&
+                ((d3 > eps && d4 < -eps) || (d3 < -eps && d4 > eps)))
+                return false;
+            if ((fabs(d1) <= eps && in_box(c, d, a)) || (fabs(d2) <= eps && in_box(c, d, b)) ||
+                (fabs(d3) <= eps && in_box(a, b, c)) || (fabs(d4) <= eps && in_box(a, b, d)))
+                return false;
+        }
+    return true;
+}
+
+static void test_triangulate_sweep_against_pairs(void **state)
+{
+    (void)state;
+    /* Random polygons of 4 to 12 vertices, half of them on a 4 x 4 grid of
+     * integer points (touching, collinear overlapping and coincident
+     * vertices, decided exactly) and half anywhere in the unit square;
+     * most intersect themselves.  In the (u, v) frame of the normal +z the
+     * coordinates are (-y, x) up to the first vertex: exact for these. */
+    uint64_t state_bits = 12345;
+    _Alignas(double) unsigned char scratch[RAD_TRIANGULATE_SCRATCH(12)];
+    uint32_t t[3 * 12];
+    size_t simple = 0, refused = 0;
+    for (int trial = 0; trial < 4000; trial++) {
+        size_t n = 4 + (size_t)(random_unit(&state_bits) * 9.0);
+        vec3 v[12];
+        for (size_t i = 0; i < n; i++) {
+            double x = random_unit(&state_bits), y = random_unit(&state_bits);
+            v[i] = trial % 2 ? v3(x, y, 0.0) : v3(floor(4.0 * x), floor(4.0 * y), 0.0);
+        }
+        double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, twice_area = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            x0 = fmin(x0, v[i].x);
+            x1 = fmax(x1, v[i].x);
+            y0 = fmin(y0, v[i].y);
+            y1 = fmax(y1, v[i].y);
+            twice_area += orient_xy(v[0], v[i], v[(i + 1) % n]);
+        }
+        double eps = 64.0 * DBL_EPSILON * ((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0));
+        if (fabs(twice_area) <= eps)
+            continue; /* refused before either test */
+        bool expected = brute_force_simple(v, n, eps);
+        size_t count = rad_triangulate_polygon(NULL, v, n, v3(0, 0, 1), scratch, t);
+        if (count != (expected ? n - 2 : 0))
+            print_error("trial %d: %zu vertices, pairs say %s, got %zu triangles\n", trial, n,
+                        expected ? "simple" : "not simple", count);
+        assert_int_equal(count, expected ? n - 2 : 0);
+        if (expected) {
+            assert_close_relative(triangles_area(v, t, n - 2, v3(0, 0, 1)), 0.5 * twice_area, 1e-12);
+            simple++;
+        } else {
+            refused++;
+        }
+    }
+    print_message("%zu simple, %zu refused\n", simple, refused);
+    assert_true(simple > 300 && refused > 1000); /* both kinds well represented */
+}
+
+static void test_triangulate_cancelled(void **state)
+{
+    (void)state;
+    vec3 *v = malloc(BIG * sizeof *v);
+    assert_non_null(v);
+    size_t n = big_star(v);
+    rad_context_cancel(ctx, true);
+    rad_result r;
+    assert_null(build_face(v, n, &r));
+    assert_int_equal(r, RAD_ERROR_INTERRUPTED);
+    assert_string_equal(rad_context_error(ctx), "big.obj:3: interrupted while triangulating a "
+                                                "polygon of 100000 vertices in surface 'big'");
+    /* And through the OBJ reader, from memory. */
+    size_t capacity = 64 * (size_t)BIG, length = 0;
+    char *obj = malloc(capacity);
+    assert_non_null(obj);
+    length += (size_t)snprintf(obj, capacity, "o big\n");
+    for (size_t i = 0; i < n; i++)
+        length += (size_t)snprintf(obj + length, capacity - length, "v %.9g %.9g 0\n", v[i].x, v[i].y);
+    length += (size_t)snprintf(obj + length, capacity - length, "f");
+    for (size_t i = 0; i < n; i++)
+        length += (size_t)snprintf(obj + length, capacity - length, " %zu", i + 1);
+    length += (size_t)snprintf(obj + length, capacity - length, "\n");
+    assert_true(length < capacity);
+    rad_scene sentinel, *scene = &sentinel;
+    rad_api_enter(ctx);
+    assert_int_equal(rad_scene_load_memory(ctx, "big.obj", obj, length, NULL, 0, &scene),
+                     RAD_ERROR_INTERRUPTED);
+    assert_null(scene);
+    assert_contains(rad_context_error(ctx), "interrupted");
+    rad_context_cancel(ctx, false);
+    free(obj);
+    free(v);
 }
 
 /* ---- bad input: the code, and a message naming the file (and line) ---- */
@@ -1804,6 +2108,10 @@ int main(void)
         cmocka_unit_test(test_triangulate_l_shape),
         cmocka_unit_test(test_triangulate_collinear),
         cmocka_unit_test(test_triangulate_rejects),
+        cmocka_unit_test(test_triangulate_big_faces),
+        cmocka_unit_test(test_triangulate_big_refusals),
+        cmocka_unit_test(test_triangulate_sweep_against_pairs),
+        cmocka_unit_test(test_triangulate_cancelled),
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_bad_memory),
         cmocka_unit_test(test_missing_file),

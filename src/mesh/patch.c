@@ -196,7 +196,13 @@ static rad_result make_patches(rad_context *ctx, const rad_scene *scene, patch_l
             for (size_t k = 0; k < n && ok; k++)
                 ok = push_triangle(out, poly, (uint32_t)pi, c, v[k], v[(k + 1) % n]);
         } else {
-            size_t nt = rad_triangulate_polygon(v, n, poly->normal, work, tri);
+            size_t nt = rad_triangulate_polygon(ctx, v, n, poly->normal, work, tri);
+            if (nt == RAD_TRIANGULATE_INTERRUPTED) {
+                r = rad_fail(ctx, RAD_ERROR_INTERRUPTED,
+                             "%s: interrupted while triangulating polygon %zu of surface '%s'",
+                             scene->source, pi, scene->surfaces[poly->surface].name);
+                break;
+            }
             if (nt == 0) {
                 r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                              "%s: polygon %zu of surface '%s' cannot be triangulated "

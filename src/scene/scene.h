@@ -107,16 +107,26 @@ double rad_scene_diagonal(const rad_scene *scene); /* m */
 #define RAD_MAX_COORDINATE 1e30
 #define RAD_MIN_LENGTH 1e-30
 
-/* Bytes of working space rad_triangulate_polygon needs for n vertices. */
-#define RAD_TRIANGULATE_SCRATCH(n) ((size_t)(n) * (2 * sizeof(double) + 2 * sizeof(uint32_t)))
+/* Bytes of working space rad_triangulate_polygon needs for n vertices: the
+ * projected points and seven words per vertex (a multiple of 4, so what
+ * follows it stays aligned for uint32_t). */
+#define RAD_TRIANGULATE_SCRATCH(n) ((size_t)(n) * (2 * sizeof(double) + 7 * sizeof(uint32_t)))
+
+/* rad_triangulate_polygon's answer when the context was cancelled. */
+#define RAD_TRIANGULATE_INTERRUPTED SIZE_MAX
 
 /* Triangulate a simple planar polygon (convex or not) by ear clipping in
  * the plane of `normal`, in `scratch` (RAD_TRIANGULATE_SCRATCH(n) bytes,
  * aligned as malloc aligns).  Writes (n - 2) * 3 local vertex indices into
- * `triangles`.  Returns the number of triangles, or 0 if the polygon is not
- * simple (self-intersecting) or degenerate.  Allocates nothing. */
-size_t rad_triangulate_polygon(const vec3 *vertices, size_t n, vec3 normal, void *scratch,
-                               uint32_t *triangles);
+ * `triangles`, every triangle of positive area and in the polygon's
+ * winding; collinear vertices are kept as corners.  Returns the number of
+ * triangles, or 0 if the polygon is not simple (edges that cross or touch)
+ * or degenerate, or RAD_TRIANGULATE_INTERRUPTED once rad_cancelled(ctx)
+ * (polled every few thousand steps; ctx may be NULL).  O(n log n) for the
+ * simplicity test; the clipping is as fast on every shape tried, quadratic
+ * only for inputs built against it.  Allocates nothing. */
+size_t rad_triangulate_polygon(const rad_context *ctx, const vec3 *vertices, size_t n,
+                               vec3 normal, void *scratch, uint32_t *triangles);
 
 /* Newell's normal (unnormalised; its length is twice the area). */
 vec3 rad_polygon_newell(const vec3 *vertices, size_t n);
