@@ -554,6 +554,18 @@ RAD_API double rad_image_auto_exposure(const rad_image *image);
 RAD_API rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image,
                                            const char *path, double exposure);
 
+/* Radiosity at a point of surface `surface`, W/m^2 RGB, interpolated from
+ * the vertex values (rad_solution_vertex_radiosity) as smooth shading
+ * interpolates them: the point is taken to the nearest
+ * point of the surface's polygons, which must be within 1e-3 of the
+ * scene's size, else RAD_ERROR_INVALID_ARGUMENT naming the distance (and
+ * for a surface index out of range, a point not finite, or NULL ctx,
+ * solution, point or rgb; rgb is then NaN).  O(polygons of the surface);
+ * the first call after a solve computes the vertex values (O(elements)):
+ * not at the same time as other calls on the same solution. */
+RAD_API rad_result rad_solution_point_radiosity(rad_context *ctx, rad_solution *solution, size_t surface,
+                                                const double point[3], double rgb[3]);
+
 /* ---- the solution file: solve once, render from any camera ---- */
 
 /* Write the solved solution to `path` (docs/formats.md, "Solution file"):

@@ -141,6 +141,8 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     s->history_failed = false;
     rad_free(s->vertex_radiosity);
     s->vertex_radiosity = NULL;
+    rad_free(s->point_values);
+    s->point_values = NULL;
     rad_result r = s->strategy->solve(ctx, s->state, &hook);
     refresh_view(s);
     if (r == RAD_OK)
@@ -184,6 +186,7 @@ void rad_solution_destroy(rad_solution *s)
         s->strategy->destroy(s->state);
     rad_free(s->history);
     rad_free(s->vertex_radiosity);
+    rad_free(s->point_values);
     rad_free(s);
 }
 
@@ -370,6 +373,71 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     s->view.render_rays = (uint64_t)w * (uint64_t)h * (uint64_t)spp * (uint64_t)spp;
     rad_free(display);
     return r;
+}
+
+rad_result rad_solution_point_radiosity(rad_context *ctx, rad_solution *s, size_t surface,
+                                       const double point[3], double rgb[3])
+{
+    rad_api_enter(ctx);
+    if (rgb)
+        rgb[0] = rgb[1] = rgb[2] = NAN;
+    if (!ctx || !s || !point || !rgb)
+        return rad_null_argument(ctx, __func__);
+    if (surface >= s->scene->surface_count)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "point radiosity: surface %zu of %zu", surface,
+                        s->scene->surface_count);
+    vec3 p = v3(point[0], point[1], point[2]);
+    if (!v3_finite(p))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "point radiosity: the point is not finite");
+    /* The nearest point of the surface's patches: parameters clamped to
+     * the patch (the unit square, or the triangle s, t >= 0, s + t <= 1). */
+    const rad_mesh *mesh = s->view.mesh;
+    double best = INFINITY, best_s = 0.0, best_t = 0.0;
+    uint32_t best_patch = 0;
+    for (size_t i = 0; i < mesh->patch_count; i++) {
+        const rad_patch *patch = &mesh->patches[i];
+        if (patch->surface != surface)
+            continue;
+        double ps, pt;
+        rad_patch_parameters(patch, p, &ps, &pt);
+        ps = fmin(fmax(ps, 0.0), 1.0);
+        pt = fmin(fmax(pt, 0.0), 1.0);
+        if (patch->corner_count == 3 && ps + pt > 1.0) {
+            double excess = 0.5 * (ps + pt - 1.0);
+            ps = fmax(ps - excess, 0.0);
+            pt = fmin(1.0 - ps, fmax(pt - excess, 0.0));
+        }
+        double d = v3_length(v3_sub(p, rad_patch_point(patch, ps, pt)));
+        if (d < best) {
+            best = d;
+            best_s = ps;
+            best_t = pt;
+            best_patch = (uint32_t)i;
+        }
+    }
+    double allowed = 1e-3 * rad_scene_diagonal(s->scene);
+    if (!(best <= allowed))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "point radiosity: (%g, %g, %g) is %.3g m from surface '%s', more than 1e-3 of "
+                        "the scene's size (%.3g m): give a point on the surface",
+                        p.x, p.y, p.z, best, s->scene->surfaces[surface].name, allowed);
+    if (!s->point_values) {
+        rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+        double *values = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * mesh->vertex_count, sizeof *values,
+                                   "point radiosity: vertex values");
+        if (!values)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        rad_result r = rad_vertex_values(ctx, mesh, s->view.radiosity, values);
+        if (r != RAD_OK) {
+            rad_free(values);
+            return r;
+        }
+        s->point_values = values;
+    }
+    double ls, lt;
+    uint32_t e = rad_mesh_locate(mesh, best_patch, best_s, best_t, &ls, &lt);
+    rad_element_interpolate(mesh, &mesh->elements[e], s->point_values, ls, lt, rgb);
+    return RAD_OK;
 }
 
 rad_result rad_solution_save(rad_context *ctx, rad_solution *s, const char *path)

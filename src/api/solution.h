@@ -23,7 +23,10 @@ struct rad_solution {
     rad_solve_step *history;       /* the last solve's steps */
     size_t history_count, history_capacity;
     bool history_failed;           /* the history could not grow (out of memory) */
-    double *vertex_radiosity;      /* 3 per vertex of view.mesh, computed on demand */
+    double *vertex_radiosity;      /* 3 per vertex of view.mesh, computed on demand: what is
+                                      displayed (a partial shooting solution's ambient added) */
+    double *point_values;          /* 3 per vertex: the radiosity itself, for point queries
+                                      (computed on the first one after a solve) */
 };
 
 #endif /* RAD_SOLUTION_H */

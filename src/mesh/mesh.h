@@ -126,11 +126,11 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
                                 size_t tree_count, const uint32_t *patch_root,
                                 double crease_angle_degrees, rad_mesh **out);
 
-/* Patch parameters (s, t) of a point on (or near) the patch plane. */
 /* A triangle's or quad's width, m: its shortest edge or 2 x area / its
  * longest edge, whichever is less; 0 when it has no extent. */
 double rad_corners_width(const vec3 *corner, uint32_t count);
 
+/* Patch parameters (s, t) of a point on (or near) the patch plane. */
 void rad_patch_parameters(const rad_patch *patch, vec3 p, double *s, double *t);
 
 /* The point of the patch at parameters (s, t). */
