@@ -175,15 +175,21 @@ rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *r
             for (int dy = -1; dy <= 1; dy++)
                 for (int dx = -1; dx <= 1; dx++) {
                     uint64_t key = cell_key(cx + dx, cy + dy, cz + dz);
+                    /* A cell's entries are in raw order (cell_entry_cmp), so
+                     * the first match is the earliest and the scan stops
+                     * there: N coincident points (the apex of a fan of 10^5
+                     * triangles) cost O(N), not O(N^2). */
                     for (size_t k = cell_index_find(&cix, nraw, key); k < nraw && cells[k].key == key; k++) {
                         uint32_t c = cells[k].item;
                         if (c >= r || c >= best)
-                            continue;
+                            break;
                         const rad_patch *pc = &mesh->patches[raw[c].patch];
                         if (pc->surface != pr->surface || v3_dot(pc->normal, pr->normal) < cos_crease)
                             continue;
-                        if (v3_length(v3_sub(raw[c].position, p)) <= tol)
+                        if (v3_length(v3_sub(raw[c].position, p)) <= tol) {
                             best = c;
+                            break;
+                        }
                     }
                 }
         if (best != UINT32_MAX) {
