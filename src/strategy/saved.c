@@ -210,7 +210,8 @@ void rad_saved_put_scene_and_mesh(rad_bytes *b, const rad_scene *scene, const ra
 
 /* ---- decoding ---- */
 
-/* A bounds-checked reader over the payload. */
+/* A reader over the payload.  Its size was checked against the counts
+ * before any read (rad_saved_read), so the reads need no bounds. */
 typedef struct cursor {
     const unsigned char *p, *end;
 } cursor;
@@ -601,7 +602,7 @@ static rad_result read_mesh(rad_context *ctx, const char *name, const rad_scene 
         m->tree[i] = get_u32(c);
 
     rad_result r = RAD_OK;
-    double diag = rad_scene_diagonal(scene), area_sum = 0.0, scene_area = 0.0;
+    double area_sum = 0.0, scene_area = 0.0;
     for (size_t s = 0; s < scene->surface_count; s++)
         scene_area += scene->surfaces[s].area;
     for (size_t i = 0; r == RAD_OK && i < elements; i++) {
@@ -656,7 +657,6 @@ static rad_result read_mesh(rad_context *ctx, const char *name, const rad_scene 
     if (r == RAD_OK && !(fabs(area_sum - scene_area) <= 1e-3 * scene_area))
         r = BAD("%s: the elements' areas add up to %.9g m^2, the scene's surfaces to %.9g m^2", name,
                 area_sum, scene_area);
-    (void)diag;
     rad_free(seen);
     if (r != RAD_OK) {
         rad_mesh_destroy(m);
