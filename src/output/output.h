@@ -1,6 +1,7 @@
 /*
  * output.h -- turning a solution into files: images (render.c, image.c),
- * automatic camera framing (camera.c), stats and view-factor files (stats.c).
+ * automatic camera framing (camera.c), stats and view-factor files (stats.c),
+ * lit meshes (mesh_export.c).
  */
 #ifndef RAD_OUTPUT_H
 #define RAD_OUTPUT_H
@@ -89,6 +90,11 @@ rad_result rad_write_solution(rad_context *ctx, const rad_solution_view *view, c
  * surface-level or, with `elements`, element-level.  Fails without F. */
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *view, const char *path,
                                   bool elements);
+
+/* The lit mesh by the path's extension (.glb, .gltf, .ply; docs/formats.md):
+ * vertices with their radiosity B (W/m^2) and display colour, the radiance
+ * B/pi times `exposure` (0 = the automatic rule over the vertices). */
+rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure);
 
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path);
