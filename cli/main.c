@@ -348,13 +348,14 @@ int main(int argc, char **argv)
         goto done;
     status = 1;
 
-    /* 1. load: a scene, or for render a solution file (by its signature),
-     * which is solved already */
+    /* 1. load: a scene, or for render and export a solution file (by its
+     * signature), which is solved already */
     double t0 = now_seconds();
     bool saved = s.scene_path && rad_file_is_solution(s.scene_path);
-    if (saved && s.command != CLI_RENDER) {
-        fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it; %s needs the "
-                        "scene it was solved for\n", s.scene_path, cli_command_name(s.command));
+    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT) {
+        fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it and `radiosity "
+                        "export` writes its lit mesh; %s needs the scene it was solved for\n",
+                s.scene_path, cli_command_name(s.command));
         status = EXIT_USAGE;
         goto done;
     }

@@ -223,6 +223,14 @@ static void test_solution_file(void **state)
     assert_true(na > 100 && na < sizeof a);
     assert_int_equal(na, nb);
     assert_memory_equal(a, b, na);
+    /* export draws its lit mesh from the file as from the solve, to the byte. */
+    assert_int_equal(run("export box.radsol -q -o from_file.glb"), 0);
+    assert_int_equal(run("export --elements 200 -q -o solved.glb"), 0);
+    na = read_bytes("from_file.glb", a, sizeof a);
+    nb = read_bytes("solved.glb", b, sizeof b);
+    assert_true(na > 1000 && na < sizeof a);
+    assert_int_equal(na, nb);
+    assert_memory_equal(a, b, na);
     /* Refused before any work: another extension, a solution where a
      * scene is needed, a solve to follow. */
     assert_int_equal(run("solve --elements 50 -o box.png"), 2);
