@@ -5,7 +5,8 @@
  *   2. mesh      surfaces -> elements            } rad_solution_create
  *   3. couple    visibility + form factors F_ij  }
  *   4. solve     B = E + rho F B                   rad_solution_solve
- *   5. output    image / view factors / stats      rad_solution_render, ..._write_*
+ *   5. output    image / view factors / lit mesh   rad_solution_render, ..._write_*
+ *                / stats
  *
  * Flags live in one table (options.c), shared by every command, which
  * takes each flag's range, default and help from the library's option
@@ -225,7 +226,7 @@ static const char *where(const char *path, char *buf)
  * set: every file appears at the end, or none (docs/robustness.md). */
 typedef struct run_outputs {
     rad_output_set *set;
-    const char *main;      /* the image or view-factor file: its temporary */
+    const char *main;      /* the image, view-factor or mesh file: its temporary */
     const char *stats, *history;
 } run_outputs;
 
@@ -236,6 +237,7 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
 {
     rad_output_kind kind = s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS
                            : s->command == CLI_SOLVE     ? RAD_OUTPUT_SOLUTION
+                           : s->command == CLI_EXPORT    ? RAD_OUTPUT_MESH
                                                          : RAD_OUTPUT_IMAGE;
     rad_result r = rad_output_set_create(ctx, &o->set);
     if (r == RAD_OK && s->scene_path)
@@ -244,7 +246,7 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
         r = rad_output_set_add(ctx, o->set, s->output, kind, &o->main);
     if (r == RAD_OK && s->stats)
         r = rad_output_set_add(ctx, o->set, s->stats, RAD_OUTPUT_FILE, &o->stats);
-    if (r == RAD_OK && s->history && (s->command == CLI_RENDER || s->command == CLI_SOLVE))
+    if (r == RAD_OK && s->history && s->command != CLI_VIEWFACTORS)
         r = rad_output_set_add(ctx, o->set, s->history, RAD_OUTPUT_FILE, &o->history);
     if (r == RAD_OK)
         return -1;
@@ -300,7 +302,7 @@ static int write_solution(rad_context *ctx, const settings *s, rad_solution *sol
 int main(int argc, char **argv)
 {
     /* Every command's flags come from the one table in options.c;
-     * generate runs in generate.c, render and viewfactors below. */
+     * generate runs in generate.c, render, viewfactors and export below. */
     settings s;
     memset(&s, 0, sizeof s);
     int status = parse_args(argc, argv, &s);
@@ -346,13 +348,14 @@ int main(int argc, char **argv)
         goto done;
     status = 1;
 
-    /* 1. load: a scene, or for render a solution file (by its signature),
-     * which is solved already */
+    /* 1. load: a scene, or for render and export a solution file (by its
+     * signature), which is solved already */
     double t0 = now_seconds();
     bool saved = s.scene_path && rad_file_is_solution(s.scene_path);
-    if (saved && s.command != CLI_RENDER) {
-        fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it; %s needs the "
-                        "scene it was solved for\n", s.scene_path, cli_command_name(s.command));
+    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT) {
+        fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it and `radiosity "
+                        "export` writes its lit mesh; %s needs the scene it was solved for\n",
+                s.scene_path, cli_command_name(s.command));
         status = EXIT_USAGE;
         goto done;
     }
@@ -395,8 +398,9 @@ int main(int argc, char **argv)
         status = s.camera ? EXIT_USAGE : 1;
         goto done;
     }
-    if (s.command == CLI_RENDER && !s.quiet && !s.scene_path)
-        printf("radiosity: no scene given, rendering the built-in Cornell box\n");
+    if (s.command != CLI_VIEWFACTORS && !s.quiet && !s.scene_path)
+        printf("radiosity: no scene given, %s the built-in Cornell box\n",
+               s.command == CLI_EXPORT ? "exporting" : "rendering");
 
     /* Progressive display keeps one exposure for all frames (the user's, or
      * the first frame's automatic one), so the picture visibly brightens as
@@ -486,13 +490,18 @@ int main(int argc, char **argv)
         goto done;
     }
 
-    /* 5. image, stats and history, into their temporaries, then all put in
-     * place together.  Signals from here on are noted, not acted upon. */
+    /* 5. image or lit mesh, stats and history, into their temporaries,
+     * then all put in place together.  Signals from here on are noted, not
+     * acted upon. */
     begin_saving(ctx);
-    r = rad_solution_render(ctx, sol, &s.render, &image);
-    progress_end(&progress);
-    if (r == RAD_OK)
-        r = rad_image_write_exposed(ctx, image, out.main, s.render.exposure);
+    if (s.command == CLI_EXPORT) {
+        r = rad_solution_write_mesh(ctx, sol, out.main, s.render.exposure);
+    } else {
+        r = rad_solution_render(ctx, sol, &s.render, &image);
+        progress_end(&progress);
+        if (r == RAD_OK)
+            r = rad_image_write_exposed(ctx, image, out.main, s.render.exposure);
+    }
     if (r == RAD_OK && s.stats)
         r = rad_solution_write_stats(ctx, sol, out.stats, partial);
     if (r == RAD_OK && s.history)
@@ -516,9 +525,14 @@ int main(int argc, char **argv)
             snprintf(measure, sizeof measure, "unshot %.2g", h[steps - 1].unshot);
         else
             snprintf(measure, sizeof measure, "residual %.2g", residual);
-        printf("wrote %s (%dx%d, %zu elements, %s, %.1f s)%s\n", where(output, full),
-               rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
-               measure, now_seconds() - t0, partial ? " [partial]" : "");
+        if (s.command == CLI_EXPORT)
+            printf("wrote %s (%zu vertices, %zu elements, %s, %.1f s)%s\n", where(output, full),
+                   rad_solution_vertex_count(sol), rad_solution_element_count(sol), measure,
+                   now_seconds() - t0, partial ? " [partial]" : "");
+        else
+            printf("wrote %s (%dx%d, %zu elements, %s, %.1f s)%s\n", where(output, full),
+                   rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
+                   measure, now_seconds() - t0, partial ? " [partial]" : "");
     }
     if (cancel_signal && !partial)
         fprintf(stderr, "radiosity: interrupted while writing the outputs; they were completed first\n");

@@ -36,6 +36,8 @@ static const command_def COMMANDS[] = {
     {CLI_RENDER, "render", "render [SCENE] [options]", "solve the scene and write an image"},
     {CLI_VIEWFACTORS, "viewfactors", "viewfactors [SCENE] [options]",
      "write the view factors between the scene's named surfaces"},
+    {CLI_EXPORT, "export", "export [SCENE] [options]",
+     "solve the scene and write the lit mesh: glTF 2.0 (.glb, .gltf) or PLY (docs/formats.md)"},
     {CLI_GENERATE, "generate", "generate office [options]",
      "write a procedural office floor as OBJ + MTL (docs/scenes.md)"},
     {CLI_SOLVE, "solve", "solve [SCENE] [options]",
@@ -53,9 +55,11 @@ const char *cli_command_name(int command)
 
 /* ---- the flags ---- */
 
-#define RS (CLI_RENDER | CLI_SOLVE)
-#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_SOLVE)
-#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_GENERATE | CLI_SOLVE)
+/* The commands that solve (render, export, solve), and those that also
+ * mesh and couple (viewfactors). */
+#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE)
+#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
 #define RENDER(field_) .target = CLI_TO_RENDER, .field = #field_
 #define OFFICE(field_) .target = CLI_TO_OFFICE, .field = #field_
@@ -72,6 +76,9 @@ static const cli_flag FLAGS[] = {
     {"output", 'o', "FILE", CLI_VIEWFACTORS, OWN(output, RAD_OPTION_STRING),
      .own.help = "output view factors: .json, .csv or .mtx (docs/formats.md)",
      .own.default_text = "viewfactors.json"},
+    {"output", 'o', "FILE", CLI_EXPORT, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output lit mesh: .glb or .gltf (glTF 2.0) or .ply (docs/formats.md)",
+     .own.default_text = "lit.glb"},
     {"output", 'o', "FILE", CLI_GENERATE, OWN(output, RAD_OPTION_STRING),
      .own.help = "output OBJ; the MTL is written beside it", .own.default_text = "office.obj"},
     {"output", 'o', "FILE", CLI_SOLVE, OWN(output, RAD_OPTION_STRING),
@@ -113,6 +120,8 @@ static const cli_flag FLAGS[] = {
                  "vertical field of view in degrees (40)",
      .own.default_text = "the scene's camera, else framed automatically"},
     {"exposure", 0, "X", CLI_RENDER, RENDER(exposure)},
+    {"exposure", 0, "X", CLI_EXPORT, RENDER(exposure),
+     .help = "multiplier on radiance for the display colours (glTF COLOR_0, PLY red/green/blue)"},
     {"flat", 0, NULL, CLI_RENDER, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
     {"seed", 0, "S", RV, SOLVE(seed)},
@@ -341,7 +350,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
     for (; i < argc; i++) {
         const char *arg = argv[i];
         if (arg[0] != '-' || arg[1] == '\0') {
-            /* A scene: a file for render and viewfactors, a kind for generate. */
+            /* A scene: a file for render, viewfactors and export, a kind for generate. */
             if (!s->command) {
                 usage_error(e, "unknown command '%s'", arg);
                 return CLI_USAGE_ERROR;
@@ -365,7 +374,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         if (!f && !known)
             bad = usage_error(e, "unknown option '%s'", arg);
         else if (!f && !s->command)
-            bad = usage_error(e, "%s needs a command: render, viewfactors or generate", arg);
+            bad = usage_error(e, "%s needs a command: render, viewfactors, export or generate", arg);
         else if (!f)
             bad = usage_error(e, "%s does not apply to %s", arg, cli_command_name(s->command));
         else if (f->metavar && !value && i + 1 >= argc)
@@ -395,7 +404,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render, viewfactors or generate");
+        usage_error(e, "no command given: use render, viewfactors, export or generate");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
@@ -616,8 +625,9 @@ void cli_print_man(FILE *out)
           "\\fBradiosity\\fR solves the radiosity equation B = E + rho F B for diffuse (Lambertian)\n"
           "scenes: it meshes the surfaces into elements, computes the form factors F between them\n"
           "with one of several methods, solves for the radiosity B of every element and writes an\n"
-          "image, the view factors between named surfaces, or statistics.  The library behind it\n"
-          "is declared in radiosity.h; its option structs have the ranges and defaults given here.\n"
+          "image, the view factors between named surfaces, the lit mesh, or statistics.  The\n"
+          "library behind it is declared in radiosity.h; its option structs have the ranges and\n"
+          "defaults given here.\n"
           ".PP\n",
           out);
     roff(out, DESCRIPTION);
@@ -651,7 +661,8 @@ void cli_print_man(FILE *out)
           ".SH FILES\n"
           "Scenes are OBJ with MTL (Kd: reflectance, Ke: emitted radiance) or glTF 2.0 (.gltf, .glb).\n"
           "Images are PNG (exposed, sRGB), Radiance HDR or PFM (linear radiance).  View factors are\n"
-          "JSON, CSV or Matrix Market; statistics are JSON.  Every output is written to a temporary\n"
+          "JSON, CSV or Matrix Market; lit meshes glTF 2.0 (.glb, .gltf) or binary PLY, with the\n"
+          "radiosity of every vertex in W/m^2 and its display colour; statistics are JSON.  Every output is written to a temporary\n"
           "name and renamed, so it is whole or absent.\n"
           ".SH UNITS\n"
           "Lengths in metres, areas in m^2; radiosity B and emission E in W/m^2 (exitance);\n"

@@ -1,6 +1,6 @@
 /*
  * options.h -- the `radiosity` command's flags and their parser, shared by
- * every command (render, viewfactors, generate, solve).
+ * every command (render, viewfactors, export, generate, solve).
  *
  * One table of flags (options.c): each maps to a field of the library's
  * option structs, whose row in the library's option table (radiosity.h,
@@ -23,7 +23,7 @@
 #include <stdio.h>
 
 /* The commands, as bits: a flag lists those that take it. */
-enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_SOLVE = 16 };
+enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -38,9 +38,9 @@ typedef enum cli_action {
 
 /* The parsed command line; zero-initialised, 0 means the default. */
 typedef struct cli_settings {
-    int command;              /* CLI_RENDER, CLI_VIEWFACTORS, CLI_GENERATE or CLI_SOLVE */
-    const char *scene_path;   /* render, viewfactors, solve: NULL = the built-in Cornell box;
-                                 render: a solution file too */
+    int command;              /* CLI_RENDER, CLI_VIEWFACTORS, CLI_EXPORT, CLI_GENERATE or CLI_SOLVE */
+    const char *scene_path;   /* render, viewfactors, export, solve: NULL = the built-in Cornell
+                                 box; render: a solution file too */
     const char *scene_kind;   /* generate: "office" */
     const char *output;       /* the command's default when not given */
     const char *stats;

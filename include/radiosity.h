@@ -17,6 +17,7 @@
  *           rad_solution_solve    B per element, residual
  *             rad_solution_render image of radiance L = B / pi
  *             rad_solution_write_stats / rad_solution_write_view_factors
+ *             rad_solution_write_mesh   the lit mesh (glTF 2.0, PLY)
  *
  * Conventions (docs/units.md): lengths in metres, radiosity B and emission E
  * in W/m^2 (exitance), radiance L = B / pi in W/(m^2 sr).  OBJ/MTL `Ke` and
@@ -627,6 +628,28 @@ RAD_API rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad
 RAD_API rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution *solution,
                                                    const char *path, bool elements);
 
+/* The lit mesh, by extension (docs/formats.md): .glb (binary glTF 2.0),
+ * .gltf (glTF 2.0 with its buffer inside as a base64 data URI: one file) or
+ * .ply (binary little-endian PLY).  The mesh is the solution's: its welded
+ * vertices (rad_solution_vertex_position) and elements, quads split into
+ * two triangles in glTF.  Each vertex holds its radiosity B as
+ * rad_solution_vertex_radiosity gives it (W/m^2, as float: glTF attribute
+ * _RADIOSITY, PLY radiosity_r/g/b) and a display colour, the radiance
+ * B / pi times `exposure` clamped to [0, 1] (glTF COLOR_0, linear, with
+ * unlit materials of base colour 1; PLY red/green/blue, sRGB-encoded 8 bits
+ * as in PNG images).  `exposure` is a multiplier on radiance in
+ * W/(m^2 sr); 0 = automatic: the rule of rad_image_auto_exposure applied to
+ * the vertices' radiances.  The exposure used is in the file (glTF
+ * asset.extras.radiosity.exposure, a PLY comment).  glTF has one node and
+ * mesh per surface, named after it, and one primitive per material of the
+ * surface.  Atomic like the image writer; the solution is only read (a
+ * solution being solved must not be written).  Fails with RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY; an unknown extension, a negative or non-finite
+ * exposure, a .glb above 4 GiB or a NULL ctx, solution or path:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_write_mesh(rad_context *ctx, const rad_solution *solution,
+                                           const char *path, double exposure);
+
 /* ------------------------------------------------------------------------
  * Output sets: the files of one run, written all together or not at all.
  *
@@ -659,6 +682,7 @@ typedef enum rad_output_kind {
     RAD_OUTPUT_FILE = 0,        /* any name: stats, history, OBJ */
     RAD_OUTPUT_IMAGE = 1,       /* .png, .hdr, .pfm (rad_image_write) */
     RAD_OUTPUT_VIEW_FACTORS = 2, /* .json, .csv, .mtx (rad_solution_write_view_factors) */
+    RAD_OUTPUT_MESH = 3,         /* .glb, .gltf, .ply (rad_solution_write_mesh) */
     RAD_OUTPUT_SOLUTION = 16     /* .radsol (rad_solution_save) */
 } rad_output_kind;
 

@@ -7,6 +7,10 @@
 #   RADIOSITY_CMAKE_ARGS  extra arguments for cmake's configure step
 #   RADIOSITY_FUZZ=1      also install clang 14 and build the libFuzzer
 #                         targets into build-fuzz/ (docs/testing.md, "Fuzzing")
+#
+# Where npm is installed, the Khronos glTF validator (npm package
+# gltf-validator) goes into $build/npm for test_export; without npm, or
+# offline, that test skips the validator and the setup goes on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -34,6 +38,17 @@ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release ${RADIOSITY_CMAKE_ARGS:-} >/de
 cmake --build "$build" -j "$(nproc)" 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make|Consolidate compiler' || true
 test -x "$build/radiosity" || { echo "setup: build failed" >&2; exit 1; }
 echo "setup: built $build/radiosity"
+
+if [ ! -f "$build/npm/node_modules/gltf-validator/package.json" ]; then
+  if ! command -v npm >/dev/null 2>&1; then
+    echo "setup: npm not found: test_export will skip the glTF validator"
+  elif timeout 300 npm install --prefix "$build/npm" --no-audit --no-fund --silent gltf-validator \
+         >/dev/null 2>&1; then
+    echo "setup: installed the glTF validator (npm gltf-validator) in $build/npm"
+  else
+    echo "setup: npm could not install gltf-validator (offline?): test_export will skip the glTF validator"
+  fi
+fi
 
 if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
   CC=clang-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRADIOSITY_FUZZ=ON \

@@ -95,7 +95,7 @@ static void clear_outputs(void)
 
 /* ---- one run: the outputs its writers finished ---- */
 
-#define MAX_OUTPUTS 8
+#define MAX_OUTPUTS 12
 
 typedef struct outputs {
     const char *written[MAX_OUTPUTS]; /* names in the output folder */
@@ -228,6 +228,11 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     if (r == RAD_OK) {
         output_path("history.csv", path, sizeof path);
         r = write_done(rad_solution_write_history(ctx, s, path), out, "history.csv");
+    }
+    static const char *const meshes[] = {"lit.glb", "lit.gltf", "lit.ply"};
+    for (size_t k = 0; k < 3 && r == RAD_OK; k++) {
+        output_path(meshes[k], path, sizeof path);
+        r = write_done(rad_solution_write_mesh(ctx, s, path, 0.0), out, meshes[k]);
     }
     free(vertex);
     rad_image_destroy(image);

@@ -268,6 +268,12 @@ static void test_null_solution(void **state)
                    "rad_solution_write_view_factors");
     assert_false(file_exists(vf));
 
+    const char *lit = temp_path("lit.glb");
+    assert_invalid(rad_solution_write_mesh(NULL, s, lit, 0.0), NULL, "rad_solution_write_mesh");
+    assert_invalid(rad_solution_write_mesh(ctx, NULL, lit, 0.0), ctx, "rad_solution_write_mesh");
+    assert_invalid(rad_solution_write_mesh(ctx, s, NULL, 1.0), ctx, "rad_solution_write_mesh");
+    assert_false(file_exists(lit));
+
     /* Element and vertex accessors: NULL solution or output writes nothing. */
     double xyz[3] = {7, 7, 7}, rgb3[3] = {7, 7, 7};
     size_t corners[4] = {7, 7, 7, 7};

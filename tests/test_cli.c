@@ -223,6 +223,14 @@ static void test_solution_file(void **state)
     assert_true(na > 100 && na < sizeof a);
     assert_int_equal(na, nb);
     assert_memory_equal(a, b, na);
+    /* export draws its lit mesh from the file as from the solve, to the byte. */
+    assert_int_equal(run("export box.radsol -q -o from_file.glb"), 0);
+    assert_int_equal(run("export --elements 200 -q -o solved.glb"), 0);
+    na = read_bytes("from_file.glb", a, sizeof a);
+    nb = read_bytes("solved.glb", b, sizeof b);
+    assert_true(na > 1000 && na < sizeof a);
+    assert_int_equal(na, nb);
+    assert_memory_equal(a, b, na);
     /* Refused before any work: another extension, a solution where a
      * scene is needed, a solve to follow. */
     assert_int_equal(run("solve --elements 50 -o box.png"), 2);
@@ -524,6 +532,41 @@ static void test_render_reports_output(void **state)
     assert_int_equal(run("render good.obj --elements 50 --width 16 --height 16 -o good.pfm -q"), 0);
     assert_true(exists("good.pfm"));
     assert_string_equal(out_text, "");
+}
+
+/* export: an unknown mesh format is a usage error before the load (the
+ * scene named does not even exist); a good run writes the mesh and its
+ * stats, and says where. */
+static void test_export(void **state)
+{
+    (void)state;
+    assert_int_equal(run("export no_such_scene.obj -o x.obj --stats x.json"), 2);
+    assert_one_line_error("x.obj: unknown mesh format", ".glb, .gltf or .ply");
+    assert_no_output("x.");
+    write_file("good.obj", good_obj);
+    write_file("good.mtl", good_mtl);
+    assert_int_equal(run("export good.obj -o x.obj"), 2);
+    assert_one_line_error("x.obj: unknown mesh format", NULL);
+    assert_no_output("x.");
+    /* Flags of render only are refused. */
+    assert_int_equal(run("export good.obj --width 16 -o lit.glb"), 2);
+    assert_one_line_error("--width does not apply to export", NULL);
+    assert_no_output("lit.");
+    assert_int_equal(run("export good.obj --elements 50 --solver southwell --exposure 2 -o lit.glb --stats lit.json"),
+                     0);
+    assert_true(exists("lit.glb"));
+    assert_true(exists("lit.json"));
+    assert_non_null(strstr(out_text, "lit.glb ("));
+    assert_non_null(strstr(out_text, " vertices, "));
+    assert_string_equal(err_text, "");
+    assert_int_equal(run("export good.obj --elements 50 -o lit.ply -q"), 0);
+    assert_true(exists("lit.ply"));
+    assert_string_equal(out_text, "");
+    assert_int_equal(run("export --help"), 0);
+    assert_non_null(strstr(out_text, "usage: radiosity export"));
+    assert_non_null(strstr(out_text, "--exposure X"));
+    assert_non_null(strstr(out_text, "--solver NAME"));
+    assert_null(strstr(out_text, "--camera"));
 }
 
 static void test_help_version_methods(void **state)
@@ -874,6 +917,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_seed),
         cmocka_unit_test(test_unwritable_output),
         cmocka_unit_test(test_render_reports_output),
+        cmocka_unit_test(test_export),
         cmocka_unit_test(test_help_version_methods),
         cmocka_unit_test(test_viewfactors_csv),
         cmocka_unit_test(test_deterministic_across_threads),

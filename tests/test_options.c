@@ -281,7 +281,7 @@ static cli_action parse(const char *first, ...)
 /* The first command that takes a flag. */
 static const char *command_of(const cli_flag *f)
 {
-    for (int bit = CLI_RENDER; bit <= CLI_GENERATE; bit <<= 1)
+    for (int bit = CLI_RENDER; bit <= CLI_EXPORT; bit <<= 1)
         if (f->commands & bit)
             return cli_command_name(bit);
     return NULL;
@@ -464,7 +464,7 @@ static void test_generate_takes_the_shared_parser(void **state)
     assert_int_equal(parse("viewfactors", NULL), CLI_RUN);
     assert_string_equal(settings.output, "viewfactors.json");
     assert_int_equal(parse("--rooms", "3", NULL), CLI_USAGE_ERROR);
-    assert_string_equal(err, "--rooms needs a command: render, viewfactors or generate");
+    assert_string_equal(err, "--rooms needs a command: render, viewfactors, export or generate");
 }
 
 /* ---- --help, the man page, the messages ---- */
@@ -501,8 +501,8 @@ static int line_with(const char *text, const char *a, const char *b)
 static void test_help_lists_every_flag_with_default(void **state)
 {
     (void)state;
-    const int commands[] = {0, CLI_RENDER, CLI_VIEWFACTORS, CLI_GENERATE};
-    for (size_t c = 0; c < 4; c++) {
+    const int commands[] = {0, CLI_RENDER, CLI_VIEWFACTORS, CLI_EXPORT, CLI_GENERATE};
+    for (size_t c = 0; c < 5; c++) {
         char *help = capture_help(commands[c]);
         for (size_t k = 0; cli_flag_get(k); k++) {
             const cli_flag *f = cli_flag_get(k);

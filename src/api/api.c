@@ -603,6 +603,15 @@ rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution 
     return rad_write_view_factors(ctx, &s->view, path, elements);
 }
 
+rad_result rad_solution_write_mesh(rad_context *ctx, const rad_solution *s, const char *path, double exposure)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+    return rad_write_mesh(ctx, &s->view, path, exposure);
+}
+
 rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, const char *path)
 {
     rad_api_enter(ctx);

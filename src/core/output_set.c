@@ -131,8 +131,12 @@ static rad_result check_format(rad_context *ctx, const char *path, rad_output_ki
     if (kind == RAD_OUTPUT_SOLUTION && strcmp(ext, "radsol") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: a solution file is named .radsol (docs/formats.md)", path);
+    if (kind == RAD_OUTPUT_MESH && strcmp(ext, "glb") != 0 && strcmp(ext, "gltf") != 0 &&
+        strcmp(ext, "ply") != 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: unknown mesh format (use .glb, .gltf or .ply)", path);
     if (kind != RAD_OUTPUT_FILE && kind != RAD_OUTPUT_IMAGE && kind != RAD_OUTPUT_VIEW_FACTORS &&
-        kind != RAD_OUTPUT_SOLUTION)
+        kind != RAD_OUTPUT_SOLUTION && kind != RAD_OUTPUT_MESH)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown output kind %d", path,
                         (int)kind);
     return RAD_OK;

@@ -109,17 +109,18 @@ static float select_kth(float *a, size_t n, size_t k)
     return a[kk];
 }
 
-/* Unlit (black) and non-finite pixels are left out: an image that is mostly
- * background would otherwise be exposed for the background. */
-rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *exposure)
+/* Unlit (black) and non-finite values are left out: an image that is mostly
+ * background would otherwise be exposed for the background, a lit mesh for
+ * its unlit backs. */
+rad_result rad_radiance_exposure(rad_context *ctx, const float *rgb, size_t count, double *exposure)
 {
     *exposure = 1.0;
-    size_t n = (size_t)image->width * (size_t)image->height, lit = 0;
-    float *y = rad_alloc(ctx, RAD_MEM_RENDER, n, sizeof *y, "exposure: luminances");
+    size_t lit = 0;
+    float *y = rad_alloc(ctx, RAD_MEM_RENDER, count, sizeof *y, "exposure: luminances");
     if (!y)
         return RAD_ERROR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < n; i++) {
-        double value = luminance(&image->pixels[3 * i]);
+    for (size_t i = 0; i < count; i++) {
+        double value = luminance(&rgb[3 * i]);
         if (!(value > 0.0) || !isfinite(value))
             continue;
         y[lit++] = (float)value;
@@ -128,6 +129,12 @@ rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *
     rad_free(y);
     *exposure = key > 0.0 ? 0.8 / key : 1.0;
     return RAD_OK;
+}
+
+rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *exposure)
+{
+    return rad_radiance_exposure(ctx, image->pixels, (size_t)image->width * (size_t)image->height,
+                                 exposure);
 }
 
 double rad_image_auto_exposure(const rad_image *image)
@@ -140,8 +147,7 @@ double rad_image_auto_exposure(const rad_image *image)
 
 /* ---- writers ---- */
 
-/* IEC 61966-2-1 sRGB encoding of a linear value in [0, 1]. */
-static double srgb_encode(double linear)
+double rad_srgb_encode(double linear)
 {
     if (!(linear > 0.0))
         return 0.0;
@@ -171,7 +177,7 @@ static rad_result write_png(rad_context *ctx, const rad_image *image, const char
     if (!bytes)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < 3 * n; i++)
-        bytes[i] = (unsigned char)lround(255.0 * srgb_encode(exposure * image->pixels[i]));
+        bytes[i] = (unsigned char)lround(255.0 * rad_srgb_encode(exposure * image->pixels[i]));
     stb_sink sink = {file->file, 0};
     int ok = stbi_write_png_to_func(stb_write, &sink, image->width, image->height, 3, bytes,
                                     3 * image->width);

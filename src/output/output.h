@@ -1,6 +1,7 @@
 /*
  * output.h -- turning a solution into files: images (render.c, image.c),
- * automatic camera framing (camera.c), stats and view-factor files (stats.c).
+ * automatic camera framing (camera.c), stats and view-factor files (stats.c),
+ * lit meshes (mesh_export.c).
  */
 #ifndef RAD_OUTPUT_H
 #define RAD_OUTPUT_H
@@ -59,7 +60,21 @@ rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, con
  * memory (a float per pixel). */
 rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *exposure);
 
+/* The same rule over any `count` RGB radiances (pixels, a lit mesh's
+ * vertices): the values that are black or not finite left out, 1 when
+ * none is left.  Fails only for memory (a float per value). */
+rad_result rad_radiance_exposure(rad_context *ctx, const float *rgb, size_t count, double *exposure);
+
+/* IEC 61966-2-1 sRGB encoding of a linear value, clamped to [0, 1] (the
+ * exact piecewise curve); 255 x it, rounded, is an 8-bit channel. */
+double rad_srgb_encode(double linear);
+
 /* ---- results as files (stats.c); every file is written atomically ---- */
+
+/* `text` as valid UTF-8: each byte that does not begin a well-formed
+ * sequence (RFC 3629) becomes U+FFFD.  A new string in the context's
+ * output memory (rad_free it); NULL when out of memory. */
+char *rad_utf8_clean(rad_context *ctx, const char *text);
 
 /* The stats JSON of a solution (docs/stats.md); `partial` marks an
  * interrupted run. */
@@ -75,6 +90,11 @@ rad_result rad_write_solution(rad_context *ctx, const rad_solution_view *view, c
  * surface-level or, with `elements`, element-level.  Fails without F. */
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *view, const char *path,
                                   bool elements);
+
+/* The lit mesh by the path's extension (.glb, .gltf, .ply; docs/formats.md):
+ * vertices with their radiosity B (W/m^2) and display colour, the radiance
+ * B/pi times `exposure` (0 = the automatic rule over the vertices). */
+rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure);
 
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path);

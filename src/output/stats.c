@@ -41,9 +41,9 @@ static int utf8_sequence(const unsigned char *p)
     return len;
 }
 
-/* `text` as valid UTF-8 (above), a new string in the output's memory; NULL
- * when out of memory (the allocator's message is set). */
-static char *utf8_clean(rad_context *ctx, const char *text)
+/* As output.h says: the rule above; NULL when out of memory (the
+ * allocator's message is set). */
+char *rad_utf8_clean(rad_context *ctx, const char *text)
 {
     size_t len = strlen(text);
     char *out = rad_alloc(ctx, RAD_MEM_OUTPUT, 3 * len + 1, 1, "outputs: names");
@@ -70,7 +70,7 @@ static char *utf8_clean(rad_context *ctx, const char *text)
 /* Add `text` to a JSON object as valid UTF-8.  Fails only for memory. */
 static rad_result add_text(rad_context *ctx, cJSON *object, const char *key, const char *text)
 {
-    char *clean = utf8_clean(ctx, text ? text : "");
+    char *clean = rad_utf8_clean(ctx, text ? text : "");
     if (!clean)
         return RAD_ERROR_OUT_OF_MEMORY;
     cJSON_AddStringToObject(object, key, clean);
@@ -376,7 +376,7 @@ static void json_string(FILE *f, const char *text)
     fputc('"', f);
 }
 
-/* Names (valid UTF-8, utf8_clean) and areas of the rows of the matrix being
+/* Names (valid UTF-8, rad_utf8_clean) and areas of the rows of the matrix being
  * written: surfaces, or elements ("surface#k", k counting the surface's
  * elements). */
 typedef struct vf_rows {
@@ -428,7 +428,7 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
         if (result == RAD_OK && with_err)
             result = surface_std_errors(ctx, s, r->err);
         for (size_t k = 0; k < S && result == RAD_OK; k++) {
-            r->names[k] = utf8_clean(ctx, s->scene->surfaces[k].name);
+            r->names[k] = rad_utf8_clean(ctx, s->scene->surfaces[k].name);
             r->area[k] = s->scene->surfaces[k].area;
             if (!r->names[k])
                 result = RAD_ERROR_OUT_OF_MEMORY;
@@ -439,7 +439,7 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
             result = RAD_ERROR_OUT_OF_MEMORY;
         for (size_t i = 0; i < n && result == RAD_OK; i++) {
             uint32_t si = s->mesh->elements[i].surface;
-            char *surface = utf8_clean(ctx, s->scene->surfaces[si].name);
+            char *surface = rad_utf8_clean(ctx, s->scene->surfaces[si].name);
             size_t size = surface ? strlen(surface) + 24 : 0;
             r->names[i] = surface ? rad_alloc(ctx, RAD_MEM_OUTPUT, size, 1, "view factors: names") : NULL;
             if (r->names[i])
