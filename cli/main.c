@@ -302,7 +302,7 @@ static int write_solution(rad_context *ctx, const settings *s, rad_solution *sol
 int main(int argc, char **argv)
 {
     /* Every command's flags come from the one table in options.c;
-     * generate runs in generate.c, render, viewfactors and export below. */
+     * generate runs in generate.c, render, solve, viewfactors and export below. */
     settings s;
     memset(&s, 0, sizeof s);
     int status = parse_args(argc, argv, &s);

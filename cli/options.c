@@ -350,7 +350,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
     for (; i < argc; i++) {
         const char *arg = argv[i];
         if (arg[0] != '-' || arg[1] == '\0') {
-            /* A scene: a file for render, viewfactors and export, a kind for generate. */
+            /* A scene: a file for render, viewfactors, solve and export, a kind for generate. */
             if (!s->command) {
                 usage_error(e, "unknown command '%s'", arg);
                 return CLI_USAGE_ERROR;
@@ -374,7 +374,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         if (!f && !known)
             bad = usage_error(e, "unknown option '%s'", arg);
         else if (!f && !s->command)
-            bad = usage_error(e, "%s needs a command: render, viewfactors, export or generate", arg);
+            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export or generate", arg);
         else if (!f)
             bad = usage_error(e, "%s does not apply to %s", arg, cli_command_name(s->command));
         else if (f->metavar && !value && i + 1 >= argc)
@@ -404,7 +404,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render, viewfactors, export or generate");
+        usage_error(e, "no command given: use render, solve, viewfactors, export or generate");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
