@@ -10,7 +10,8 @@
  *    text --lines--> tokens --checks--> "scene.obj:12: face references vertex 40 of 32"
  *
  * Not a parser: it checks vertex coordinates, face/line/point indices,
- * Kd/Ke and material names, and lists the `mtllib` statements; assimp
+ * Kd/Ke and material names, lists the `mtllib` statements and notes what
+ * a material says beyond Kd and Ke (said after the load: unused.c); assimp
  * reads the text afterwards.  The statements are those of Wavefront's
  * "Object Files (.obj)" and "Material Library Files (.mtl)", Appendices B1
  * and B2 of the Advanced Visualizer manual.  Works on buffers (which need
