@@ -8,7 +8,7 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    rad_context_options co = {.threads = 1};
+    rad_context_options co = {.threads = 1, .on_warning = fuzz_check_warning};
     rad_context *ctx = NULL;
     if (rad_context_create(&co, &ctx) != RAD_OK)
         return 0;

@@ -14,6 +14,15 @@
 #include <math.h>
 #include <string.h>
 
+/* A warning (an orthographic camera replaced, material properties the
+ * engine does not use) is one non-empty line of bounded length; it never
+ * stops the load. */
+static void fuzz_check_warning(void *user, const char *message)
+{
+    (void)user;
+    FUZZ_CHECK(message[0] != '\0' && strchr(message, '\n') == NULL && strlen(message) < 1024);
+}
+
 static void fuzz_check_load(rad_context *ctx, rad_result r, rad_scene *scene)
 {
     if (r != RAD_OK) {

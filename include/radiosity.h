@@ -125,8 +125,10 @@ typedef void (*rad_error_fn)(void *user, rad_result result, const char *message)
 
 /* Called when a call succeeds but reads its input differently from what the
  * file asks (a glTF orthographic camera, which the renderer does not draw,
- * replaced), or meets geometry finer than its rays resolve (a polygon
- * narrower than the shadow rays' tolerance, 1e-5 of the scene's size):
+ * replaced; a material's highlight, texture or transparency, which the
+ * diffuse engine does not use: one line a material, after the load), or
+ * meets geometry finer than its rays resolve (a polygon narrower than the
+ * shadow rays' tolerance, 1e-5 of the scene's size):
  * one line naming the file, valid during the callback only; from the
  * thread that made the call. */
 typedef void (*rad_warning_fn)(void *user, const char *message);

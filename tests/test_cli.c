@@ -348,6 +348,26 @@ static void test_gltf_orthographic_camera(void **state)
     assert_true(exists("ortho.png"));
 }
 
+/* What a material says that the engine does not use (a highlight, a
+ * texture) is said once on stderr, one line a material; the run still
+ * exits 0 and writes its image. */
+static void test_unused_material_properties(void **state)
+{
+    (void)state;
+    write_file("shiny.mtl", "newmtl white\nKd 0.5 0.5 0.5\nKs 0.8 0.8 0.8\nNs 100\nillum 2\n"
+                            "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\nKs 0 0 0\nd 1\nillum 1\n");
+    write_file("shiny.obj", "mtllib shiny.mtl\n"
+                            "o floor\nusemtl white\n"
+                            "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
+                            "o lamp\nusemtl lamp\n"
+                            "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n");
+    assert_int_equal(run("render shiny.obj -o shiny.png --elements 50 --width 32 --height 32"), 0);
+    assert_one_line_error("radiosity: warning: shiny.mtl: material 'white' (surface 'floor'): Ks, "
+                          "Ns and illum 2 are not used (the engine is diffuse: Kd and Ke only)",
+                          NULL);
+    assert_true(exists("shiny.png"));
+}
+
 /* glTF files refused before assimp reads them: a tree 2,000 nodes deep
  * (20,000 overflowed the stack inside assimp), an index out of range
  * (assimp dropped the triangle): one line, exit 1, no output. */
@@ -908,6 +928,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_empty_scene),
         cmocka_unit_test(test_malformed_gltf),
         cmocka_unit_test(test_gltf_orthographic_camera),
+        cmocka_unit_test(test_unused_material_properties),
         cmocka_unit_test(test_gltf_refused),
         cmocka_unit_test(test_scene_format_by_content),
         cmocka_unit_test(test_face_vertex_count),

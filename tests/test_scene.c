@@ -1097,6 +1097,194 @@ static void test_gltf_orthographic_camera(void **state)
     rad_context_destroy(warned);
 }
 
+/* ---- what the materials say that the engine does not use ---- */
+
+/* Every warning of one load, in order. */
+typedef struct warning_lines {
+    size_t count;
+    char lines[16][1024];
+} warning_lines;
+
+static void note_warning_line(void *user, const char *message)
+{
+    warning_lines *w = user;
+    if (w->count < sizeof w->lines / sizeof w->lines[0])
+        snprintf(w->lines[w->count], sizeof w->lines[0], "%s", message);
+    w->count++;
+}
+
+/* Load `obj` + `mtl` (or the glTF `obj` when `mtl` is NULL) from memory in a
+ * context that collects warnings into `seen`; returns the result. */
+static rad_result load_noting(const char *name, const char *obj, const char *mtl,
+                              warning_lines *seen)
+{
+    memset(seen, 0, sizeof *seen);
+    rad_context_options co = {.threads = 1, .on_warning = note_warning_line, .warning_user = seen};
+    rad_context *noting = NULL;
+    assert_int_equal(rad_context_create(&co, &noting), RAD_OK);
+    rad_scene *scene = NULL;
+    rad_result r = rad_scene_load_memory(noting, name, obj, strlen(obj), mtl,
+                                         mtl ? strlen(mtl) : 0, &scene);
+    if (r != RAD_OK)
+        print_message("%s\n", rad_context_error(noting));
+    rad_scene_destroy(scene);
+    rad_context_destroy(noting);
+    return r;
+}
+
+/* An MTL's specular, glossy and textured materials are said once, one line
+ * each, naming the surfaces that use them; a plain material with values
+ * that say nothing (Ks 0 0 0, d 1, Tr 0, Ni without transparency, illum 2
+ * without a highlight) is not; a material no surface uses is not. */
+static void test_mtl_unused_properties(void **state)
+{
+    (void)state;
+    const char *obj = "mtllib room.mtl\n"
+                      "o mirror_panel\nusemtl mirror\n"
+                      "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
+                      "o frame\nusemtl mirror\nv 0 1 0\nv 1 1 0\nv 1 1 1\nf 5 6 7\n"
+                      "o desk\nusemtl wood\nv 0 0 0\nv 0 1 0\nv 0 1 1\nf 8 9 10\n"
+                      "o lamp\nusemtl light\nv 0 0.5 0\nv 0 0.5 1\nv 1 0.5 1\nf 11 12 13\n"
+                      "o mirror_panel\nusemtl mirror\nv 2 0 0\nv 3 0 0\nv 3 0 1\nf 14 15 16\n";
+    const char *mtl = "newmtl mirror\nKd 0.1 0.1 0.1\nKs 0.9 0.9 0.9\nNs 200\nillum 3\n"
+                      "newmtl wood\nKd 0.5 0.4 0.3\nmap_Kd -bm 1 wood.png\n"
+                      "newmtl light\nKa 1 1 1\nKd 0.5 0.5 0.5\nKe 10 10 10\nKs 0 0 0\nNs 10\n"
+                      "d 1\nTr 0\nNi 1.45\nTf 1 1 1\nillum 2\n"
+                      "newmtl unused\nKd 0.5 0.5 0.5\nKs 1 1 1\nmap_Bump b.png\n";
+    warning_lines seen;
+    assert_int_equal(load_noting("room.obj", obj, mtl, &seen), RAD_OK);
+    assert_int_equal(seen.count, 2);
+    assert_string_equal(seen.lines[0],
+                        "room.mtl: material 'mirror' (surfaces 'mirror_panel', 'frame'): Ks, Ns "
+                        "and illum 3 are not used (the engine is diffuse: Kd and Ke only)");
+    assert_string_equal(seen.lines[1],
+                        "room.mtl: material 'wood' (surface 'desk'): map_Kd 'wood.png' is not "
+                        "used: its reflectance is Kd (0.5 0.4 0.3)");
+
+    /* Glass, a metal and the texture statements (8 named, then counted),
+     * beside Ke from a map.  Not `decal`: assimp 5.2 reads it as `d`
+     * followed by "ecal", and fails. */
+    const char *one = "mtllib one.mtl\no a\nusemtl m\nv 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 2 3\n";
+    const char *glass = "newmtl m\nKd 0.1 0.1 0.1\nd 0.4\nNi 1.5\nTf 0.9 1 0.9\nillum 7\n"
+                        "Pm 1\nPr 0.2\nPc 0 \nPcr 0.1\nmap_Ke glow.png\nbump n.png\nmap_Ks s.png\n"
+                        "map_d a.png\nnorm n2.png\ndisp h.png\nrefl -type sphere e.png\n"
+                        "map_Bump nb.png\nmap_Ns ns.png\n";
+    assert_int_equal(load_noting("one.obj", one, glass, &seen), RAD_OK);
+    assert_int_equal(seen.count, 1);
+    assert_string_equal(seen.lines[0],
+                        "one.mtl: material 'm' (surface 'a'): Ni, d, Tf, illum 7, Pr, Pm, "
+                        "map_Ke 'glow.png', bump 'n.png', map_Ks 's.png', map_d 'a.png', "
+                        "norm 'n2.png', disp 'h.png', refl 'e.png', map_Bump 'nb.png' and 1 more are "
+                        "not used: its emission is 0 (no Ke)");
+
+    /* Nothing to say: no warning. */
+    assert_int_equal(load_noting("one.obj", one, "newmtl m\nKd 0.5 0.5 0.5\nKs 0 0 0\nillum 1\n",
+                                 &seen),
+                     RAD_OK);
+    assert_int_equal(seen.count, 0);
+
+    /* A load that fails after the library's notes says nothing. */
+    const char *broken = "mtllib one.mtl\no a\nusemtl m\nv 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 2 3\n"
+                         "usemtl other\n";
+    assert_int_equal(load_noting("one.obj", broken, "newmtl m\nKd 0.5 0.5 0.5\nKs 1 1 1\n", &seen),
+                     RAD_ERROR_PARSE);
+    assert_int_equal(seen.count, 0);
+}
+
+/* 15 materials with something unused: 10 lines, then one counting the 5
+ * others. */
+static void test_mtl_unused_cap(void **state)
+{
+    (void)state;
+    char obj[8192] = "mtllib many.mtl\n", mtl[8192] = "";
+    size_t o = strlen(obj), m = 0;
+    for (int i = 0; i < 15; i++) {
+        o += (size_t)snprintf(obj + o, sizeof obj - o,
+                              "o s%d\nusemtl m%d\nv %d 0 0\nv %d 1 0\nv %d 1 1\nf -3 -2 -1\n", i,
+                              i, i, i, i);
+        m += (size_t)snprintf(mtl + m, sizeof mtl - m, "newmtl m%d\nKd 0.5 0.5 0.5\nKs 0.5 0.5 0.5\n",
+                              i);
+    }
+    warning_lines seen;
+    assert_int_equal(load_noting("many.obj", obj, mtl, &seen), RAD_OK);
+    assert_int_equal(seen.count, 11);
+    for (int i = 0; i < 10; i++) {
+        char expected[256];
+        snprintf(expected, sizeof expected,
+                 "many.mtl: material 'm%d' (surface 's%d'): Ks is not used (the engine is "
+                 "diffuse: Kd and Ke only)", i, i);
+        assert_string_equal(seen.lines[i], expected);
+    }
+    assert_string_equal(seen.lines[10],
+                        "many.obj: ... and 5 more materials with unused properties");
+
+    /* Names past 3 surfaces are counted. */
+    char five[1024] = "mtllib five.mtl\nusemtl m\n";
+    size_t f = strlen(five);
+    for (int i = 0; i < 5; i++)
+        f += (size_t)snprintf(five + f, sizeof five - f,
+                              "o s%d\nv %d 0 0\nv %d 1 0\nv %d 1 1\nf -3 -2 -1\n", i, i, i, i);
+    assert_int_equal(load_noting("five.obj", five, "newmtl m\nKd 0.5 0.5 0.5\nillum 4\n", &seen),
+                     RAD_OK);
+    assert_int_equal(seen.count, 1);
+    assert_string_equal(seen.lines[0],
+                        "five.mtl: material 'm' (surfaces 's0', 's1', 's2' and 2 more): illum 4 "
+                        "is not used (the engine is diffuse: Kd and Ke only)");
+}
+
+/* A glTF's texture, metal and transmission are said; an extension of
+ * extensionsUsed that nothing reads, once for the file; a plain material
+ * (metallicFactor 0) and the emissive strength, which is read, are not. */
+static void test_gltf_unused_properties(void **state)
+{
+    (void)state;
+    const char *gltf =
+        "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0,\n"
+        " \"extensionsUsed\": [\"KHR_materials_transmission\", \"KHR_lights_punctual\", "
+        "\"KHR_materials_emissive_strength\"],\n"
+        " \"scenes\": [{\"nodes\": [0, 1, 2, 3, 4]}],\n"
+        " \"nodes\": [{\"name\": \"desk\", \"mesh\": 0}, {\"name\": \"shelf\", \"mesh\": 0, "
+        "\"translation\": [0, 0, 2]},\n"
+        "   {\"name\": \"window\", \"mesh\": 1, \"translation\": [0, 0, 4]}, {\"name\": \"floor\", "
+        "\"mesh\": 2, \"translation\": [0, 0, 6]},\n"
+        "   {\"name\": \"lamp\", \"mesh\": 3, \"translation\": [0, 1, 0]}],\n"
+        " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, "
+        "\"material\": 0}]},\n"
+        "   {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 1}]},\n"
+        "   {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 2}]},\n"
+        "   {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 3}]}],\n"
+        " \"materials\": [{\"name\": \"wood\", \"pbrMetallicRoughness\": {\"baseColorFactor\": "
+        "[0.5, 0.4, 0.3, 1], \"baseColorTexture\": {\"index\": 0}, \"metallicFactor\": 1}},\n"
+        "   {\"name\": \"glass\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.2, 0.2, 0.2, "
+        "1], \"metallicFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": "
+        "{\"transmissionFactor\": 1}}},\n"
+        "   {\"name\": \"plain\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, "
+        "1], \"metallicFactor\": 0}, \"alphaMode\": \"BLEND\"},\n"
+        "   {\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1], "
+        "\"metallicFactor\": 0}, \"emissiveFactor\": [1, 1, 1], \"extensions\": "
+        "{\"KHR_materials_emissive_strength\": {\"emissiveStrength\": 2}}}],\n"
+        " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"wood.png\"}],\n"
+        " \"buffers\": [{\"byteLength\": 60, \"uri\": \"data:application/octet-stream;base64,"
+        "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA\"}],\n"
+        " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": "
+        "48, \"byteLength\": 12}],\n"
+        " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": "
+        "\"VEC3\"},\n"
+        "   {\"bufferView\": 1, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n";
+    warning_lines seen;
+    assert_int_equal(load_noting("x.gltf", gltf, NULL, &seen), RAD_OK);
+    assert_int_equal(seen.count, 3);
+    assert_string_equal(seen.lines[0], "x.gltf: extension KHR_lights_punctual is not used");
+    assert_string_equal(seen.lines[1],
+                        "x.gltf: material 'wood' (surfaces 'desk', 'shelf'): baseColorTexture "
+                        "'wood.png' and metallicFactor 1 are not used: its reflectance is "
+                        "baseColorFactor (0.5 0.4 0.3)");
+    assert_string_equal(seen.lines[2],
+                        "x.gltf: material 'glass' (surface 'window'): KHR_materials_transmission "
+                        "is not used (the engine is diffuse: baseColorFactor and emissiveFactor "
+                        "only)");
+}
+
 /* ---- the reader is chosen by content ---- */
 
 /* Write `size` bytes to temp_dir/name; returns the path (static). */
@@ -2101,6 +2289,9 @@ int main(void)
         cmocka_unit_test(test_gltf_bad_primitives),
         cmocka_unit_test(test_gltf_strips_and_fans),
         cmocka_unit_test(test_gltf_orthographic_camera),
+        cmocka_unit_test(test_mtl_unused_properties),
+        cmocka_unit_test(test_mtl_unused_cap),
+        cmocka_unit_test(test_gltf_unused_properties),
         cmocka_unit_test(test_builder_surfaces_and_materials),
         cmocka_unit_test(test_builder_non_planar),
         cmocka_unit_test(test_builder_errors),

@@ -52,6 +52,7 @@
 #include <assimp/scene.h>
 #include <cjson/cJSON.h>
 
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -131,7 +132,17 @@ typedef struct converter {
     const cJSON *gltf_materials; /* the glTF "materials" array; NULL for other formats */
     vec3 *face;                  /* the face being converted */
     size_t face_capacity;
+    import_notes *notes;         /* what the file says that is not used (unused.c) */
+    int *note_of;                /* aiMaterial index -> its note; -1 = none; NULL: no notes */
+    struct note_use *uses;       /* which surfaces use a noted material */
+    size_t use_count, use_capacity;
 } converter;
+
+/* A surface that uses a material with a note. */
+typedef struct note_use {
+    size_t note;
+    int surface; /* the builder's index: the order of first use */
+} note_use;
 
 /* The builder material for assimp material `index`, added on first use so
  * that materials no polygon uses are never validated. */
@@ -195,6 +206,115 @@ static bool face_repeats_index(const struct aiFace *face)
     return face->mNumIndices == 3 && (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]);
 }
 
+/* ---- the surfaces of the materials with notes (unused.c) ---- */
+
+/* A material's name in the notes, for sorting and searching. */
+typedef struct noted_name {
+    const char *name;
+    size_t note;
+} noted_name;
+
+static int compare_noted_names(const void *a, const void *b)
+{
+    return strcmp(((const noted_name *)a)->name, ((const noted_name *)b)->name);
+}
+
+/* Find the assimp material of each note: a glTF's by its index (assimp
+ * keeps the file's order, its default material last), an OBJ's by name. */
+static rad_result notes_match(converter *cv)
+{
+    const import_notes *notes = cv->notes;
+    unsigned materials = cv->ai->mNumMaterials;
+    if (notes->count == 0 || materials == 0)
+        return RAD_OK;
+    cv->note_of = rad_alloc(cv->ctx, RAD_MEM_SCENE, materials, sizeof *cv->note_of, cv->name);
+    noted_name *names = cv->note_of ? rad_alloc(cv->ctx, RAD_MEM_SCENE, notes->count,
+                                                sizeof *names, cv->name)
+                                    : NULL;
+    if (!names)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    size_t named = 0;
+    for (unsigned k = 0; k < materials; k++)
+        cv->note_of[k] = -1;
+    for (size_t n = 0; n < notes->count; n++) {
+        const import_note *note = &notes->items[n];
+        if (note->material)
+            names[named++] = (noted_name){note->material, n};
+        else if (note->index < materials && note->index <= INT_MAX)
+            cv->note_of[note->index] = (int)n;
+    }
+    if (named > 0) {
+        qsort(names, named, sizeof *names, compare_noted_names);
+        for (unsigned k = 0; k < materials; k++) {
+            struct aiString name;
+            name.length = 0;
+            name.data[0] = '\0';
+            aiGetMaterialString(cv->ai->mMaterials[k], AI_MATKEY_NAME, &name);
+            noted_name key = {name.data, 0};
+            const noted_name *found =
+                bsearch(&key, names, named, sizeof *names, compare_noted_names);
+            if (found && found->note <= INT_MAX)
+                cv->note_of[k] = (int)found->note;
+        }
+    }
+    rad_free(names);
+    return RAD_OK;
+}
+
+/* Note that `surface` uses assimp material `material` (if it has a note). */
+static rad_result note_use_add(converter *cv, unsigned material, int surface)
+{
+    if (!cv->note_of || cv->note_of[material] < 0)
+        return RAD_OK;
+    note_use use = {(size_t)cv->note_of[material], surface};
+    if (cv->use_count > 0 && cv->uses[cv->use_count - 1].note == use.note &&
+        cv->uses[cv->use_count - 1].surface == surface)
+        return RAD_OK;
+    if (cv->use_count == cv->use_capacity) {
+        size_t grown = cv->use_capacity ? 2 * cv->use_capacity : 16;
+        note_use *uses = rad_realloc(cv->ctx, RAD_MEM_SCENE, cv->uses, grown, sizeof *uses,
+                                     cv->name);
+        if (!uses)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        cv->uses = uses;
+        cv->use_capacity = grown;
+    }
+    cv->uses[cv->use_count++] = use;
+    return RAD_OK;
+}
+
+static int compare_note_uses(const void *a, const void *b)
+{
+    const note_use *x = a, *y = b;
+    if (x->note != y->note)
+        return (x->note > y->note) - (x->note < y->note);
+    return (x->surface > y->surface) - (x->surface < y->surface);
+}
+
+/* Give each note the surfaces that use its material (the first 3 in the
+ * order they were met, and how many). */
+static rad_result notes_name_surfaces(converter *cv)
+{
+    if (cv->use_count > 1)
+        qsort(cv->uses, cv->use_count, sizeof *cv->uses, compare_note_uses);
+    rad_result r = RAD_OK;
+    for (size_t i = 0; i < cv->use_count && r == RAD_OK;) {
+        const char *names[3];
+        size_t total = 0, j = i;
+        for (; j < cv->use_count && cv->uses[j].note == cv->uses[i].note; j++) {
+            if (j > i && cv->uses[j].surface == cv->uses[j - 1].surface)
+                continue;
+            if (total < 3)
+                names[total] = rad_scene_builder_surface_name(cv->builder, cv->uses[j].surface);
+            total++;
+        }
+        r = import_note_set_surfaces(cv->ctx, &cv->notes->items[cv->uses[i].note], names,
+                                     total < 3 ? total : 3, total);
+        i = j;
+    }
+    return r;
+}
+
 static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigned mesh_index,
                                const affine *world)
 {
@@ -217,6 +337,9 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
             material = surface < 0 ? -1 : convert_material(cv, mesh->mMaterialIndex);
             if (material < 0)
                 return cv->ctx ? cv->ctx->last_result : RAD_ERROR_INVALID_SCENE;
+            rad_result noted = note_use_add(cv, mesh->mMaterialIndex, surface);
+            if (noted != RAD_OK)
+                return noted;
         }
         if (face->mNumIndices > cv->face_capacity) {
             vec3 *grown = rad_realloc(cv->ctx, RAD_MEM_SCENE, cv->face, face->mNumIndices,
@@ -384,7 +507,7 @@ static rad_result import_gltf_parse_and_check(rad_context *ctx, const char *name
 }
 
 /* Import `in`, read from `name`, with assimp (through `io`). */
-static rad_result import_scene(rad_context *ctx, const char *name, const import_input *in,
+static rad_result import_scene(rad_context *ctx, const char *name, import_input *in,
                                struct aiFileIO *io, rad_scene **out)
 {
     bool gltf = in->format != IMPORT_OBJ, glb = in->format == IMPORT_GLB;
@@ -400,8 +523,12 @@ static rad_result import_scene(rad_context *ctx, const char *name, const import_
     if (gltf) {
         rad_result checked = import_gltf_parse_and_check(ctx, name, data, size, glb, io, &json,
                                                          &facts);
-        if (checked != RAD_OK)
+        if (checked == RAD_OK)
+            checked = import_gltf_note_unused(ctx, name, json, &in->notes);
+        if (checked != RAD_OK) {
+            cJSON_Delete(json);
             return checked;
+        }
     }
 
     struct aiPropertyStore *properties = aiCreatePropertyStore();
@@ -425,7 +552,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, const import_
     }
 
     rad_result r = RAD_OK;
-    converter cv = {.ctx = ctx, .name = name, .ai = ai};
+    converter cv = {.ctx = ctx, .name = name, .ai = ai, .notes = &in->notes};
     cv.gltf_materials = cJSON_GetObjectItemCaseSensitive(json, "materials");
     if (!ai->mRootNode || ai->mNumMeshes == 0) {
         r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE, "%s: scene is empty (no polygons)", name);
@@ -440,7 +567,11 @@ static rad_result import_scene(rad_context *ctx, const char *name, const import_
     }
     for (unsigned i = 0; i < ai->mNumMaterials; i++)
         cv.material_of[i] = -1;
-    r = convert_nodes(&cv, ai->mRootNode);
+    r = notes_match(&cv);
+    if (r == RAD_OK)
+        r = convert_nodes(&cv, ai->mRootNode);
+    if (r == RAD_OK)
+        r = notes_name_surfaces(&cv);
     if (r != RAD_OK)
         goto done;
     if (gltf && facts.has_camera)
@@ -453,6 +584,8 @@ static rad_result import_scene(rad_context *ctx, const char *name, const import_
 done:
     rad_scene_builder_destroy(cv.builder);
     rad_free(cv.material_of);
+    rad_free(cv.note_of);
+    rad_free(cv.uses);
     rad_free(cv.face);
     aiReleaseImport(ai);
     cJSON_Delete(json);
@@ -499,6 +632,7 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
         rad_scene_set_inputs(*out, log.paths, log.count);
         log.paths = NULL;
         log.count = 0;
+        import_notes_warn(ctx, path, &in.notes); /* said once the load stands */
     }
     import_file_log_free(&log);
     import_input_free(&in);
@@ -525,6 +659,8 @@ rad_result rad_import_assimp_memory(rad_context *ctx, const char *name, const vo
         *out = NULL;
         r = RAD_ERROR_OUT_OF_MEMORY;
     }
+    if (r == RAD_OK)
+        import_notes_warn(ctx, name, &in.notes); /* said once the load stands */
     import_input_free(&in);
     return r;
 }

@@ -91,6 +91,7 @@ void import_input_free(import_input *in)
     rad_free(in->alias);
     rad_free(in->owned[0]);
     rad_free(in->owned[1]);
+    import_notes_free(&in->notes);
     memset(in, 0, sizeof *in);
 }
 
@@ -264,6 +265,7 @@ typedef struct libraries {
     double read;            /* bytes of the scene's text read so far */
     library_text all;
     import_material_names names;
+    import_notes *notes;    /* what the libraries say that is not used */
     library_seen *seen;
     size_t seen_count, seen_capacity;
 } libraries;
@@ -322,7 +324,7 @@ static rad_result read_library(libraries *l, const char *name, size_t name_lengt
         import_file_log_add(l->log, path);
         l->read += (double)size;
         skip_byte_order_mark(&start, &size);
-        r = import_mtl_prescan(l->ctx, path, start, size, &l->names);
+        r = import_mtl_prescan(l->ctx, path, start, size, &l->names, l->notes);
     }
     if (r == RAD_OK)
         r = append_library(l->ctx, &l->all, start, size, what);
@@ -421,7 +423,8 @@ rad_result import_input_read_file(rad_context *ctx, const char *path, import_fil
                    .obj_path = path,
                    .folder = slash ? (size_t)(slash - path) + 1 : 0,
                    .log = log,
-                   .read = (double)size};
+                   .read = (double)size,
+                   .notes = &in->notes};
     r = read_libraries(&l, &scan);
     if (r == RAD_OK && scan.mtllib_count > 0)
         r = check_materials(ctx, path, text, size, &l.names);
@@ -477,7 +480,7 @@ rad_result import_input_from_memory(rad_context *ctx, const char *name, const ch
             int stem = dot && (!slash || dot > slash) ? (int)(dot - name) : (int)strlen(name);
             snprintf(mtl_name, sizeof mtl_name, "%.*s.mtl", stem, name);
         }
-        r = import_mtl_prescan(ctx, mtl_name, mtl, mtl_size, &names);
+        r = import_mtl_prescan(ctx, mtl_name, mtl, mtl_size, &names, &in->notes);
         if (r == RAD_OK)
             r = check_materials(ctx, name, data, size, &names);
         in->materials = mtl;

@@ -8,6 +8,8 @@
  *    gltf_fixes.c    GLB framing checked before assimp; glTF JSON read after
  *    gltf_check.c    a glTF's nodes, meshes, buffers and memory checked before
  *                    assimp; its camera
+ *    unused.c        what a file's materials say that the engine does not use,
+ *                    noted before assimp, said as warnings after the load
  *    assimp_io.c     the file system assimp reads through: the input from
  *                    memory, a glTF's other files logged and confined
  *    import_assimp.c aiScene -> rad_scene_builder, and the two entry points
@@ -20,6 +22,54 @@
 struct aiFileIO;
 struct cJSON;
 typedef struct import_file_log import_file_log; /* assimp_io.c */
+
+/* ---- unused.c ---- */
+
+/* One note of what a file says that the engine does not use: a material's
+ * properties (listed with the surfaces that use it once the scene is
+ * built), or something of the whole file. */
+typedef struct import_note {
+    char *subject;   /* "scene.mtl: material 'mirror'", "x.gltf" (rad_alloc'd) */
+    char *what;      /* "Ks and illum 3 are not used (...)" (rad_alloc'd) */
+    char *material;  /* OBJ: the material's name, as assimp names it (rad_alloc'd); else NULL */
+    size_t index;    /* glTF: the material's index; IMPORT_NOTE_FILE: the whole file;
+                        SIZE_MAX with `material` */
+    char *surfaces;  /* "surfaces 'a', 'b'" once known (rad_alloc'd); NULL: no surface uses
+                        the material, and nothing is said */
+} import_note;
+
+#define IMPORT_NOTE_FILE (SIZE_MAX - 1)
+
+typedef struct import_notes {
+    import_note *items; /* in the order said (rad_alloc'd) */
+    size_t count, capacity;
+} import_notes;
+
+/* Most lines of notes one load says; then one line counts the rest. */
+#define IMPORT_NOTES_MAX_LINES 10
+
+/* Add a note (the strings are copied); RAD_ERROR_OUT_OF_MEMORY else. */
+rad_result import_notes_add(rad_context *ctx, import_notes *notes, const char *subject,
+                            const char *material, size_t index, const char *what);
+/* Join `count` items as "a", "a and b", "a, b and c". */
+void import_join_items(char *text, size_t size, const char *const *items, size_t count);
+/* Note what the glTF `root` (of file `name`) says that is not used: per
+ * material, textures, metallicFactor > 0, alphaMode BLEND / MASK where it
+ * shows, material extensions other than KHR_materials_emissive_strength,
+ * vertex colours of its primitives; the extensions of extensionsUsed that
+ * nothing else names.  RAD_ERROR_OUT_OF_MEMORY or RAD_OK. */
+rad_result import_gltf_note_unused(rad_context *ctx, const char *name, const struct cJSON *root,
+                                   import_notes *notes);
+/* Set `note`'s surfaces: `shown` names (at most 3) of `total` distinct
+ * surfaces.  RAD_ERROR_OUT_OF_MEMORY or RAD_OK. */
+rad_result import_note_set_surfaces(rad_context *ctx, import_note *note,
+                                    const char *const *names, size_t shown, size_t total);
+/* Say the notes through rad_warn, the whole file's first, then each
+ * material's that some surface uses: at most IMPORT_NOTES_MAX_LINES lines,
+ * then "NAME: ... and N more materials with unused properties" (`name`: the
+ * scene's).  Cannot fail. */
+void import_notes_warn(rad_context *ctx, const char *name, const import_notes *notes);
+void import_notes_free(import_notes *notes);
 
 /* ---- obj_prescan.c ---- */
 
@@ -61,9 +111,10 @@ typedef struct import_material_names {
 } import_material_names;
 
 /* Check the MTL text [text, text + size), as import_obj_prescan, and add
- * its materials to `names`. */
+ * its materials to `names`; note in `notes` (NULL: none) what each
+ * material says beyond Kd and Ke that would change its look. */
 rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
-                              import_material_names *names);
+                              import_material_names *names, import_notes *notes);
 /* After the last library: a name defined twice (in one library or two)
  * fails, naming both places (assimp would merge the two silently). */
 rad_result import_material_names_check(rad_context *ctx, import_material_names *names);
@@ -104,6 +155,7 @@ typedef struct import_input {
     size_t size;
     const char *materials; /* OBJ: every library's text, one after the other; NULL: none */
     size_t materials_size;
+    import_notes notes;    /* what the pre-scans found unused, said after a load (unused.c) */
     char *owned[2];        /* the blocks above that are ours (rad_free) */
 } import_input;
 
@@ -121,7 +173,7 @@ rad_result import_input_read_file(rad_context *ctx, const char *path, import_fil
 rad_result import_input_from_memory(rad_context *ctx, const char *name, const char *data,
                                     size_t size, const char *mtl, size_t mtl_size,
                                     import_input *in);
-/* Free what `in` owns.  Cannot fail. */
+/* Free what `in` owns, its notes included.  Cannot fail. */
 void import_input_free(import_input *in);
 
 /* ---- gltf_fixes.c ---- */

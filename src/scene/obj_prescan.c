@@ -10,7 +10,8 @@
  *    text --lines--> tokens --checks--> "scene.obj:12: face references vertex 40 of 32"
  *
  * Not a parser: it checks vertex coordinates, face/line/point indices,
- * Kd/Ke and material names, and lists the `mtllib` statements; assimp
+ * Kd/Ke and material names, lists the `mtllib` statements and notes what
+ * a material says beyond Kd and Ke (said after the load: unused.c); assimp
  * reads the text afterwards.  The statements are those of Wavefront's
  * "Object Files (.obj)" and "Material Library Files (.mtl)", Appendices B1
  * and B2 of the Advanced Visualizer manual.  Works on buffers (which need
@@ -459,82 +460,318 @@ static rad_result add_material_name(rad_context *ctx, import_material_names *nam
     return RAD_OK;
 }
 
+/* ---- what an MTL material says beyond Kd and Ke ---- */
+
+/* The statements of Wavefront's MTL (and the PBR extension exporters
+ * write: Pr, Pm, Ps, Pc, Pcr, aniso, anisor) that describe what a diffuse
+ * engine does not draw.  Ka is not among them: ambient light is what
+ * radiosity computes. */
+enum {
+    MTL_KS, MTL_NS, MTL_NI, MTL_D, MTL_TR, MTL_TF, MTL_ILLUM, MTL_PR, MTL_PM, MTL_PS, MTL_PC,
+    MTL_PCR, MTL_ANISO, MTL_ANISOR, MTL_PROPERTIES
+};
+static const char *const mtl_property_names[MTL_PROPERTIES] = {
+    "Ks", "Ns", "Ni", "d", "Tr", "Tf", "illum", "Pr", "Pm", "Ps", "Pc", "Pcr", "aniso", "anisor",
+};
+
+enum { MTL_MAPS = 8, MTL_ITEM = TOKEN_SIZE + 40 };
+
+/* What one material says beyond Kd and Ke, judged at its end (whether Ns
+ * shows depends on Ks, wherever each is). */
+typedef struct mtl_extras {
+    bool seen[MTL_PROPERTIES];
+    bool numeric[MTL_PROPERTIES]; /* its values all numbers (not "spectral", "-halo") */
+    double low[MTL_PROPERTIES], high[MTL_PROPERTIES];
+    char illum[16];               /* illum's value as written */
+    bool has_kd, has_ke, map_kd, map_ke;
+    double kd[3], ke[3];
+    char map_statements[MTL_MAPS][32];
+    char maps[MTL_MAPS][MTL_ITEM]; /* "map_Kd 'wood.png'", in the file's order, each once */
+    size_t map_count, maps_more;
+} mtl_extras;
+
+static int mtl_property_of(const char *statement)
+{
+    for (int k = 0; k < MTL_PROPERTIES; k++)
+        if (strcasecmp(statement, mtl_property_names[k]) == 0)
+            return k;
+    return -1;
+}
+
+/* Texture statements: every map_*, and bump, disp, decal, refl, norm. */
+static bool is_mtl_map(const char *statement)
+{
+    static const char *const others[] = {"bump", "disp", "decal", "refl", "norm"};
+    if (strncasecmp(statement, "map_", 4) == 0)
+        return true;
+    for (size_t i = 0; i < sizeof others / sizeof others[0]; i++)
+        if (strcasecmp(statement, others[i]) == 0)
+            return true;
+    return false;
+}
+
+/* Note property `k`'s values, the rest of its line [p, end); a statement
+ * without values says nothing (assimp reads zeros). */
+static void note_property(mtl_extras *x, int k, const char *p, const char *end)
+{
+    char token[TOKEN_SIZE];
+    size_t length;
+    int count = 0;
+    bool numeric = true;
+    double value, low = 0.0, high = 0.0;
+    while ((length = next_token(&p, end, token)) > 0) {
+        if (parse_number(token, length, &value) != NUMBER_FINITE) {
+            numeric = false;
+        } else {
+            low = count == 0 || value < low ? value : low;
+            high = count == 0 || value > high ? value : high;
+        }
+        if (k == MTL_ILLUM && count == 0)
+            snprintf(x->illum, sizeof x->illum, "%.15s", token);
+        count++;
+    }
+    if (count == 0)
+        return;
+    x->seen[k] = true;
+    x->numeric[k] = numeric;
+    x->low[k] = low;
+    x->high[k] = high;
+}
+
+/* Note texture statement `statement`, its file the last word of its line
+ * (options such as "-bm 0.5" come first). */
+static void note_map(mtl_extras *x, const char *statement, const char *p, const char *end)
+{
+    char token[TOKEN_SIZE], file[TOKEN_SIZE] = "";
+    while (next_token(&p, end, token) > 0)
+        memcpy(file, token, sizeof file);
+    if (strcasecmp(statement, "map_Kd") == 0)
+        x->map_kd = true;
+    if (strcasecmp(statement, "map_Ke") == 0)
+        x->map_ke = true;
+    for (size_t i = 0; i < x->map_count; i++)
+        if (strcasecmp(x->map_statements[i], statement) == 0)
+            return;
+    if (x->map_count == MTL_MAPS) {
+        x->maps_more++;
+        return;
+    }
+    snprintf(x->map_statements[x->map_count], sizeof x->map_statements[0], "%s", statement);
+    if (file[0])
+        snprintf(x->maps[x->map_count], MTL_ITEM, "%.31s '%s'", statement, file);
+    else
+        snprintf(x->maps[x->map_count], MTL_ITEM, "%.31s", statement);
+    x->map_count++;
+}
+
+/* Whether property `k` was given with a value above 0 (or words). */
+static bool above_zero(const mtl_extras *x, int k)
+{
+    return x->seen[k] && (!x->numeric[k] || x->high[k] > 0.0);
+}
+
+/* Note, in `notes`, what material `material` (its full `name`, for
+ * matching assimp's; `label` printable) of library `path` says that would
+ * change its look.  Not said: Ks 0 0 0; Ns without a highlight; d 1 and
+ * Tr 0 (opaque); Ni and Tf on an opaque material without refraction
+ * (illum 6 or 7), and Tf 1 1 1; illum 0 and 1 (diffuse), and 2
+ * (highlights) without Ks; Pr without a highlight or metal; Pcr without
+ * Pc, anisor without aniso. */
+static rad_result note_mtl_material(rad_context *ctx, const char *path, const char *name,
+                                    const char *label, const mtl_extras *x, import_notes *notes)
+{
+    bool specular = above_zero(x, MTL_KS);
+    bool transparent = (x->seen[MTL_D] && (!x->numeric[MTL_D] || x->low[MTL_D] < 1.0)) ||
+                       above_zero(x, MTL_TR);
+    int illum = -1;
+    if (x->seen[MTL_ILLUM] && x->numeric[MTL_ILLUM] && x->low[MTL_ILLUM] == x->high[MTL_ILLUM] &&
+        x->high[MTL_ILLUM] >= 0.0 && x->high[MTL_ILLUM] <= 10.0 &&
+        x->high[MTL_ILLUM] == floor(x->high[MTL_ILLUM]))
+        illum = (int)x->high[MTL_ILLUM];
+    bool refractive = illum == 6 || illum == 7;
+    bool listed[MTL_PROPERTIES] = {false};
+    listed[MTL_KS] = specular;
+    listed[MTL_NS] = x->seen[MTL_NS] && specular;
+    listed[MTL_NI] = x->seen[MTL_NI] && (transparent || refractive);
+    listed[MTL_D] = x->seen[MTL_D] && (!x->numeric[MTL_D] || x->low[MTL_D] < 1.0);
+    listed[MTL_TR] = above_zero(x, MTL_TR);
+    listed[MTL_TF] = x->seen[MTL_TF] && (transparent || refractive) &&
+                     (!x->numeric[MTL_TF] || x->low[MTL_TF] < 1.0);
+    listed[MTL_ILLUM] =
+        x->seen[MTL_ILLUM] && !(illum == 0 || illum == 1 || (illum == 2 && !specular));
+    listed[MTL_PM] = above_zero(x, MTL_PM);
+    listed[MTL_PR] = x->seen[MTL_PR] && (listed[MTL_PM] || specular);
+    listed[MTL_PS] = above_zero(x, MTL_PS);
+    listed[MTL_PC] = above_zero(x, MTL_PC);
+    listed[MTL_PCR] = x->seen[MTL_PCR] && listed[MTL_PC];
+    listed[MTL_ANISO] = above_zero(x, MTL_ANISO);
+    listed[MTL_ANISOR] = x->seen[MTL_ANISOR] && listed[MTL_ANISO];
+
+    const char *items[MTL_PROPERTIES + MTL_MAPS + 1];
+    size_t count = 0;
+    char illum_item[32], more[32];
+    for (int k = 0; k < MTL_PROPERTIES; k++) {
+        if (!listed[k])
+            continue;
+        if (k == MTL_ILLUM) {
+            snprintf(illum_item, sizeof illum_item, "illum %s", x->illum);
+            items[count++] = illum_item;
+        } else {
+            items[count++] = mtl_property_names[k];
+        }
+    }
+    for (size_t i = 0; i < x->map_count; i++)
+        items[count++] = x->maps[i];
+    if (x->maps_more > 0) {
+        snprintf(more, sizeof more, "%zu more", x->maps_more);
+        items[count++] = more;
+    }
+    if (count == 0)
+        return RAD_OK;
+
+    char what[1024];
+    import_join_items(what, sizeof what, items, count);
+    size_t used = strlen(what);
+    used += (size_t)snprintf(what + used, sizeof what - used, " %s not used",
+                             count == 1 ? "is" : "are");
+    char colour[96];
+    if (x->map_kd && used < sizeof what) {
+        if (x->has_kd)
+            snprintf(colour, sizeof colour, "Kd (%g %g %g)", x->kd[0], x->kd[1], x->kd[2]);
+        else
+            snprintf(colour, sizeof colour, "0.6 0.6 0.6 (no Kd)"); /* assimp's default */
+        used += (size_t)snprintf(what + used, sizeof what - used, ": its reflectance is %s",
+                                 colour);
+    }
+    if (x->map_ke && used < sizeof what) {
+        if (x->has_ke)
+            snprintf(colour, sizeof colour, "Ke (%g %g %g)", x->ke[0], x->ke[1], x->ke[2]);
+        else
+            snprintf(colour, sizeof colour, "0 (no Ke)");
+        used += (size_t)snprintf(what + used, sizeof what - used, "%s its emission is %s",
+                                 x->map_kd ? "," : ":", colour);
+    }
+    if (!x->map_kd && !x->map_ke && used < sizeof what)
+        snprintf(what + used, sizeof what - used, " (the engine is diffuse: Kd and Ke only)");
+    char subject[512];
+    snprintf(subject, sizeof subject, "%s: material '%s'", path, label);
+    return import_notes_add(ctx, notes, subject, name, SIZE_MAX, what);
+}
+
 /* Check an MTL: nothing before the first newmtl, which names its
  * material; Kd (reflectance) and Ke (emitted radiance) are 3 finite
  * numbers, Kd in [0, 1) and Ke >= 0.  Every material is noted in `names`
- * (import_material_names_check then finds names defined twice). */
+ * (import_material_names_check then finds names defined twice), and what
+ * it says beyond Kd and Ke in `notes` (note_mtl_material). */
 rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *text, size_t size,
-                              import_material_names *names)
+                              import_material_names *names, import_notes *notes)
 {
     char token[TOKEN_SIZE], material[64] = "";
-    const char *p, *end;
+    const char *p, *end, *name = NULL; /* the current material's full name */
     bool seen_newmtl = false;
     rad_result added = add_library(ctx, names, path);
     if (added != RAD_OK)
         return added;
+    mtl_extras *extras = notes ? rad_alloc(ctx, RAD_MEM_SCENE, 1, sizeof *extras, path) : NULL;
+    if (notes && !extras)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_result r = RAD_OK;
     text_lines lines = text_lines_of(text, size);
-    while (next_line(&lines, &p, &end)) {
-        if (has_nul(p, end))
-            return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: NUL byte in the text", path,
-                            lines.number);
+    while (r == RAD_OK && next_line(&lines, &p, &end)) {
+        if (has_nul(p, end)) {
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: NUL byte in the text", path,
+                         lines.number);
+            break;
+        }
         if (next_token(&p, end, token) == 0 || token[0] == '#')
             continue;
         if (strcmp(token, "newmtl") == 0) {
             /* The name is the rest of the line, as assimp reads it and
              * `usemtl` names it: it may hold blanks. */
-            char *name = rest_of_line_copy(ctx, p, end, path);
-            if (!name)
-                return RAD_ERROR_OUT_OF_MEMORY;
-            if (!name[0]) {
-                rad_free(name);
-                return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: 'newmtl' names no material", path,
-                                lines.number);
+            char *copy = rest_of_line_copy(ctx, p, end, path);
+            if (!copy) {
+                r = RAD_ERROR_OUT_OF_MEMORY;
+                break;
             }
-            snprintf(material, sizeof material, "%s", name);
-            make_printable(material);
-            rad_result r = add_material_name(ctx, names, path, lines.number, name);
+            if (!copy[0]) {
+                rad_free(copy);
+                r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: 'newmtl' names no material", path,
+                             lines.number);
+                break;
+            }
+            if (extras && seen_newmtl) /* the material before is complete */
+                r = note_mtl_material(ctx, path, name, material, extras, notes);
             if (r != RAD_OK) {
-                rad_free(name);
-                return r;
+                rad_free(copy);
+                break;
             }
+            snprintf(material, sizeof material, "%s", copy);
+            make_printable(material);
+            r = add_material_name(ctx, names, path, lines.number, copy);
+            if (r != RAD_OK) {
+                rad_free(copy);
+                break;
+            }
+            name = copy; /* the names own it now */
+            if (extras)
+                memset(extras, 0, sizeof *extras);
             seen_newmtl = true;
             continue;
         }
         /* Every statement belongs to a material; assimp 5.2 dereferences a
          * null material for a texture map (map_Kd ...) before the first
          * newmtl (found by fuzz_mtl). */
-        if (!seen_newmtl)
-            return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: '%s' before any 'newmtl'", path,
-                            lines.number, token);
+        if (!seen_newmtl) {
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: '%s' before any 'newmtl'", path,
+                         lines.number, token);
+            break;
+        }
         bool is_kd = strcasecmp(token, "Kd") == 0, is_ke = strcasecmp(token, "Ke") == 0;
-        if (!is_kd && !is_ke)
+        if (!is_kd && !is_ke) {
+            int property = mtl_property_of(token);
+            if (extras && property >= 0)
+                note_property(extras, property, p, end);
+            else if (extras && is_mtl_map(token))
+                note_map(extras, token, p, end);
             continue;
+        }
         const char *key = is_kd ? "Kd" : "Ke";
         double values[3];
         int count = 0;
         size_t length;
-        while ((length = next_token(&p, end, token)) > 0) {
+        while (r == RAD_OK && (length = next_token(&p, end, token)) > 0) {
             if (count == 3 || parse_number(token, length, &values[count]) != NUMBER_FINITE)
-                return rad_fail(ctx, RAD_ERROR_PARSE,
-                                "%s:%d: material '%s': %s value '%s' is not a finite number",
-                                path, lines.number, material, key, token);
+                r = rad_fail(ctx, RAD_ERROR_PARSE,
+                             "%s:%d: material '%s': %s value '%s' is not a finite number",
+                             path, lines.number, material, key, token);
             count++;
         }
-        if (count != 3) /* assimp reads "Kd 0.5" as (0.5, 0, 0) */
-            return rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: material '%s': %s needs 3 numbers",
-                            path, lines.number, material, key);
-        for (int c = 0; c < count; c++) {
+        if (r != RAD_OK)
+            break;
+        if (count != 3) { /* assimp reads "Kd 0.5" as (0.5, 0, 0) */
+            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: material '%s': %s needs 3 numbers",
+                         path, lines.number, material, key);
+            break;
+        }
+        for (int c = 0; c < count && r == RAD_OK; c++) {
             if (is_kd && !(values[c] >= 0.0 && values[c] < 1.0))
-                return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
-                                "%s:%d: material '%s': reflectance (Kd) %g is outside [0, 1)",
-                                path, lines.number, material, values[c]);
+                r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
+                             "%s:%d: material '%s': reflectance (Kd) %g is outside [0, 1)",
+                             path, lines.number, material, values[c]);
             if (is_ke && values[c] < 0.0)
-                return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
-                                "%s:%d: material '%s': emission (Ke) %g is negative", path,
-                                lines.number, material, values[c]);
+                r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
+                             "%s:%d: material '%s': emission (Ke) %g is negative", path,
+                             lines.number, material, values[c]);
+        }
+        if (extras) {
+            memcpy(is_kd ? extras->kd : extras->ke, values, sizeof values);
+            *(is_kd ? &extras->has_kd : &extras->has_ke) = true;
         }
     }
-    return RAD_OK;
+    if (r == RAD_OK && extras && seen_newmtl)
+        r = note_mtl_material(ctx, path, name, material, extras, notes);
+    rad_free(extras);
+    return r;
 }
 
 static int compare_material_names(const void *a, const void *b)

@@ -160,6 +160,11 @@ static uint64_t name_hash(const char *name)
     return h;
 }
 
+const char *rad_scene_builder_surface_name(const rad_scene_builder *b, int surface)
+{
+    return b->surfaces[surface].name;
+}
+
 int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
 {
     if (!b)

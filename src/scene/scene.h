@@ -70,6 +70,9 @@ int rad_scene_builder_material(rad_scene_builder *b, const char *name,
 /* Returns the index of the surface with that name, creating it if new;
  * -1 on failure. */
 int rad_scene_builder_surface(rad_scene_builder *b, const char *name);
+/* The name of surface `surface` (an index rad_scene_builder_surface gave),
+ * valid while the builder lives.  Cannot fail. */
+const char *rad_scene_builder_surface_name(const rad_scene_builder *b, int surface);
 /* Add a polygon; `line` (0 if unknown) is used in error messages.  Returns
  * RAD_OK or an error (with message) for bad input. */
 rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int material,
