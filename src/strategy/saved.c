@@ -584,6 +584,8 @@ static rad_result read_mesh(rad_context *ctx, const char *name, const rad_scene 
         e->vertex_count = get_u32(c);
         for (int k = 0; k < 4; k++)
             e->vertex[k] = get_u32(c);
+        if (e->vertex_count == 3)
+            e->vertex[3] = 0; /* unused: never an index out of range */
         e->centroid = get_vec3(c);
         e->normal = get_vec3(c);
         e->area = get_f64(c);
@@ -611,8 +613,9 @@ static rad_result read_mesh(rad_context *ctx, const char *name, const rad_scene 
                   unit(e->normal) && v3_finite(e->centroid) && isfinite(e->area) && e->area >= 0.0;
         for (uint32_t k = 0; ok && k < e->vertex_count; k++)
             ok = e->vertex[k] < vertices;
-        if (ok)
-            ok = e->surface == m->patches[e->patch].surface && e->material == m->patches[e->patch].material;
+        if (ok) /* its patch's surface and material, and its patch's shape: grid cells and leaves are */
+            ok = e->surface == m->patches[e->patch].surface && e->material == m->patches[e->patch].material &&
+                 e->vertex_count == m->patches[e->patch].corner_count;
         if (!ok)
             r = BAD("%s: element %zu is malformed (patch, corners, vertex indices, normal or area)", name, i);
         else
