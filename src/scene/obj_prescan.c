@@ -556,7 +556,7 @@ static void note_map(mtl_extras *x, const char *statement, const char *p, const 
         x->maps_more++;
         return;
     }
-    snprintf(x->map_statements[x->map_count], sizeof x->map_statements[0], "%s", statement);
+    snprintf(x->map_statements[x->map_count], sizeof x->map_statements[0], "%.31s", statement);
     if (file[0])
         snprintf(x->maps[x->map_count], MTL_ITEM, "%.31s '%s'", statement, file);
     else
