@@ -35,8 +35,13 @@ fi
 build="${RADIOSITY_BUILD_DIR:-build}"
 # shellcheck disable=SC2086
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release ${RADIOSITY_CMAKE_ARGS:-} >/dev/null
-cmake --build "$build" -j "$(nproc)" 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make|Consolidate compiler' || true
-test -x "$build/radiosity" || { echo "setup: build failed" >&2; exit 1; }
+# The build's own status, not the filter's: a stale binary from an earlier
+# build must not pass for a build that failed.
+set +e
+cmake --build "$build" -j "$(nproc)" 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make|Consolidate compiler'
+built=${PIPESTATUS[0]}
+set -e
+[ "$built" -eq 0 ] && test -x "$build/radiosity" || { echo "setup: build failed" >&2; exit 1; }
 echo "setup: built $build/radiosity"
 
 if [ ! -f "$build/npm/node_modules/gltf-validator/package.json" ]; then
