@@ -464,10 +464,9 @@ char *cli_rewrite_message(const char *message, char *out, size_t size)
             k++;
         for (size_t c = 0; !skip && c < sizeof context_fields / sizeof context_fields[0]; c++) {
             size_t length = strlen(context_fields[c].field);
-            char next = p[length];
-            if (strncmp(p, context_fields[c].field, length) != 0 || next == '_' ||
-                isalnum((unsigned char)next))
-                continue;
+            if (strncmp(p, context_fields[c].field, length) != 0 || p[length] == '_' ||
+                isalnum((unsigned char)p[length]))
+                continue; /* p[length] is read only once the field matched: within the text */
             for (k = 0; k < FLAG_COUNT && strcmp(FLAGS[k].name, context_fields[c].flag) != 0; k++)
                 ;
             skip = k < FLAG_COUNT ? length : 0;
