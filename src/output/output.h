@@ -96,6 +96,61 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *vie
  * B/pi times `exposure` (0 = the automatic rule over the vertices). */
 rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure);
 
+/* ---- lightmaps (lightmap.c): the solution baked into atlases of texels ---- */
+
+/* How a texel got its value (docs/formats.md, "Lightmap"). */
+enum { RAD_TEXEL_EMPTY = 0, RAD_TEXEL_INSIDE, RAD_TEXEL_BORDER, RAD_TEXEL_DILATED };
+
+/* One patch's chart: its frame in the patch plane and its place in an atlas. */
+typedef struct rad_chart {
+    uint32_t patch;
+    uint32_t atlas;
+    int x, y;                /* the box's first texel in the atlas (its padding is around it) */
+    int width, height;       /* the box, texels (>= 2 each) */
+    vec3 origin;             /* m: the point at the box's corner (x, y) */
+    vec3 axis_u, axis_v;     /* unit: u along the patch's longest edge, v = normal x u */
+    uint32_t corner_count;   /* the patch's corners in the box, texels from (x, y), ccw */
+    double corner_u[4], corner_v[4];
+} rad_chart;
+
+typedef struct rad_atlas {
+    int width, height;       /* texels, powers of two; row 0 is the image's first row */
+    float *texels;           /* 3 per texel: the quantity, W/m^2 (0 where no chart is) */
+    int32_t *owner;          /* per texel: the chart whose padded box holds it, or -1 */
+    unsigned char *state;    /* per texel: RAD_TEXEL_* */
+} rad_atlas;
+
+typedef struct rad_lightmap {
+    double texels_per_metre;
+    int quantity;            /* RAD_LIGHTMAP_RADIOSITY or RAD_LIGHTMAP_IRRADIANCE */
+    rad_chart *charts;       /* one per patch, in patch order */
+    size_t chart_count;
+    rad_atlas *atlases;
+    size_t atlas_count;
+    double chart_texels;     /* the charts' boxes, texels */
+    double atlas_texels;     /* the atlases', texels: chart_texels / this is the fill ratio */
+} rad_lightmap;
+
+typedef struct rad_lightmap_options {
+    double texels_per_metre; /* 0 = 10 */
+    int atlas_size;          /* the largest atlas side, a power of two from 8 to 16384; 0 = 2048 */
+    int quantity;            /* RAD_LIGHTMAP_RADIOSITY (0) or RAD_LIGHTMAP_IRRADIANCE */
+} rad_lightmap_options;
+
+/* Chart every patch of the view's mesh, pack the charts and fill the
+ * atlases (lightmap.c).  Fails with RAD_ERROR_INVALID_ARGUMENT for bad
+ * options or a chart larger than an atlas, RAD_ERROR_OUT_OF_MEMORY (with
+ * a message naming the limit) when the atlases exceed the solution's
+ * memory limit, RAD_ERROR_INTERRUPTED when cancelled; *out is then NULL. */
+rad_result rad_lightmap_bake(rad_context *ctx, const rad_solution_view *view, const rad_lightmap_options *options,
+                             rad_lightmap **out);
+void rad_lightmap_destroy(rad_lightmap *lightmap);
+
+/* Continuous atlas texel coordinates (texel centres at k + 0.5) of point p
+ * of chart c's patch, and back.  Cannot fail. */
+void rad_chart_texel(const rad_lightmap *lightmap, const rad_chart *c, vec3 p, double *x, double *y);
+vec3 rad_chart_point(const rad_lightmap *lightmap, const rad_chart *c, double x, double y);
+
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path);
 
