@@ -746,6 +746,13 @@ typedef struct rad_bake_options {
     double exposure;             /* the glTF's COLOR_0, as rad_solution_write_mesh; 0 = automatic */
 } rad_bake_options;
 
+typedef struct rad_bake_stats {
+    size_t atlases;
+    double chart_texels;         /* the charts' boxes */
+    double atlas_texels;         /* the atlases': chart_texels / atlas_texels is the fill ratio */
+    double seconds;              /* charting, packing, filling and writing */
+} rad_bake_stats;
+
 /* Bake the solution into lightmaps and write the lit mesh that uses them.
  * `path` (.glb or .gltf) must be in `set` already (rad_output_set_add with
  * RAD_OUTPUT_BAKE or RAD_OUTPUT_MESH); the atlases are added to the set
@@ -758,9 +765,19 @@ typedef struct rad_bake_options {
  * (atlas coordinates) and MOZ_lightmap on every material.  Fails with
  * RAD_ERROR_INVALID_ARGUMENT (bad options, a chart larger than an atlas, a
  * path not in the set), RAD_ERROR_OUT_OF_MEMORY (the atlases above the
- * memory limit: the message says so), RAD_ERROR_IO. */
+ * memory limit: the message says so), RAD_ERROR_IO.  `stats`, if not
+ * NULL, gets the atlases' figures. */
 RAD_API rad_result rad_solution_bake(rad_context *ctx, const rad_solution *solution,
-                                     const rad_bake_options *options, rad_output_set *set, const char *path);
+                                     const rad_bake_options *options, rad_output_set *set, const char *path,
+                                     rad_bake_stats *stats);
+
+/* The name of atlas `atlas`'s lightmap beside the baked mesh `path`:
+ * `path` without its extension, "_lightmap", the atlas number, ".",
+ * `extension` ("room.glb", 0, "png": "room_lightmap0.png"), into `out`
+ * (snprintf's rules: `size` bytes at most, NUL included).  Returns the
+ * name's length, 0 for a NULL path or extension.  For planning outputs:
+ * the first atlas always exists. */
+RAD_API size_t rad_bake_image_path(const char *path, size_t atlas, const char *extension, char *out, size_t size);
 
 /* ------------------------------------------------------------------------
  * Method registries

@@ -18,6 +18,21 @@
 
 #include <cjson/cJSON.h>
 #include <stdio.h>
+
+/* The Debian package's stb_image, to read the lightmaps back. */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wall"
+#pragma GCC diagnostic ignored "-Wextra"
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wshadow"
+#pragma GCC diagnostic ignored "-Wcast-qual"
+#pragma GCC diagnostic ignored "-Wmissing-prototypes"
+#pragma GCC diagnostic ignored "-Wundef"
+#pragma GCC diagnostic ignored "-Wvla"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
@@ -32,7 +47,7 @@ static rad_solution *solution;
 static rad_lightmap *lightmap;   /* radiosity at 100 texels per metre (about 55 across a wall) */
 static double *vertex_B;         /* 3 per vertex, W/m^2 */
 
-static __attribute__((unused)) const char *temp_path(const char *name)
+static const char *temp_path(const char *name)
 {
     static char path[4][512];
     static int next;
@@ -41,7 +56,7 @@ static __attribute__((unused)) const char *temp_path(const char *name)
     return path[next];
 }
 
-static __attribute__((unused)) bool file_exists(const char *path) { return access(path, F_OK) == 0; }
+static bool file_exists(const char *path) { return access(path, F_OK) == 0; }
 
 static rad_lightmap *bake(double texels_per_metre, int atlas_size, int quantity)
 {
@@ -431,6 +446,235 @@ static void test_irradiance(void **state)
     rad_lightmap_destroy(lm);
 }
 
+/* ---- the files ---- */
+
+static unsigned char *read_bytes(const char *path, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    unsigned char *data = malloc((size_t)n + 1);
+    assert_non_null(data);
+    assert_int_equal(fread(data, 1, (size_t)n, f), (size_t)n);
+    data[n] = 0;
+    fclose(f);
+    *size = (size_t)n;
+    return data;
+}
+
+static uint32_t get_u32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static float get_f32(const unsigned char *p)
+{
+    uint32_t bits = get_u32(p);
+    float v;
+    memcpy(&v, &bits, 4);
+    return v;
+}
+
+static int json_int(const cJSON *object, const char *key)
+{
+    const cJSON *item = cJSON_GetObjectItemCaseSensitive(object, key);
+    assert_true(cJSON_IsNumber(item));
+    return item->valueint;
+}
+
+/* Bake at 100 texels per metre into 128-texel atlases (several), through
+ * an output set as the program does. */
+static void bake_files(const char *glb, size_t *atlases)
+{
+    rad_output_set *set;
+    const char *temp;
+    rad_bake_options o = {100.0, 128, RAD_LIGHTMAP_RADIOSITY, 0.0};
+    rad_bake_stats stats;
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, glb, RAD_OUTPUT_BAKE, &temp), RAD_OK);
+    assert_int_equal(rad_solution_bake(ctx, solution, &o, set, glb, &stats), RAD_OK);
+    assert_false(file_exists(glb)); /* not before the commit */
+    assert_int_equal(rad_output_set_commit(ctx, set), RAD_OK);
+    rad_output_set_destroy(set);
+    assert_true(stats.atlases > 1 && stats.chart_texels > 0.0 && stats.chart_texels < stats.atlas_texels);
+    *atlases = stats.atlases;
+}
+
+/* The glTF: every triangle's TEXCOORD_1 in one chart of its material's
+ * atlas, at the chart coordinates of its vertices' positions; the HDR and
+ * the RGBM PNG of each atlas hold the lightmap's texels / pi. */
+static void test_files(void **state)
+{
+    (void)state;
+    char glb[512];
+    snprintf(glb, sizeof glb, "%s", temp_path("room.glb"));
+    size_t atlases;
+    bake_files(glb, &atlases);
+    rad_lightmap *lm = bake(100.0, 128, RAD_LIGHTMAP_RADIOSITY);
+    assert_int_equal(lm->atlas_count, atlases);
+
+    size_t size;
+    unsigned char *bytes = read_bytes(glb, &size);
+    uint32_t json_length = get_u32(bytes + 12);
+    cJSON *json = cJSON_ParseWithLength((const char *)bytes + 20, json_length);
+    assert_non_null(json);
+    const unsigned char *bin = bytes + 20 + json_length + 8;
+    const cJSON *used = cJSON_GetObjectItemCaseSensitive(json, "extensionsUsed");
+    bool moz = false;
+    for (int k = 0; k < cJSON_GetArraySize(used); k++)
+        moz = moz || strcmp(cJSON_GetArrayItem(used, k)->valuestring, "MOZ_lightmap") == 0;
+    assert_true(moz);
+    assert_null(cJSON_GetObjectItemCaseSensitive(json, "extensionsRequired"));
+    const cJSON *images = cJSON_GetObjectItemCaseSensitive(json, "images");
+    assert_int_equal(cJSON_GetArraySize(images), (int)atlases);
+    for (size_t a = 0; a < atlases; a++) {
+        char want[64];
+        snprintf(want, sizeof want, "room_lightmap%zu.png", a);
+        assert_string_equal(cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(images, (int)a), "uri")->valuestring,
+                            want);
+    }
+    const cJSON *accessors = cJSON_GetObjectItemCaseSensitive(json, "accessors");
+    const cJSON *views = cJSON_GetObjectItemCaseSensitive(json, "bufferViews");
+    const cJSON *materials = cJSON_GetObjectItemCaseSensitive(json, "materials");
+    const cJSON *mesh;
+    size_t triangles = 0;
+    cJSON_ArrayForEach(mesh, cJSON_GetObjectItemCaseSensitive(json, "meshes"))
+    {
+        const cJSON *prim;
+        cJSON_ArrayForEach(prim, cJSON_GetObjectItemCaseSensitive(mesh, "primitives"))
+        {
+            const cJSON *attributes = cJSON_GetObjectItemCaseSensitive(prim, "attributes");
+            const cJSON *material = cJSON_GetArrayItem(materials, json_int(prim, "material"));
+            const cJSON *moz_lightmap = cJSON_GetObjectItemCaseSensitive(
+                cJSON_GetObjectItemCaseSensitive(material, "extensions"), "MOZ_lightmap");
+            assert_non_null(moz_lightmap);
+            assert_int_equal(json_int(moz_lightmap, "intensity"), 1);
+            const cJSON *texture = cJSON_GetObjectItemCaseSensitive(moz_lightmap, "texture");
+            assert_int_equal(json_int(texture, "texCoord"), 1);
+            int atlas = json_int(texture, "index");
+            const unsigned char *data[3];
+            static const char *const names[3] = {"POSITION", "TEXCOORD_1", NULL};
+            for (int k = 0; k < 3; k++) {
+                const cJSON *accessor = cJSON_GetArrayItem(
+                    accessors, k < 2 ? json_int(attributes, names[k]) : json_int(prim, "indices"));
+                const cJSON *view = cJSON_GetArrayItem(views, json_int(accessor, "bufferView"));
+                data[k] = bin + json_int(view, "byteOffset") + json_int(accessor, "byteOffset");
+            }
+            int count = json_int(cJSON_GetArrayItem(accessors, json_int(prim, "indices")), "count");
+            for (int t = 0; t < count; t += 3) {
+                double x[3], y[3];
+                vec3 p[3];
+                for (int k = 0; k < 3; k++) {
+                    uint32_t v = get_u32(data[2] + 4 * (t + k));
+                    p[k] = v3(get_f32(data[0] + 12 * v), get_f32(data[0] + 12 * v + 4), get_f32(data[0] + 12 * v + 8));
+                    x[k] = get_f32(data[1] + 8 * v) * lm->atlases[atlas].width;
+                    y[k] = get_f32(data[1] + 8 * v + 4) * lm->atlases[atlas].height;
+                }
+                /* The chart whose box holds the triangle's centre. */
+                double cx = (x[0] + x[1] + x[2]) / 3, cy = (y[0] + y[1] + y[2]) / 3;
+                const rad_chart *chart = NULL;
+                for (size_t i = 0; i < lm->chart_count && !chart; i++) {
+                    const rad_chart *c = &lm->charts[i];
+                    if ((int)c->atlas == atlas && cx >= c->x && cx <= c->x + c->width && cy >= c->y &&
+                        cy <= c->y + c->height)
+                        chart = c;
+                }
+                if (!chart)
+                    fail_msg("a triangle's texture coordinates (%g, %g) are in no chart of atlas %d", cx, cy, atlas);
+                for (int k = 0; k < 3; k++) {
+                    double wx, wy;
+                    rad_chart_texel(lm, chart, p[k], &wx, &wy);
+                    if (fabs(wx - x[k]) > 1e-3 || fabs(wy - y[k]) > 1e-3)
+                        fail_msg("vertex (%g, %g, %g): TEXCOORD_1 at texel (%g, %g), its chart puts it at (%g, %g)",
+                                 p[k].x, p[k].y, p[k].z, x[k], y[k], wx, wy);
+                }
+                triangles++;
+            }
+        }
+    }
+    assert_true(triangles >= rad_solution_element_count(solution));
+    const cJSON *extras = cJSON_GetObjectItemCaseSensitive(
+        cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(json, "asset"), "extras"), "radiosity");
+    const cJSON *info = cJSON_GetObjectItemCaseSensitive(extras, "lightmap");
+    double range = cJSON_GetObjectItemCaseSensitive(info, "rgbm_range")->valuedouble;
+    assert_true(range >= 1.0);
+    assert_int_equal(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(info, "hdr")), (int)atlases);
+
+    /* The images, texel by texel. */
+    for (size_t a = 0; a < atlases; a++) {
+        const rad_atlas *atlas = &lm->atlases[a];
+        char name[64];
+        int w = 0, h = 0, n = 0;
+        snprintf(name, sizeof name, "room_lightmap%zu.hdr", a);
+        float *hdr = stbi_loadf(temp_path(name), &w, &h, &n, 3);
+        assert_non_null(hdr);
+        assert_true(w == atlas->width && h == atlas->height);
+        snprintf(name, sizeof name, "room_lightmap%zu.png", a);
+        unsigned char *png = stbi_load(temp_path(name), &w, &h, &n, 4);
+        assert_non_null(png);
+        assert_true(w == atlas->width && h == atlas->height && n == 4);
+        for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
+            double peak = 0.0;
+            for (int c = 0; c < 3; c++)
+                peak = fmax(peak, atlas->texels[3 * i + (size_t)c] / M_PI);
+            for (int c = 0; c < 3; c++) {
+                double L = atlas->texels[3 * i + (size_t)c] / M_PI;
+                /* RGBE: 8 bits of mantissa under the largest channel. */
+                if (fabs(hdr[3 * i + (size_t)c] - L) > peak / 128.0 + 1e-30)
+                    fail_msg("atlas %zu texel %zu: HDR %g, lightmap %g", a, i, hdr[3 * i + (size_t)c], L);
+                /* RGBM: value = rgb x a x M, rgb rounded to 1/255 of a x M. */
+                double m = png[4 * i + 3] / 255.0 * range;
+                double decoded = png[4 * i + (size_t)c] / 255.0 * m;
+                if (fabs(decoded - L) > 0.5 / 255.0 * m + 1e-9)
+                    fail_msg("atlas %zu texel %zu: RGBM %g, lightmap %g", a, i, decoded, L);
+            }
+        }
+        stbi_image_free(hdr);
+        stbi_image_free(png);
+    }
+    cJSON_Delete(json);
+    free(bytes);
+    rad_lightmap_destroy(lm);
+}
+
+/* ---- the Khronos validator, where it is installed (as test_export) ---- */
+
+static void test_validator(void **state)
+{
+    (void)state;
+    const char *modules = RAD_NPM_MODULES;
+    char package[600];
+    snprintf(package, sizeof package, "%s/gltf-validator/package.json", modules);
+    if (system("command -v node >/dev/null 2>&1") != 0 || !file_exists(package)) {
+        printf("# gltf-validator: skipped (needs node and %s: scripts/setup.sh installs it with npm)\n", package);
+        skip();
+    }
+    char glb[512], gltf[512], report[512];
+    snprintf(glb, sizeof glb, "%s", temp_path("valid.glb"));
+    snprintf(gltf, sizeof gltf, "%s", temp_path("valid room.gltf"));
+    snprintf(report, sizeof report, "%s", temp_path("report.txt"));
+    size_t atlases;
+    bake_files(glb, &atlases);
+    bake_files(gltf, &atlases);
+    char cmd[3000];
+    snprintf(cmd, sizeof cmd, "node '%s/validate_gltf.js' '%s' '%s' '%s' >'%s' 2>&1", RAD_TEST_SOURCE, modules, glb,
+             gltf, report);
+    int status = system(cmd);
+    size_t size;
+    unsigned char *text = read_bytes(report, &size);
+    printf("%s", (const char *)text); /* the counts, and every error and warning */
+    fflush(stdout);
+    assert_non_null(strstr((const char *)text, "valid.glb: 0 errors"));
+    assert_non_null(strstr((const char *)text, "valid room.gltf: 0 errors"));
+    /* Its one warning: unlit and MOZ_lightmap on one material, as meant. */
+    for (const char *line = (const char *)text; (line = strstr(line, "  warning ")); line++)
+        assert_true(strncmp(line, "  warning MULTIPLE_EXTENSIONS ", 30) == 0);
+    free(text);
+    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -440,6 +684,8 @@ int main(void)
         cmocka_unit_test(test_texel_centres),
         cmocka_unit_test(test_seams),
         cmocka_unit_test(test_irradiance),
+        cmocka_unit_test(test_files),
+        cmocka_unit_test(test_validator),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -65,6 +65,11 @@ rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *
  * none is left.  Fails only for memory (a float per value). */
 rad_result rad_radiance_exposure(rad_context *ctx, const float *rgb, size_t count, double *exposure);
 
+/* Raw pixels written atomically, row 0 first: 8-bit RGBA as PNG, float RGB
+ * as Radiance HDR (RGBE).  RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY. */
+rad_result rad_write_png_rgba(rad_context *ctx, const char *path, int width, int height, const unsigned char *rgba);
+rad_result rad_write_hdr_rgb(rad_context *ctx, const char *path, int width, int height, const float *rgb);
+
 /* IEC 61966-2-1 sRGB encoding of a linear value, clamped to [0, 1] (the
  * exact piecewise curve); 255 x it, rounded, is an 8-bit channel. */
 double rad_srgb_encode(double linear);
@@ -150,6 +155,27 @@ void rad_lightmap_destroy(rad_lightmap *lightmap);
  * of chart c's patch, and back.  Cannot fail. */
 void rad_chart_texel(const rad_lightmap *lightmap, const rad_chart *c, vec3 p, double *x, double *y);
 vec3 rad_chart_point(const rad_lightmap *lightmap, const rad_chart *c, double x, double y);
+
+/* What the lit mesh needs to use lightmaps (rad_write_mesh_baked). */
+typedef struct rad_mesh_lightmaps {
+    const rad_lightmap *lightmap;
+    char **png_uris;         /* atlas_count relative URIs of the RGBM PNGs, percent-encoded */
+    char **hdr_names;        /* atlas_count file names of the HDRs, for asset.extras */
+    double rgbm_range;       /* M: radiance = rgb x alpha x M (each in [0, 1]) */
+} rad_mesh_lightmaps;
+
+/* rad_write_mesh's glTF (.glb, .gltf) with every vertex split per patch,
+ * TEXCOORD_1 its chart's atlas coordinates, one material per scene
+ * material and atlas, each with MOZ_lightmap on its atlas's PNG. */
+rad_result rad_write_mesh_baked(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure,
+                                const rad_mesh_lightmaps *maps);
+
+/* Bake and write: the lightmap of `options`, its atlases added to `set`
+ * beside `path` (which the set holds) as STEM_lightmapK.hdr / .png and
+ * written into their temporaries with the glTF (bake.c); the atlases'
+ * figures in *stats (all but seconds). */
+rad_result rad_write_bake(rad_context *ctx, const rad_solution_view *view, const rad_bake_options *options,
+                          rad_output_set *set, const char *path, rad_bake_stats *stats);
 
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path);
