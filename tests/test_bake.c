@@ -191,6 +191,30 @@ static void test_refused(void **state)
     rad_api_enter(ctx);
     assert_int_equal(rad_lightmap_bake(ctx, &view, &o, &lm), RAD_ERROR_OUT_OF_MEMORY);
     assert_non_null(strstr(rad_context_error(ctx), "memory limit"));
+    /* The public call: NULLs, a path the set does not hold, a format without
+     * images. */
+    rad_output_set *set;
+    const char *temp;
+    assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
+    assert_int_equal(rad_solution_bake(ctx, NULL, NULL, set, "a.glb", NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_solution_bake(ctx, solution, NULL, NULL, "a.glb", NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, temp_path("a.glb"), NULL),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rad_context_error(ctx), "not in the output set"));
+    assert_int_equal(rad_output_set_add(ctx, set, temp_path("a.ply"), RAD_OUTPUT_BAKE, &temp),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_output_set_add(ctx, set, temp_path("a.ply"), RAD_OUTPUT_MESH, &temp), RAD_OK);
+    assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, temp_path("a.ply"), NULL),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    rad_output_set_destroy(set);
+    assert_false(file_exists(temp_path("a.ply")));
+    char name[64];
+    assert_int_equal(rad_bake_image_path("out/room.v2.glb", 3, "png", name, sizeof name), 25);
+    assert_string_equal(name, "out/room.v2_lightmap3.png");
+    assert_int_equal(rad_bake_image_path("dir.d/room", 0, "hdr", name, sizeof name), 24);
+    assert_string_equal(name, "dir.d/room_lightmap0.hdr");
+    assert_int_equal(rad_bake_image_path(NULL, 0, "hdr", name, sizeof name), 0);
 }
 
 /* ---- lookups ---- */
