@@ -90,30 +90,36 @@ static rad_result chart_frame(rad_context *ctx, const rad_patch *patch, uint32_t
 
 /* ---- packing ---- */
 
-static const rad_chart *sort_charts; /* qsort has no user pointer; set only while sorting */
+/* A chart's place in the packing order: its box's height, then width,
+ * descending; then its patch.  (The sizes are copied in: qsort has no user
+ * pointer, and a global would not let two bakes run at once.) */
+typedef struct pack_key {
+    int height, width;
+    uint32_t chart;
+} pack_key;
 
-static int padded_cmp(const void *a, const void *b)
+static int pack_key_cmp(const void *a, const void *b)
 {
-    const rad_chart *x = &sort_charts[*(const uint32_t *)a], *y = &sort_charts[*(const uint32_t *)b];
+    const pack_key *x = a, *y = b;
     if (x->height != y->height)
         return x->height > y->height ? -1 : 1;
     if (x->width != y->width)
         return x->width > y->width ? -1 : 1;
-    return x->patch < y->patch ? -1 : (x->patch > y->patch);
+    return x->chart < y->chart ? -1 : (x->chart > y->chart);
 }
 
 /* Shelf-pack the charts in `order` into atlases of side `side`, at most
  * `max_atlases` of them: sets each chart's atlas and box and each atlas's
  * used height in used_height[] (sized max_atlases).  Returns the atlases
  * used, or 0 when they do not fit.  Cannot fail otherwise. */
-static size_t shelf_pack(rad_chart *charts, const uint32_t *order, size_t count, int side, size_t max_atlases,
+static size_t shelf_pack(rad_chart *charts, const pack_key *order, size_t count, int side, size_t max_atlases,
                          int *used_height)
 {
     size_t atlas = 0;
     int x = 0, y = 0, shelf = 0; /* the shelf's left cursor, its bottom, its height */
     used_height[0] = 0;
     for (size_t k = 0; k < count; k++) {
-        rad_chart *c = &charts[order[k]];
+        rad_chart *c = &charts[order[k].chart];
         int w = c->width + 2 * PADDING, h = c->height + 2 * PADDING;
         if (x + w > side) /* a new shelf */
             y += shelf, x = 0, shelf = 0;
@@ -319,7 +325,7 @@ rad_result rad_lightmap_bake(rad_context *ctx, const rad_solution_view *view, co
     lm->texels_per_metre = tpm;
     lm->quantity = options->quantity;
     lm->charts = rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *lm->charts, "lightmap: charts");
-    uint32_t *order = lm->charts ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *order, "lightmap: charts") : NULL;
+    pack_key *order = lm->charts ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *order, "lightmap: charts") : NULL;
     int *used = order ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *used, "lightmap: atlases") : NULL;
     double *vertex_value = used ? rad_alloc(ctx, RAD_MEM_OUTPUT, mesh->vertex_count, 3 * sizeof *vertex_value,
                                             "lightmap: vertex values")
@@ -333,7 +339,7 @@ rad_result rad_lightmap_bake(rad_context *ctx, const rad_solution_view *view, co
     int widest = 0;
     for (size_t k = 0; k < n && r == RAD_OK; k++) {
         r = chart_frame(ctx, &mesh->patches[k], (uint32_t)k, tpm, limit, &lm->charts[k]);
-        order[k] = (uint32_t)k;
+        order[k] = (pack_key){lm->charts[k].height, lm->charts[k].width, (uint32_t)k};
         area += (double)(lm->charts[k].width + 2 * PADDING) * (double)(lm->charts[k].height + 2 * PADDING);
         lm->chart_texels += (double)lm->charts[k].width * (double)lm->charts[k].height;
         int side = (lm->charts[k].width > lm->charts[k].height ? lm->charts[k].width : lm->charts[k].height);
@@ -352,9 +358,7 @@ rad_result rad_lightmap_bake(rad_context *ctx, const rad_solution_view *view, co
                      area, tpm, 17.0 * area / 1073741824.0, limit_bytes / 1073741824.0);
         goto done;
     }
-    sort_charts = lm->charts;
-    qsort(order, n, sizeof *order, padded_cmp);
-    sort_charts = NULL;
+    qsort(order, n, sizeof *order, pack_key_cmp);
     /* One atlas at the smallest side that holds everything, else as many
      * of the largest as it takes. */
     size_t atlases = 0;
