@@ -238,12 +238,24 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
     rad_output_kind kind = s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS
                            : s->command == CLI_SOLVE     ? RAD_OUTPUT_SOLUTION
                            : s->command == CLI_EXPORT    ? RAD_OUTPUT_MESH
+                           : s->command == CLI_BAKE      ? RAD_OUTPUT_BAKE
                                                          : RAD_OUTPUT_IMAGE;
     rad_result r = rad_output_set_create(ctx, &o->set);
     if (r == RAD_OK && s->scene_path)
         r = rad_output_set_add_input(ctx, o->set, s->scene_path);
     if (r == RAD_OK)
         r = rad_output_set_add(ctx, o->set, s->output, kind, &o->main);
+    /* bake: the first atlas's lightmaps (there is always one); others are
+     * added when the packing knows them. */
+    static const char *const lightmap_ext[2] = {"hdr", "png"};
+    for (int k = 0; k < 2 && r == RAD_OK && s->command == CLI_BAKE; k++) {
+        char name[PATH_MAX];
+        const char *temp;
+        if (rad_bake_image_path(s->output, 0, lightmap_ext[k], name, sizeof name) >= sizeof name)
+            r = RAD_ERROR_INVALID_ARGUMENT;
+        else
+            r = rad_output_set_add(ctx, o->set, name, RAD_OUTPUT_IMAGE, &temp);
+    }
     if (r == RAD_OK && s->stats)
         r = rad_output_set_add(ctx, o->set, s->stats, RAD_OUTPUT_FILE, &o->stats);
     if (r == RAD_OK && s->history && s->command != CLI_VIEWFACTORS)
@@ -352,7 +364,7 @@ int main(int argc, char **argv)
      * signature), which is solved already */
     double t0 = now_seconds();
     bool saved = s.scene_path && rad_file_is_solution(s.scene_path);
-    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT) {
+    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT && s.command != CLI_BAKE) {
         fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it and `radiosity "
                         "export` writes its lit mesh; %s needs the scene it was solved for\n",
                 s.scene_path, cli_command_name(s.command));
@@ -400,7 +412,7 @@ int main(int argc, char **argv)
     }
     if (s.command != CLI_VIEWFACTORS && !s.quiet && !s.scene_path)
         printf("radiosity: no scene given, %s the built-in Cornell box\n",
-               s.command == CLI_EXPORT ? "exporting" : "rendering");
+               s.command == CLI_EXPORT ? "exporting" : s.command == CLI_BAKE ? "baking" : "rendering");
 
     /* Progressive display keeps one exposure for all frames (the user's, or
      * the first frame's automatic one), so the picture visibly brightens as
@@ -494,8 +506,13 @@ int main(int argc, char **argv)
      * then all put in place together.  Signals from here on are noted, not
      * acted upon. */
     begin_saving(ctx);
+    rad_bake_stats baked = {0};
     if (s.command == CLI_EXPORT) {
         r = rad_solution_write_mesh(ctx, sol, out.main, s.render.exposure);
+    } else if (s.command == CLI_BAKE) {
+        rad_bake_options bo = {s.texels_per_metre, s.atlas_size, (rad_lightmap_quantity)s.lightmap_quantity,
+                               s.render.exposure};
+        r = rad_solution_bake(ctx, sol, &bo, out.set, output, &baked);
     } else {
         r = rad_solution_render(ctx, sol, &s.render, &image);
         progress_end(&progress);
@@ -525,7 +542,12 @@ int main(int argc, char **argv)
             snprintf(measure, sizeof measure, "unshot %.2g", h[steps - 1].unshot);
         else
             snprintf(measure, sizeof measure, "residual %.2g", residual);
-        if (s.command == CLI_EXPORT)
+        if (s.command == CLI_BAKE)
+            printf("wrote %s and %zu lightmap%s (fill %.1f%%, baked in %.2f s; %zu elements, %s, %.1f s)%s\n",
+                   where(output, full), baked.atlases, baked.atlases == 1 ? "" : "s",
+                   100.0 * baked.chart_texels / baked.atlas_texels, baked.seconds, rad_solution_element_count(sol),
+                   measure, now_seconds() - t0, partial ? " [partial]" : "");
+        else if (s.command == CLI_EXPORT)
             printf("wrote %s (%zu vertices, %zu elements, %s, %.1f s)%s\n", where(output, full),
                    rad_solution_vertex_count(sol), rad_solution_element_count(sol), measure,
                    now_seconds() - t0, partial ? " [partial]" : "");

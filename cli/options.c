@@ -42,6 +42,9 @@ static const command_def COMMANDS[] = {
      "write a procedural office floor as OBJ + MTL (docs/scenes.md)"},
     {CLI_SOLVE, "solve", "solve [SCENE] [options]",
      "solve the scene and write the solution file, to render from any camera without solving again"},
+    {CLI_BAKE, "bake", "bake [SCENE|SOLUTION.radsol] [options]",
+     "solve the scene (or load the solution) and write lightmaps (HDR, RGBM PNG) with the glTF lit mesh "
+     "that uses them (docs/formats.md)"},
 };
 #define COMMAND_COUNT (sizeof COMMANDS / sizeof COMMANDS[0])
 
@@ -57,9 +60,9 @@ const char *cli_command_name(int command)
 
 /* The commands that solve (render, export, solve), and those that also
  * mesh and couple (viewfactors). */
-#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE)
-#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE)
-#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE)
+#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
+#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
 #define RENDER(field_) .target = CLI_TO_RENDER, .field = #field_
 #define OFFICE(field_) .target = CLI_TO_OFFICE, .field = #field_
@@ -68,6 +71,9 @@ const char *cli_command_name(int command)
 #define ACTION(action_) .target = CLI_TO_ACTION, .action = action_
 
 static const rad_option_word level_words[] = {{"surface", 0}, {"element", 1}, {NULL, 0}};
+static const rad_option_word lightmap_words[] = {{"radiosity", RAD_LIGHTMAP_RADIOSITY},
+                                                 {"irradiance", RAD_LIGHTMAP_IRRADIANCE},
+                                                 {NULL, 0}};
 
 static const cli_flag FLAGS[] = {
     {"output", 'o', "FILE", CLI_RENDER, OWN(output, RAD_OPTION_STRING),
@@ -84,6 +90,17 @@ static const cli_flag FLAGS[] = {
     {"output", 'o', "FILE", CLI_SOLVE, OWN(output, RAD_OPTION_STRING),
      .own.help = "output solution file, .radsol (docs/formats.md); `radiosity render FILE` draws it",
      .own.default_text = "solution.radsol"},
+    {"output", 'o', "FILE", CLI_BAKE, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output lit mesh: .glb or .gltf; the lightmaps FILE_lightmapK.hdr and .png beside it",
+     .own.default_text = "lightmapped.glb"},
+    {"texels-per-metre", 0, "N", CLI_BAKE, OWN(texels_per_metre, RAD_OPTION_DOUBLE), .own.min = 0.0,
+     .own.max = 1e6, .own.min_open = true, .own.default_text = "10",
+     .own.help = "lightmap texels per metre of surface"},
+    {"atlas-size", 0, "S", CLI_BAKE, OWN(atlas_size, RAD_OPTION_INT), .own.min = 8.0, .own.max = 16384.0,
+     .own.default_text = "2048", .own.help = "largest atlas side in texels, a power of two"},
+    {"lightmap", 0, "WHICH", CLI_BAKE, OWN(lightmap_quantity, RAD_OPTION_ENUM), .own.words = lightmap_words,
+     .own.default_text = "radiosity",
+     .own.help = "what the texels hold: radiosity B, or irradiance H = (B - E)/rho (as B/pi, H/pi, W/(m^2 sr))"},
     {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
     {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
     {"mesh-size", 0, "L", RV, SOLVE(mesh_size)},
@@ -120,7 +137,7 @@ static const cli_flag FLAGS[] = {
                  "vertical field of view in degrees (40)",
      .own.default_text = "the scene's camera, else framed automatically"},
     {"exposure", 0, "X", CLI_RENDER, RENDER(exposure)},
-    {"exposure", 0, "X", CLI_EXPORT, RENDER(exposure),
+    {"exposure", 0, "X", CLI_EXPORT | CLI_BAKE, RENDER(exposure),
      .help = "multiplier on radiance for the display colours (glTF COLOR_0, PLY red/green/blue)"},
     {"flat", 0, NULL, CLI_RENDER, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
@@ -409,6 +426,10 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
         usage_error(e, "no scene kind given (known: office)");
+        return CLI_USAGE_ERROR;
+    }
+    if (s->atlas_size & (s->atlas_size - 1)) {
+        usage_error(e, "--atlas-size: expected a power of two, got %d", s->atlas_size);
         return CLI_USAGE_ERROR;
     }
     if (s->every && !s->progress_dir) {

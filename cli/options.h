@@ -23,7 +23,7 @@
 #include <stdio.h>
 
 /* The commands, as bits: a flag lists those that take it. */
-enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16 };
+enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -38,7 +38,7 @@ typedef enum cli_action {
 
 /* The parsed command line; zero-initialised, 0 means the default. */
 typedef struct cli_settings {
-    int command;              /* CLI_RENDER, CLI_VIEWFACTORS, CLI_EXPORT, CLI_GENERATE or CLI_SOLVE */
+    int command;              /* CLI_RENDER, CLI_VIEWFACTORS, CLI_EXPORT, CLI_GENERATE, CLI_SOLVE or CLI_BAKE */
     const char *scene_path;   /* render, viewfactors, export, solve: NULL = the built-in Cornell
                                  box; render: a solution file too */
     const char *scene_kind;   /* generate: "office" */
@@ -55,6 +55,9 @@ typedef struct cli_settings {
     int threads;
     int quiet;
     int read_outside;         /* --read-outside-scene-folder */
+    double texels_per_metre;  /* bake: 0 = the library's default */
+    int atlas_size;           /* bake: 0 = the library's default */
+    int lightmap_quantity;    /* bake: rad_lightmap_quantity */
 } cli_settings;
 
 /* Where a flag's value goes. */

@@ -685,6 +685,7 @@ typedef enum rad_output_kind {
     RAD_OUTPUT_IMAGE = 1,       /* .png, .hdr, .pfm (rad_image_write) */
     RAD_OUTPUT_VIEW_FACTORS = 2, /* .json, .csv, .mtx (rad_solution_write_view_factors) */
     RAD_OUTPUT_MESH = 3,         /* .glb, .gltf, .ply (rad_solution_write_mesh) */
+    RAD_OUTPUT_BAKE = 4,         /* .glb, .gltf (rad_solution_bake) */
     RAD_OUTPUT_SOLUTION = 16     /* .radsol (rad_solution_save) */
 } rad_output_kind;
 
@@ -730,6 +731,55 @@ RAD_API rad_result rad_output_set_commit(rad_context *ctx, rad_output_set *set);
 /* Free the set, removing every temporary not committed (the old files
  * stay).  NULL: no-op. */
 RAD_API void rad_output_set_destroy(rad_output_set *set);
+
+/* ------------------------------------------------------------------------
+ * Lightmaps: the solution baked into textures (docs/formats.md, "Lightmap").
+ */
+
+typedef enum rad_lightmap_quantity {
+    RAD_LIGHTMAP_RADIOSITY = 0,  /* B, written as radiance B/pi, W/(m^2 sr) */
+    RAD_LIGHTMAP_IRRADIANCE = 1  /* H = (B - E)/rho (0 where rho = 0), written as H/pi */
+} rad_lightmap_quantity;
+
+typedef struct rad_bake_options {
+    double texels_per_metre;     /* 0 = 10 */
+    int atlas_size;              /* the largest atlas side, a power of two from 8 to 16384; 0 = 2048 */
+    rad_lightmap_quantity quantity;
+    double exposure;             /* the glTF's COLOR_0, as rad_solution_write_mesh; 0 = automatic */
+} rad_bake_options;
+
+typedef struct rad_bake_stats {
+    size_t atlases;
+    double chart_texels;         /* the charts' boxes */
+    double atlas_texels;         /* the atlases': chart_texels / atlas_texels is the fill ratio */
+    double seconds;              /* charting, packing, filling and writing */
+} rad_bake_stats;
+
+/* Bake the solution into lightmaps and write the lit mesh that uses them.
+ * `path` (.glb or .gltf) must be in `set` already (rad_output_set_add with
+ * RAD_OUTPUT_BAKE or RAD_OUTPUT_MESH); the atlases are added to the set
+ * beside it as STEM_lightmapK.hdr (linear radiance, Radiance RGBE) and
+ * STEM_lightmapK.png (RGBM), K from 0, and every file is written into its
+ * temporary: rad_output_set_commit puts them all in place.  Each patch is a
+ * chart in its own plane at options->texels_per_metre, packed with 2 texels
+ * of dilated padding into power-of-two atlases.  The glTF is
+ * rad_solution_write_mesh's with each vertex split per patch, TEXCOORD_1
+ * (atlas coordinates) and MOZ_lightmap on every material.  Fails with
+ * RAD_ERROR_INVALID_ARGUMENT (bad options, a chart larger than an atlas, a
+ * path not in the set), RAD_ERROR_OUT_OF_MEMORY (the atlases above the
+ * memory limit: the message says so), RAD_ERROR_IO.  `stats`, if not
+ * NULL, gets the atlases' figures. */
+RAD_API rad_result rad_solution_bake(rad_context *ctx, const rad_solution *solution,
+                                     const rad_bake_options *options, rad_output_set *set, const char *path,
+                                     rad_bake_stats *stats);
+
+/* The name of atlas `atlas`'s lightmap beside the baked mesh `path`:
+ * `path` without its extension, "_lightmap", the atlas number, ".",
+ * `extension` ("room.glb", 0, "png": "room_lightmap0.png"), into `out`
+ * (snprintf's rules: `size` bytes at most, NUL included).  Returns the
+ * name's length, 0 for a NULL path or extension.  For planning outputs:
+ * the first atlas always exists. */
+RAD_API size_t rad_bake_image_path(const char *path, size_t atlas, const char *extension, char *out, size_t size);
 
 /* ------------------------------------------------------------------------
  * Method registries

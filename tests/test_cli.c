@@ -589,6 +589,42 @@ static void test_export(void **state)
     assert_null(strstr(out_text, "--camera"));
 }
 
+/* bake: an unknown mesh format or a bad atlas size is a usage error before
+ * the load; a good run writes the glTF and the first atlas's HDR and PNG
+ * beside it, from a scene or from a solution file. */
+static void test_bake(void **state)
+{
+    (void)state;
+    assert_int_equal(run("bake no_such_scene.obj -o baked.obj --stats baked.json"), 2);
+    assert_one_line_error("baked.obj: unknown lightmapped mesh format", ".glb or .gltf");
+    assert_no_output("baked");
+    assert_int_equal(run("bake no_such_scene.obj -o baked.ply"), 2);
+    assert_one_line_error("baked.ply: unknown lightmapped mesh format", NULL);
+    assert_int_equal(run("bake no_such_scene.obj -o baked.glb --atlas-size 1000"), 2);
+    assert_one_line_error("--atlas-size: expected a power of two", NULL);
+    assert_no_output("baked");
+    write_file("good.obj", good_obj);
+    write_file("good.mtl", good_mtl);
+    assert_int_equal(run("bake good.obj --elements 50 --texels-per-metre 20 -o baked.glb --stats baked.json"), 0);
+    assert_true(exists("baked.glb"));
+    assert_true(exists("baked_lightmap0.hdr"));
+    assert_true(exists("baked_lightmap0.png"));
+    assert_true(exists("baked.json"));
+    assert_non_null(strstr(out_text, "baked.glb and 1 lightmap (fill "));
+    assert_string_equal(err_text, "");
+    /* Too many texels for an atlas: one line, nothing written. */
+    assert_int_equal(run("bake good.obj --elements 50 --texels-per-metre 1e5 -o huge.glb -q"), 1);
+    assert_one_line_error("above the atlas limit", NULL);
+    assert_no_output("huge.glb");
+    assert_no_output("huge_");
+    assert_int_equal(run("solve good.obj --elements 50 -q -o baked.radsol"), 0);
+    assert_int_equal(run("bake baked.radsol --lightmap irradiance -q -o again.gltf"), 0);
+    assert_true(exists("again.gltf") && exists("again_lightmap0.png") && exists("again_lightmap0.hdr"));
+    assert_int_equal(run("bake --help"), 0);
+    assert_non_null(strstr(out_text, "--texels-per-metre N"));
+    assert_non_null(strstr(out_text, "--lightmap WHICH"));
+}
+
 static void test_help_version_methods(void **state)
 {
     (void)state;
@@ -939,6 +975,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_unwritable_output),
         cmocka_unit_test(test_render_reports_output),
         cmocka_unit_test(test_export),
+        cmocka_unit_test(test_bake),
         cmocka_unit_test(test_help_version_methods),
         cmocka_unit_test(test_viewfactors_csv),
         cmocka_unit_test(test_deterministic_across_threads),

@@ -281,7 +281,7 @@ static cli_action parse(const char *first, ...)
 /* The first command that takes a flag. */
 static const char *command_of(const cli_flag *f)
 {
-    for (int bit = CLI_RENDER; bit <= CLI_EXPORT; bit <<= 1)
+    for (int bit = CLI_RENDER; bit <= CLI_BAKE; bit <<= 1)
         if (f->commands & bit)
             return cli_command_name(bit);
     return NULL;

@@ -6,7 +6,8 @@
 // MODULE_DIR is the node_modules folder that holds gltf-validator
 // (scripts/setup.sh installs it into build/npm/node_modules).  Prints one
 // line per file, "FILE: N errors, N warnings, N infos, N hints", then each
-// error and warning as "  severity code pointer: message".  Exit status: 0
+// error and warning as "  severity code pointer: message".  Images a file
+// names by relative URI are read from its folder.  Exit status: 0
 // when no file has an error, 1 when one has, 2 when the validator cannot
 // be loaded or a file read.
 'use strict';
@@ -28,11 +29,18 @@ async function main() {
   let errors = 0;
   for (const file of files) {
     const bytes = new Uint8Array(fs.readFileSync(file));
-    // The files hold their buffer (GLB chunk or data URI): nothing external.
+    // The files hold their buffer (GLB chunk or data URI); images (the
+    // lightmaps of `radiosity bake`) are read from the file's folder.
     const report = await validator.validateBytes(bytes, {
       uri: path.basename(file),
       maxIssues: 0,
-      externalResourceFunction: (uri) => Promise.reject(new Error(`external resource ${uri}`)),
+      externalResourceFunction: (uri) => new Promise((resolve, reject) => {
+        const name = decodeURIComponent(uri);
+        if (name.includes('/') || name.includes('..'))
+          reject(new Error(`external resource ${uri} outside the file's folder`));
+        else
+          fs.readFile(path.join(path.dirname(file), name), (e, data) => e ? reject(e) : resolve(new Uint8Array(data)));
+      }),
     });
     const i = report.issues;
     console.log(`${file}: ${i.numErrors} errors, ${i.numWarnings} warnings, ${i.numInfos} infos, ` +

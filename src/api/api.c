@@ -612,6 +612,23 @@ rad_result rad_solution_write_mesh(rad_context *ctx, const rad_solution *s, cons
     return rad_write_mesh(ctx, &s->view, path, exposure);
 }
 
+rad_result rad_solution_bake(rad_context *ctx, const rad_solution *s, const rad_bake_options *options,
+                             rad_output_set *set, const char *path, rad_bake_stats *stats)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !s || !set || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+    rad_bake_options o = options ? *options : (rad_bake_options){0};
+    double t = rad_seconds();
+    rad_bake_stats figures = {0};
+    rad_result r = rad_write_bake(ctx, &s->view, &o, set, path, &figures);
+    figures.seconds = rad_seconds() - t;
+    if (r == RAD_OK && stats)
+        *stats = figures;
+    return r;
+}
+
 rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, const char *path)
 {
     rad_api_enter(ctx);

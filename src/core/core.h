@@ -328,6 +328,9 @@ rad_result rad_atomic_commit(rad_context *ctx, rad_atomic_file *file);
 /* Remove the temporary file (after a failed write).  Cannot fail. */
 void rad_atomic_abort(rad_atomic_file *file);
 
+/* The temporary an output set holds for `path` (as added), or NULL. */
+const char *rad_output_set_temp(const rad_output_set *set, const char *path);
+
 /* Lower-case extension of a path without the dot ("" if none), in `ext`. */
 void rad_path_extension(const char *path, char *ext, size_t ext_size);
 

@@ -135,8 +135,12 @@ static rad_result check_format(rad_context *ctx, const char *path, rad_output_ki
         strcmp(ext, "ply") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: unknown mesh format (use .glb, .gltf or .ply)", path);
+    if (kind == RAD_OUTPUT_BAKE && strcmp(ext, "glb") != 0 && strcmp(ext, "gltf") != 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: unknown lightmapped mesh format (use .glb or .gltf; the lightmaps are written "
+                        "beside it)", path);
     if (kind != RAD_OUTPUT_FILE && kind != RAD_OUTPUT_IMAGE && kind != RAD_OUTPUT_VIEW_FACTORS &&
-        kind != RAD_OUTPUT_SOLUTION && kind != RAD_OUTPUT_MESH)
+        kind != RAD_OUTPUT_SOLUTION && kind != RAD_OUTPUT_MESH && kind != RAD_OUTPUT_BAKE)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown output kind %d", path,
                         (int)kind);
     return RAD_OK;
@@ -243,6 +247,14 @@ static void link_backup(output_entry *e)
         }
     }
     rad_free(folder);
+}
+
+const char *rad_output_set_temp(const rad_output_set *set, const char *path)
+{
+    for (size_t i = 0; set && path && i < set->output_count; i++)
+        if (set->outputs[i].temp && strcmp(set->outputs[i].path, path) == 0)
+            return set->outputs[i].temp;
+    return NULL;
 }
 
 rad_result rad_output_set_commit(rad_context *ctx, rad_output_set *set)

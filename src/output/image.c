@@ -222,6 +222,38 @@ static rad_result write_pfm(rad_context *ctx, const rad_image *image, const char
     return failed ? rad_fail(ctx, RAD_ERROR_IO, "%s: write failed", path) : RAD_OK;
 }
 
+/* `bytes` or `floats` written by stb into an atomic file at `path`. */
+static rad_result write_stb(rad_context *ctx, const char *path, int width, int height, int channels,
+                            const unsigned char *bytes, const float *floats)
+{
+    rad_atomic_file file;
+    rad_result r = rad_atomic_open(ctx, path, &file);
+    if (r != RAD_OK)
+        return r;
+    stb_sink sink = {file.file, 0};
+    int ok = bytes ? stbi_write_png_to_func(stb_write, &sink, width, height, channels, bytes, channels * width)
+                   : stbi_write_hdr_to_func(stb_write, &sink, width, height, channels, floats);
+    if (!ok)
+        r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: %s encoding failed", path, bytes ? "PNG" : "HDR");
+    else if (sink.failed)
+        r = rad_fail(ctx, RAD_ERROR_IO, "%s: write failed", path);
+    if (r != RAD_OK) {
+        rad_atomic_abort(&file);
+        return r;
+    }
+    return rad_atomic_commit(ctx, &file);
+}
+
+rad_result rad_write_png_rgba(rad_context *ctx, const char *path, int width, int height, const unsigned char *rgba)
+{
+    return write_stb(ctx, path, width, height, 4, rgba, NULL);
+}
+
+rad_result rad_write_hdr_rgb(rad_context *ctx, const char *path, int width, int height, const float *rgb)
+{
+    return write_stb(ctx, path, width, height, 3, NULL, rgb);
+}
+
 rad_result rad_image_write_exposed(rad_context *ctx, const rad_image *image, const char *path,
                                    double exposure)
 {

@@ -31,6 +31,14 @@
  *     view 2  COLOR_0     the vertex (area-weighted: one surface within
  *     view 3  _RADIOSITY  the crease angle, so they nearly agree)
  *     view 4  indices     uint32, every primitive's triangles in turn
+ *     view 5  TEXCOORD_1  with lightmaps (rad_write_mesh_baked, bake.c):
+ *                         float VEC2, the vertex's atlas coordinates
+ *
+ * With lightmaps a vertex is written once per chart (patch) it is on, as
+ * two charts put it at different atlas coordinates; primitives are also
+ * split by atlas, and each (material, atlas) is a material whose
+ * MOZ_lightmap names that atlas's texture (TEXCOORD_0 is the same
+ * accessor: glTF numbers coordinate sets without gaps).
  *
  * References: the glTF 2.0 specification (Khronos Group, 2021): meshes and
  * attributes (3.7.2, POSITION's min/max, COLOR_0 in [0, 1], application
@@ -146,9 +154,10 @@ static rad_result write_ply(rad_context *ctx, const rad_solution_view *view, con
 
 /* ---- glTF: the elements grouped into primitives ---- */
 
-/* An element's place in the order of primitives: surface, material, element. */
+/* An element's place in the order of primitives: surface, material,
+ * atlas (0 without lightmaps), element. */
 typedef struct element_key {
-    uint32_t surface, material, element;
+    uint32_t surface, material, atlas, element;
 } element_key;
 
 static int element_key_cmp(const void *a, const void *b)
@@ -158,18 +167,29 @@ static int element_key_cmp(const void *a, const void *b)
         return x->surface < y->surface ? -1 : 1;
     if (x->material != y->material)
         return x->material < y->material ? -1 : 1;
+    if (x->atlas != y->atlas)
+        return x->atlas < y->atlas ? -1 : 1;
     return x->element < y->element ? -1 : (x->element > y->element);
 }
 
-static int u32_cmp(const void *a, const void *b)
+static int u64_cmp(const void *a, const void *b)
 {
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
     return x < y ? -1 : (x > y);
 }
 
-/* One primitive: the elements of one material of one surface. */
+/* A written vertex: the solution's vertex, and with lightmaps the patch
+ * (chart) it is written for in the high half, so that a vertex of two
+ * charts is written once for each. */
+static uint64_t vertex_key(const rad_element *e, uint32_t corner, bool split)
+{
+    return (split ? (uint64_t)e->patch << 32 : 0) | e->vertex[corner];
+}
+
+/* One primitive: the elements of one material of one surface (and of one
+ * atlas, with lightmaps). */
 typedef struct primitive {
-    uint32_t surface, material;
+    uint32_t surface, material, atlas;
     size_t first_key, key_count;        /* its elements, in `keys` */
     size_t first_vertex, vertex_count;  /* its vertices, in `source` */
     size_t first_index, index_count;    /* its triangles' corners */
@@ -180,7 +200,7 @@ typedef struct primitives {
     element_key *keys;       /* n, sorted */
     primitive *list;
     size_t count;
-    uint32_t *source;        /* written vertex -> the solution's vertex */
+    uint64_t *source;        /* written vertex -> its key (vertex_key), sorted in each primitive */
     size_t vertex_count;     /* written vertices */
     size_t index_count;
 } primitives;
@@ -193,8 +213,10 @@ static void primitives_free(primitives *p)
 }
 
 /* Sort the elements into primitives and list each one's vertices in the
- * solution's order.  Fails only for memory. */
-static rad_result primitives_make(rad_context *ctx, const rad_mesh *mesh, primitives *p)
+ * solution's order (with a lightmap, split per chart and grouped by atlas).
+ * Fails only for memory. */
+static rad_result primitives_make(rad_context *ctx, const rad_mesh *mesh, const rad_lightmap *lightmap,
+                                  primitives *p)
 {
     memset(p, 0, sizeof *p);
     size_t n = mesh->element_count, corners = 0;
@@ -203,14 +225,15 @@ static rad_result primitives_make(rad_context *ctx, const rad_mesh *mesh, primit
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < n; i++) {
         const rad_element *e = &mesh->elements[i];
-        p->keys[i] = (element_key){e->surface, e->material, (uint32_t)i};
+        p->keys[i] = (element_key){e->surface, e->material, lightmap ? lightmap->charts[e->patch].atlas : 0,
+                                   (uint32_t)i};
         corners += e->vertex_count;
         p->index_count += 3 * (e->vertex_count - 2);
     }
     qsort(p->keys, n, sizeof *p->keys, element_key_cmp);
     for (size_t i = 0; i < n; i++)
         if (i == 0 || p->keys[i].surface != p->keys[i - 1].surface ||
-            p->keys[i].material != p->keys[i - 1].material)
+            p->keys[i].material != p->keys[i - 1].material || p->keys[i].atlas != p->keys[i - 1].atlas)
             p->count++;
     p->list = rad_alloc(ctx, RAD_MEM_OUTPUT, p->count, sizeof *p->list, "lit mesh: primitives");
     p->source = p->list ? rad_alloc(ctx, RAD_MEM_OUTPUT, corners, sizeof *p->source, "lit mesh: vertices") : NULL;
@@ -223,21 +246,24 @@ static rad_result primitives_make(rad_context *ctx, const rad_mesh *mesh, primit
         primitive *prim = &p->list[g];
         prim->surface = p->keys[k].surface;
         prim->material = p->keys[k].material;
+        prim->atlas = p->keys[k].atlas;
         prim->first_key = k;
         prim->first_vertex = p->vertex_count;
         prim->first_index = index;
         /* Its elements' corners, then sorted and made unique in place. */
-        uint32_t *v = &p->source[p->vertex_count];
+        uint64_t *v = &p->source[p->vertex_count];
         size_t used = 0;
-        for (; k < n && p->keys[k].surface == prim->surface && p->keys[k].material == prim->material; k++) {
+        for (; k < n && p->keys[k].surface == prim->surface && p->keys[k].material == prim->material &&
+               p->keys[k].atlas == prim->atlas;
+             k++) {
             const rad_element *e = &mesh->elements[p->keys[k].element];
             for (uint32_t c = 0; c < e->vertex_count; c++)
-                v[used++] = e->vertex[c];
+                v[used++] = vertex_key(e, c, lightmap != NULL);
             index += 3 * (e->vertex_count - 2);
         }
         prim->key_count = k - prim->first_key;
         prim->index_count = index - prim->first_index;
-        qsort(v, used, sizeof *v, u32_cmp);
+        qsort(v, used, sizeof *v, u64_cmp);
         size_t unique = 0;
         for (size_t i = 0; i < used; i++)
             if (unique == 0 || v[i] != v[unique - 1])
@@ -250,23 +276,41 @@ static rad_result primitives_make(rad_context *ctx, const rad_mesh *mesh, primit
 
 /* ---- glTF: the binary buffer ---- */
 
-enum { VIEW_POSITION, VIEW_NORMAL, VIEW_COLOUR, VIEW_RADIOSITY, VIEW_INDICES, VIEW_COUNT };
+enum { VIEW_POSITION, VIEW_NORMAL, VIEW_COLOUR, VIEW_RADIOSITY, VIEW_INDICES, VIEW_TEXCOORD, VIEW_COUNT };
 
-/* Fill the buffer (layout above) and each primitive's bounds.  `local`
- * (one per solution vertex) and `normal` (3 per written vertex) are
- * scratch.  Cannot fail. */
-static void fill_buffer(const rad_mesh *mesh, const lit_vertices *lit, primitives *p, unsigned char *buffer,
-                        uint32_t *local, double *normal)
+/* Where view k begins: four float VEC3 views, the indices, then (with
+ * lightmaps) float VEC2 texture coordinates; each a multiple of 4 bytes. */
+static size_t view_offset(const primitives *p, int k)
 {
-    size_t V = p->vertex_count;
+    return k <= VIEW_INDICES ? (size_t)k * 12 * p->vertex_count : 48 * p->vertex_count + 4 * p->index_count;
+}
+
+static size_t view_length(const primitives *p, int k)
+{
+    return k == VIEW_INDICES ? 4 * p->index_count : k == VIEW_TEXCOORD ? 8 * p->vertex_count : 12 * p->vertex_count;
+}
+
+/* The written vertex of element e's corner c in primitive `prim`. */
+static uint32_t local_index(const primitives *p, const primitive *prim, const rad_element *e, uint32_t c,
+                            bool split)
+{
+    uint64_t key = vertex_key(e, c, split);
+    const uint64_t *found = bsearch(&key, &p->source[prim->first_vertex], prim->vertex_count, sizeof key, u64_cmp);
+    return (uint32_t)(found - &p->source[prim->first_vertex]);
+}
+
+/* Fill the buffer (layout above) and each primitive's bounds.  `normal`
+ * (3 per written vertex) is scratch.  Cannot fail. */
+static void fill_buffer(const rad_mesh *mesh, const lit_vertices *lit, const rad_lightmap *lightmap, primitives *p,
+                        unsigned char *buffer, double *normal)
+{
     unsigned char *view[VIEW_COUNT];
     for (int k = 0; k < VIEW_COUNT; k++)
-        view[k] = buffer + (size_t)k * 12 * V;
+        view[k] = buffer + view_offset(p, k);
+    bool split = lightmap != NULL;
     for (size_t g = 0; g < p->count; g++) {
         primitive *prim = &p->list[g];
-        const uint32_t *source = &p->source[prim->first_vertex];
-        for (size_t j = 0; j < prim->vertex_count; j++)
-            local[source[j]] = (uint32_t)j;
+        const uint64_t *source = &p->source[prim->first_vertex];
         /* Area-weighted normals of the elements around each vertex; the
          * triangles, as local indices, counter-clockwise as the elements. */
         double *nsum = &normal[3 * prim->first_vertex];
@@ -274,18 +318,20 @@ static void fill_buffer(const rad_mesh *mesh, const lit_vertices *lit, primitive
         unsigned char *q = view[VIEW_INDICES] + 4 * prim->first_index;
         for (size_t k = prim->first_key; k < prim->first_key + prim->key_count; k++) {
             const rad_element *e = &mesh->elements[p->keys[k].element];
+            uint32_t local[4];
             for (uint32_t c = 0; c < e->vertex_count; c++) {
-                double *s = &nsum[3 * local[e->vertex[c]]];
+                local[c] = local_index(p, prim, e, c, split);
+                double *s = &nsum[3 * local[c]];
                 s[0] += e->area * e->normal.x, s[1] += e->area * e->normal.y, s[2] += e->area * e->normal.z;
             }
             for (uint32_t t = 1; t + 1 < e->vertex_count; t++) {
-                q = put_u32(q, local[e->vertex[0]]);
-                q = put_u32(q, local[e->vertex[t]]);
-                q = put_u32(q, local[e->vertex[t + 1]]);
+                q = put_u32(q, local[0]);
+                q = put_u32(q, local[t]);
+                q = put_u32(q, local[t + 1]);
             }
         }
         for (size_t j = 0; j < prim->vertex_count; j++) {
-            size_t at = 12 * (prim->first_vertex + j), v = source[j];
+            size_t at = 12 * (prim->first_vertex + j), v = (uint32_t)source[j];
             vec3 pos = mesh->vertices[v];
             float xyz[3] = {(float)pos.x, (float)pos.y, (float)pos.z};
             vec3 nrm = v3_normalize(v3(nsum[3 * j], nsum[3 * j + 1], nsum[3 * j + 2]));
@@ -300,6 +346,16 @@ static void fill_buffer(const rad_mesh *mesh, const lit_vertices *lit, primitive
                 put_f32(view[VIEW_NORMAL] + off, n3[c]);
                 put_f32(view[VIEW_COLOUR] + off, (float)display(lit, lit->radiance[3 * v + (size_t)c]));
                 put_f32(view[VIEW_RADIOSITY] + off, (float)lit->radiosity[3 * v + (size_t)c]);
+            }
+            if (split) {
+                /* The chart's atlas coordinates, as fractions of the atlas
+                 * (glTF's (0, 0) is the image's first texel's corner). */
+                const rad_chart *chart = &lightmap->charts[source[j] >> 32];
+                const rad_atlas *atlas = &lightmap->atlases[chart->atlas];
+                double x, y;
+                rad_chart_texel(lightmap, chart, pos, &x, &y);
+                unsigned char *t = view[VIEW_TEXCOORD] + 8 * (prim->first_vertex + j);
+                put_f32(put_f32(t, (float)(x / atlas->width)), (float)(y / atlas->height));
             }
         }
     }
@@ -354,24 +410,58 @@ static void add_vec3(cJSON *parent, const char *key, const float v[3], bool *ok)
 }
 
 /* glTF's component types and buffer-view targets. */
-enum { GLTF_UNSIGNED_INT = 5125, GLTF_FLOAT = 5126, GLTF_ARRAY_BUFFER = 34962, GLTF_ELEMENT_ARRAY_BUFFER = 34963 };
+enum { GLTF_UNSIGNED_INT = 5125, GLTF_FLOAT = 5126, GLTF_ARRAY_BUFFER = 34962, GLTF_ELEMENT_ARRAY_BUFFER = 34963,
+       GLTF_LINEAR = 9729, GLTF_CLAMP_TO_EDGE = 33071 };
 
-static int add_accessor(cJSON *accessors, int view, size_t offset, size_t count, bool floats, bool *ok)
+/* An accessor of view `view`: uint32 scalars (the indices), else floats
+ * of `type`. */
+static int add_accessor(cJSON *accessors, int view, size_t offset, size_t count, const char *type, bool *ok)
 {
     cJSON *a = add_item(accessors, NULL, cJSON_CreateObject(), ok);
     add_number(a, "bufferView", view, ok);
     add_number(a, "byteOffset", (double)offset, ok);
-    add_number(a, "componentType", floats ? GLTF_FLOAT : GLTF_UNSIGNED_INT, ok);
+    add_number(a, "componentType", view == VIEW_INDICES ? GLTF_UNSIGNED_INT : GLTF_FLOAT, ok);
     add_number(a, "count", (double)count, ok);
-    add_string(a, "type", floats ? "VEC3" : "SCALAR", ok);
+    add_string(a, "type", type, ok);
     return cJSON_GetArraySize(accessors) - 1;
+}
+
+/* The lightmaps' part of asset.extras.radiosity, images, textures and the
+ * sampler (bilinear, clamped: the padding is dilated for it). */
+static void add_lightmaps(cJSON *root, cJSON *extras, const rad_mesh_lightmaps *maps, bool *ok)
+{
+    const rad_lightmap *lm = maps->lightmap;
+    cJSON *info = add_item(extras, "lightmap", cJSON_CreateObject(), ok);
+    add_string(info, "quantity",
+               lm->quantity == RAD_LIGHTMAP_IRRADIANCE ? "irradiance H = (B - E)/rho, as H/pi, W/(m^2 sr)"
+                                                       : "radiosity B, as radiance B/pi, W/(m^2 sr)",
+               ok);
+    add_number(info, "texels_per_metre", lm->texels_per_metre, ok);
+    add_number(info, "rgbm_range", maps->rgbm_range, ok);
+    add_string(info, "png", "RGBM: value = (R, G, B) x A x rgbm_range, each channel / 255, linear", ok);
+    cJSON *hdr = add_item(info, "hdr", cJSON_CreateArray(), ok);
+    cJSON *images = add_item(root, "images", cJSON_CreateArray(), ok);
+    cJSON *textures = add_item(root, "textures", cJSON_CreateArray(), ok);
+    for (size_t a = 0; a < lm->atlas_count; a++) {
+        add_string(hdr, NULL, maps->hdr_names[a], ok);
+        cJSON *image = add_item(images, NULL, cJSON_CreateObject(), ok);
+        add_string(image, "uri", maps->png_uris[a], ok);
+        cJSON *texture = add_item(textures, NULL, cJSON_CreateObject(), ok);
+        add_number(texture, "sampler", 0, ok);
+        add_number(texture, "source", (double)a, ok);
+    }
+    cJSON *sampler = add_item(add_item(root, "samplers", cJSON_CreateArray(), ok), NULL, cJSON_CreateObject(), ok);
+    add_number(sampler, "magFilter", GLTF_LINEAR, ok);
+    add_number(sampler, "minFilter", GLTF_LINEAR, ok);
+    add_number(sampler, "wrapS", GLTF_CLAMP_TO_EDGE, ok);
+    add_number(sampler, "wrapT", GLTF_CLAMP_TO_EDGE, ok);
 }
 
 /* The glTF document for `p` over a buffer of `bytes`, its buffer last, with
  * an empty "uri" when `uri` (the .gltf writer fills it in).  NULL when out
  * of memory. */
 static cJSON *gltf_json(rad_context *ctx, const rad_solution_view *view, const lit_vertices *lit,
-                        const primitives *p, size_t bytes, bool uri)
+                        const primitives *p, const rad_mesh_lightmaps *maps, size_t bytes, bool uri)
 {
     const rad_scene *scene = view->scene;
     bool ok = true;
@@ -384,8 +474,10 @@ static cJSON *gltf_json(rad_context *ctx, const rad_solution_view *view, const l
     add_number(extras, "exposure", lit->exposure, &ok);
     add_string(extras, "colour", "linear radiance B/pi times exposure, W/(m^2 sr)", &ok);
     add_string(extras, "_RADIOSITY", "vertex radiosity B, W/m^2", &ok);
-    add_item(add_item(root, "extensionsUsed", cJSON_CreateArray(), &ok), NULL,
-             cJSON_CreateString("KHR_materials_unlit"), &ok);
+    cJSON *used = add_item(root, "extensionsUsed", cJSON_CreateArray(), &ok);
+    add_item(used, NULL, cJSON_CreateString("KHR_materials_unlit"), &ok);
+    if (maps)
+        add_item(used, NULL, cJSON_CreateString("MOZ_lightmap"), &ok);
     add_number(root, "scene", 0, &ok);
     cJSON *scenes = add_item(root, "scenes", cJSON_CreateArray(), &ok);
     cJSON *scene0 = add_item(scenes, NULL, cJSON_CreateObject(), &ok);
@@ -396,9 +488,11 @@ static cJSON *gltf_json(rad_context *ctx, const rad_solution_view *view, const l
     cJSON *materials = add_item(root, "materials", cJSON_CreateArray(), &ok);
     cJSON *accessors = add_item(root, "accessors", cJSON_CreateArray(), &ok);
 
-    /* The scene's materials that primitives use, numbered as first used. */
-    int *material_index = rad_alloc(ctx, RAD_MEM_OUTPUT, scene->material_count + 1, sizeof *material_index,
-                                    "lit mesh: materials");
+    /* The scene's materials that primitives use, numbered as first used;
+     * with lightmaps, one for each atlas it is on. */
+    size_t atlases = maps ? maps->lightmap->atlas_count : 1;
+    int *material_index = rad_alloc(ctx, RAD_MEM_OUTPUT, (scene->material_count + 1) * atlases,
+                                    sizeof *material_index, "lit mesh: materials");
     if (!material_index) {
         cJSON_Delete(root);
         return NULL;
@@ -417,8 +511,9 @@ static cJSON *gltf_json(rad_context *ctx, const rad_solution_view *view, const l
             add_name(ctx, mesh, scene->surfaces[prim->surface].name, &ok);
             primitive_list = add_item(mesh, "primitives", cJSON_CreateArray(), &ok);
         }
-        if (material_index[prim->material] == 0) {
-            material_index[prim->material] = ++material_count;
+        size_t material_key = (size_t)prim->material * atlases + prim->atlas;
+        if (material_index[material_key] == 0) {
+            material_index[material_key] = ++material_count;
             cJSON *m = add_item(materials, NULL, cJSON_CreateObject(), &ok);
             add_name(ctx, m, prim->material < scene->material_count ? scene->materials[prim->material].name : "",
                      &ok);
@@ -428,14 +523,22 @@ static cJSON *gltf_json(rad_context *ctx, const rad_solution_view *view, const l
                 add_number(base, NULL, 1.0, &ok);
             add_number(pbr, "metallicFactor", 0.0, &ok);
             add_number(pbr, "roughnessFactor", 1.0, &ok);
-            add_item(add_item(m, "extensions", cJSON_CreateObject(), &ok), "KHR_materials_unlit",
-                     cJSON_CreateObject(), &ok);
+            cJSON *extensions = add_item(m, "extensions", cJSON_CreateObject(), &ok);
+            add_item(extensions, "KHR_materials_unlit", cJSON_CreateObject(), &ok);
+            if (maps) {
+                /* As three.js's GLTFLoader plugin for it reads it. */
+                cJSON *lightmap = add_item(extensions, "MOZ_lightmap", cJSON_CreateObject(), &ok);
+                cJSON *texture = add_item(lightmap, "texture", cJSON_CreateObject(), &ok);
+                add_number(texture, "index", prim->atlas, &ok);
+                add_number(texture, "texCoord", 1, &ok);
+                add_number(lightmap, "intensity", 1, &ok);
+            }
         }
         cJSON *prim_json = add_item(primitive_list, NULL, cJSON_CreateObject(), &ok);
         cJSON *attributes = add_item(prim_json, "attributes", cJSON_CreateObject(), &ok);
         static const char *const names[4] = {"POSITION", "NORMAL", "COLOR_0", "_RADIOSITY"};
         for (int k = 0; k < 4; k++) {
-            int a = add_accessor(accessors, k, 12 * prim->first_vertex, prim->vertex_count, true, &ok);
+            int a = add_accessor(accessors, k, 12 * prim->first_vertex, prim->vertex_count, "VEC3", &ok);
             add_number(attributes, names[k], a, &ok);
             if (k == VIEW_POSITION) {
                 cJSON *position = cJSON_GetArrayItem(accessors, a);
@@ -443,25 +546,33 @@ static cJSON *gltf_json(rad_context *ctx, const rad_solution_view *view, const l
                 add_vec3(position, "max", prim->max, &ok);
             }
         }
+        if (maps) {
+            /* glTF numbers texture coordinates from 0 without gaps: set 0 is
+             * the same accessor (no texture of ours reads it). */
+            int a = add_accessor(accessors, VIEW_TEXCOORD, 8 * prim->first_vertex, prim->vertex_count, "VEC2", &ok);
+            add_number(attributes, "TEXCOORD_0", a, &ok);
+            add_number(attributes, "TEXCOORD_1", a, &ok);
+        }
         add_number(prim_json, "indices",
-                   add_accessor(accessors, VIEW_INDICES, 4 * prim->first_index, prim->index_count, false, &ok),
+                   add_accessor(accessors, VIEW_INDICES, 4 * prim->first_index, prim->index_count, "SCALAR", &ok),
                    &ok);
-        add_number(prim_json, "material", material_index[prim->material] - 1, &ok);
+        add_number(prim_json, "material", material_index[material_key] - 1, &ok);
         add_number(prim_json, "mode", 4, &ok); /* triangles */
     }
     rad_free(material_index);
 
     cJSON *views = add_item(root, "bufferViews", cJSON_CreateArray(), &ok);
-    for (int k = 0; k < VIEW_COUNT; k++) {
+    for (int k = 0; k < (maps ? VIEW_COUNT : VIEW_TEXCOORD); k++) {
         cJSON *v = add_item(views, NULL, cJSON_CreateObject(), &ok);
-        size_t length = k == VIEW_INDICES ? 4 * p->index_count : 12 * p->vertex_count;
         add_number(v, "buffer", 0, &ok);
-        add_number(v, "byteOffset", (double)((size_t)k * 12 * p->vertex_count), &ok);
-        add_number(v, "byteLength", (double)length, &ok);
+        add_number(v, "byteOffset", (double)view_offset(p, k), &ok);
+        add_number(v, "byteLength", (double)view_length(p, k), &ok);
         if (k != VIEW_INDICES)
-            add_number(v, "byteStride", 12, &ok);
+            add_number(v, "byteStride", k == VIEW_TEXCOORD ? 8 : 12, &ok);
         add_number(v, "target", k == VIEW_INDICES ? GLTF_ELEMENT_ARRAY_BUFFER : GLTF_ARRAY_BUFFER, &ok);
     }
+    if (maps)
+        add_lightmaps(root, extras, maps, &ok);
     /* Last, so that the .gltf writer finds the empty uri at the end. */
     cJSON *buffer = add_item(add_item(root, "buffers", cJSON_CreateArray(), &ok), NULL, cJSON_CreateObject(), &ok);
     add_number(buffer, "byteLength", (double)bytes, &ok);
@@ -502,29 +613,28 @@ static int write_base64(FILE *f, const unsigned char *data, size_t size)
 }
 
 static rad_result write_gltf(rad_context *ctx, const rad_solution_view *view, const lit_vertices *lit,
-                             const char *path, bool binary, FILE *f)
+                             const rad_mesh_lightmaps *maps, const char *path, bool binary, FILE *f)
 {
     primitives p;
-    rad_result r = primitives_make(ctx, view->mesh, &p);
+    const rad_lightmap *lightmap = maps ? maps->lightmap : NULL;
+    rad_result r = primitives_make(ctx, view->mesh, lightmap, &p);
     if (r != RAD_OK)
         return r;
-    /* Four float VEC3 per vertex, a uint32 per corner: a multiple of 4. */
-    size_t bytes = 48 * p.vertex_count + 4 * p.index_count;
+    /* Four float VEC3 (and with lightmaps a VEC2) per vertex, a uint32 per
+     * corner: a multiple of 4. */
+    size_t bytes = view_offset(&p, VIEW_TEXCOORD) + (lightmap ? view_length(&p, VIEW_TEXCOORD) : 0);
     unsigned char *buffer = rad_alloc(ctx, RAD_MEM_OUTPUT, bytes, 1, "lit mesh: buffer");
-    uint32_t *local = buffer ? rad_alloc(ctx, RAD_MEM_OUTPUT, view->mesh->vertex_count, sizeof *local,
-                                         "lit mesh: vertex numbers")
-                             : NULL;
-    double *normal = local ? rad_alloc(ctx, RAD_MEM_OUTPUT, p.vertex_count, 3 * sizeof *normal,
-                                       "lit mesh: normals")
-                           : NULL;
+    double *normal = buffer ? rad_alloc(ctx, RAD_MEM_OUTPUT, p.vertex_count, 3 * sizeof *normal,
+                                        "lit mesh: normals")
+                            : NULL;
     cJSON *root = NULL;
     char *text = NULL;
     if (!normal) {
         r = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
     }
-    fill_buffer(view->mesh, lit, &p, buffer, local, normal);
-    root = gltf_json(ctx, view, lit, &p, bytes, !binary);
+    fill_buffer(view->mesh, lit, lightmap, &p, buffer, normal);
+    root = gltf_json(ctx, view, lit, &p, maps, bytes, !binary);
     text = root ? cJSON_PrintUnformatted(root) : NULL;
     if (!text) {
         r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory building JSON", path);
@@ -569,21 +679,22 @@ done:
     cJSON_free(text);
     cJSON_Delete(root);
     rad_free(normal);
-    rad_free(local);
     rad_free(buffer);
     primitives_free(&p);
     return r;
 }
 
-/* ---- the writer ---- */
+/* ---- the writers ---- */
 
-rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure)
+static rad_result write_mesh(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure,
+                             const rad_mesh_lightmaps *maps)
 {
     char ext[8];
     rad_path_extension(path, ext, sizeof ext);
     bool glb = strcmp(ext, "glb") == 0, gltf = strcmp(ext, "gltf") == 0, ply = strcmp(ext, "ply") == 0;
-    if (!glb && !gltf && !ply)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown mesh format (use .glb, .gltf or .ply)", path);
+    if (!glb && !gltf && (!ply || maps))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown mesh format (use .glb, .gltf%s)", path,
+                        maps ? "" : " or .ply");
     if (!(exposure >= 0.0) || !isfinite(exposure))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: exposure must be >= 0, got %g", path, exposure);
     if (view->mesh->element_count == 0)
@@ -595,7 +706,8 @@ rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const
     rad_atomic_file file;
     r = rad_atomic_open(ctx, path, &file);
     if (r == RAD_OK) {
-        r = ply ? write_ply(ctx, view, &lit, path, file.file) : write_gltf(ctx, view, &lit, path, glb, file.file);
+        r = ply ? write_ply(ctx, view, &lit, path, file.file)
+                : write_gltf(ctx, view, &lit, maps, path, glb, file.file);
         if (r == RAD_OK)
             r = rad_atomic_commit(ctx, &file);
         else
@@ -603,4 +715,15 @@ rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const
     }
     lit_vertices_free(&lit);
     return r;
+}
+
+rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure)
+{
+    return write_mesh(ctx, view, path, exposure, NULL);
+}
+
+rad_result rad_write_mesh_baked(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure,
+                                const rad_mesh_lightmaps *maps)
+{
+    return write_mesh(ctx, view, path, exposure, maps);
 }

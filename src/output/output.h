@@ -65,6 +65,11 @@ rad_result rad_image_exposure(rad_context *ctx, const rad_image *image, double *
  * none is left.  Fails only for memory (a float per value). */
 rad_result rad_radiance_exposure(rad_context *ctx, const float *rgb, size_t count, double *exposure);
 
+/* Raw pixels written atomically, row 0 first: 8-bit RGBA as PNG, float RGB
+ * as Radiance HDR (RGBE).  RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY. */
+rad_result rad_write_png_rgba(rad_context *ctx, const char *path, int width, int height, const unsigned char *rgba);
+rad_result rad_write_hdr_rgb(rad_context *ctx, const char *path, int width, int height, const float *rgb);
+
 /* IEC 61966-2-1 sRGB encoding of a linear value, clamped to [0, 1] (the
  * exact piecewise curve); 255 x it, rounded, is an 8-bit channel. */
 double rad_srgb_encode(double linear);
@@ -95,6 +100,82 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *vie
  * vertices with their radiosity B (W/m^2) and display colour, the radiance
  * B/pi times `exposure` (0 = the automatic rule over the vertices). */
 rad_result rad_write_mesh(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure);
+
+/* ---- lightmaps (lightmap.c): the solution baked into atlases of texels ---- */
+
+/* How a texel got its value (docs/formats.md, "Lightmap"). */
+enum { RAD_TEXEL_EMPTY = 0, RAD_TEXEL_INSIDE, RAD_TEXEL_BORDER, RAD_TEXEL_DILATED };
+
+/* One patch's chart: its frame in the patch plane and its place in an atlas. */
+typedef struct rad_chart {
+    uint32_t patch;
+    uint32_t atlas;
+    int x, y;                /* the box's first texel in the atlas (its padding is around it) */
+    int width, height;       /* the box, texels (>= 2 each) */
+    vec3 origin;             /* m: the point at the box's corner (x, y) */
+    vec3 axis_u, axis_v;     /* unit: u along the patch's longest edge, v = normal x u */
+    uint32_t corner_count;   /* the patch's corners in the box, texels from (x, y), ccw */
+    double corner_u[4], corner_v[4];
+} rad_chart;
+
+typedef struct rad_atlas {
+    int width, height;       /* texels, powers of two; row 0 is the image's first row */
+    float *texels;           /* 3 per texel: the quantity, W/m^2 (0 where no chart is) */
+    int32_t *owner;          /* per texel: the chart whose padded box holds it, or -1 */
+    unsigned char *state;    /* per texel: RAD_TEXEL_* */
+} rad_atlas;
+
+typedef struct rad_lightmap {
+    double texels_per_metre;
+    int quantity;            /* RAD_LIGHTMAP_RADIOSITY or RAD_LIGHTMAP_IRRADIANCE */
+    rad_chart *charts;       /* one per patch, in patch order */
+    size_t chart_count;
+    rad_atlas *atlases;
+    size_t atlas_count;
+    double chart_texels;     /* the charts' boxes, texels */
+    double atlas_texels;     /* the atlases', texels: chart_texels / this is the fill ratio */
+} rad_lightmap;
+
+typedef struct rad_lightmap_options {
+    double texels_per_metre; /* 0 = 10 */
+    int atlas_size;          /* the largest atlas side, a power of two from 8 to 16384; 0 = 2048 */
+    int quantity;            /* RAD_LIGHTMAP_RADIOSITY (0) or RAD_LIGHTMAP_IRRADIANCE */
+} rad_lightmap_options;
+
+/* Chart every patch of the view's mesh, pack the charts and fill the
+ * atlases (lightmap.c).  Fails with RAD_ERROR_INVALID_ARGUMENT for bad
+ * options or a chart larger than an atlas, RAD_ERROR_OUT_OF_MEMORY (with
+ * a message naming the limit) when the atlases exceed the solution's
+ * memory limit, RAD_ERROR_INTERRUPTED when cancelled; *out is then NULL. */
+rad_result rad_lightmap_bake(rad_context *ctx, const rad_solution_view *view, const rad_lightmap_options *options,
+                             rad_lightmap **out);
+void rad_lightmap_destroy(rad_lightmap *lightmap);
+
+/* Continuous atlas texel coordinates (texel centres at k + 0.5) of point p
+ * of chart c's patch, and back.  Cannot fail. */
+void rad_chart_texel(const rad_lightmap *lightmap, const rad_chart *c, vec3 p, double *x, double *y);
+vec3 rad_chart_point(const rad_lightmap *lightmap, const rad_chart *c, double x, double y);
+
+/* What the lit mesh needs to use lightmaps (rad_write_mesh_baked). */
+typedef struct rad_mesh_lightmaps {
+    const rad_lightmap *lightmap;
+    char **png_uris;         /* atlas_count relative URIs of the RGBM PNGs, percent-encoded */
+    char **hdr_names;        /* atlas_count file names of the HDRs, for asset.extras */
+    double rgbm_range;       /* M: radiance = rgb x alpha x M (each in [0, 1]) */
+} rad_mesh_lightmaps;
+
+/* rad_write_mesh's glTF (.glb, .gltf) with every vertex split per patch,
+ * TEXCOORD_1 its chart's atlas coordinates, one material per scene
+ * material and atlas, each with MOZ_lightmap on its atlas's PNG. */
+rad_result rad_write_mesh_baked(rad_context *ctx, const rad_solution_view *view, const char *path, double exposure,
+                                const rad_mesh_lightmaps *maps);
+
+/* Bake and write: the lightmap of `options`, its atlases added to `set`
+ * beside `path` (which the set holds) as STEM_lightmapK.hdr / .png and
+ * written into their temporaries with the glTF (bake.c); the atlases'
+ * figures in *stats (all but seconds). */
+rad_result rad_write_bake(rad_context *ctx, const rad_solution_view *view, const rad_bake_options *options,
+                          rad_output_set *set, const char *path, rad_bake_stats *stats);
 
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path);
