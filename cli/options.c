@@ -391,7 +391,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         if (!f && !known)
             bad = usage_error(e, "unknown option '%s'", arg);
         else if (!f && !s->command)
-            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export or generate", arg);
+            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export, bake or generate", arg);
         else if (!f)
             bad = usage_error(e, "%s does not apply to %s", arg, cli_command_name(s->command));
         else if (f->metavar && !value && i + 1 >= argc)
@@ -421,7 +421,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render, solve, viewfactors, export or generate");
+        usage_error(e, "no command given: use render, solve, viewfactors, export, bake or generate");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
