@@ -395,10 +395,18 @@ static rad_result read_options(rad_context *ctx, const char *name, const cJSON *
         }
     }
     o.max_memory_bytes = 0.0; /* the reader's machine, not the writer's */
-    rad_result r = rad_options_resolve(ctx, &o, out, names);
+    /* Checked in a context of its own, so that the message that reaches the
+     * caller is one line naming the file (a context keeps a call's first
+     * failure, which would be the option's alone). */
+    rad_context *check = NULL;
+    rad_context_options co = {.threads = 1};
+    if (rad_context_create(&co, &check) != RAD_OK)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory checking the options", name);
+    rad_result r = rad_options_resolve(check, &o, out, names);
     if (r != RAD_OK)
-        return rad_fail(ctx, RAD_ERROR_PARSE, "%s: saved options: %s", name, rad_context_error(ctx));
-    return RAD_OK;
+        r = rad_fail(ctx, RAD_ERROR_PARSE, "%s: saved options: %s", name, rad_context_error(check));
+    rad_context_destroy(check);
+    return r;
 }
 
 /* Rebuild the scene through the builder, which validates every polygon:
@@ -420,7 +428,9 @@ static rad_result read_scene(rad_context *ctx, const char *name, const cJSON *he
     cursor values = {table.p + 16 * polygons, c->end};
     cursor camera_at = {values.p + 48 * material_count, c->end};
     c->p = camera_at.p + 88;
-    rad_scene_builder *b = rad_scene_builder_create(ctx, source);
+    /* The builder's messages name the file being read; the scene keeps the
+     * name of the one it was solved for (below). */
+    rad_scene_builder *b = rad_scene_builder_create(ctx, name);
     if (!b)
         return RAD_ERROR_OUT_OF_MEMORY;
     int surface_count = cJSON_GetArraySize(surfaces);
@@ -510,6 +520,13 @@ static rad_result read_scene(rad_context *ctx, const char *name, const cJSON *he
         return BAD("%s: the scene rebuilt from the file has checksum %s, not the %s it was saved with",
                    name, hex, checksum);
     }
+    char *original = rad_strdup(ctx, RAD_MEM_SCENE, source, "solution file: scene name");
+    if (!original) {
+        rad_scene_destroy(built);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    rad_free(built->source);
+    built->source = original;
     *out = built;
     return RAD_OK;
 }
