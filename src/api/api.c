@@ -312,10 +312,13 @@ static rad_result display_values(rad_context *ctx, rad_solution *s, double **dis
     double *display = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *display, "render: element values");
     if (!display)
         return RAD_ERROR_OUT_OF_MEMORY;
+    /* Never below 0: overshooting (Southwell with relaxation above 1) makes
+     * the unshot light, and so the ambient term, negative on purpose. */
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++)
-            display[3 * i + c] = s->view.radiosity[3 * i + c] +
-                                 s->view.reflectance[3 * i + c] * s->view.solve->ambient[c];
+            display[3 * i + c] = fmax(s->view.radiosity[3 * i + c] +
+                                          s->view.reflectance[3 * i + c] * s->view.solve->ambient[c],
+                                      0.0);
     rad_free(s->vertex_radiosity);
     s->vertex_radiosity = rad_alloc(ctx, RAD_MEM_RENDER, 3 * s->view.mesh->vertex_count, sizeof *s->vertex_radiosity,
                                     "render: vertex values");

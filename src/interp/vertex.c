@@ -295,6 +295,16 @@ void rad_element_interpolate(const rad_mesh *mesh, const rad_element *e,
                              const double *vertex_value, double s, double t, double rgb[3])
 {
     (void)mesh;
+    /* A point found by a ray or a projection can lie a rounding error
+     * outside its element; clamped, the weights stay a convex combination,
+     * so values >= 0 give a value >= 0 (-7e-18 W/m^2 reached a picture). */
+    s = fmin(fmax(s, 0.0), 1.0);
+    t = fmin(fmax(t, 0.0), 1.0);
+    if (e->vertex_count != 4 && s + t > 1.0) {
+        double sum = s + t;
+        s /= sum;
+        t /= sum;
+    }
     const double *v0 = &vertex_value[3 * e->vertex[0]];
     const double *v1 = &vertex_value[3 * e->vertex[1]];
     const double *v2 = &vertex_value[3 * e->vertex[2]];

@@ -132,6 +132,13 @@ int rad_scene_builder_material(rad_scene_builder *b, const char *name,
                      b->source, name, emission[c]);
             return -1;
         }
+        if (emission[c] > RAD_MAX_EXITANCE) {
+            rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                     "%s: material '%s': emission %g W/m^2 is above the %g W/m^2 the engine works in "
+                     "(are the units right?)",
+                     b->source, name, emission[c], RAD_MAX_EXITANCE);
+            return -1;
+        }
     }
     if (b->material_count >= INT_MAX) {
         rad_fail(b->ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: too many materials", b->source);
@@ -237,38 +244,6 @@ static rad_result polygon_error(const rad_scene_builder *b, int surface, int lin
                     b->surfaces[surface].name, problem);
 }
 
-
-/* Headroom between the emitted power and the largest double: radiosity is
- * E / (1 - rho), up to 10^6 E for rho = 0.999999, and the solvers add up
- * A B over all elements.  A scene within it can be solved without overflow;
- * 1.8e308 / 1e12 = 1.8e296 W is still beyond any physical scene. */
-#define RAD_POWER_HEADROOM 1e12
-
-/* Refuse emission whose total power, sum A E, would overflow a double on
- * its way through the solver, naming the material that carries most of it. */
-static rad_result check_emitted_power(const rad_scene_builder *b)
-{
-    double total = 0.0, largest = 0.0;
-    size_t culprit = 0;
-    for (size_t p = 0; p < b->polygon_count; p++) {
-        const rad_polygon *polygon = &b->polygons[p];
-        const double *E = b->materials[polygon->material].emission;
-        double power = polygon->area * fmax(E[0], fmax(E[1], E[2]));
-        total += power;
-        if (power > largest || !isfinite(power)) {
-            largest = power;
-            culprit = polygon->material;
-        }
-    }
-    if (isfinite(total * RAD_POWER_HEADROOM))
-        return RAD_OK;
-    const rad_material *m = &b->materials[culprit];
-    return rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
-                    "%s: material '%s': emission %g W/m^2 makes the emitted power overflow "
-                    "(%g W in all; at most %g W can be solved): scale the emission or the scene down",
-                    b->source, m->name, fmax(m->emission[0], fmax(m->emission[1], m->emission[2])), total,
-                    1.7976931348623157e308 / RAD_POWER_HEADROOM);
-}
 
 /* Append one checked planar polygon; its vertices get fresh positions. */
 static rad_result append_polygon(rad_scene_builder *b, int surface, int material,
@@ -526,8 +501,6 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
                      b->source);
         goto done;
     }
-    if ((r = check_emitted_power(b)) != RAD_OK)
-        goto done;
     surface_map = rad_alloc(b->ctx, RAD_MEM_SCENE, b->surface_count, sizeof *surface_map, b->source);
     material_map = surface_map ? rad_alloc(b->ctx, RAD_MEM_SCENE, b->material_count, sizeof *material_map,
                                            b->source)

@@ -110,6 +110,15 @@ double rad_scene_diagonal(const rad_scene *scene); /* m */
 #define RAD_MAX_COORDINATE 1e30
 #define RAD_MIN_LENGTH 1e-30
 
+/* The largest exitance a material may have, W/m^2 (the Sun's is 6.3e7).
+ * Radiosity reaches 10^6 E at a reflectance of 0.999999, and pictures hold
+ * radiance in float (3.4e38 at most): within 1e30 W/m^2 every value an
+ * image can show stays finite.  With the lengths above, the emitted power
+ * sum A E stays below 1e90 W a polygon, so no sum of it can overflow the
+ * solvers' doubles (which once had to be checked apart: a glTF
+ * emissiveStrength of 5e307). */
+#define RAD_MAX_EXITANCE 1e30
+
 /* Bytes of working space rad_triangulate_polygon needs for n vertices: the
  * projected points and seven words per vertex (a multiple of 4, so what
  * follows it stays aligned for uint32_t). */

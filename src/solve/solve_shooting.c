@@ -285,7 +285,7 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
         if (p->monitor) {
             for (int c = 0; c < 3; c++) {
                 double rho_avg = rho_area[c] / area;
-                stats->ambient[c] = unshot_c[c] / area / (1.0 - rho_avg);
+                stats->ambient[c] = fmax(unshot_c[c], 0.0) / area / (1.0 - rho_avg);
             }
             rad_solve_step step = {(int)(batch + 1 < 2147483647LL ? batch + 1 : 2147483647LL),
                                    rad_seconds() - t0, NAN, unshot};
@@ -308,7 +308,9 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     }
     for (int c = 0; c < 3; c++) {
         double rho_avg = rho_area[c] / area;
-        stats->ambient[c] = unshot_c[c] / area / (1.0 - rho_avg);
+        /* The unshot power is a running sum: round-off can leave it at
+         * -1e-18 where all is shot, which no ambient light should become. */
+        stats->ambient[c] = fmax(unshot_c[c], 0.0) / area / (1.0 - rho_avg);
     }
     stats->iterations = batch > 2147483647LL ? 2147483647 : (int)batch;
     stats->unshot = unshot;

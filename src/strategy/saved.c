@@ -766,13 +766,22 @@ rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned cha
     }
     st->mesh = mesh;
     mesh = NULL;
-    /* The values: B finite, at least E (light only adds), per element;
-     * the vertex values are the renderer's and are made again from them. */
+    /* The values: B at least E (light only adds) and within what
+     * conservation allows, 4 E_max / (1 - rho_max), as every solve is held
+     * to (api.c); the vertex values are the renderer's and are made again
+     * from them. */
+    double e_max = 0.0, rho_max = 0.0;
+    for (size_t i = 0; i < 3 * elements; i++) {
+        e_max = fmax(e_max, st->elements.emission[i]);
+        rho_max = fmax(rho_max, st->elements.reflectance[i]);
+    }
+    double bound = 4.0 * e_max / (1.0 - rho_max);
     for (size_t i = 0; r == RAD_OK && i < 3 * elements; i++) {
         double b = get_f64(&c);
-        if (!(isfinite(b) && b >= st->elements.emission[i] * (1.0 - 1e-9)))
-            r = BAD("%s: element %zu has radiosity %g W/m^2, below its emission %g or not finite", name,
-                    i / 3, b, st->elements.emission[i]);
+        if (!(isfinite(b) && b >= st->elements.emission[i] * (1.0 - 1e-9) && b <= bound))
+            r = BAD("%s: element %zu has radiosity %g W/m^2, outside [its emission %g, %g] (what "
+                    "conservation allows)",
+                    name, i / 3, b, st->elements.emission[i], bound);
         st->elements.radiosity[i] = b;
     }
     for (size_t i = 0; r == RAD_OK && i < 3 * vertices; i++) {
