@@ -33,11 +33,13 @@ typedef struct command_def {
 } command_def;
 
 static const command_def COMMANDS[] = {
-    {CLI_RENDER, "render", "render [SCENE] [options]", "solve the scene and write an image"},
+    {CLI_RENDER, "render", "render [SCENE|SOLUTION.radsol] [options]",
+     "solve the scene (or load the solution) and write an image"},
     {CLI_VIEWFACTORS, "viewfactors", "viewfactors [SCENE] [options]",
      "write the view factors between the scene's named surfaces"},
-    {CLI_EXPORT, "export", "export [SCENE] [options]",
-     "solve the scene and write the lit mesh: glTF 2.0 (.glb, .gltf) or PLY (docs/formats.md)"},
+    {CLI_EXPORT, "export", "export [SCENE|SOLUTION.radsol] [options]",
+     "solve the scene (or load the solution) and write the lit mesh: glTF 2.0 (.glb, .gltf) or PLY "
+     "(docs/formats.md)"},
     {CLI_GENERATE, "generate", "generate office [options]",
      "write a procedural office floor as OBJ + MTL (docs/scenes.md)"},
     {CLI_SOLVE, "solve", "solve [SCENE] [options]",
@@ -567,7 +569,10 @@ void cli_print_help(FILE *out, int command)
         fprintf(out, "radiosity %s -- diffuse global illumination by the radiosity method\n\nusage:\n",
                 RAD_VERSION_STRING);
         for (size_t k = 0; k < COMMAND_COUNT; k++)
-            fprintf(out, "  radiosity %-32s %s\n", COMMANDS[k].synopsis, COMMANDS[k].summary);
+            if (strlen(COMMANDS[k].synopsis) <= 32)
+                fprintf(out, "  radiosity %-32s %s\n", COMMANDS[k].synopsis, COMMANDS[k].summary);
+            else /* too long for the column: the summary on a line of its own */
+                fprintf(out, "  radiosity %s\n  %-42s %s\n", COMMANDS[k].synopsis, "", COMMANDS[k].summary);
         fprintf(out, "  radiosity %-32s %s\n", "COMMAND --help", "the options of one command");
         fprintf(out, "  radiosity --list-methods | --version | --man | --help\n\n%s\n"
                      "options ([...]: the commands that take it, where not all do):\n",
