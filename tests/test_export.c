@@ -18,6 +18,7 @@
 #include <cmocka.h>
 
 #include "radiosity.h"
+#include "gltf_support.h"
 
 #include <assimp/cimport.h>
 #include <assimp/scene.h>
@@ -53,34 +54,8 @@ static const char *temp_path(const char *name)
 
 static bool file_exists(const char *path) { return access(path, F_OK) == 0; }
 
-static unsigned char *read_bytes(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *bytes = malloc((size_t)n + 1);
-    assert_non_null(bytes);
-    assert_int_equal(fread(bytes, 1, (size_t)n, f), (size_t)n);
-    bytes[n] = '\0';
-    fclose(f);
-    *size = (size_t)n;
-    return bytes;
-}
 
-static uint32_t get_u32(const unsigned char *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
 
-static float get_f32(const unsigned char *p)
-{
-    uint32_t bits = get_u32(p);
-    float v;
-    memcpy(&v, &bits, 4);
-    return v;
-}
 
 /* What the writer promises for display: min(1, B/pi x exposure), B/pi
  * rounded to float first as the file's radiance is. */
@@ -200,22 +175,22 @@ static void gltf_open(const char *path, bool binary, gltf_file *g)
 {
     size_t size;
     memset(g, 0, sizeof *g);
-    g->bytes = read_bytes(path, &size);
+    g->bytes = support_read_bytes(path, &size);
     cJSON *buffer;
     if (binary) {
         /* header (magic, version 2, length), JSON chunk, BIN chunk */
         assert_true(size >= 28);
-        assert_int_equal(get_u32(g->bytes), 0x46546C67u);
-        assert_int_equal(get_u32(g->bytes + 4), 2);
-        assert_int_equal(get_u32(g->bytes + 8), size);
-        uint32_t json_length = get_u32(g->bytes + 12);
-        assert_int_equal(get_u32(g->bytes + 16), 0x4E4F534Au);
+        assert_int_equal(support_le_u32(g->bytes), 0x46546C67u);
+        assert_int_equal(support_le_u32(g->bytes + 4), 2);
+        assert_int_equal(support_le_u32(g->bytes + 8), size);
+        uint32_t json_length = support_le_u32(g->bytes + 12);
+        assert_int_equal(support_le_u32(g->bytes + 16), 0x4E4F534Au);
         assert_int_equal(json_length % 4, 0);
         g->json = cJSON_ParseWithLength((const char *)g->bytes + 20, json_length);
         unsigned char *bin = g->bytes + 20 + json_length;
-        assert_int_equal(get_u32(bin + 4), 0x004E4942u);
+        assert_int_equal(support_le_u32(bin + 4), 0x004E4942u);
         g->buffer = bin + 8;
-        g->buffer_size = get_u32(bin);
+        g->buffer_size = support_le_u32(bin);
         assert_int_equal(20 + json_length + 8 + g->buffer_size, size);
         assert_non_null(g->json);
         buffer = cJSON_GetArrayItem(cJSON_GetObjectItem(g->json, "buffers"), 0);
@@ -323,7 +298,7 @@ static void check_gltf(const char *path, bool binary, double exposure_given)
         assert_int_equal(count, n);
         for (size_t j = 0; j < n; j++)
             for (int c = 0; c < 3; c++)
-                assert_true(get_f32(B + j * stride + 4 * (size_t)c) == (float)vertex_B[3 * expected[j] + (size_t)c]);
+                assert_true(support_le_f32(B + j * stride + 4 * (size_t)c) == (float)vertex_B[3 * expected[j] + (size_t)c]);
         meshes++;
     }
     assert_int_equal(meshes, rad_scene_surface_count(scene));
@@ -451,7 +426,7 @@ static double srgb(double linear)
 static void check_ply(const char *path, double exposure_given)
 {
     size_t size;
-    unsigned char *bytes = read_bytes(path, &size);
+    unsigned char *bytes = support_read_bytes(path, &size);
     const char *end = strstr((const char *)bytes, "end_header\n");
     assert_non_null(end);
     size_t header_length = (size_t)(end - (const char *)bytes) + strlen("end_header\n");
@@ -481,9 +456,9 @@ static void check_ply(const char *path, double exposure_given)
         double xyz[3];
         assert_true(rad_solution_vertex_position(solution, v, xyz));
         for (int c = 0; c < 3; c++) {
-            assert_true(get_f32(p + 4 * c) == (float)xyz[c]);
+            assert_true(support_le_f32(p + 4 * c) == (float)xyz[c]);
             double B = vertex_B[3 * v + (size_t)c];
-            assert_true(get_f32(p + 12 + 4 * c) == (float)B);
+            assert_true(support_le_f32(p + 12 + 4 * c) == (float)B);
             long byte = lround(255.0 * srgb(display_value(B, exposure)));
             assert_int_equal(p[24 + c], byte); /* the PNG writer's bytes */
         }
@@ -495,10 +470,10 @@ static void check_ply(const char *path, double exposure_given)
         assert_int_equal(*p++, k);
         double v[4][3];
         for (int c = 0; c < k; c++, p += 4) {
-            assert_int_equal(get_u32(p), corner[c]);
-            float xyz[3] = {get_f32(bytes + header_length + 27 * corner[c]),
-                            get_f32(bytes + header_length + 27 * corner[c] + 4),
-                            get_f32(bytes + header_length + 27 * corner[c] + 8)};
+            assert_int_equal(support_le_u32(p), corner[c]);
+            float xyz[3] = {support_le_f32(bytes + header_length + 27 * corner[c]),
+                            support_le_f32(bytes + header_length + 27 * corner[c] + 4),
+                            support_le_f32(bytes + header_length + 27 * corner[c] + 8)};
             for (int d = 0; d < 3; d++)
                 v[c][d] = xyz[d];
         }
@@ -556,28 +531,11 @@ static void test_refused(void **state)
 static void test_validator(void **state)
 {
     (void)state;
-    const char *modules = RAD_NPM_MODULES;
-    char package[600];
-    snprintf(package, sizeof package, "%s/gltf-validator/package.json", modules);
-    if (system("command -v node >/dev/null 2>&1") != 0 || !file_exists(package)) {
-        printf("# gltf-validator: skipped (needs node and %s: scripts/setup.sh installs it with npm)\n", package);
-        skip();
-    }
-    const char *glb = temp_path("valid.glb"), *gltf = temp_path("valid.gltf"), *report = temp_path("report.txt");
+    const char *glb = temp_path("valid.glb"), *gltf = temp_path("valid.gltf");
     assert_int_equal(rad_solution_write_mesh(ctx, solution, glb, 0.0), RAD_OK);
     assert_int_equal(rad_solution_write_mesh(ctx, solution, gltf, 10.0), RAD_OK);
-    char cmd[3000];
-    snprintf(cmd, sizeof cmd, "node '%s/validate_gltf.js' '%s' '%s' '%s' >'%s' 2>&1", RAD_TEST_SOURCE, modules, glb,
-             gltf, report);
-    int status = system(cmd);
-    size_t size;
-    unsigned char *text = read_bytes(report, &size);
-    printf("%s", (const char *)text); /* the counts, and every error and warning */
-    fflush(stdout);
-    assert_non_null(strstr((const char *)text, "valid.glb: 0 errors"));
-    assert_non_null(strstr((const char *)text, "valid.gltf: 0 errors"));
-    free(text);
-    assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    const char *paths[2] = {glb, gltf};
+    support_validate_gltf(RAD_TEST_SOURCE, RAD_NPM_MODULES, paths, 2, NULL, temp_path("report.txt"));
 }
 
 int main(void)
