@@ -702,6 +702,78 @@ static void test_scale_ratio(void **state)
     free(t.data);
 }
 
+/* ---- light leaks where geometry meets (contact lines, mesh/conform.c) ---- */
+
+/* A closed 6 x 3 x 4 m room of single-quad faces, split at x = 3 by a
+ * sealed partition: a closed box 2 cm thick standing on the floor and
+ * touching the ceiling and both long walls.  The left wall (x = 0) glows.
+ * Nothing on the right of the partition can receive light: every
+ * element there (floor, ceiling, walls, the partition's right face) must
+ * stay exactly dark, whatever the mesh and the strategy.  Elements that
+ * straddled the partition carried light through it (0.012 - 0.053 of the
+ * lit side before patches were cut along contact lines). */
+static void partition_room(text *t)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {6, 3, 4};
+    box(t, "room", "white", NULL, lo, hi, 1, 1.0);
+    const double plo[3] = {2.99, 0, 0}, phi[3] = {3.01, 3, 4};
+    box(t, "partition", "white", NULL, plo, phi, 0, 1.0);
+    /* the glowing left wall, just in front of the room's x0 wall */
+    double a[3] = {1e-3, 0.5, 0.5}, b[3] = {1e-3, 0.5, 3.5}, c[3] = {1e-3, 2.5, 3.5}, d[3] = {1e-3, 2.5, 0.5};
+    quad(t, "lamp", "lamp", a, d, c, b, 1.0); /* facing +x */
+}
+
+static void assert_dark_side(const char *solver, size_t elements)
+{
+    text t = {0};
+    partition_room(&t);
+    rad_scene *scene;
+    if (load(&t, &scene) != RAD_OK)
+        fail_msg("load: %s", rad_context_error(ctx));
+    rad_options o = {0};
+    o.target_elements = elements;
+    o.solver = solver;
+    o.tolerance = 1e-9;
+    rad_solution *sol;
+    if (rad_solution_create(ctx, scene, &o, &sol) != RAD_OK || rad_solution_solve(ctx, sol) != RAD_OK)
+        fail_msg("%s: %s", solver, rad_context_error(ctx));
+    size_t n = rad_solution_element_count(sol), dark = 0, lit = 0;
+    double lit_max = 0.0, dark_max = 0.0;
+    for (size_t e = 0; e < n; e++) {
+        double c[3], normal[3], B[3], E[3], rho[3];
+        assert_true(rad_solution_element_geometry(sol, e, normal, c));
+        assert_true(rad_solution_element_values(sol, e, rho, E, B));
+        if (E[0] > 0.0)
+            continue;
+        if (c[0] > 3.01 - 1e-9) { /* the right room, the partition's right face included */
+            dark_max = fmax(dark_max, B[0]);
+            dark++;
+        } else if (c[0] < 2.99) {
+            lit_max = fmax(lit_max, B[0]);
+            lit++;
+        }
+    }
+    assert_true(dark > 0 && lit > 0);
+    assert_true(lit_max > 0.01);
+    if (!(dark_max <= 1e-9 * lit_max))
+        fail_msg("%s, %zu elements: the dark side reaches B = %.3g (lit side %.3g)", solver, n, dark_max,
+                 lit_max);
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+    free(t.data);
+}
+
+static void test_sealed_partition(void **state)
+{
+    (void)state;
+    static const size_t counts[] = {100, 500, 3000};
+    for (size_t k = 0; k < sizeof counts / sizeof counts[0]; k++) {
+        assert_dark_side("gauss-seidel", counts[k]);
+        assert_dark_side("shooting", counts[k]);
+        assert_dark_side("hierarchical", counts[k]);
+    }
+}
+
 /* Two closed rooms 2 m apart, lit by their ceilings, with different
  * reflectances: together, each surface's radiosity is what that room gives
  * solved alone (F is block-diagonal). */
@@ -869,6 +941,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_camera_distance),
         cmocka_unit_test(test_scale_ratio),
         cmocka_unit_test(test_two_separate_rooms),
+        cmocka_unit_test(test_sealed_partition),
         cmocka_unit_test(test_open_scene),
         cmocka_unit_test(test_allocation_overflow),
     };

@@ -176,6 +176,23 @@ static void test_mesh_welding_and_tvertices(void **state)
     }
     rad_mesh_destroy(mesh);
     rad_scene_destroy(scene);
+
+    /* The same two grids, the small one turned up 90 degrees about the
+     * shared edge (a box's faces are one surface): their vertices along
+     * the edge are not T-vertices of each other, or one face's shading
+     * would pass to the other across the corner. */
+    b = rad_scene_builder_create(ctx, "corner");
+    m = rad_scene_builder_material(b, "m", r, e);
+    s = rad_scene_builder_surface(b, "box");
+    const vec3 upright[4] = {{1, 0, 0}, {1, 0.5, 0}, {1, 0.5, 0.5}, {1, 0, 0.5}};
+    assert_int_equal(rad_scene_builder_polygon(b, s, m, big, 4, 0), RAD_OK);
+    assert_int_equal(rad_scene_builder_polygon(b, s, m, upright, 4, 0), RAD_OK);
+    assert_int_equal(rad_scene_builder_finish(b, &scene), RAD_OK);
+    assert_int_equal(rad_mesh_build(ctx, scene, &o, &mesh), RAD_OK);
+    assert_int_equal(mesh->element_count, 9 + 4);
+    assert_int_equal(mesh->tvertex_count, 0);
+    rad_mesh_destroy(mesh);
+    rad_scene_destroy(scene);
 }
 
 /* ---- the point-to-polygon kernel: exact cases from cases.json ---- */

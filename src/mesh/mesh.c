@@ -148,7 +148,7 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
          * make the search quadratic). */
         double typical = mesh->element_count ? sqrt(total_area / (double)mesh->element_count) : h;
         double hg = fmax(fmin(h, typical), 10.0 * tol);
-        r = mesh_find_tvertices(ctx, mesh, tol, hg);
+        r = mesh_find_tvertices(ctx, mesh, tol, hg, cos(o.crease_angle_degrees * M_PI / 180.0));
     }
     rad_free(raw);
     rad_free(weld_of);
@@ -245,7 +245,7 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
         /* The T-vertex search grid: about the typical leaf size. */
         double h = leaf_count ? sqrt(area / (double)leaf_count) : 1.0;
         mesh->mesh_size = h;
-        r = mesh_find_tvertices(ctx, mesh, tol, h > tol ? h : tol);
+        r = mesh_find_tvertices(ctx, mesh, tol, h > tol ? h : tol, cos(crease * M_PI / 180.0));
     }
     rad_free(raw);
     rad_free(weld_of);

@@ -32,6 +32,16 @@ typedef struct cell_entry {
 rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene,
                                       rad_patch **patches, size_t *count);
 
+/* ---- conform.c ---- */
+
+/* Split the patches along their contact lines: where another patch
+ * crosses or touches a patch's plane (within tol, m) inside it.  Replaces
+ * *patches (each patch by its pieces, in order) and sets *cut_patches to
+ * the number of patches split.  Fails for memory or cancellation (then
+ * *patches is unchanged). */
+rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patches, size_t *count,
+                                size_t *cut_patches);
+
 /* ---- grid.c ---- */
 
 /* Size every patch's grid (nu, nv, element_count) for edge length h (m);
@@ -68,8 +78,9 @@ rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *r
                      size_t *count);
 
 /* Record in mesh->tvertices the welded vertices lying (within `tol`) inside
- * a boundary edge of an element of their surface; `h` (m) is the search
- * grid's cell size.  Fails only for memory. */
-rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, double h);
+ * a boundary edge of an element of their surface whose normal is within
+ * the crease (cos_crease) of theirs; `h` (m) is the search grid's cell
+ * size.  Fails only for memory. */
+rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, double h, double cos_crease);
 
 #endif /* RAD_MESH_INTERNAL_H */

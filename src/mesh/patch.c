@@ -294,6 +294,28 @@ rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene,
         return r;
     }
     merge_triangle_pairs(&pl);
+    /* Contact lines: the weld rule's distance (1e-6 of the scene, under
+     * 1e-3 of the narrowest patch), and no less than the round-off of the
+     * coordinates themselves (a float-imported room 10 km from the origin). */
+    double diag = rad_scene_diagonal(scene), reach = 0.0, narrowest = HUGE_VAL;
+    for (size_t i = 0; i < pl.count; i++) {
+        const rad_patch *p = &pl.items[i];
+        for (uint32_t k = 0; k < p->corner_count; k++)
+            reach = fmax(reach, fmax(fabs(p->corner[k].x), fmax(fabs(p->corner[k].y), fabs(p->corner[k].z))));
+        double width = rad_corners_width(p->corner, p->corner_count);
+        if (width > 0.0)
+            narrowest = fmin(narrowest, width);
+    }
+    double tol = fmin(1e-6 * (diag > 0.0 ? diag : 1.0), 1e-3 * narrowest);
+    tol = fmax(tol, 1e-7 * reach);
+    size_t cut = 0;
+    r = mesh_conform_patches(ctx, tol, &pl.items, &pl.count, &cut);
+    if (r != RAD_OK) {
+        rad_free(pl.items);
+        *patches = NULL;
+        *count = 0;
+        return r;
+    }
     *patches = pl.items;
     *count = pl.count;
     return RAD_OK;

@@ -209,9 +209,12 @@ rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *r
 /* ---- T-vertices ---- */
 
 /* Find welded vertices lying inside boundary edges of elements of the same
- * surface (T-vertices).  Only vertices on boundary edges can be T-vertices,
+ * surface and plane (T-vertices): a vertex whose elements turn by more than
+ * the crease from the edge's element is not constrained by it (the corner
+ * of a box, whose faces are one surface, must not pass a face's shading to
+ * the next: red blotches on the Cornell tall block's front).  Only vertices on boundary edges can be T-vertices,
  * so both sets are small; they are matched through a grid of cell size h. */
-rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, double h)
+rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, double h, double cos_crease)
 {
     typedef struct edge_rec {
         uint32_t a, b, element;
@@ -223,6 +226,7 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
     cell_entry *order = NULL, *grid = NULL;
     uint8_t *on_boundary = NULL;
     uint32_t *vsurf = NULL;
+    vec3 *vnormal = NULL;
     cell_index gix = {NULL, NULL, 0};
     edge_rec *edges = rad_alloc(ctx, RAD_MEM_MESH, ne, sizeof *edges, "mesh: edges");
     if (!edges)
@@ -263,15 +267,21 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
     }
     /* Vertex -> a surface and normal, from any element that uses it. */
     vsurf = rad_alloc(ctx, RAD_MEM_MESH, mesh->vertex_count, sizeof *vsurf, "mesh: vertex surfaces");
+    vnormal = vsurf ? rad_alloc(ctx, RAD_MEM_MESH, mesh->vertex_count, sizeof *vnormal, "mesh: vertex normals")
+                    : NULL;
     size_t nbv = 0;
     for (size_t v = 0; v < mesh->vertex_count; v++)
         nbv += on_boundary[v];
-    grid = vsurf ? rad_alloc(ctx, RAD_MEM_MESH, nbv, sizeof *grid, "mesh: vertex grid") : NULL;
+    grid = vnormal ? rad_alloc(ctx, RAD_MEM_MESH, nbv, sizeof *grid, "mesh: vertex grid") : NULL;
     if (!grid)
         goto done;
+    /* Welded vertices join elements within the crease of each other, so
+     * any one element's normal stands for the vertex's plane. */
     for (size_t i = 0; i < mesh->element_count; i++)
-        for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++)
+        for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++) {
             vsurf[mesh->elements[i].vertex[c]] = mesh->elements[i].surface;
+            vnormal[mesh->elements[i].vertex[c]] = mesh->elements[i].normal;
+        }
     /* Cells of the mesh size h: a boundary edge is walked along its
      * length in pieces of half a cell, so a long edge visits the cells it
      * passes and no others.  (Cells as wide as the longest boundary edge
@@ -332,7 +342,8 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
                         uint64_t key = cell_key(x, y, z);
                         for (size_t q = cell_index_find(&gix, g, key); q < g && grid[q].key == key; q++) {
                             uint32_t v = grid[q].item;
-                            if (v == ed->a || v == ed->b || vsurf[v] != el->surface)
+                            if (v == ed->a || v == ed->b || vsurf[v] != el->surface ||
+                                v3_dot(vnormal[v], el->normal) < cos_crease)
                                 continue;
                             vec3 d = v3_sub(mesh->vertices[v], a);
                             double t = v3_dot(d, ab) / len2;
@@ -364,6 +375,7 @@ done:
     rad_free(order);
     rad_free(on_boundary);
     rad_free(vsurf);
+    rad_free(vnormal);
     rad_free(grid);
     cell_index_free(&gix);
     return result;
