@@ -81,7 +81,7 @@ static int offices(rad_context *ctx, const int *rooms, int count, bool per_room,
     double lx[8], ll[8], lt[8];
     int runs = 0;
     for (int i = 0; i < count && i < 8; i++) {
-        rad_office_options oo = {rooms[i], 0};
+        rad_office_options oo = {rooms[i], 0, 0};
         rad_scene *scene = NULL;
         if (rad_scene_generate_office(ctx, &oo, &scene) != RAD_OK)
             return 1;

@@ -105,6 +105,7 @@ static const cli_flag FLAGS[] = {
      .own.help = "what the texels hold: radiosity B, or irradiance H = (B - E)/rho (as B/pi, H/pi, W/(m^2 sr))"},
     {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
     {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
+    {"closed-doors", 0, NULL, CLI_GENERATE, OFFICE(closed_doors)},
     {"mesh-size", 0, "L", RV, SOLVE(mesh_size)},
     {"elements", 0, "N", RV, SOLVE(target_elements)},
     {"form-factors", 0, "NAME", RV, SOLVE(form_factors)},

@@ -229,6 +229,8 @@ RAD_API rad_result rad_scene_create_cornell_box(rad_context *ctx, rad_scene **ou
 typedef struct rad_office_options {
     int rooms;                   /* 1 to 100000; 0 = 4 */
     uint64_t seed;               /* any value (0 included) */
+    int closed_doors;            /* nonzero: every door opening holds a closed door leaf on
+                                    both faces of its wall, so each room is sealed */
 } rad_office_options;
 
 /* `options` may be NULL (the defaults).  Fails with

@@ -307,10 +307,12 @@ static void test_cornell_box_closure_and_energy(void **state)
     assert_non_null(s);
     /* The box is open at the front (z = 0): rows sum below 1.  A row can
      * exceed 1 only by the noise of its shadow-ray visibility estimates
-     * (unbiased; 0.3-0.6% on the worst of 1000 rows at 4-16 rays per pair);
-     * a closure error of the factors themselves would show as a mean above
-     * the open box's (~0.81). */
-    assert_true(cli_stats_number(s, "form_factors", "row_sum_max") < 1.0 + 1e-2);
+     * (unbiased; on the worst of 1000 rows at 4-16 rays per pair 0.4-0.5%
+     * for seeds 1-3 and 1.2% for seed 0: the small floor pieces cut along
+     * the blocks' footprints carry the most partly visible pairs); a
+     * closure error of the factors themselves would show as a mean above
+     * the open box's (~0.82). */
+    assert_true(cli_stats_number(s, "form_factors", "row_sum_max") < 1.0 + 1.5e-2);
     assert_true(cli_stats_number(s, "form_factors", "row_sum_mean") < 0.83);
     assert_true(cli_stats_number(s, "form_factors", "row_sum_mean") > 0.78);
     assert_true(cli_stats_number(s, "form_factors", "reciprocity_max") < 1e-5);

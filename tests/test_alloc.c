@@ -164,7 +164,7 @@ static rad_result run_loading(rad_context *ctx, outputs *out)
         rad_scene_destroy(scene);
     }
     if (r == RAD_OK) {
-        rad_office_options oo = {1, 3};
+        rad_office_options oo = {1, 3, 0};
         r = rad_scene_generate_office(ctx, &oo, &scene);
         rad_scene_destroy(scene);
     }

@@ -168,10 +168,14 @@ static void test_closed_box_energy(void **state)
     rad_scene_destroy(scene);
 }
 
-/* A block resting on the floor of a closed box: the leaves along the
- * contact line are partly inside it.  Without the open-fraction correction
- * (hier.c, measure_open) 0.32% of the power vanished there; with it 0.06%;
- * floating 5 cm up, 0.005%. */
+/* A block resting on the floor of a closed box.  Before patches were cut
+ * along contact lines, leaves ran under the block, partly inside it;
+ * without the open-fraction correction (hier.c, measure_open) 0.32% of the
+ * power vanished there, with it 0.06%.  Now the floor is cut along the
+ * footprint: the piece under the block sends nothing, the rest is open.
+ * What remains is the links' own error along the new 90-degree edges
+ * between floor pieces and block faces (leaf closures up to 1.27 there):
+ * +0.27% measured, bounded here at 0.4%. */
 static void test_contact_line_energy(void **state)
 {
     (void)state;
@@ -197,7 +201,8 @@ static void test_contact_line_energy(void **state)
     rad_solution *s = solve(scene, 3e-5, 0);
     double emitted, absorbed;
     rad_solution_power(s, &emitted, &absorbed);
-    assert_true(relative(absorbed, emitted) < 2e-3);
+    if (!(relative(absorbed, emitted) < 4e-3))
+        fail_msg("absorbed %.9g W, emitted %.9g W", absorbed, emitted);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }
@@ -317,13 +322,23 @@ static void assert_leaves_locate(const rad_solution *s)
         double ps, pt, ls, lt;
         rad_patch_parameters(&mesh->patches[e->patch], e->centroid, &ps, &pt);
         assert_int_equal(rad_mesh_locate(mesh, e->patch, ps, pt, &ls, &lt), i);
-        /* The centroid's local coordinates: (1/3, 1/3) on triangles; about
-         * (1/2, 1/2) on quads (the area centroid of a trapezoid is not the
-         * bilinear centre). */
-        double want = e->vertex_count == 4 ? 0.5 : 1.0 / 3.0, tol = e->vertex_count == 4 ? 0.05 : 1e-6;
-        if (!(fabs(ls - want) < tol && fabs(lt - want) < tol))
-            fail_msg("leaf %zu (%u corners): local (%g, %g), want (%g, %g)", i, e->vertex_count, ls, lt, want,
-                     want);
+        /* The centroid's local coordinates: (1/3, 1/3) on triangles; on
+         * quads the inverse of the leaf's own bilinear map (the area
+         * centroid of a trapezoid is not the bilinear centre, and pieces
+         * cut along contact lines can be far from parallelograms). */
+        double want_s = 1.0 / 3.0, want_t = 1.0 / 3.0;
+        if (e->vertex_count == 4) {
+            rad_patch own = {0};
+            own.corner_count = 4;
+            for (int c = 0; c < 4; c++)
+                own.corner[c] = mesh->vertices[e->vertex[c]];
+            own.normal = e->normal;
+            rad_patch_parameters(&own, e->centroid, &want_s, &want_t);
+            assert_true(want_s > 0.25 && want_s < 0.75 && want_t > 0.25 && want_t < 0.75);
+        }
+        if (!(fabs(ls - want_s) < 1e-6 && fabs(lt - want_t) < 1e-6))
+            fail_msg("leaf %zu (%u corners): local (%g, %g), want (%g, %g)", i, e->vertex_count, ls, lt, want_s,
+                     want_t);
     }
 }
 
@@ -399,7 +414,7 @@ static void test_thread_count_independent(void **state)
 static void test_clusters_office(void **state)
 {
     (void)state;
-    rad_office_options oo = {1, 7};
+    rad_office_options oo = {1, 7, 0};
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_generate_office(ctx, &oo, &scene), RAD_OK);
     rad_solution *with = solve(scene, 1e-3, 1), *without = solve(scene, 1e-3, -1);
@@ -575,7 +590,7 @@ static void test_cluster_sampling(void **state)
 static void test_office_energy(void **state)
 {
     (void)state;
-    rad_office_options oo = {10, 0};
+    rad_office_options oo = {10, 0, 0};
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_generate_office(ctx, &oo, &scene), RAD_OK);
     rad_solution *s = solve(scene, 1e-3, 0);
@@ -592,8 +607,11 @@ static void test_office_energy(void **state)
     rad_solution *c = solve_options(scene, (rad_options){.epsilon = 1e-3, .closure_correction = 1});
     double emitted_c, absorbed_c;
     rad_solution_power(c, &emitted_c, &absorbed_c);
-    /* Measured: 0.79% -> 0.01%, 6,966 of 7,352 leaves scaled. */
-    assert_true(relative(absorbed_c, emitted_c) < 0.001);
+    /* Measured: 0.79% -> 0.01%, 6,966 of 7,352 leaves scaled, before the
+     * patches were cut along contact lines; with them, 0.2% (more, smaller
+     * patches, each scaled by its own closure). */
+    if (!(relative(absorbed_c, emitted_c) < 0.003))
+        fail_msg("closure-corrected: absorbed %.9g W, emitted %.9g W", absorbed_c, emitted_c);
     assert_true(c->view.hier->closure_corrected > c->view.hier->leaves / 2);
     rad_solution_destroy(c);
     rad_solution_destroy(s);

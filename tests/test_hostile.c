@@ -16,6 +16,8 @@
  *   beyond 1e30 m, below 1e-30 m     a clear error naming the polygon
  *   a camera 10^6 scene sizes away   refused before the work; nearer, drawn
  *   a 1 mm lamp over a 2 km floor    its power, and the floor's closed form
+ *   a sealed partition               the dark side exactly dark, every strategy
+ *   ten rooms behind closed doors    ten independent groups of elements
  *   two separate rooms               each as if solved alone
  *   an open scene                    emitted = absorbed + escaped
  *   10^6 tiny triangles (slow)       loads and meshes in bounded time
@@ -774,6 +776,27 @@ static void test_sealed_partition(void **state)
     }
 }
 
+/* Ten generated office rooms with furniture and their doors closed: no
+ * element of one room can exchange light with another room's, so the
+ * matrix is block-diagonal and the solver finds ten lit groups (rooms saw
+ * each other through pairs whose samples all fell behind each other's
+ * planes, taken as visible: ~1e-7 factors joined them into one). */
+static void test_closed_rooms_are_components(void **state)
+{
+    (void)state;
+    rad_office_options oo = {10, 0, 1};
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_generate_office(ctx, &oo, &scene), RAD_OK);
+    rad_options o = {0};
+    o.target_elements = 1; /* one element per patch: the coarsest mesh */
+    rad_solution *sol = NULL;
+    if (rad_solution_create(ctx, scene, &o, &sol) != RAD_OK || rad_solution_solve(ctx, sol) != RAD_OK)
+        fail_msg("%s", rad_context_error(ctx));
+    assert_int_equal(sol->view.solve->components_lit, 10);
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+}
+
 /* Two closed rooms 2 m apart, lit by their ceilings, with different
  * reflectances: together, each surface's radiosity is what that room gives
  * solved alone (F is block-diagonal). */
@@ -942,6 +965,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_scale_ratio),
         cmocka_unit_test(test_two_separate_rooms),
         cmocka_unit_test(test_sealed_partition),
+        cmocka_unit_test(test_closed_rooms_are_components),
         cmocka_unit_test(test_open_scene),
         cmocka_unit_test(test_allocation_overflow),
     };

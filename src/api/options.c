@@ -121,6 +121,8 @@ static const rad_option_info office_rows[] = {
      .default_text = "4", .help = "rooms on the floor"},
     {OFFICE(seed), .type = RAD_OPTION_UINT64, UINT64_RANGE, .default_value = 0.0, .default_text = "0",
      .help = "seed of the layout; the same seed gives the same scene"},
+    {OFFICE(closed_doors), .type = RAD_OPTION_FLAG, .default_value = 0.0,
+     .help = "close every door: a door leaf on both faces of the wall, each room sealed"},
 };
 
 #define COUNT(rows) (sizeof rows / sizeof rows[0])

@@ -185,7 +185,7 @@ static double occluded_factor(const rad_ff_request *req, const elem_geom *recv,
         return sum;
     }
     int pass = rad_ff_rays(req->vis, recv_end, &end, partial ? 4 * base_rays : base_rays, rng, rays, &cast);
-    return cast > 0 ? f * pass / cast : f; /* no facing sample: slivers, taken as visible */
+    return cast > 0 ? f * pass / cast : 0.0; /* no facing ray, even between the facing parts (visibility.c) */
 }
 
 /* What every pair reads. */

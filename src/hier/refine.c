@@ -180,7 +180,7 @@ static void end_of(const hr_tree *t, const hr_node *n, rad_ff_end *e)
  * by the kernel makes k V estimate int int K V / int int K, the visibility
  * the transfer needs: a plain fraction would misjudge pairs where the near,
  * strongly coupled points are the hidden ones.  *facing = pairs cast;
- * returns 1 when none faces. */
+ * returns 0 when none faces. */
 static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s, int count,
                                  rad_rng *rng, uint64_t *rays, int *facing)
 {
@@ -193,7 +193,7 @@ static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t 
     int m = rad_ff_pairs(&ea, &eb, count, rng, ray);
     *facing = m;
     if (m == 0)
-        return 1.0;
+        return 0.0; /* not even the facing parts face (visibility.c) */
     vis->backend->occluded(vis->state, ray, (size_t)m, hit);
     *rays += (uint64_t)m;
     double floor2 = fmin(a->area, b->area) / 16.0, pass = 0.0, all = 0.0;

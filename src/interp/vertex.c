@@ -258,7 +258,9 @@ rad_result rad_vertex_values(rad_context *ctx, const rad_mesh *mesh,
     }
 
     /* T-vertices: Gauss-Seidel over the constraints until nothing moves by
-     * more than 1e-12 of the largest value (round-off level), or 100 passes. */
+     * more than 1e-12 of the largest value (round-off level), or 100 passes.
+     * The records come coarse first (mesh/weld.c), so one pass sets them
+     * all and the second confirms it. */
     double scale = 0.0;
     for (size_t i = 0; i < 3 * nv; i++)
         scale = fmax(scale, fabs(vertex_value[i]));

@@ -418,11 +418,19 @@ static bool emit_piece(rad_context *ctx, const rad_patch *from, const piece *pc,
     return true;
 }
 
+static int contact_cmp(const void *x, const void *y)
+{
+    const rad_contact *a = x, *b = y;
+    return a->polygon < b->polygon ? -1 : (a->polygon > b->polygon);
+}
+
 rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patches, size_t *count,
-                                size_t *cut_patches)
+                                size_t *cut_patches, rad_contact **contacts, size_t *contact_count)
 {
     size_t n = *count;
     *cut_patches = 0;
+    *contacts = NULL;
+    *contact_count = 0;
     cut_list cuts = {ctx, NULL, 0, 0};
     rad_result r = find_cuts(ctx, *patches, n, tol, &cuts);
     if (r != RAD_OK || cuts.count == 0) {
@@ -432,8 +440,17 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
     qsort(cuts.items, cuts.count, sizeof *cuts.items, cut_cmp);
 
     rad_patch *out = NULL;
-    size_t nout = 0, cap = 0;
-    piece *pieces = rad_alloc(ctx, RAD_MEM_MESH, MAX_PIECES, sizeof *pieces, "mesh: patch pieces");
+    size_t nout = 0, cap = 0, ncontact = 0;
+    /* The contact lines that run through a patch's interior: where the
+     * radiosity is discontinuous (a line along a patch's rim is where two
+     * faces of a curved mesh meet, which is not). */
+    rad_contact *lines = rad_alloc(ctx, RAD_MEM_MESH, cuts.count, sizeof *lines, "mesh: contact lines");
+    if (!lines) {
+        rad_free(cuts.items);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    int piece_cap = 16;
+    piece *pieces = rad_alloc(ctx, RAD_MEM_MESH, (size_t)piece_cap, sizeof *pieces, "mesh: patch pieces");
     if (!pieces) {
         rad_free(cuts.items);
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -457,7 +474,7 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
         int np = 1;
         pieces[0].n = (int)p->corner_count;
         memcpy(pieces[0].c, p->corner, p->corner_count * sizeof *p->corner);
-        for (size_t k = c0; k < c; k++) {
+        for (size_t k = c0; k < c && r == RAD_OK; k++) {
             double ax, ay, bx, by;
             to2(&f, cuts.items[k].a, &ax, &ay);
             to2(&f, cuts.items[k].b, &bx, &by);
@@ -465,6 +482,11 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
             if (!(len > tol))
                 continue;
             double nx = -dy / len, ny = dx / len;
+            piece whole;
+            whole.n = (int)p->corner_count;
+            memcpy(whole.c, p->corner, p->corner_count * sizeof *p->corner);
+            if (segment_inside(&f, &whole, ax, ay, bx, by, tol))
+                lines[ncontact++] = (rad_contact){p->polygon, cuts.items[k].a, cuts.items[k].b};
             int count_now = np;
             for (int q = 0; q < count_now; q++) {
                 if (!segment_inside(&f, &pieces[q], ax, ay, bx, by, tol))
@@ -480,10 +502,22 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
                 piece left, right;
                 if (!split_piece(&f, &pieces[q], ax, ay, nx, ny, tol, &left, &right))
                     continue;
+                if (np == piece_cap) {
+                    piece *grown = rad_realloc(ctx, RAD_MEM_MESH, pieces, 2 * (size_t)piece_cap, sizeof *pieces,
+                                               "mesh: patch pieces");
+                    if (!grown) {
+                        r = RAD_ERROR_OUT_OF_MEMORY;
+                        break;
+                    }
+                    pieces = grown;
+                    piece_cap *= 2;
+                }
                 pieces[q] = left;
                 pieces[np++] = right;
             }
         }
+        if (r != RAD_OK)
+            break;
         if (np > 1)
             (*cut_patches)++;
         for (int q = 0; q < np && r == RAD_OK; q++)
@@ -492,12 +526,19 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
     }
     rad_free(pieces);
     rad_free(cuts.items);
+    if (r != RAD_OK || ncontact == 0) {
+        rad_free(lines);
+        lines = NULL;
+    }
     if (r != RAD_OK) {
         rad_free(out);
         return r;
     }
+    qsort(lines, ncontact, sizeof *lines, contact_cmp);
     rad_free(*patches);
     *patches = out;
     *count = nout;
+    *contacts = lines;
+    *contact_count = ncontact;
     return RAD_OK;
 }

@@ -77,7 +77,7 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
     rad_mesh *mesh = rad_alloc(ctx, RAD_MEM_MESH, 1, sizeof *mesh, "mesh");
     if (!mesh)
         return RAD_ERROR_OUT_OF_MEMORY;
-    rad_result r = mesh_patches_from_polygons(ctx, scene, &mesh->patches, &mesh->patch_count);
+    rad_result r = mesh_patches_from_polygons(ctx, scene, mesh);
     if (r != RAD_OK) {
         rad_free(mesh);
         return r;
@@ -191,6 +191,18 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     memcpy(mesh->patches, base->patches, base->patch_count * sizeof *mesh->patches);
+    if (base->contact_count) {
+        mesh->contacts = rad_alloc(ctx, RAD_MEM_MESH, base->contact_count, sizeof *mesh->contacts, "mesh: contact lines");
+        if (!mesh->contacts) {
+            rad_free(raw);
+            rad_free(weld_of);
+            rad_mesh_destroy(mesh);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        memcpy(mesh->contacts, base->contacts, base->contact_count * sizeof *mesh->contacts);
+        mesh->contact_count = base->contact_count;
+    }
+    mesh->contact_tol = base->contact_tol;
     memcpy(mesh->tree, tree, 4 * tree_count * sizeof *mesh->tree);
     mesh->tree_count = tree_count;
     mesh->element_count = leaf_count;
@@ -266,5 +278,29 @@ void rad_mesh_destroy(rad_mesh *mesh)
     rad_free(mesh->vertices);
     rad_free(mesh->tvertices);
     rad_free(mesh->tree);
+    rad_free(mesh->contacts);
     rad_free(mesh);
+}
+
+bool rad_mesh_on_contact(const rad_mesh *mesh, uint32_t polygon, vec3 p)
+{
+    /* The polygon's lines: a binary search for the first. */
+    size_t lo = 0, hi = mesh->contact_count;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (mesh->contacts[mid].polygon < polygon)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    double tol = mesh->contact_tol;
+    for (size_t k = lo; k < mesh->contact_count && mesh->contacts[k].polygon == polygon; k++) {
+        vec3 a = mesh->contacts[k].a, ab = v3_sub(mesh->contacts[k].b, a);
+        double len2 = v3_dot(ab, ab);
+        double t = len2 > 0.0 ? v3_dot(v3_sub(p, a), ab) / len2 : 0.0;
+        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+        if (v3_length(v3_sub(p, v3_mad(a, ab, t))) <= tol)
+            return true;
+    }
+    return false;
 }

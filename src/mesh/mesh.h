@@ -58,6 +58,14 @@ typedef struct rad_tvertex {
     double t;
 } rad_tvertex;
 
+/* A contact line: where another surface touches or crosses scene polygon
+ * `polygon` inside it (mesh/conform.c).  The radiosity is discontinuous
+ * there, so vertices on it are not shared across it. */
+typedef struct rad_contact {
+    uint32_t polygon;
+    vec3 a, b;               /* m */
+} rad_contact;
+
 typedef struct rad_mesh {
     rad_patch *patches;
     size_t patch_count;
@@ -76,6 +84,9 @@ typedef struct rad_mesh {
      * NULL for grid meshes. */
     uint32_t *tree;
     size_t tree_count;       /* internal nodes */
+    rad_contact *contacts;   /* sorted by polygon; NULL when none */
+    size_t contact_count;
+    double contact_tol;      /* m: a point this near a contact line is on it */
 } rad_mesh;
 
 #define RAD_TREE_LEAF 0x80000000u
@@ -125,6 +136,10 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
                                 const rad_mesh_leaf *leaves, size_t leaf_count, const uint32_t *tree,
                                 size_t tree_count, const uint32_t *patch_root,
                                 double crease_angle_degrees, rad_mesh **out);
+
+/* Does point p lie (within mesh->contact_tol) on a contact line of scene
+ * polygon `polygon`?  Cannot fail. */
+bool rad_mesh_on_contact(const rad_mesh *mesh, uint32_t polygon, vec3 p);
 
 /* A triangle's or quad's width, m: its shortest edge or 2 x area / its
  * longest edge, whichever is less; 0 when it has no extent. */

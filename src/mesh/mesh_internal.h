@@ -26,21 +26,23 @@ typedef struct cell_entry {
 /* ---- patch.c ---- */
 
 /* The scene's polygons as patches: convex quads and triangles, triangle
- * pairs merged into quads.  *patches (malloc'd, NULL when there are none)
- * belongs to the caller.  Fails for memory, or for a polygon that cannot
- * be triangulated (message names it); then *patches is NULL. */
-rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene,
-                                      rad_patch **patches, size_t *count);
+ * pairs merged into quads, cut along contact lines (conform.c), which go
+ * to mesh->contacts.  Fills mesh->patches (NULL when there are none),
+ * patch_count, contacts, contact_count and contact_tol.  Fails for memory,
+ * or for a polygon that cannot be triangulated (message names it); then
+ * those fields are left empty. */
+rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene, rad_mesh *mesh);
 
 /* ---- conform.c ---- */
 
 /* Split the patches along their contact lines: where another patch
  * crosses or touches a patch's plane (within tol, m) inside it.  Replaces
  * *patches (each patch by its pieces, in order) and sets *cut_patches to
- * the number of patches split.  Fails for memory or cancellation (then
+ * the number of patches split; *contacts (malloc'd, the caller's; NULL
+ * when none) gets the lines, sorted by polygon.  Fails for memory or cancellation (then
  * *patches is unchanged). */
 rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patches, size_t *count,
-                                size_t *cut_patches);
+                                size_t *cut_patches, rad_contact **contacts, size_t *contact_count);
 
 /* ---- grid.c ---- */
 

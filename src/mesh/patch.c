@@ -282,15 +282,12 @@ static void merge_triangle_pairs(patch_list *l)
     l->count = out;
 }
 
-rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene,
-                                      rad_patch **patches, size_t *count)
+rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene, rad_mesh *mesh)
 {
     patch_list pl = {ctx, NULL, 0, 0};
     rad_result r = make_patches(ctx, scene, &pl);
     if (r != RAD_OK) {
         rad_free(pl.items);
-        *patches = NULL;
-        *count = 0;
         return r;
     }
     merge_triangle_pairs(&pl);
@@ -309,14 +306,13 @@ rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene,
     double tol = fmin(1e-6 * (diag > 0.0 ? diag : 1.0), 1e-3 * narrowest);
     tol = fmax(tol, 1e-7 * reach);
     size_t cut = 0;
-    r = mesh_conform_patches(ctx, tol, &pl.items, &pl.count, &cut);
+    r = mesh_conform_patches(ctx, tol, &pl.items, &pl.count, &cut, &mesh->contacts, &mesh->contact_count);
     if (r != RAD_OK) {
         rad_free(pl.items);
-        *patches = NULL;
-        *count = 0;
         return r;
     }
-    *patches = pl.items;
-    *count = pl.count;
+    mesh->patches = pl.items;
+    mesh->patch_count = pl.count;
+    mesh->contact_tol = tol;
     return RAD_OK;
 }

@@ -186,6 +186,11 @@ rad_result mesh_weld(rad_context *ctx, const rad_mesh *mesh, const raw_vertex *r
                         const rad_patch *pc = &mesh->patches[raw[c].patch];
                         if (pc->surface != pr->surface || v3_dot(pc->normal, pr->normal) < cos_crease)
                             continue;
+                        /* Not across a contact line: the two sides of a
+                         * partition's foot are lit and dark. */
+                        if (raw[c].patch != raw[r].patch && mesh->contact_count &&
+                            (rad_mesh_on_contact(mesh, pr->polygon, p) || rad_mesh_on_contact(mesh, pc->polygon, p)))
+                            continue;
                         if (v3_length(v3_sub(raw[c].position, p)) <= tol) {
                             best = c;
                             break;
@@ -225,8 +230,9 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
     rad_result result = RAD_ERROR_OUT_OF_MEMORY;
     cell_entry *order = NULL, *grid = NULL;
     uint8_t *on_boundary = NULL;
-    uint32_t *vsurf = NULL;
+    uint32_t *vsurf = NULL, *vcoarse = NULL, *rank = NULL;
     vec3 *vnormal = NULL;
+    cell_entry *by_size = NULL;
     cell_index gix = {NULL, NULL, 0};
     edge_rec *edges = rad_alloc(ctx, RAD_MEM_MESH, ne, sizeof *edges, "mesh: edges");
     if (!edges)
@@ -281,6 +287,45 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
         for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++) {
             vsurf[mesh->elements[i].vertex[c]] = mesh->elements[i].surface;
             vnormal[mesh->elements[i].vertex[c]] = mesh->elements[i].normal;
+        }
+    /* Who constrains whom.  Where two grids meet along a line with their
+     * vertices interleaved (pieces of a floor cut along a block's
+     * footprint), constraining each side's vertices to the other's edges
+     * ties the two into one cyclic system: its only solution is linear
+     * along the whole line, and Gauss-Seidel needed 43,000 passes to get
+     * there on the default Cornell box.  So a vertex is constrained only by
+     * an edge of an element coarser than every element it belongs to
+     * (longest edge, then index): the constraints form a hierarchy, solved
+     * in one pass from the coarse down (records sorted so), and a quadtree's
+     * small leaves still follow their big neighbours exactly. */
+    size_t ne_all = mesh->element_count;
+    by_size = rad_alloc(ctx, RAD_MEM_MESH, ne_all ? ne_all : 1, sizeof *by_size, "mesh: element sizes");
+    rank = by_size ? rad_alloc(ctx, RAD_MEM_MESH, ne_all ? ne_all : 1, sizeof *rank, "mesh: element sizes") : NULL;
+    vcoarse = rank ? rad_alloc(ctx, RAD_MEM_MESH, mesh->vertex_count ? mesh->vertex_count : 1, sizeof *vcoarse,
+                               "mesh: vertex owners")
+                   : NULL;
+    if (!vcoarse)
+        goto done;
+    for (size_t i = 0; i < ne_all; i++) {
+        const rad_element *e = &mesh->elements[i];
+        double longest = 0.0;
+        for (uint32_t c = 0; c < e->vertex_count; c++)
+            longest = fmax(longest, v3_length(v3_sub(mesh->vertices[e->vertex[(c + 1) % e->vertex_count]],
+                                                     mesh->vertices[e->vertex[c]])));
+        uint64_t bits;
+        memcpy(&bits, &longest, sizeof bits); /* >= 0: the bits order as the values */
+        by_size[i].key = UINT64_MAX - bits;   /* longest first, then by index */
+        by_size[i].item = (uint32_t)i;
+    }
+    qsort(by_size, ne_all, sizeof *by_size, cell_entry_cmp);
+    for (size_t q = 0; q < ne_all; q++)
+        rank[by_size[q].item] = (uint32_t)q; /* 0 = the coarsest */
+    for (size_t v = 0; v < mesh->vertex_count; v++)
+        vcoarse[v] = UINT32_MAX;
+    for (size_t i = 0; i < ne_all; i++)
+        for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++) {
+            uint32_t v = mesh->elements[i].vertex[c];
+            vcoarse[v] = rank[i] < vcoarse[v] ? rank[i] : vcoarse[v]; /* the rank of its coarsest element */
         }
     /* Cells of the mesh size h: a boundary edge is walked along its
      * length in pieces of half a cell, so a long edge visits the cells it
@@ -343,7 +388,13 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
                         for (size_t q = cell_index_find(&gix, g, key); q < g && grid[q].key == key; q++) {
                             uint32_t v = grid[q].item;
                             if (v == ed->a || v == ed->b || vsurf[v] != el->surface ||
-                                v3_dot(vnormal[v], el->normal) < cos_crease)
+                                v3_dot(vnormal[v], el->normal) < cos_crease ||
+                                rank[ed->element] >= vcoarse[v])
+                                continue;
+                            /* A vertex on a contact line: the edge runs along
+                             * it (the far side is not this side) or across it. */
+                            if (mesh->contact_count &&
+                                rad_mesh_on_contact(mesh, mesh->patches[el->patch].polygon, mesh->vertices[v]))
                                 continue;
                             vec3 d = v3_sub(mesh->vertices[v], a);
                             double t = v3_dot(d, ab) / len2;
@@ -370,7 +421,38 @@ rad_result mesh_find_tvertices(rad_context *ctx, rad_mesh *mesh, double tol, dou
                     }
         }
     }
+    if (result == RAD_OK && mesh->tvertex_count > 1) {
+        /* Coarse owners first: every record's edge ends are then final
+         * before it reads them.  by_size is reused as the sort's table. */
+        cell_entry *order_tv = mesh->tvertex_count <= ne_all
+                                   ? by_size
+                                   : rad_alloc(ctx, RAD_MEM_MESH, mesh->tvertex_count, sizeof *order_tv,
+                                               "mesh: T-vertex order");
+        rad_tvertex *sorted = order_tv ? rad_alloc(ctx, RAD_MEM_MESH, mesh->tvertex_count, sizeof *sorted,
+                                                   "mesh: T-vertex order")
+                                       : NULL;
+        if (!sorted) {
+            if (order_tv != by_size)
+                rad_free(order_tv);
+            result = RAD_ERROR_OUT_OF_MEMORY;
+            goto done;
+        }
+        for (size_t q = 0; q < mesh->tvertex_count; q++) {
+            order_tv[q].key = (uint64_t)vcoarse[mesh->tvertices[q].vertex] << 32 | mesh->tvertices[q].vertex;
+            order_tv[q].item = (uint32_t)q;
+        }
+        qsort(order_tv, mesh->tvertex_count, sizeof *order_tv, cell_entry_cmp);
+        for (size_t q = 0; q < mesh->tvertex_count; q++)
+            sorted[q] = mesh->tvertices[order_tv[q].item];
+        memcpy(mesh->tvertices, sorted, mesh->tvertex_count * sizeof *sorted);
+        rad_free(sorted);
+        if (order_tv != by_size)
+            rad_free(order_tv);
+    }
 done:
+    rad_free(by_size);
+    rad_free(rank);
+    rad_free(vcoarse);
     rad_free(edges);
     rad_free(order);
     rad_free(on_boundary);

@@ -211,6 +211,7 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     if (s->solved && !s->solve->converged && s->solve->warning[0])
         cJSON_AddStringToObject(so, "warning", s->solve->warning);
     cJSON_AddNumberToObject(so, "components", (double)s->solve->components);
+    cJSON_AddNumberToObject(so, "components_lit", (double)s->solve->components_lit);
     cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve->ambient));
     cJSON_AddNumberToObject(so, "seconds", s->solve->seconds);
     if (s->hier) {

@@ -150,6 +150,7 @@ typedef struct office {
     rad_scene_builder *builder;
     uint64_t seed;
     int rooms, columns, rows;
+    bool closed_doors;   /* a door leaf fills each door opening on both faces */
     double *x; /* columns + 1 wall lines, m */
     double *z; /* rows + 1 wall lines, m */
     double height; /* m, floor to ceiling */
@@ -331,6 +332,15 @@ static rad_result build_wall(office *g, room *rm, const char *side, int axis, in
                               o->y1, facing)) != RAD_OK)
                 return r;
             continue;
+        }
+        if (g->closed_doors) {
+            /* A closed door: a leaf in the opening, flush with this face
+             * of the wall (the far face gets its own). */
+            int leaf = surface(g, rm, "door_leaf_%s", side);
+            if (leaf < 0)
+                return last_error(g);
+            if ((r = vertical(g, leaf, wall, axis, c, o->a0, o->a1, 0.0, o->y1, facing)) != RAD_OK)
+                return r;
         }
         /* The door's reveal, built once, by the room on the far side of
          * the line (facing -1 is the east or south wall of the room
@@ -596,7 +606,7 @@ rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_options 
                         "rad_office_options.rooms must be in [1, %d], got %d", OFFICE_MAX_ROOMS, o.rooms);
     double start = rad_seconds();
 
-    office g = {.ctx = ctx, .seed = o.seed, .rooms = o.rooms};
+    office g = {.ctx = ctx, .seed = o.seed, .rooms = o.rooms, .closed_doors = o.closed_doors != 0};
     g.columns = (int)ceil(sqrt((double)o.rooms));
     while (g.columns * g.columns < o.rooms) /* sqrt rounding at exact squares */
         g.columns++;

@@ -313,6 +313,9 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
             ambient[c] += sub_stats.ambient[c] * group_area / area_total;
     }
     stats->components = g.count;
+    stats->components_lit = 0;
+    for (size_t k = 0; k < g.count; k++)
+        stats->components_lit += g.start[k + 1] - g.start[k] > 1 && g.emitted[k] > 0.0;
     stats->iterations = most_iterations;
     stats->residual = rad_residual_in(sys, B, row);
     rad_free(F_sub);

@@ -57,6 +57,7 @@ typedef struct rad_solve_stats {
     double absorbed;          /* matrix-free: power absorbed, W (mean over RGB); else NAN */
     uint64_t rays;            /* matrix-free: rays cast while solving */
     size_t components;        /* independent groups of elements solved separately (0 = not split) */
+    size_t components_lit;    /* of those, the groups of two or more elements holding an emitter */
     double iteration_limit;   /* the most iterations it could take (rad_solve_bound) */
     char warning[320];        /* why it stopped short of its tolerance, one line; "" when
                                  it converged or was interrupted */

@@ -828,6 +828,21 @@ rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned cha
     if (st->mesh->tree) {
         rad_mesh_options mo = {1e30, 0, options->crease_angle_degrees};
         r = rad_mesh_build(ctx, scene, &mo, &st->patches);
+        /* Ray hits name patches of that mesh and are located in the saved
+         * one: they must be the same patches (a file from a version that
+         * cut the scene's polygons differently is not). */
+        bool same = r == RAD_OK && st->patches->patch_count == st->mesh->patch_count;
+        for (size_t i = 0; same && i < st->mesh->patch_count; i++) {
+            const rad_patch *a = &st->patches->patches[i], *b = &st->mesh->patches[i];
+            same = a->corner_count == b->corner_count && a->surface == b->surface;
+            for (uint32_t k = 0; same && k < a->corner_count; k++)
+                same = v3_length(v3_sub(a->corner[k], b->corner[k])) <=
+                       1e-9 * (1.0 + v3_length(a->corner[k]));
+        }
+        if (r == RAD_OK && !same)
+            r = BAD("%s: its patches are not those this version cuts the scene into "
+                    "(%zu saved, %zu here); solve the scene again",
+                    name, st->mesh->patch_count, st->patches->patch_count);
     }
     if (r == RAD_OK)
         r = rad_vis_create(ctx, options->visibility, st->patches ? st->patches : st->mesh, &st->vis);
