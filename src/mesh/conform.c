@@ -534,7 +534,8 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
         rad_free(out);
         return r;
     }
-    qsort(lines, ncontact, sizeof *lines, contact_cmp);
+    if (ncontact > 1)
+        qsort(lines, ncontact, sizeof *lines, contact_cmp);
     rad_free(*patches);
     *patches = out;
     *count = nout;
