@@ -223,6 +223,8 @@ rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const r
             if (var)
                 var[i * n + j] = (ff_real)(var[i * n + j] * scale * scale);
         }
+    if (n == 0)
+        stats->closure_scale_min = stats->closure_scale_max = 1.0;
     stats->balanced = true;
     rad_free(work);
     return RAD_OK;
