@@ -116,6 +116,7 @@ static const cli_flag FLAGS[] = {
     {"ff-samples", 0, "N", RV, SOLVE(samples)},
     {"near-field", 0, "X", RV, SOLVE(near_field)},
     {"closure-correction", 0, NULL, RV, SOLVE(closure_correction)},
+    {"raw-form-factors", 0, NULL, RV, SOLVE(raw_form_factors)},
     {"level", 0, "WHICH", CLI_VIEWFACTORS, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
      .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
     {"epsilon", 0, "X", RS, SOLVE(epsilon)},

@@ -346,6 +346,10 @@ typedef struct rad_options {
                                      scene sum to 1 while A_i F_ij = A_j F_ji (thermal use);
                                      hierarchical: each patch sends B / its link closure;
                                      refused by shooting */
+    int raw_form_factors;         /* nonzero: keep a sampled method's F (hemicube, hemisphere,
+                                     montecarlo) as estimated; by default the two estimates
+                                     of each pair are combined (reciprocity) and rows held
+                                     to their measured closure, so energy is conserved */
 
     const char *solver;           /* NULL = "gauss-seidel" */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */

@@ -63,6 +63,9 @@ static const rad_option_info solution_rows[] = {
     {SOLUTION(closure_correction), .type = RAD_OPTION_FLAG, .default_value = 0.0,
      .help = "rescale F so rows sum to 1 keeping reciprocity; hierarchical: scale each patch's "
              "sending by its link closure (closed scenes only; refused by shooting)"},
+    {SOLUTION(raw_form_factors), .type = RAD_OPTION_FLAG, .default_value = 0.0,
+     .help = "hemicube, hemisphere, montecarlo: keep F as sampled, without the default step that "
+             "makes it reciprocal and holds its rows to their measured closure (energy conservation)"},
     {SOLUTION(solver), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_SOLVER, .default_value = NAN,
      .default_text = "gauss-seidel", .help = "solver"},
     {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0, .max_open = true,

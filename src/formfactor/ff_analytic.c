@@ -250,4 +250,5 @@ const rad_ff_method rad_ff_analytic = {
     NULL,
     analytic_pair,
     NULL,
+    NULL,
 };

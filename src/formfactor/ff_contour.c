@@ -383,4 +383,5 @@ const rad_ff_method rad_ff_contour = {
     NULL,
     contour_pair,
     NULL,
+    NULL,
 };

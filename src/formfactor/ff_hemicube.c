@@ -173,6 +173,7 @@ typedef struct hc_scratch {
     float *depth;    /* per pixel: 1/w of the nearest surface, 1/m; 0 = none */
     uint32_t *item;  /* per pixel: 0 none, j + 1 element j, n + 1 a back face */
     double *sum;     /* n + 2 accumulators, indexed like item */
+    double seen, distance; /* last hemicube: sum of dF over covered pixels, of dF w (m) */
     double *row;     /* n: the row being accumulated over the hemicube points */
 } hc_scratch;
 
@@ -183,6 +184,8 @@ typedef struct hc_setup {
     double lift;         /* apex above the element, m: rad_vis_epsilon (plus its bend) */
     double near;         /* near plane, m */
     double edge_on;      /* |apex distance from a polygon's plane| below this: edge-on, m */
+    uint8_t *levels;     /* per element: how often its row's region was split in four
+                            (written by that row only; rad_ff_balance reads them) */
     double delta[];      /* per pixel, in rad_hemicube_deltas' layout */
 } hc_setup;
 
@@ -317,7 +320,7 @@ static uint64_t hemicube_point(const hc_setup *hs, hc_scratch *s, const rad_mesh
     /* Sum by runs of equal items: the running total stays in a register. */
     memset(s->sum, 0, (n + 2) * sizeof *s->sum);
     uint32_t run = s->item[0];
-    double total = 0.0;
+    double total = 0.0, distance = 0.0;
     for (size_t p = 0; p < hs->pixels; p++) {
         if (s->item[p] != run) {
             s->sum[run] += total;
@@ -325,14 +328,93 @@ static uint64_t hemicube_point(const hc_setup *hs, hc_scratch *s, const rad_mesh
             total = 0.0;
         }
         total += hs->delta[p];
+        if (s->depth[p] > 0.0f) /* 1/w; 0 where nothing is seen */
+            distance += hs->delta[p] / s->depth[p];
     }
     s->sum[run] += total;
+    s->seen = 1.0 - s->sum[0];
+    s->distance = distance;
     return pairs;
 }
 
-/* Row i of F: the mean of four hemicubes, one at the centroid of each
- * quarter of element i (rad_ff_split4), weighted by the quarter's area.
- * Counts the element pairs projected (not behind the base). */
+/* Placements: element i's region is split in four `level` times (4^level
+ * hemicubes, one at the centre of each piece, weighted by its area).
+ * Level 1 (four) unless the element is large for what it sees: its size
+ * sqrt(A_i) over the dF-weighted mean distance (depth along the face's
+ * axis) of what the first four hemicubes see, above PLACEMENT_RATIO x 2^k,
+ * asks for level k + 1, up to MAX_LEVEL. */
+enum { MAX_LEVEL = 4, MAX_PIECES = 256 /* 4^MAX_LEVEL */ };
+/* The outer rule's error grows with size / distance: 2 keeps the Cornell
+ * box's elements at 2000 (size / distance ~0.1-0.4) at four hemicubes, and
+ * puts 256 on each face of the six-patch cube (size / distance ~2), whose
+ * factors the four missed by 2% (tests/test_accuracy.c). */
+#define PLACEMENT_RATIO 0.5
+
+/* The pieces of `corner` after `level` splits into region[] (4^level of
+ * them), corners 0-2 (triangles) or 0-3 each. */
+static int split_region(const vec3 *corner, uint32_t corners, int level, vec3 (*region)[4])
+{
+    int count = 1;
+    for (uint32_t k = 0; k < corners; k++)
+        region[0][k] = corner[k];
+    for (int l = 0; l < level; l++) {
+        for (int r = count - 1; r >= 0; r--) { /* backwards: piece r's children go to 4r..4r+3 */
+            vec3 sub[4][4];
+            rad_ff_split4(region[r], corners, sub);
+            for (int q = 0; q < 4; q++)
+                memcpy(region[4 * r + q], sub[q], sizeof sub[q]);
+        }
+        count *= 4;
+    }
+    return count;
+}
+
+/* The hemicubes of element i at one placement level: s->row = their
+ * area-weighted mean, *distance and *seen the same of s->distance and s->seen.  Returns the
+ * element pairs projected. */
+static uint64_t hemicube_level(const hc_setup *hs, hc_scratch *s, const rad_mesh *mesh, uint32_t i,
+                               int level, vec3 ux, vec3 uy, double *distance, double *seen)
+{
+    size_t n = mesh->element_count;
+    const rad_element *ei = &mesh->elements[i];
+    vec3 corner[4], region[MAX_PIECES][4];
+    double lift = hs->lift + rad_element_bend(mesh, ei);
+    for (uint32_t k = 0; k < ei->vertex_count; k++)
+        corner[k] = mesh->vertices[ei->vertex[k]];
+    int pieces = split_region(corner, ei->vertex_count, level, region);
+    double weight_sum = 0.0;
+    for (int q = 0; q < pieces; q++) {
+        const vec3 *c = region[q];
+        vec3 cross = ei->vertex_count == 4 ? v3_cross(v3_sub(c[2], c[0]), v3_sub(c[3], c[1]))
+                                           : v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0]));
+        weight_sum += v3_length(cross);
+    }
+    for (size_t j = 0; j < n; j++)
+        s->row[j] = 0.0;
+    *distance = *seen = 0.0;
+    uint64_t pairs = 0;
+    for (int q = 0; q < pieces; q++) {
+        const vec3 *c = region[q];
+        vec3 cross = ei->vertex_count == 4 ? v3_cross(v3_sub(c[2], c[0]), v3_sub(c[3], c[1]))
+                                           : v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0]));
+        vec3 centre = v3(0, 0, 0);
+        for (uint32_t k = 0; k < ei->vertex_count; k++)
+            centre = v3_add(centre, c[k]);
+        centre = v3_scale(centre, 1.0 / ei->vertex_count);
+        pairs += hemicube_point(hs, s, mesh, i, v3_mad(centre, ei->normal, lift), ux, uy);
+        double w = weight_sum > 0.0 ? v3_length(cross) / weight_sum : 1.0 / pieces;
+        for (size_t j = 0; j < n; j++)
+            s->row[j] += w * s->sum[j + 1];
+        *distance += w * s->distance;
+        *seen += w * s->seen;
+    }
+    return pairs / (uint64_t)pieces;
+}
+
+/* Row i of F: four hemicubes, one at the centre of each quarter of element
+ * i (rad_ff_split4); more where the element is large for what it sees
+ * (PLACEMENT_RATIO).  Counts the element pairs projected (not behind the
+ * base). */
 static void hemicube_row(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
                          float *F_row, float *variance_row, rad_ff_tally *tally)
 {
@@ -342,36 +424,30 @@ static void hemicube_row(const rad_ff_request *req, const void *shared, void *sc
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
     const rad_element *ei = &mesh->elements[i];
-    vec3 ux, uy, corner[4], quarter[4][4];
+    vec3 ux, uy;
     tangent_frame(ei->normal, &ux, &uy);
-    double lift = hs->lift + rad_element_bend(mesh, ei);
-    for (uint32_t k = 0; k < ei->vertex_count; k++)
-        corner[k] = mesh->vertices[ei->vertex[k]];
-    rad_ff_split4(corner, ei->vertex_count, quarter);
-    double weight[4], weight_sum = 0.0;
-    for (int q = 0; q < 4; q++) {
-        const vec3 *c = quarter[q];
-        vec3 cross = ei->vertex_count == 4 ? v3_cross(v3_sub(c[2], c[0]), v3_sub(c[3], c[1]))
-                                           : v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0]));
-        weight[q] = v3_length(cross);
-        weight_sum += weight[q];
+    double distance, seen;
+    int level = 1;
+    uint64_t pairs = hemicube_level(hs, s, mesh, i, level, ux, uy, &distance, &seen);
+    double ratio = distance > 0.0 ? sqrt(ei->area) * seen / distance : 0.0; /* size / distance */
+    int want = 1;
+    for (double r = ratio; r > PLACEMENT_RATIO && want < MAX_LEVEL; r *= 0.5)
+        want++;
+    if (want > level) {
+        level = want;
+        pairs = hemicube_level(hs, s, mesh, i, level, ux, uy, &distance, &seen);
     }
-    for (size_t j = 0; j < n; j++)
-        s->row[j] = 0.0;
-    uint64_t pairs = 0;
-    for (int q = 0; q < 4; q++) {
-        vec3 centre = v3(0, 0, 0);
-        for (uint32_t k = 0; k < ei->vertex_count; k++)
-            centre = v3_add(centre, quarter[q][k]);
-        centre = v3_scale(centre, 1.0 / ei->vertex_count);
-        pairs += hemicube_point(hs, s, mesh, i, v3_mad(centre, ei->normal, lift), ux, uy);
-        double w = weight_sum > 0.0 ? weight[q] / weight_sum : 0.25;
-        for (size_t j = 0; j < n; j++)
-            s->row[j] += w * s->sum[j + 1];
-    }
+    hs->levels[i] = (uint8_t)level;
     for (size_t j = 0; j < n; j++)
         F_row[j] = (float)s->row[j];
-    tally->pairs += pairs / 4;
+    tally->pairs += pairs;
+}
+
+/* 4^level hemicubes over A_i: rad_ff_balance's weight of row i. */
+static double hemicube_density(const rad_ff_request *req, const void *shared, uint32_t i)
+{
+    const hc_setup *hs = shared;
+    return (double)(1u << (2 * hs->levels[i])) / req->mesh->elements[i].area;
 }
 
 static rad_result hemicube_prepare(rad_context *ctx, const rad_ff_request *req, void **shared)
@@ -383,10 +459,12 @@ static rad_result hemicube_prepare(rad_context *ctx, const rad_ff_request *req, 
     int R = req->hemicube_resolution > 0 ? req->hemicube_resolution : 256;
     R += R & 1; /* side faces are R/2 high */
     size_t pixels = 3 * (size_t)R * (size_t)R;
-    hc_setup *hs = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *hs + pixels * sizeof hs->delta[0],
+    hc_setup *hs = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *hs + pixels * sizeof hs->delta[0] + n,
                                    "hemicube: delta form factors");
     if (!hs)
         return RAD_ERROR_OUT_OF_MEMORY;
+    hs->levels = (uint8_t *)(hs->delta + pixels);
+    memset(hs->levels, 0, n);
     hs->R = R;
     hs->H = R / 2;
     hs->pixels = pixels;
@@ -423,9 +501,10 @@ const rad_ff_method rad_ff_hemicube = {
     "hemicubes at the centres of each element's quarters (Cohen & Greenberg 1985): z-buffered "
     "item buffer, exact delta factors, deterministic; 5e-4 to 7e-3 at R=512 on the test cases, "
     "O(n^2 + n R^2)",
-    0,
+    RAD_FF_BALANCE,
     hemicube_prepare,
     hemicube_scratch,
     NULL,
     hemicube_row,
+    hemicube_density,
 };

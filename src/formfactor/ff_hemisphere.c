@@ -34,7 +34,10 @@
  * hit's patch and patch parameters locate the element in O(1); a hit on a
  * patch's back (one-sided surfaces) or into the void counts for nothing.
  * Rays are keyed on (seed, element): results do not depend on the thread
- * count.  Cost: N n rays; reciprocity holds only statistically.
+ * count.  Cost: N n rays.  Reciprocity holds only statistically in the
+ * raw counts: by default rad_ff_balance (reciprocity.c) combines the two
+ * counts of each pair, weighted by rays per m^2, and holds each row to the
+ * fraction of its element's rays that met a front.
  */
 #include "formfactor/formfactor.h"
 
@@ -205,13 +208,21 @@ static size_t hemisphere_scratch(const rad_ff_request *req, const void *shared, 
     return sizeof *s + n * sizeof *s->sum + (size_t)h->N * sizeof *s->perm;
 }
 
+/* N rays from each element: N / A_i per m^2 (rad_ff_balance's weight). */
+static double hemisphere_density(const rad_ff_request *req, const void *shared, uint32_t i)
+{
+    const hs_shared *h = shared;
+    return h->N / req->mesh->elements[i].area;
+}
+
 const rad_ff_method rad_ff_hemisphere = {
     "hemisphere",
     "cosine-distributed rays from stratified points of each element (Malley's method), "
     "closest hit; unbiased, std error sqrt(F(1-F)/N) per factor, N n rays",
-    RAD_FF_VARIANCE,
+    RAD_FF_VARIANCE | RAD_FF_BALANCE,
     hemisphere_prepare,
     hemisphere_scratch,
     NULL,
     hemisphere_row,
+    hemisphere_density,
 };

@@ -113,4 +113,5 @@ const rad_ff_method rad_ff_hybrid = {
     NULL,
     hybrid_pair,
     NULL,
+    NULL,
 };

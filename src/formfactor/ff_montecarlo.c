@@ -1,74 +1,94 @@
 /*
- * ff_montecarlo.c -- area-to-area form factors by Monte Carlo over point
- * pairs (the lecture notes' "Form Factor - Ray Tracing"; Cohen & Wallace,
- * "Radiosity and Realistic Image Synthesis" 1993, sec. 4.10), with
- * shadow-ray visibility.
+ * ff_montecarlo.c -- area-to-area form factors by Monte Carlo over the
+ * points of one element, with shadow rays for visibility (Cohen & Wallace,
+ * "Radiosity and Realistic Image Synthesis" 1993, sec. 4.9-4.10: point
+ * sampling of the outer integral; Nusselt / Lambert for the inner one).
  *
- *     F_ij = 1/A_i  int_{A_i} int_{A_j} cos_i cos_j V(x, y) / (pi r^2) dA_y dA_x
+ *     F_sj = 1/A_s  int_{A_s} F(x) dA,   F(x) = 1/pi int_{Omega(x)} cos_x V(x, w) dw
  *
- *          ~= 1/N  sum_k  A_j cos_i cos_j V(x_k, y_k) / (pi r_k^2)
+ * Near pairs (nearness (r_s + r_j) / d >= NEAR: summed centroid-to-corner
+ * radii over the centroid distance).  Per sample x_k, uniform on element s
+ * (with rad_element_sample's density correction):
  *
- * with x_k uniform on element i and y_k uniform on element j:
+ *     f_k = P(x_k) V(x_k, w_k)
  *
- *        x_k . ------- r_k ------- . y_k        V from one shadow ray per
- *      ____|__________        _____|_____     sample, its ends lifted off the
- *     i    n_i              j      n_j          surfaces by rad_vis_epsilon
- *                                               plus the element's bend
+ * with P(x) the unoccluded point-to-polygon factor of j's polygon clipped
+ * to x's tangent half-space (Lambert's contour formula; Baum, Rushmeier &
+ * Winget 1989) and w_k drawn with density cos_x / (pi P(x_k)) over that
+ * polygon: uniform in solid angle (a fan triangle by its solid angle, then
+ * Arvo, "Stratified sampling of spherical triangles", SIGGRAPH 1995), kept
+ * with probability cos_x / cos_max (rejection).  One shadow ray tests w_k.
+ * f_k lies in [0, P(x_k)], P <= 1: the variance is finite for every pair,
+ * touching ones included (the 1/r^2 of area sampling made it infinite
+ * where elements share an edge, and its reported errors then meant
+ * nothing), and unoccluded pairs have no variance from the inner integral.
  *
- * Each unordered pair is sampled once (F_ji = F_ij A_i / A_j, so the matrix
- * is reciprocal by construction); pairs with one element wholly behind the
- * other's plane are skipped (rad_ff_facing).  The N point pairs are
- * stratified on both ends (sqrt(N) x sqrt(N) jittered strata on each,
- * matched by a random permutation; samples beyond the largest square are
- * unstratified), and each end carries rad_element_sample's density
- * correction, so the estimate is unbiased for any flat element.  The
- * variance of the mean is estimated as (sample variance) / N.  N >= 2,
- * since a variance needs two samples.
+ *        s  ___x_k___           j's polygon, clipped to x_k's hemisphere,
+ *          |    |  \            seen from x_k: P exactly, and one ray along
+ *          |    |   \ w_k       w_k, of density cos_x / (pi P)
+ *               n_s  \______ j
  *
- * Near pairs.  The kernel is singular (1/r^2) where elements touch, and
- * with y uniform the estimator, though unbiased, has INFINITE variance for
- * pairs that share an edge: a sample within rho of the edge at both ends
- * has probability ~rho^3 and value ~1/rho^2.  Measured on the unit cube, the
- * adjacent-face factors then missed by up to 6 reported standard errors,
- * and on the Cornell box single F_ij reached 2.2 (exact 0.2) at N = 16, so
- * rows summed to 2.8 and the solver diverged.  So for pairs closer than
- * twice their summed radii, half the samples of y are drawn instead from
+ * Far pairs sample a point y_k of j too: f_k = A_j cos_x cos_y V / (pi r^2)
+ * (1/r^2 varies by a bounded factor there, and a point is 5-10x cheaper
+ * than a contour).
  *
- *     q(y) = 1 / (pi L r^2)  on the disk of j's plane around the foot of x
- *                            (x at height h) through j's farthest corner
- *                            (radius R);  L = ln(1 + R^2/h^2)
+ * Which end: s is the smaller element of the pair (the lower index on a
+ * tie), where F(x) varies least; F_js = F_sj A_s / A_j, so the matrix is
+ * reciprocal by construction.  Stratification with an honest variance: the
+ * N samples (N even) are two per stratum of an H = N/2 cell grid over s
+ * (rows x columns, rows the largest divisor of H up to sqrt(H)), so
  *
- * (rho = h sqrt(e^(u L) - 1), phi = 2 pi v; misses of j count as 0), and
- * every sample is weighted by the balance heuristic, 1 / (p_uniform/2 +
- * q/2) in place of A_j (Veach & Guibas 1995).  Then kernel / density <=
- * 2 cos_i cos_j L: only logarithmically singular, so the variance is finite
- * and the reported error means something (cube: within 3.5 standard
- * errors over 8 seeds).  Edge pairs remain the noisiest (the Cornell box's
- * rows reach 1.5 at N = 16, 1.15 at N = 64); ff_analytic.c is exact there.
- * Samples are keyed on (seed, pair): results do not depend on the thread
- * count.  Cost: about N rays per visible pair.
+ *     F = 1/N sum_k f_k,   var F = 1/H^2 sum_h (f_h1 - f_h2)^2 / 4
+ *
+ * is the unbiased variance of a stratified mean (Cochran, "Sampling
+ * Techniques", 3rd ed., sec. 5.4); the sample variance / N ignored the
+ * strata and read 4-5x the true error for separated pairs.  Directions and
+ * points of j are independent within a stratum, as that estimator needs.
+ * Measured over 100 seeds (tests/test_ff_stats.c): the z-scores of
+ * separated and touching squares have deviations 0.91 to 1.0.
+ *
+ * Samples per pair: --ff-samples N for every pair, or by default 64 x
+ * nearness^2 in [4, 256]: the six faces of a cube (one element each) get
+ * 256 (adjacent) and 128 (opposite), most of a 2,000-element Cornell box's
+ * pairs 4.  Samples are keyed on (seed, pair): results do not depend on
+ * the thread count.  Cost: one shadow ray per sample; near samples also a
+ * clip, a contour and one or two spherical triangles.  Each pair's
+ * estimate is unbiased, but a row sums the noise of all its pairs: by
+ * default rad_ff_balance (reciprocity.c) holds rows to their closure,
+ * measured by rays.
  */
 #include "formfactor/formfactor.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-enum { CHUNK = 256 }; /* samples per occlusion batch */
+/* Pairs nearer than this (nearness(), below) integrate j's polygon exactly;
+ * farther ones sample a point of j: there 1/r^2 varies over the pair by
+ * (1 +- 1/2)^2 at most, and points are 5-10x cheaper than the contour. */
+#define NEAR 0.5
+
+enum {
+    CHUNK = 256,        /* samples per occlusion batch (even: whole strata) */
+    MIN_SAMPLES = 4,    /* default for far pairs: two strata */
+    MAX_SAMPLES = 256,  /* default for the nearest pairs */
+    /* Rejection sampling's tries; each keeps at least mean cos / max cos
+     * over the polygon, so 64 misses is vanishingly rare, and the 64th
+     * direction is then used. */
+    MAX_ATTEMPTS = 64
+};
 
 /* Per-thread buffers, allocated once per thread. */
 typedef struct mc_scratch {
-    double kernel[CHUNK];     /* per sample of the chunk: the estimate of F_ij it gives */
+    double value[CHUNK];      /* per sample of the chunk: f_k, visibility not yet applied */
     uint32_t sample[CHUNK];   /* per ray: the sample it tests */
     rad_ray rays[CHUNK];
     uint8_t blocked[CHUNK];
     int count, rays_count;    /* samples and rays in the chunk */
-    double mean, m2;          /* Welford: running mean and sum of squared deviations */
-    int seen;                 /* samples folded in */
-    uint32_t perm[];          /* N: stratum on j of each stratum on i */
+    double sum, spread;       /* sum of f_k; sum over strata of (f_h1 - f_h2)^2 */
 } mc_scratch;
 
-/* Cast the chunk's shadow rays, zero what they find blocked, and fold the
- * chunk's samples into the running mean and variance. */
+/* Cast the chunk's shadow rays, zero the samples they find blocked, and fold
+ * the chunk's strata (samples 2h, 2h + 1) into the sums. */
 static void flush_chunk(const rad_ff_request *req, mc_scratch *s, uint64_t *rays_cast)
 {
     if (s->rays_count) {
@@ -76,24 +96,22 @@ static void flush_chunk(const rad_ff_request *req, mc_scratch *s, uint64_t *rays
         *rays_cast += (uint64_t)s->rays_count;
         for (int r = 0; r < s->rays_count; r++)
             if (s->blocked[r])
-                s->kernel[s->sample[r]] = 0.0;
+                s->value[s->sample[r]] = 0.0;
     }
-    for (int k = 0; k < s->count; k++) {
-        double delta = s->kernel[k] - s->mean;
-        s->mean += delta / ++s->seen;
-        s->m2 += delta * (s->kernel[k] - s->mean);
+    for (int k = 0; k + 1 < s->count; k += 2) {
+        double d = s->value[k] - s->value[k + 1];
+        s->sum += s->value[k] + s->value[k + 1];
+        s->spread += d * d;
     }
     s->count = s->rays_count = 0;
 }
 
-/* Element j as the near-pair sampler sees it: flat, its corners projected
- * onto the plane through its centroid, split into the fan (0,1,2), (0,2,3). */
+/* Element j as the sampler sees it: flat, its corners projected onto the
+ * plane through its centroid (counter-clockwise about its normal). */
 typedef struct mc_target {
     vec3 corner[4];
     uint32_t corners;
-    vec3 normal, e1, e2; /* unit normal and an orthonormal tangent pair */
-    vec3 centroid;
-    double area1, area;  /* first fan triangle, whole polygon, m^2 */
+    vec3 normal, centroid;
 } mc_target;
 
 static void target_init(const rad_mesh *mesh, const rad_element *e, mc_target *t)
@@ -105,166 +123,198 @@ static void target_init(const rad_mesh *mesh, const rad_element *e, mc_target *t
         vec3 p = mesh->vertices[e->vertex[k]];
         t->corner[k] = v3_mad(p, e->normal, -v3_dot(e->normal, v3_sub(p, e->centroid)));
     }
-    vec3 a = fabs(e->normal.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
-    t->e1 = v3_normalize(v3_sub(a, v3_scale(e->normal, v3_dot(a, e->normal))));
-    t->e2 = v3_cross(e->normal, t->e1);
-    t->area1 = 0.5 * v3_length(v3_cross(v3_sub(t->corner[1], t->corner[0]), v3_sub(t->corner[2], t->corner[0])));
-    t->area = t->area1;
-    if (t->corners == 4)
-        t->area += 0.5 * v3_length(v3_cross(v3_sub(t->corner[2], t->corner[0]), v3_sub(t->corner[3], t->corner[0])));
 }
 
-/* A point uniform in area on the target, from (u, v) in [0,1)^2. */
-static vec3 target_uniform(const mc_target *t, double u, double v)
+/* The solid angle of the spherical triangle of unit vectors a, b, c, sr
+ * (Van Oosterom & Strackee 1983). */
+static double triangle_solid_angle(vec3 a, vec3 b, vec3 c)
 {
-    vec3 a = t->corner[0], b = t->corner[1], c = t->corner[2];
-    double split = t->area1 / t->area;
-    if (t->corners == 4 && u >= split) {
-        u = (u - split) / (1.0 - split);
-        b = t->corner[2];
-        c = t->corner[3];
-    } else if (t->corners == 4) {
-        u /= split;
-    }
-    if (u + v > 1.0) {
-        u = 1.0 - u;
-        v = 1.0 - v;
-    }
-    return v3_add(a, v3_add(v3_scale(v3_sub(b, a), u), v3_scale(v3_sub(c, a), v)));
+    double num = fabs(v3_dot(a, v3_cross(b, c)));
+    double den = 1.0 + v3_dot(a, b) + v3_dot(b, c) + v3_dot(c, a);
+    return 2.0 * atan2(num, den);
 }
 
-/* Is y (on the target's plane) inside it?  Corners are counter-clockwise
- * about the normal, and the polygon is convex. */
-static bool target_contains(const mc_target *t, vec3 y)
+static double clamp1(double x) { return x < -1.0 ? -1.0 : x > 1.0 ? 1.0 : x; }
+
+/* A direction uniform in solid angle over the spherical triangle (a, b, c)
+ * of solid angle `area`, from (u1, u2) in [0,1)^2 (Arvo 1995: the
+ * sub-triangle of area u1 * area first, then along its far edge).  Falls
+ * back to the triangle's centre direction where it is too thin for the
+ * formula's divisions. */
+static vec3 sample_spherical_triangle(vec3 a, vec3 b, vec3 c, double area, double u1, double u2)
 {
-    for (uint32_t k = 0; k < t->corners; k++) {
-        vec3 a = t->corner[k], b = t->corner[(k + 1) % t->corners];
-        if (v3_dot(t->normal, v3_cross(v3_sub(b, a), v3_sub(y, a))) < 0.0)
-            return false;
-    }
-    return true;
+    vec3 nab = v3_normalize(v3_cross(a, b)), nac = v3_normalize(v3_cross(a, c));
+    double alpha = acos(clamp1(v3_dot(nab, nac)));
+    double s = sin(u1 * area - alpha), t = cos(u1 * area - alpha);
+    double u = t - cos(alpha), v = s + sin(alpha) * v3_dot(a, b);
+    double q = ((v * t - u * s) * cos(alpha) - v) / ((v * s + u * t) * sin(alpha));
+    vec3 c_perp = v3_normalize(v3_sub(c, v3_scale(a, v3_dot(c, a))));
+    q = clamp1(q);
+    vec3 c_hat = v3_add(v3_scale(a, q), v3_scale(c_perp, sqrt(fmax(0.0, 1.0 - q * q))));
+    double z = clamp1(1.0 - u2 * (1.0 - v3_dot(c_hat, b)));
+    vec3 b_perp = v3_normalize(v3_sub(c_hat, v3_scale(b, v3_dot(c_hat, b))));
+    vec3 w = v3_add(v3_scale(b, z), v3_scale(b_perp, sqrt(fmax(0.0, 1.0 - z * z))));
+    if (!(isfinite(w.x) && isfinite(w.y) && isfinite(w.z)))
+        w = v3_normalize(v3_add(a, v3_add(b, c)));
+    return w;
 }
 
-/* Stratified numbers for sample k of m: (u1, v1) on i in stratum k and
- * (u2, v2) on j in stratum perm[k] of a side x side grid; samples past the
- * grid are unstratified. */
-static void stratified(rad_rng *rng, const uint32_t *perm, int side, int k, double *u1, double *v1,
-                       double *u2, double *v2)
+/* The largest n . w over the convex spherical polygon dir[0..m-1]: 1 when
+ * n points into it, else the largest over its edges (great-circle arcs:
+ * at an end, or where n's projection on the arc's plane falls inside). */
+static double polygon_cos_max(const vec3 *dir, int m, vec3 n)
 {
-    if (k < side * side) {
-        int o = (int)perm[k];
-        *u1 = ((k % side) + rad_rng_uniform(rng)) / side;
-        *v1 = ((k / side) + rad_rng_uniform(rng)) / side;
-        *u2 = ((o % side) + rad_rng_uniform(rng)) / side;
-        *v2 = ((o / side) + rad_rng_uniform(rng)) / side;
-    } else {
-        *u1 = rad_rng_uniform(rng);
-        *v1 = rad_rng_uniform(rng);
-        *u2 = rad_rng_uniform(rng);
-        *v2 = rad_rng_uniform(rng);
+    vec3 centre = v3(0, 0, 0);
+    for (int c = 0; c < m; c++)
+        centre = v3_add(centre, dir[c]);
+    bool inside = true;
+    double best = -1.0;
+    for (int c = 0; c < m; c++) {
+        vec3 a = dir[c], b = dir[(c + 1) % m], edge = v3_cross(a, b);
+        inside &= (v3_dot(edge, n) >= 0.0) == (v3_dot(edge, centre) >= 0.0);
+        best = fmax(best, v3_dot(n, a));
+        double l = v3_length(edge);
+        if (!(l > 0.0))
+            continue;
+        edge = v3_scale(edge, 1.0 / l);
+        vec3 p = v3_sub(n, v3_scale(edge, v3_dot(n, edge)));
+        if (v3_dot(v3_cross(a, p), edge) >= 0.0 && v3_dot(v3_cross(p, b), edge) >= 0.0)
+            best = fmax(best, v3_length(p));
     }
+    return inside ? 1.0 : best;
 }
 
-/* A random permutation of the side x side strata; returns side. */
-static int shuffle_strata(rad_rng *rng, uint32_t *perm, int m)
+/* The shadow ray of the chunk's last sample, from a to b: blocked, the
+ * sample counts 0. */
+static void add_ray(mc_scratch *sc, vec3 a, vec3 b)
 {
-    int side = (int)floor(sqrt((double)m));
-    while ((side + 1) * (side + 1) <= m) /* sqrt rounding */
-        side++;
-    int strata = side * side;
-    for (int k = 0; k < strata; k++)
-        perm[k] = (uint32_t)k;
-    for (int k = strata - 1; k > 0; k--) { /* Fisher-Yates */
-        int r = (int)(rad_rng_uniform(rng) * (k + 1));
-        uint32_t t = perm[k];
-        perm[k] = perm[r];
-        perm[r] = t;
-    }
-    return side;
+    rad_ray *ray = &sc->rays[sc->rays_count];
+    ray->origin = a;
+    ray->direction = v3_sub(b, a);
+    ray->tnear = 0.0;
+    ray->tfar = 1.0;
+    sc->sample[sc->rays_count++] = (uint32_t)(sc->count - 1);
 }
 
-/* One pair: F_ij and the variance of its estimate.  `near`: half the
- * samples of y are drawn by the polar technique (file header), each
- * technique stratified on its own. */
-static void estimate(const rad_ff_request *req, mc_scratch *s, uint32_t i, uint32_t j, int N, bool near,
-                     double eps, double *F_ij, double *var_ij, uint64_t *rays_cast)
+/* The rows x columns grid of H strata: rows the largest divisor of H up to
+ * sqrt(H). */
+static int strata_rows(int H)
+{
+    int rows = (int)floor(sqrt((double)H));
+    while (rows > 1 && H % rows != 0)
+        rows--;
+    return rows < 1 ? 1 : rows;
+}
+
+/* F from element s to element j (s's points sampled, j's polygon exact)
+ * with N samples, and the variance of that estimate. */
+static void estimate(const rad_ff_request *req, mc_scratch *sc, uint32_t s, uint32_t j, int N, bool near,
+                     double eps, double *F_sj, double *var_sj, uint64_t *rays_cast)
 {
     const rad_mesh *mesh = req->mesh;
-    const rad_element *ei = &mesh->elements[i], *ej = &mesh->elements[j];
-    rad_rng rng = rad_rng_keyed(req->seed, i, j);
+    const rad_element *es = &mesh->elements[s], *ej = &mesh->elements[j];
+    rad_rng rng = rad_rng_keyed(req->seed, s < j ? s : j, s < j ? j : s);
     mc_target tj;
-    if (near)
-        target_init(mesh, ej, &tj);
-    int count_uniform = near ? (N + 1) / 2 : N, count_polar = N - count_uniform;
-    double c_uniform = (double)count_uniform / N, c_polar = (double)count_polar / N;
-    double lift_i = eps + rad_element_bend(mesh, ei), lift_j = eps + rad_element_bend(mesh, ej);
-    s->count = s->rays_count = s->seen = 0;
-    s->mean = s->m2 = 0.0;
-    for (int pass = 0; pass < 2; pass++) {
-        bool polar = pass == 1;
-        int m = polar ? count_polar : count_uniform;
-        if (m == 0)
-            continue;
-        int side = shuffle_strata(&rng, s->perm, m);
-        for (int k = 0; k < m; k++) {
-            double u1, v1, u2, v2;
-            stratified(&rng, s->perm, side, k, &u1, &v1, &u2, &v2);
-            if (s->count == CHUNK)
-                flush_chunk(req, s, rays_cast);
-            double *kernel = &s->kernel[s->count++];
-            *kernel = 0.0;
-            vec3 x = rad_element_sample(mesh, ei, u1, v1), y;
-            double per_area; /* 1 / (density of y on j), m^2 */
-            if (!near) {
-                y = rad_element_sample(mesh, ej, u2, v2);
-                per_area = ej->area * rad_element_sample_weight(mesh, ej, u2, v2);
-            } else {
-                double h = v3_dot(tj.normal, v3_sub(x, tj.centroid)); /* height of x over j */
-                if (!(h > 0.0))
-                    continue; /* behind j: cos_j <= 0 */
-                vec3 foot = v3_mad(x, tj.normal, -h);
-                double reach2 = 0.0;
-                for (uint32_t c = 0; c < tj.corners; c++) {
-                    vec3 d = v3_sub(tj.corner[c], foot);
-                    reach2 = fmax(reach2, v3_dot(d, d));
-                }
-                double L = log1p(reach2 / (h * h));
-                if (!polar) {
-                    y = target_uniform(&tj, u2, v2);
-                } else {
-                    double rho = h * sqrt(expm1(u2 * L)), phi = 2.0 * M_PI * v2;
-                    y = v3_add(foot, v3_add(v3_scale(tj.e1, rho * cos(phi)), v3_scale(tj.e2, rho * sin(phi))));
-                    if (!target_contains(&tj, y))
-                        continue; /* a miss: this sample estimates 0 */
-                }
-                vec3 d = v3_sub(y, x);
-                double q = 1.0 / (M_PI * L * v3_dot(d, d)); /* polar density: h^2 + rho^2 = r^2 */
-                per_area = 1.0 / (c_uniform / tj.area + c_polar * q);
-            }
-            vec3 d = v3_sub(y, x);
-            double r2 = v3_dot(d, d), ci = v3_dot(ei->normal, d), cj = -v3_dot(ej->normal, d);
-            if (!(ci > 0.0 && cj > 0.0 && r2 > 0.0))
+    target_init(mesh, ej, &tj);
+    double lift_s = eps + rad_element_bend(mesh, es), lift_j = eps + rad_element_bend(mesh, ej);
+    int H = N / 2, rows = strata_rows(H), cols = H / rows;
+    sc->count = sc->rays_count = 0;
+    sc->sum = sc->spread = 0.0;
+    for (int k = 0; k < N; k++) {
+        int h = k / 2;
+        double u = ((h % cols) + rad_rng_uniform(&rng)) / cols;
+        double v = ((h / cols) + rad_rng_uniform(&rng)) / rows;
+        if (sc->count == CHUNK)
+            flush_chunk(req, sc, rays_cast);
+        double *value = &sc->value[sc->count++];
+        *value = 0.0;
+        vec3 x = rad_element_sample(mesh, es, u, v);
+        double weight = rad_element_sample_weight(mesh, es, u, v);
+        if (!near) {
+            /* Far: y uniform on j, f_k = A_j cos_x cos_y V / (pi r^2). */
+            double u2 = rad_rng_uniform(&rng), v2 = rad_rng_uniform(&rng);
+            vec3 y = rad_element_sample(mesh, ej, u2, v2), d = v3_sub(y, x);
+            double r2 = v3_dot(d, d), cx = v3_dot(es->normal, d), cy = -v3_dot(ej->normal, d);
+            if (!(cx > 0.0 && cy > 0.0 && r2 > 0.0))
                 continue;
-            *kernel = ci * cj / (M_PI * r2 * r2) * per_area * rad_element_sample_weight(mesh, ei, u1, v1);
-            if (req->vis) {
-                vec3 a = v3_mad(x, ei->normal, lift_i), b = v3_mad(y, ej->normal, lift_j);
-                rad_ray *ray = &s->rays[s->rays_count];
-                ray->origin = a;
-                ray->direction = v3_sub(b, a);
-                ray->tnear = 0.0;
-                ray->tfar = 1.0;
-                s->sample[s->rays_count++] = (uint32_t)(s->count - 1);
-            }
+            *value = cx * cy / (M_PI * r2 * r2) * ej->area * weight * rad_element_sample_weight(mesh, ej, u2, v2);
+            if (req->vis)
+                add_ray(sc, v3_mad(x, es->normal, lift_s), v3_mad(y, ej->normal, lift_j));
+            continue;
         }
+        double height = v3_dot(tj.normal, v3_sub(x, tj.centroid)); /* x over j's plane */
+        if (!(height > 0.0))
+            continue; /* behind j: F(x) = 0 */
+        /* j clipped to x's hemisphere (Sutherland-Hodgman), seen from x. */
+        vec3 dir[5];
+        int m = 0;
+        for (uint32_t c = 0; c < tj.corners; c++) {
+            vec3 pa = tj.corner[c], pb = tj.corner[(c + 1) % tj.corners];
+            double da = v3_dot(es->normal, v3_sub(pa, x)), db = v3_dot(es->normal, v3_sub(pb, x));
+            if (da >= 0.0)
+                dir[m++] = v3_sub(pa, x);
+            if ((da >= 0.0) != (db >= 0.0))
+                dir[m++] = v3_sub(v3_lerp(pa, pb, da / (da - db)), x);
+        }
+        if (m < 3)
+            continue;
+        bool degenerate = false;
+        for (int c = 0; c < m; c++) {
+            double l = v3_length(dir[c]);
+            degenerate |= !(l > 0.0);
+            dir[c] = v3_scale(dir[c], 1.0 / l);
+        }
+        if (degenerate)
+            continue; /* x on a corner of j (probability 0) */
+        /* P(x) by Lambert's contour formula: the vertices run clockwise
+         * seen from x, so the sum is negative. */
+        double contour = 0.0;
+        for (int c = 0; c < m; c++) {
+            vec3 cr = v3_cross(dir[c], dir[(c + 1) % m]);
+            double l = v3_length(cr);
+            if (l > 0.0)
+                contour += atan2(l, v3_dot(dir[c], dir[(c + 1) % m])) * v3_dot(es->normal, cr) / l;
+        }
+        double P = -contour / (2.0 * M_PI);
+        if (!(P > 0.0))
+            continue;
+        *value = P * weight;
+        if (!req->vis)
+            continue;
+        /* One direction with density cos_x / (pi P(x)) over the polygon:
+         * uniform in solid angle (a fan triangle by its solid angle, then
+         * Arvo within it), kept with probability cos_x / cos_max. */
+        double omega[3], total = 0.0;
+        for (int c = 1; c + 1 < m; c++)
+            total += omega[c - 1] = triangle_solid_angle(dir[0], dir[c], dir[c + 1]);
+        double cos_max = polygon_cos_max(dir, m, es->normal);
+        if (!(total > 0.0 && cos_max > 0.0))
+            continue;
+        vec3 w = es->normal;
+        for (int attempt = 0; attempt < MAX_ATTEMPTS; attempt++) {
+            int tri = 0;
+            double at = rad_rng_uniform(&rng) * total;
+            while (tri < m - 3 && at >= omega[tri])
+                at -= omega[tri++];
+            double w1 = rad_rng_uniform(&rng), w2 = rad_rng_uniform(&rng);
+            w = sample_spherical_triangle(dir[0], dir[tri + 1], dir[tri + 2], omega[tri], w1, w2);
+            if (rad_rng_uniform(&rng) * cos_max < v3_dot(es->normal, w))
+                break;
+        }
+        double cos_x = v3_dot(es->normal, w), toward = -v3_dot(tj.normal, w);
+        if (!(cos_x > 0.0 && toward > 0.0))
+            continue;
+        vec3 y = v3_mad(x, w, height / toward);
+        add_ray(sc, v3_mad(x, es->normal, lift_s), v3_mad(y, tj.normal, lift_j));
     }
-    flush_chunk(req, s, rays_cast);
-    *F_ij = s->mean;
-    *var_ij = s->m2 / ((double)(N - 1) * N);
+    flush_chunk(req, sc, rays_cast);
+    *F_sj = sc->sum / N;
+    *var_sj = sc->spread / (4.0 * (double)H * (double)H);
 }
 
 /* What every pair reads. */
 typedef struct mc_shared {
-    int N;              /* point pairs per element pair */
+    int N;              /* samples per element pair; 0: by distance (file header) */
     double eps;         /* m: the ray-end lift, rad_vis_epsilon (0 without visibility) */
     double radius[];    /* per element: largest centroid-to-corner distance, m */
 } mc_shared;
@@ -276,9 +326,8 @@ static rad_result montecarlo_prepare(rad_context *ctx, const rad_ff_request *req
     mc_shared *m = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 1, sizeof *m + n * sizeof m->radius[0], "form factors: element table");
     if (!m)
         return RAD_ERROR_OUT_OF_MEMORY;
-    m->N = req->samples > 0 ? req->samples : 16;
-    if (m->N < 2)
-        m->N = 2;
+    /* Two samples per stratum: an even count, at least 2. */
+    m->N = req->samples > 0 ? req->samples + (req->samples & 1) : 0;
     m->eps = req->vis ? rad_vis_epsilon(mesh) : 0.0;
     for (size_t i = 0; i < n; i++) {
         const rad_element *e = &mesh->elements[i];
@@ -292,38 +341,61 @@ static rad_result montecarlo_prepare(rad_context *ctx, const rad_ff_request *req
 
 static size_t montecarlo_scratch(const rad_ff_request *req, const void *shared, void *block)
 {
-    (void)req, (void)block; /* nothing to lay out: the strata are the struct's last member */
-    const mc_shared *m = shared;
-    return sizeof(mc_scratch) + (size_t)m->N * sizeof(uint32_t);
+    (void)req, (void)shared, (void)block; /* fixed size, nothing to lay out */
+    return sizeof(mc_scratch);
 }
 
-/* F_ji = F_ij A_i / A_j: one estimate per pair, reciprocal by construction. */
+/* How near a pair is: (r_i + r_j) / d, the summed centroid-to-corner
+ * radii over the centroid distance (infinite for coincident centroids). */
+static double nearness(const mc_shared *m, const rad_element *ei, const rad_element *ej, uint32_t i, uint32_t j)
+{
+    vec3 gap = v3_sub(ej->centroid, ei->centroid);
+    double d = v3_length(gap);
+    return d > 0.0 ? (m->radius[i] + m->radius[j]) / d : INFINITY;
+}
+
+/* The samples of a pair by default: 64 x nearness^2, even, in
+ * [MIN_SAMPLES, MAX_SAMPLES]. */
+static int default_samples(double near)
+{
+    double want = 64.0 * near * near;
+    if (!(want < MAX_SAMPLES))
+        return MAX_SAMPLES;
+    int N = (int)ceil(want);
+    N += N & 1;
+    return N < MIN_SAMPLES ? MIN_SAMPLES : N;
+}
+
+/* One estimate per pair, from the smaller element: reciprocal by
+ * construction. */
 static void montecarlo_pair(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
                             uint32_t j, rad_ff_pair *out, rad_ff_tally *tally)
 {
     const mc_shared *m = shared;
     const rad_element *ei = &req->mesh->elements[i], *ej = &req->mesh->elements[j];
-    /* Near: closer than twice their summed radii, where the kernel's 1/r^2
-     * makes uniform sampling's variance explode. */
-    double reach = 2.0 * (m->radius[i] + m->radius[j]);
-    vec3 gap = v3_sub(ej->centroid, ei->centroid);
-    bool near = v3_dot(gap, gap) < reach * reach;
+    double near = nearness(m, ei, ej, i, j);
+    int N = m->N > 0 ? m->N : default_samples(near);
+    bool from_i = ei->area <= ej->area;
+    uint32_t s = from_i ? i : j, o = from_i ? j : i;
     double f, var;
-    estimate(req, scratch, i, j, m->N, near, m->eps, &f, &var, &tally->rays);
-    double ratio = ei->area / ej->area;
-    out->F_ij = f;
-    out->F_ji = f * ratio;
-    out->var_ij = var;
-    out->var_ji = var * ratio * ratio;
+    estimate(req, scratch, s, o, N, near >= NEAR, m->eps, &f, &var, &tally->rays);
+    double ratio = req->mesh->elements[s].area / req->mesh->elements[o].area; /* F_os = F_so ratio */
+    double f_other = f * ratio, var_other = var * ratio * ratio;
+    out->F_ij = from_i ? f : f_other;
+    out->F_ji = from_i ? f_other : f;
+    out->var_ij = from_i ? var : var_other;
+    out->var_ji = from_i ? var_other : var;
 }
 
 const rad_ff_method rad_ff_montecarlo = {
     "montecarlo",
-    "area-to-area Monte Carlo: stratified point pairs (default 16 per pair), one shadow ray "
-    "each, 1/r^2 sampling mixed in where elements touch; unbiased, variance reported; O(n^2 N)",
-    RAD_FF_VARIANCE,
+    "stratified points of the smaller element of each pair, the other's polygon exact (Lambert), "
+    "one shadow ray each uniform in its solid angle; unbiased, stratified variance reported; "
+    "4 to 256 points per pair by distance; O(n^2 N)",
+    RAD_FF_VARIANCE | RAD_FF_BALANCE,
     montecarlo_prepare,
     montecarlo_scratch,
     montecarlo_pair,
+    NULL,
     NULL,
 };

@@ -373,6 +373,12 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     rad_result r = method->prepare ? method->prepare(ctx, req, &shared) : RAD_OK;
     if (r == RAD_OK)
         r = run_method(ctx, method, req, shared, F, var, stats);
+    if (r == RAD_OK && (method->flags & RAD_FF_BALANCE) && !req->raw) {
+        rad_ff_stats raw;
+        diagnostics(req->mesh, F, &raw);
+        stats->raw_reciprocity_max = raw.reciprocity_max;
+        r = rad_ff_balance(ctx, method, req, shared, F, var, stats);
+    }
     rad_free(shared);
     if (r == RAD_OK && close && req->escape) {
         /* Now that F says which elements see something (what sees

@@ -28,6 +28,8 @@ typedef struct rad_ff_request {
      * sees something; NULL: not checked.  `source` names the scene. */
     const double *escape;
     const char *source;
+    bool raw;                 /* keep a sampled method's F as estimated: no reciprocity and
+                                 closure step (rad_ff_balance) */
 } rad_ff_request;
 
 typedef struct rad_ff_stats {
@@ -43,11 +45,15 @@ typedef struct rad_ff_stats {
     bool closure_corrected;   /* the symmetric closure correction was applied */
     double escaped;           /* with the closure correction: the light escaping the scene
                                  (rad_ff_escaped), else 0 */
+    bool balanced;            /* rad_ff_balance restored reciprocity and closure */
+    double raw_reciprocity_max, raw_row_sum_max; /* balanced: as the method estimated F */
+    double closure_scale_min, closure_scale_max; /* balanced: the rows' scale factors x_i */
 } rad_ff_stats;
 
 /* Method flags. */
 enum {
-    RAD_FF_VARIANCE = 1u << 0 /* the kernel also estimates the variance of each F_ij */
+    RAD_FF_VARIANCE = 1u << 0, /* the kernel also estimates the variance of each F_ij */
+    RAD_FF_BALANCE = 1u << 1   /* sampled: rad_ff_balance runs after it unless req->raw */
 };
 
 /* What the kernels count while they run: per thread, summed by the loop. */
@@ -93,6 +99,11 @@ typedef struct rad_ff_method {
                  uint32_t j, rad_ff_pair *out, rad_ff_tally *tally);
     void (*row)(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
                 float *F_row, float *variance_row, rad_ff_tally *tally);
+    /* Optional, row methods with RAD_FF_BALANCE: the samples per m^2 behind
+     * row i (after the loop, before `shared` is freed): how much element i's
+     * estimate of a pair weighs against the other's.  Its rows sum to the
+     * closure it measured.  NULL: reciprocal by construction. */
+    double (*density)(const rad_ff_request *req, const void *shared, uint32_t i);
 } rad_ff_method;
 
 extern const rad_ff_method *const rad_ff_methods[]; /* NULL-terminated */
@@ -107,6 +118,16 @@ const rad_ff_method *rad_ff_find(const char *name);
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
                             const rad_ff_request *req, double max_memory, bool close,
                             float **F_out, float **variance_out, rad_ff_stats *stats);
+
+/* The default step after a RAD_FF_BALANCE method (reciprocity.c): the two
+ * estimates of each pair combined by method->density (row methods), then
+ * rows rescaled symmetrically toward their closure (measured by the row
+ * methods; by cosine rays here for pair methods, with req->vis) and none
+ * left above 1.  F (and var, if not NULL) n x n, changed in place; fills
+ * the stats' balance fields.  Polls rad_cancelled (RAD_ERROR_INTERRUPTED);
+ * fails otherwise only for memory (F then unchanged). */
+rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
+                          const void *shared, float *F, float *var, rad_ff_stats *stats);
 
 /* ---- the plane tolerance and the facing test (formfactor.c): every
  * method, and the hierarchical links ---- */

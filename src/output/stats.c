@@ -189,6 +189,13 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddNumberToObject(ff, "reciprocity_max", s->ff->reciprocity_max);
     cJSON_AddNumberToObject(ff, "diagonal_max", s->ff->diagonal_max);
     cJSON_AddBoolToObject(ff, "closure_corrected", s->ff->closure_corrected);
+    cJSON_AddBoolToObject(ff, "reciprocity_enforced", s->ff->balanced);
+    if (s->ff->balanced) { /* what the method estimated, and how far rows were scaled */
+        cJSON_AddNumberToObject(ff, "raw_reciprocity_max", s->ff->raw_reciprocity_max);
+        cJSON_AddNumberToObject(ff, "raw_row_sum_max", s->ff->raw_row_sum_max);
+        cJSON_AddNumberToObject(ff, "closure_scale_min", s->ff->closure_scale_min);
+        cJSON_AddNumberToObject(ff, "closure_scale_max", s->ff->closure_scale_max);
+    }
     if (s->options->closure_correction) /* the openness measured before correcting */
         cJSON_AddNumberToObject(ff, "escaped", s->ff->escaped);
     if (s->F_variance)

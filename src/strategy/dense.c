@@ -89,7 +89,7 @@ static rad_result dense_create(rad_context *ctx, const rad_scene *scene, const r
         r = check_ff_scratch(ctx, o, m->mesh->element_count, m->threads);
     if (r == RAD_OK) {
         rad_ff_request req = {m->mesh, m->vis, o->seed, o->shadow_rays, o->hemicube_resolution, o->samples,
-                              o->near_field, escape, scene->source};
+                              o->near_field, escape, scene->source, o->raw_form_factors != 0};
         r = rad_form_factors(ctx, rad_ff_find(o->form_factors), &req, o->max_memory_bytes,
                              o->closure_correction != 0, &st->F, &st->F_variance, &m->ff_stats);
         m->seconds.form_factors = m->ff_stats.seconds;
