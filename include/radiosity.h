@@ -345,7 +345,7 @@ typedef struct rad_options {
                                      hierarchical: each patch sends B / its link closure;
                                      refused by shooting */
 
-    const char *solver;           /* NULL = "gauss-seidel" */
+    const char *solver;           /* NULL = "hierarchical" */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */

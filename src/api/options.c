@@ -64,7 +64,9 @@ static const rad_option_info solution_rows[] = {
      .help = "rescale F so rows sum to 1 keeping reciprocity; hierarchical: scale each patch's "
              "sending by its link closure (closed scenes only; refused by shooting)"},
     {SOLUTION(solver), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_SOLVER, .default_value = NAN,
-     .default_text = "gauss-seidel", .help = "solver"},
+     .default_text = "hierarchical",
+     .help = "solver (the program without --solver: gauss-seidel for viewfactors, --progress-images, "
+             "--elements, --mesh-size or --form-factors)"},
     {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0, .max_open = true,
      .default_value = 1e-6, .default_text = "1e-6",
      .help = "stop when the residual (unaccounted power / emitted power) falls below this"},
