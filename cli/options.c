@@ -445,6 +445,16 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
                        "(its elements change while it solves; use --history)");
         return CLI_USAGE_ERROR;
     }
+    /* The default solver is hierarchical, which meshes as it solves.  What
+     * needs a uniform mesh or a form-factor matrix takes gauss-seidel
+     * instead when no --solver is given: the view factors (a matrix's F),
+     * progress images (elements that stay put while solving), and the
+     * uniform mesh's and the matrix's own options, which hierarchical would
+     * ignore. */
+    if (!s->solve.solver &&
+        (s->command == CLI_VIEWFACTORS || s->progress_dir || s->solve.target_elements != 0 ||
+         s->solve.mesh_size != 0.0 || s->solve.form_factors))
+        s->solve.solver = "gauss-seidel";
     if (!s->output)
         s->output = default_output(s->command);
     if (s->history)

@@ -351,7 +351,7 @@ typedef struct rad_options {
                                      of each pair are combined (reciprocity) and rows held
                                      to their measured closure, so energy is conserved */
 
-    const char *solver;           /* NULL = "gauss-seidel" */
+    const char *solver;           /* NULL = "hierarchical" */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */
@@ -514,7 +514,8 @@ typedef enum rad_shading { RAD_SHADING_SMOOTH = 0, RAD_SHADING_FLAT = 1 } rad_sh
 
 typedef struct rad_render_options {
     int width, height;            /* pixels; 0 = 512 x 512 */
-    int samples;                  /* anti-aliasing samples per pixel (square); 0 = 4 */
+    int samples;                  /* anti-aliasing samples per pixel (square) where a 2 x 2 pilot
+                                     sees more than one patch; 0 = 4 */
     const rad_camera *camera;     /* NULL = the scene's, else framed automatically */
     rad_shading shading;
     double exposure;              /* multiplier on radiance; 0 = automatic */

@@ -149,13 +149,14 @@ static rad_result load(const text *t, rad_scene **scene)
 
 /* Load, mesh (elements no longer than mesh_size x scale, or about
  * `elements` in all when mesh_size is 0), compute the form factors and
- * solve to 1e-12.  Fails the test on any error. */
+ * solve to 1e-12 by gauss-seidel.  Fails the test on any error. */
 static solved solve(const text *t, double mesh_size, size_t elements)
 {
     solved s = {NULL, NULL};
     if (load(t, &s.scene) != RAD_OK)
         fail_msg("load: %s", rad_context_error(ctx));
     rad_options o = {0};
+    o.solver = "gauss-seidel";
     o.mesh_size = mesh_size;
     o.target_elements = elements;
     o.tolerance = 1e-12;
@@ -903,6 +904,7 @@ static void test_million_tiny_triangles(void **state)
 
     /* Dense form factors for them: refused up front, naming the way out. */
     rad_options dense = {0};
+    dense.solver = "gauss-seidel";
     dense.target_elements = 2000;
     assert_int_equal(rad_solution_create(ctx, scene, &dense, &sol), RAD_ERROR_OUT_OF_MEMORY);
     assert_null(sol);

@@ -67,7 +67,9 @@ static const rad_option_info solution_rows[] = {
      .help = "hemicube, hemisphere, montecarlo: keep F as sampled, without the default step that "
              "makes it reciprocal and holds its rows to their measured closure (energy conservation)"},
     {SOLUTION(solver), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_SOLVER, .default_value = NAN,
-     .default_text = "gauss-seidel", .help = "solver"},
+     .default_text = "hierarchical",
+     .help = "solver (the program without one: gauss-seidel for view factors, progress images, "
+             "an element count, a mesh size or a form-factor method)"},
     {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0, .max_open = true,
      .default_value = 1e-6, .default_text = "1e-6",
      .help = "stop when the residual (unaccounted power / emitted power) falls below this"},
@@ -112,7 +114,9 @@ static const rad_option_info render_rows[] = {
     {RENDER(height), .type = RAD_OPTION_INT, .min = 1.0, .max = 16384.0, .default_value = 512.0,
      .default_text = "512", .help = "image height, pixels"},
     {RENDER(samples), .type = RAD_OPTION_INT, .min = 1.0, .max = 16384.0, .default_value = 4.0,
-     .default_text = "4", .help = "anti-aliasing: samples per pixel along each axis (their square in all)"},
+     .default_text = "4",
+     .help = "anti-aliasing: samples per pixel along each axis (their square in all) where a 2 x 2 pilot "
+             "sees more than one patch (edges); elsewhere the pilot"},
     {RENDER(shading), .type = RAD_OPTION_ENUM, .words = shading_words, .default_value = 0.0,
      .default_text = "smooth", .help = "smooth (vertex values interpolated) or flat (one colour per element)"},
     {RENDER(exposure), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,

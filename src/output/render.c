@@ -14,8 +14,15 @@
  *
  * Anti-aliasing: samples x samples strata per pixel, each jittered by a
  * random offset keyed by (pixel, sample), so the image does not depend on
- * the thread count.  Rows are shared out to OpenMP threads; each thread
- * sends its row's rays to the visibility backend in batches.
+ * the thread count.  Adaptively: each pixel first takes a 2 x 2 pilot;
+ * where its four rays see the same patch (the same element, flat), the
+ * pixel lies inside one continuous piece of the shading and the pilot's
+ * mean is its value; only the others (edges, shadows' silhouettes against
+ * the background, misses) take all samples x samples strata.  Most pixels
+ * of a view are inside a surface, so an image costs about 4 rays a pixel
+ * instead of 16 at the default 4 x 4, with the edges as before.  Rows are
+ * shared out to OpenMP threads; each thread sends its row's rays to the
+ * visibility backend in batches.
  */
 #include "output/output.h"
 
@@ -92,71 +99,118 @@ static rad_result make_view(rad_context *ctx, const rad_camera *camera, int widt
     return RAD_OK;
 }
 
+#define RENDER_MISS UINT32_MAX        /* what a ray saw: nothing */
+#define RENDER_BACK (UINT32_MAX - 1u) /* what a ray saw: the back of a patch */
+
 /* Radiosity (W/m^2) seen along `ray` given its hit; 0 for a miss or the
- * back of a patch. */
-static void shade(const rad_render_input *input, rad_shading shading, const rad_ray *ray,
-                  const rad_hit *hit, double rgb[3])
+ * back of a patch.  Returns what was seen: the patch (smooth shading,
+ * continuous across it) or the element (flat), RENDER_MISS or RENDER_BACK. */
+static uint32_t shade(const rad_render_input *input, rad_shading shading, const rad_ray *ray,
+                      const rad_hit *hit, double rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     if (!isfinite(hit->t))
-        return;
+        return RENDER_MISS;
     const rad_mesh *mesh = input->mesh;
     const rad_patch *patch = &mesh->patches[hit->patch];
     if (v3_dot(ray->direction, patch->normal) > 0.0)
-        return;
+        return RENDER_BACK;
     vec3 p = v3_mad(ray->origin, ray->direction, hit->t);
     double s, t, local_s, local_t;
     rad_patch_parameters(patch, p, &s, &t);
     uint32_t e = rad_mesh_locate(mesh, hit->patch, s, t, &local_s, &local_t);
-    if (shading == RAD_SHADING_SMOOTH && input->vertex_radiosity) {
+    bool smooth = shading == RAD_SHADING_SMOOTH && input->vertex_radiosity;
+    if (smooth) {
         rad_element_interpolate(mesh, &mesh->elements[e], input->vertex_radiosity, local_s,
                                 local_t, rgb);
     } else {
         for (int c = 0; c < 3; c++)
             rgb[c] = input->element_radiosity[3 * (size_t)e + (size_t)c];
     }
+    return smooth ? hit->patch : e;
 }
 
-/* One row: width x samples^2 rays in batches of `batch`; writes the row's
- * pixels. */
-static void render_row(const rad_render_input *input, rad_shading shading,
-                       const render_view *view, int y, size_t batch, rad_ray *rays, rad_hit *hits,
-                       double *sum, float *pixels)
+/* The camera ray through stratum `stratum` of `grid` x `grid` of pixel
+ * (x, y), jittered by the stream `stream` keyed on (pixel, stratum). */
+static void camera_ray(const render_view *view, uint64_t stream, uint64_t x, int y, uint64_t stratum,
+                       uint64_t grid, rad_ray *ray)
 {
-    const uint64_t per_pixel = (uint64_t)view->samples * (uint64_t)view->samples;
-    const uint64_t total = (uint64_t)view->width * per_pixel;
-    for (int x = 0; x < 3 * view->width; x++)
-        sum[x] = 0.0;
+    uint64_t pixel = (uint64_t)y * (uint64_t)view->width + x;
+    rad_rng rng = rad_rng_keyed(stream, pixel, stratum);
+    double jx = rad_rng_uniform(&rng), jy = rad_rng_uniform(&rng);
+    double fx = ((double)x + ((double)(stratum % grid) + jx) / (double)grid) / view->width;
+    double fy = ((double)y + ((double)(stratum / grid) + jy) / (double)grid) / view->height;
+    ray->origin = view->position;
+    ray->direction = v3_mad(v3_mad(view->forward, view->right, 2.0 * fx - 1.0), view->up, 1.0 - 2.0 * fy);
+    ray->tnear = 0.0;
+    ray->tfar = INFINITY;
+}
+
+#define RENDER_MIXED (UINT32_MAX - 2u) /* what a pixel's rays saw: not all the same */
+
+/* Pixels `pixel[0 .. count)` of row y, `grid` x `grid` strata each, in
+ * batches of `batch` rays: their sums into sum[3 x]; seen[x] what all of a
+ * pixel's rays saw when they agree, RENDER_MIXED when they do not. */
+static void trace_pixels(const rad_render_input *input, rad_shading shading, const render_view *view, int y,
+                         const uint32_t *pixel, size_t count, uint64_t grid, uint64_t stream, size_t batch,
+                         rad_ray *rays, rad_hit *hits, double *sum, uint32_t *seen)
+{
+    const uint64_t per_pixel = grid * grid, total = (uint64_t)count * per_pixel;
     for (uint64_t first = 0; first < total; first += batch) {
-        size_t count = (size_t)(total - first < batch ? total - first : batch);
-        for (size_t k = 0; k < count; k++) {
-            uint64_t r = first + k, x = r / per_pixel, sample = r % per_pixel;
-            uint64_t pixel = (uint64_t)y * (uint64_t)view->width + x;
-            rad_rng rng = rad_rng_keyed(0, pixel, sample);
-            double jx = rad_rng_uniform(&rng), jy = rad_rng_uniform(&rng);
-            double fx = ((double)x + ((double)(sample % (uint64_t)view->samples) + jx) /
-                                         view->samples) / view->width;
-            double fy = ((double)y + ((double)(sample / (uint64_t)view->samples) + jy) /
-                                         view->samples) / view->height;
-            vec3 direction = v3_mad(v3_mad(view->forward, view->right, 2.0 * fx - 1.0), view->up,
-                                    1.0 - 2.0 * fy);
-            rays[k].origin = view->position;
-            rays[k].direction = direction;
-            rays[k].tnear = 0.0;
-            rays[k].tfar = INFINITY;
+        size_t n = (size_t)(total - first < batch ? total - first : batch);
+        for (size_t k = 0; k < n; k++) {
+            uint64_t r = first + k;
+            camera_ray(view, stream, pixel[r / per_pixel], y, r % per_pixel, grid, &rays[k]);
         }
-        input->vis->backend->intersect(input->vis->state, rays, count, hits);
-        for (size_t k = 0; k < count; k++) {
+        input->vis->backend->intersect(input->vis->state, rays, n, hits);
+        for (size_t k = 0; k < n; k++) {
+            uint64_t r = first + k, x = pixel[r / per_pixel];
             double rgb[3];
-            shade(input, shading, &rays[k], &hits[k], rgb);
-            uint64_t x = (first + k) / per_pixel;
+            uint32_t what = shade(input, shading, &rays[k], &hits[k], rgb);
+            if (r % per_pixel == 0) {
+                sum[3 * x] = sum[3 * x + 1] = sum[3 * x + 2] = 0.0;
+                seen[x] = what;
+            } else if (seen[x] != what) {
+                seen[x] = RENDER_MIXED;
+            }
             for (int c = 0; c < 3; c++)
                 sum[3 * x + (uint64_t)c] += rgb[c];
         }
     }
-    double scale = 1.0 / (M_PI * (double)per_pixel); /* mean, and L = B / pi */
-    for (int x = 0; x < 3 * view->width; x++)
-        pixels[x] = (float)(sum[x] * scale);
+}
+
+/* One row: every pixel's 2 x 2 pilot, then all strata where the pilot
+ * saw more than one thing (file header); writes the row's pixels. */
+static void render_row(const rad_render_input *input, rad_shading shading,
+                       const render_view *view, int y, size_t batch, rad_ray *rays, rad_hit *hits,
+                       double *sum, uint32_t *seen, uint32_t *pixel, float *pixels)
+{
+    const uint64_t grid = (uint64_t)view->samples, pilot = grid > 2 ? 2 : grid;
+    size_t width = (size_t)view->width;
+    for (size_t x = 0; x < width; x++)
+        pixel[x] = (uint32_t)x;
+    /* The pilot is the final sampling when the grid is no finer (stream 0,
+     * as the full strata: the same rays then). */
+    trace_pixels(input, shading, view, y, pixel, width, pilot, pilot == grid ? 0 : 1, batch, rays, hits, sum,
+                 seen);
+    double scale[2] = {1.0 / (M_PI * (double)(pilot * pilot)), /* mean, and L = B / pi */
+                       1.0 / (M_PI * (double)(grid * grid))};
+    size_t again = 0;
+    if (pilot < grid)
+        for (size_t x = 0; x < width; x++)
+            if (seen[x] == RENDER_MIXED)
+                pixel[again++] = (uint32_t)x;
+    for (size_t x = 0; x < width; x++)
+        seen[x] = 0; /* pilot scale */
+    for (size_t i = 0; i < again; i++)
+        seen[pixel[i]] = 1;
+    /* Sums of the refined pixels are overwritten with their full strata. */
+    uint32_t *unused = pixel + width; /* what the full strata saw: not needed */
+    if (again)
+        trace_pixels(input, shading, view, y, pixel, again, grid, 0, batch, rays, hits, sum, unused);
+    for (size_t x = 0; x < width; x++)
+        for (int c = 0; c < 3; c++)
+            pixels[3 * x + (size_t)c] = (float)(sum[3 * x + (size_t)c] * scale[seen[x]]);
 }
 
 rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
@@ -189,7 +243,11 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
     double *sums = hits ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * (size_t)width, 3 * sizeof(double),
                                     "render rows")
                         : NULL;
-    if (!sums) {
+    /* Per thread and pixel of a row: what it saw, and two pixel lists. */
+    uint32_t *marks = sums ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * (size_t)width, 3 * sizeof(uint32_t),
+                                       "render rows")
+                           : NULL;
+    if (!marks) {
         rad_image_destroy(image);
         rad_free(rays);
         rad_free(hits);
@@ -208,6 +266,7 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
         rad_ray *my_rays = rays + (size_t)thread * batch;
         rad_hit *my_hits = hits + (size_t)thread * batch;
         double *my_sum = sums + (size_t)thread * (size_t)width * 3;
+        uint32_t *my_seen = marks + (size_t)thread * (size_t)width * 3, *my_pixel = my_seen + width;
 #pragma omp for schedule(dynamic)
         for (int y = 0; y < height; y++) {
             if (rad_cancelled(ctx)) {
@@ -215,7 +274,7 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
                 rows_skipped++;
                 continue;
             }
-            render_row(input, o.shading, &view, y, batch, my_rays, my_hits, my_sum,
+            render_row(input, o.shading, &view, y, batch, my_rays, my_hits, my_sum, my_seen, my_pixel,
                        &image->pixels[(size_t)y * (size_t)width * 3]);
             int done;
 #pragma omp atomic capture
@@ -227,6 +286,7 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
     rad_free(rays);
     rad_free(hits);
     rad_free(sums);
+    rad_free(marks);
     rad_progress(ctx, "render", (uint64_t)rows_done, (uint64_t)height);
     *out = image;
     if (rows_skipped > 0)
