@@ -259,7 +259,7 @@ static void test_analytic_cube(void **state)
     rad_mesh *mesh = NULL;
     assert_int_equal(rad_mesh_build(ctx, scene, &o, &mesh), RAD_OK);
     rad_ff_request req = {.mesh = mesh, .seed = 7, .shadow_rays = 4}; /* no occluders in a cube */
-    float *F = NULL;
+    double *F = NULL;
     rad_ff_stats st;
     assert_int_equal(rad_form_factors(ctx, rad_ff_find("analytic"), &req, 1e9, false, &F, NULL, &st), RAD_OK);
     size_t n = mesh->element_count;
@@ -271,7 +271,7 @@ static void test_analytic_cube(void **state)
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++)
             if (mesh->elements[i].surface == mesh->elements[j].surface)
-                assert_true(F[i * n + j] == 0.0f);
+                assert_true(F[i * n + j] == 0.0);
     rad_free(F);
 
     /* The memory limit is checked before allocating. */
@@ -287,7 +287,7 @@ static void test_analytic_cube(void **state)
 /* ---- the form-factor loop (formfactor.c): threads, reciprocity, cancellation ---- */
 
 static rad_result form_factors_with(int threads, bool cancel, const rad_ff_method *method,
-                                    const rad_ff_request *req, float **F, float **variance,
+                                    const rad_ff_request *req, double **F, double **variance,
                                     rad_ff_stats *st)
 {
     rad_context_options o = {0};
@@ -319,7 +319,7 @@ static void test_ff_loop(void **state)
     size_t n = mesh->element_count;
     for (size_t k = 0; rad_ff_methods[k]; k++) {
         const rad_ff_method *m = rad_ff_methods[k];
-        float *F1 = NULL, *F3 = NULL, *V1 = NULL, *V3 = NULL;
+        double *F1 = NULL, *F3 = NULL, *V1 = NULL, *V3 = NULL;
         rad_ff_stats s1, s3;
         assert_int_equal(form_factors_with(1, false, m, &req, &F1, &V1, &s1), RAD_OK);
         assert_int_equal(form_factors_with(3, false, m, &req, &F3, &V3, &s3), RAD_OK);
@@ -331,7 +331,7 @@ static void test_ff_loop(void **state)
         if (m->pair) {
             size_t coupled = 0;
             for (size_t i = 0; i < n; i++) {
-                assert_true(F1[i * n + i] == 0.0f);
+                assert_true(F1[i * n + i] == 0.0);
                 for (size_t j = i + 1; j < n; j++) {
                     double gij = mesh->elements[i].area * F1[i * n + j];
                     double gji = mesh->elements[j].area * F1[j * n + i];
@@ -346,7 +346,7 @@ static void test_ff_loop(void **state)
         rad_free(V1);
         rad_free(V3);
 
-        float *F = NULL;
+        double *F = NULL;
         assert_int_equal(form_factors_with(2, true, m, &req, &F, NULL, &s1), RAD_ERROR_INTERRUPTED);
         assert_true(s1.pairs < s3.pairs);
         rad_free(F);
@@ -362,7 +362,7 @@ static void test_ff_loop(void **state)
 static void test_solvers_two_patch(void **state)
 {
     (void)state;
-    const float F[4] = {0.0f, 0.25f, 0.25f, 0.0f};
+    const double F[4] = {0.0, 0.25, 0.25, 0.0};
     const double area[2] = {1.0, 1.0};
     const double rho[6] = {0.8, 0.5, 0.2, 0.8, 0.5, 0.2};
     const double E[6] = {1.0, 2.0, 3.0, 0.0, 0.0, 0.0};
@@ -393,7 +393,7 @@ static void test_solvers_two_patch(void **state)
 static void test_residual_definition(void **state)
 {
     (void)state;
-    const float F[4] = {0.0f, 0.5f, 0.5f, 0.0f};
+    const double F[4] = {0.0, 0.5, 0.5, 0.0};
     const double area[2] = {2.0, 2.0};
     const double rho[6] = {0.5, 0.5, 0.5, 0.5, 0.5, 0.5};
     const double E[6] = {1, 1, 1, 0, 0, 0};
@@ -439,10 +439,10 @@ static void test_bound_arithmetic(void **state)
 }
 
 /* Two facing planes that see only each other (F = [0 1; 1 0], rows exactly
- * 1 in float): both emit E = 1 and reflect rho, so B = E / (1 - rho). */
+ * 1): both emit E = 1 and reflect rho, so B = E / (1 - rho). */
 static rad_system plates(double rho, double *reflectance, double *emission)
 {
-    static const float F[4] = {0.0f, 1.0f, 1.0f, 0.0f};
+    static const double F[4] = {0.0, 1.0, 1.0, 0.0};
     static const double area[2] = {1.0, 1.0};
     for (int k = 0; k < 6; k++) {
         reflectance[k] = rho;

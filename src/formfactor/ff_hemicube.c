@@ -334,7 +334,7 @@ static uint64_t hemicube_point(const hc_setup *hs, hc_scratch *s, const rad_mesh
  * quarter of element i (rad_ff_split4), weighted by the quarter's area.
  * Counts the element pairs projected (not behind the base). */
 static void hemicube_row(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
-                         float *F_row, float *variance_row, rad_ff_tally *tally)
+                         double *F_row, double *variance_row, rad_ff_tally *tally)
 {
     (void)variance_row;
     const hc_setup *hs = shared;
@@ -370,7 +370,7 @@ static void hemicube_row(const rad_ff_request *req, const void *shared, void *sc
             s->row[j] += w * s->sum[j + 1];
     }
     for (size_t j = 0; j < n; j++)
-        F_row[j] = (float)s->row[j];
+        F_row[j] = s->row[j];
     tally->pairs += pairs / 4;
 }
 
