@@ -289,7 +289,7 @@ static void test_separate_rooms(void **state)
         cli_stats_surface_radiosity(sb, "b_z0", floor);
         assert_true(wall[0] > 1.5 * wall[1] && wall[2] == 0.0);
         for (int c = 0; c < 3; c++)
-            assert_relative(floor[c], 2.0, 1e-7, "black emitter"); /* Ke is read as float */
+            assert_relative(floor[c], 2.0, 1e-14, "black emitter"); /* pi x Ke, Ke read to 17 digits */
         cJSON_Delete(sb);
         cJSON_Delete(sa);
         cJSON_Delete(sr);
@@ -677,7 +677,7 @@ static void test_bright_boxes_matrix_free(void **state)
         cJSON *s = render_loud(scene[b], tag, "--solver shooting --mesh-size 0.5 --ff-samples 64", errors, sizeof errors);
         double u = cli_stats_number(s, "solver", "unshot");
         double emitted = cli_stats_number(s, "power_W", "emitted");
-        /* E as read (Ke = E / pi goes through a float): the emitted power / 6 m^2. */
+        /* E as read (pi x Ke): the emitted power / 6 m^2. */
         assert_relative(cube_mean(s), emitted / 6.0 * (1.0 - rho[b] * u) / (1.0 - rho[b]), 1e-9,
                         "shooting: deposited power");
         assert_relative(cli_stats_number(s, "power_W", "absorbed"), emitted * (1.0 - u), 1e-9, "shooting: absorbed");
