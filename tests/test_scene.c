@@ -11,6 +11,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "formfactor/formfactor.h"
 #include "scene/import_internal.h"
 #include "scene/scene.h"
 
@@ -281,6 +282,76 @@ static void test_obj_face_forms(void **state)
     assert_int_equal(rad_scene_load_file(ctx, write_temp("bom.obj", with_bom), &scene), RAD_OK);
     check_face_forms(scene);
     remove_temp("bom.obj");
+}
+
+/* Every digit: OBJ coordinates and MTL Kd / Ke of 16-17 significant digits
+ * reach the scene as strtod reads them, bit for bit (assimp alone keeps
+ * floats: 7 digits), in every face form, through relative indices and a
+ * homogeneous "v x y z w"; so the area of a rectangle and the factor from
+ * a point under its corner to a parallel rectangle above it match their
+ * closed forms in double to 1e-14 (with float coordinates: 1e-8). */
+static void test_obj_exact_digits(void **state)
+{
+    (void)state;
+    static const char *const x[2] = {"-0.12345678912345678", "1.2345678912345679"};
+    static const char *const y[2] = {"0.31415926535897931", "2.7182818284590451"};
+    static const char *const h = "0.98765432109876543";
+    char obj[2048];
+    snprintf(obj, sizeof obj,
+             "mtllib digits.mtl\n"
+             "v %s %s 0\nv %s %s 0\nv %s %s 0\nv %s %s 0\n"
+             "v %s %s %s\nv %s %s %s\nv %s %s %s\n"
+             "v %s %s 1.9753086421975308 2\n" /* (x0, y1, h) with w = 2: halved exactly */
+             "vt 0 0\nvn 0 0 1\n"
+             "o floor\nusemtl grey\nf 1/1 2//1 3/1/1 4\n"
+             "o ceiling\nusemtl lamp\nf -1 -2 -3 -4\n",
+             x[0], y[0], x[1], y[0], x[1], y[1], x[0], y[1],        /* floor, facing up */
+             x[0], y[0], h, x[1], y[0], h, x[1], y[1], h,           /* ceiling, facing down */
+             "-0.24691357824691357", "5.4365636569180900");
+    static const char mtl[] = "newmtl grey\nKd 0.12345678901234567 0.5 0.66666666666666663\n"
+                              "newmtl lamp\nKd 0 0 0\nKe 0.33333333333333331 1.4142135623730951 7\n";
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "digits.obj", obj, strlen(obj), mtl, strlen(mtl),
+                                           &scene),
+                     RAD_OK);
+    double X[2] = {strtod(x[0], NULL), strtod(x[1], NULL)};
+    double Y[2] = {strtod(y[0], NULL), strtod(y[1], NULL)};
+    double H = strtod(h, NULL);
+    /* Every corner is one of the file's positions, bit for bit. */
+    size_t floor = surface_index(scene, "floor"), ceiling = surface_index(scene, "ceiling");
+    const vec3 *ceiling_polygon = NULL;
+    for (size_t p = 0; p < scene->polygon_count; p++) {
+        const rad_polygon *polygon = &scene->polygons[p];
+        assert_int_equal(polygon->vertex_count, 4);
+        const vec3 *corner = &scene->positions[scene->indices[polygon->first_index]];
+        if (polygon->surface == ceiling)
+            ceiling_polygon = corner;
+        for (size_t k = 0; k < 4; k++) {
+            vec3 q = scene->positions[scene->indices[polygon->first_index + k]];
+            assert_true(q.x == X[0] || q.x == X[1]);
+            assert_true(q.y == Y[0] || q.y == Y[1]);
+            assert_true(q.z == (polygon->surface == floor ? 0.0 : H));
+        }
+    }
+    assert_non_null(ceiling_polygon);
+    /* Kd exactly, E = pi Ke exactly as computed from the doubles. */
+    const rad_material *grey = surface_material(scene, floor), *lamp = surface_material(scene, ceiling);
+    assert_true(grey->reflectance[0] == strtod("0.12345678901234567", NULL));
+    assert_true(grey->reflectance[2] == strtod("0.66666666666666663", NULL));
+    assert_true(lamp->emission[0] == M_PI * strtod("0.33333333333333331", NULL));
+    assert_true(lamp->emission[1] == M_PI * strtod("1.4142135623730951", NULL));
+    /* Areas, and the factor from (x0, y0, 0) facing up to the ceiling
+     * (Howell's catalogue, B-3: a = b / c, the sides over the height). */
+    double a = X[1] - X[0], b = Y[1] - Y[0];
+    assert_close_relative(rad_scene_surface_area(scene, floor), a * b, 1e-14);
+    assert_close_relative(rad_scene_surface_area(scene, ceiling), a * b, 1e-14);
+    double A = a / H, B = b / H;
+    double exact = (A / sqrt(1 + A * A) * atan(B / sqrt(1 + A * A)) +
+                    B / sqrt(1 + B * B) * atan(A / sqrt(1 + B * B))) /
+                   (2.0 * M_PI);
+    double F = rad_point_polygon_ff(v3(X[0], Y[0], 0.0), v3(0, 0, 1), ceiling_polygon, 4);
+    assert_close_relative(F, exact, 1e-14);
+    rad_scene_destroy(scene);
 }
 
 /* ---- glTF 2.0 ---- */
@@ -2281,6 +2352,7 @@ int main(void)
         cmocka_unit_test(test_obj_from_memory),
         cmocka_unit_test(test_obj_groups),
         cmocka_unit_test(test_obj_face_forms),
+        cmocka_unit_test(test_obj_exact_digits),
         cmocka_unit_test(test_format_by_content),
         cmocka_unit_test(test_material_libraries),
         cmocka_unit_test(test_gltf),

@@ -416,7 +416,7 @@ static uint64_t hemicube_level(const hc_setup *hs, hc_scratch *s, const rad_mesh
  * (PLACEMENT_RATIO).  Counts the element pairs projected (not behind the
  * base). */
 static void hemicube_row(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
-                         float *F_row, float *variance_row, rad_ff_tally *tally)
+                         double *F_row, double *variance_row, rad_ff_tally *tally)
 {
     (void)variance_row;
     const hc_setup *hs = shared;
@@ -439,7 +439,7 @@ static void hemicube_row(const rad_ff_request *req, const void *shared, void *sc
     }
     hs->levels[i] = (uint8_t)level;
     for (size_t j = 0; j < n; j++)
-        F_row[j] = (float)s->row[j];
+        F_row[j] = s->row[j];
     tally->pairs += pairs;
 }
 

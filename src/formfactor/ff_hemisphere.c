@@ -112,7 +112,7 @@ static void trace_batch(const rad_ff_request *req, hs_scratch *s, size_t count, 
 /* Row i of F (and of the variance); counts its rays and the elements it
  * hit. */
 static void hemisphere_row(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
-                           float *F_row, float *variance_row, rad_ff_tally *tally)
+                           double *F_row, double *variance_row, rad_ff_tally *tally)
 {
     const hs_shared *h = shared;
     hs_scratch *s = scratch;
@@ -172,10 +172,10 @@ static void hemisphere_row(const rad_ff_request *req, const void *shared, void *
     for (size_t j = 0; j < n; j++) {
         double f = s->sum[j];
         tally->pairs += f > 0.0;
-        F_row[j] = (float)f;
+        F_row[j] = f;
         if (variance_row) {
             double p = fmin(fmax(f, 0.0), 1.0);
-            variance_row[j] = (float)(p * (1.0 - p) / N);
+            variance_row[j] = p * (1.0 - p) / N;
         }
     }
     tally->rays += (uint64_t)N;

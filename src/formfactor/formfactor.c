@@ -54,14 +54,14 @@ const rad_ff_method *rad_ff_find(const char *name)
 
 /* Row sums, the worst reciprocity error and the largest F_ii.  Pairs whose
  * larger power coupling is below 1e-9 of the larger area are ignored: there
- * single-precision rounding of F dominates the relative error. */
-static void diagnostics(const rad_mesh *mesh, const float *F, rad_ff_stats *s)
+ * the rounding of the methods' sums dominates the relative error. */
+static void diagnostics(const rad_mesh *mesh, const double *F, rad_ff_stats *s)
 {
     size_t n = mesh->element_count;
     double rmin = INFINITY, rmax = -INFINITY, rsum = 0.0, recip = 0.0, diag = 0.0;
     for (size_t i = 0; i < n; i++) {
         double row = 0.0;
-        const float *Fi = F + i * n;
+        const double *Fi = F + i * n;
         for (size_t j = 0; j < n; j++)
             row += Fi[j];
         rmin = fmin(rmin, row);
@@ -141,7 +141,7 @@ static void row_done(rad_context *ctx, uint64_t *rows_done, size_t rows, volatil
 
 /* Row i of a pair method: the facing pairs (i, j > i), both directions. */
 static void pair_row(const rad_ff_method *method, const rad_ff_request *req, const void *shared,
-                     void *scratch, uint32_t i, double plane_tol, float *F, float *variance,
+                     void *scratch, uint32_t i, double plane_tol, double *F, double *variance,
                      rad_ff_tally *tally)
 {
     const rad_mesh *mesh = req->mesh;
@@ -152,18 +152,18 @@ static void pair_row(const rad_ff_method *method, const rad_ff_request *req, con
         tally->pairs++;
         rad_ff_pair f = {0};
         method->pair(req, shared, scratch, i, (uint32_t)j, &f, tally);
-        F[i * n + j] = (float)f.F_ij;
-        F[j * n + i] = (float)f.F_ji;
+        F[i * n + j] = f.F_ij;
+        F[j * n + i] = f.F_ji;
         if (variance) {
-            variance[i * n + j] = (float)f.var_ij;
-            variance[j * n + i] = (float)f.var_ji;
+            variance[i * n + j] = f.var_ij;
+            variance[j * n + i] = f.var_ji;
         }
     }
 }
 
 /* The one loop: every row, in parallel; the counts into stats. */
 static rad_result run_method(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
-                             const void *shared, float *F, float *variance, rad_ff_stats *stats)
+                             const void *shared, double *F, double *variance, rad_ff_stats *stats)
 {
     size_t n = req->mesh->element_count;
     double plane_tol = rad_ff_plane_tolerance(req->mesh);
@@ -214,7 +214,7 @@ static rad_result run_method(rad_context *ctx, const rad_ff_method *method, cons
     return RAD_OK;
 }
 
-rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F)
+rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, double *F)
 {
     size_t n = mesh->element_count;
     double *x = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 2 * n, sizeof *x, "form factors: closure correction");
@@ -229,7 +229,7 @@ rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F)
     for (int it = 0; it < 200; it++) {
         double worst = 0.0;
         for (size_t i = 0; i < n; i++) {
-            const float *Fi = F + i * n;
+            const double *Fi = F + i * n;
             double s = 0.0;
             for (size_t j = 0; j < n; j++)
                 s += (double)Fi[j] * x[j];
@@ -247,7 +247,7 @@ rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F)
     }
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++)
-            F[i * n + j] = (float)((double)F[i * n + j] * x[i] * x[j]);
+            F[i * n + j] *= x[i] * x[j];
     rad_free(x);
     return RAD_OK;
 }
@@ -311,7 +311,7 @@ rad_result rad_ff_escape_rays(rad_context *ctx, const rad_mesh *mesh, const rad_
     return RAD_OK;
 }
 
-double rad_ff_escaped(const rad_mesh *mesh, const double *fraction, const float *F)
+double rad_ff_escaped(const rad_mesh *mesh, const double *fraction, const double *F)
 {
     size_t n = mesh->element_count;
     double area = 0.0, lost = 0.0;
@@ -341,7 +341,7 @@ rad_result rad_ff_refuse_open(rad_context *ctx, const char *source, double escap
 }
 
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
-                            double max_memory, bool close, float **F_out, float **variance_out,
+                            double max_memory, bool close, double **F_out, double **variance_out,
                             rad_ff_stats *stats)
 {
     *F_out = NULL;
@@ -351,7 +351,7 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     memset(stats, 0, sizeof *stats);
     stats->method = method->name;
     size_t n = req->mesh->element_count;
-    double bytes = (double)n * (double)n * sizeof(float) * (want_variance ? 2.0 : 1.0);
+    double bytes = (double)n * (double)n * sizeof(double) * (want_variance ? 2.0 : 1.0);
     if (bytes > max_memory)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "form factors: the dense matrix for %zu elements needs %.2f GiB, above "
@@ -359,8 +359,8 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
                         "solver 'shooting' (rad_options.solver, O(n) memory) or fewer elements "
                         "(rad_options.target_elements)",
                         n, bytes / 1073741824.0, max_memory / 1073741824.0);
-    float *F = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *F, "form factors: dense matrix");
-    float *var = F && want_variance
+    double *F = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *F, "form factors: dense matrix");
+    double *var = F && want_variance
                      ? rad_alloc(ctx, RAD_MEM_FORM_FACTORS, n * n, sizeof *var, "form factors: variances")
                      : NULL;
     if (!F || (want_variance && !var)) {

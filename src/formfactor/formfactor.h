@@ -93,12 +93,12 @@ typedef struct rad_ff_method {
      * its parallel region and hands `block` to the kernels.  Cannot fail. */
     size_t (*scratch)(const rad_ff_request *req, const void *shared, void *block);
     /* Exactly one of these.  pair: the factors of elements i < j into
-     * *out (zeroed by the caller).  row: row i of F into F_row (n floats,
+     * *out (zeroed by the caller).  row: row i of F into F_row (n doubles,
      * zeroed) and, when variance_row is not NULL, of the variances. */
     void (*pair)(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
                  uint32_t j, rad_ff_pair *out, rad_ff_tally *tally);
     void (*row)(const rad_ff_request *req, const void *shared, void *scratch, uint32_t i,
-                float *F_row, float *variance_row, rad_ff_tally *tally);
+                double *F_row, double *variance_row, rad_ff_tally *tally);
     /* Optional, row methods with RAD_FF_BALANCE: the samples per m^2 behind
      * row i (after the loop, before `shared` is freed): how much element i's
      * estimate of a pair weighs against the other's.  Its rows sum to the
@@ -117,7 +117,7 @@ const rad_ff_method *rad_ff_find(const char *name);
  * the closure correction; fill the diagnostics. */
 rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
                             const rad_ff_request *req, double max_memory, bool close,
-                            float **F_out, float **variance_out, rad_ff_stats *stats);
+                            double **F_out, double **variance_out, rad_ff_stats *stats);
 
 /* The default step after a RAD_FF_BALANCE method (reciprocity.c): the two
  * estimates of each pair combined by method->density (row methods), then
@@ -127,7 +127,7 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
  * the stats' balance fields.  Polls rad_cancelled (RAD_ERROR_INTERRUPTED);
  * fails otherwise only for memory (F then unchanged). */
 rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
-                          const void *shared, float *F, float *var, rad_ff_stats *stats);
+                          const void *shared, double *F, double *var, rad_ff_stats *stats);
 
 /* ---- the plane tolerance and the facing test (formfactor.c): every
  * method, and the hierarchical links ---- */
@@ -157,7 +157,7 @@ bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_to
  * power-coupling matrix G = A F), then F_ij <- x_i x_j F_ij.  Keeps zeros,
  * positivity and A_i F_ij = A_j F_ji; rows that see nothing stay 0.
  * Fails only for memory (2n doubles), F then unchanged. */
-rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, float *F);
+rad_result rad_ff_close(rad_context *ctx, const rad_mesh *mesh, double *F);
 
 /* Is the scene closed?  Per element, the fraction of the light leaving it
  * that escapes the scene, into fraction[n]: cosine-distributed rays from
@@ -180,7 +180,7 @@ rad_result rad_ff_escape_rays(rad_context *ctx, const rad_mesh *mesh, const rad_
  * closure correction leaves its row at 0, and it is mostly faces pressed
  * against others (a box's bottom on a floor, whose rays start below the
  * floor and escape).  0 when nothing sees anything.  Cannot fail. */
-double rad_ff_escaped(const rad_mesh *mesh, const double *fraction, const float *F);
+double rad_ff_escaped(const rad_mesh *mesh, const double *fraction, const double *F);
 
 /* The refusal of the closure correction on an open scene (`escaped` of the
  * light escapes), naming the scene `source`: RAD_ERROR_INVALID_ARGUMENT. */

@@ -46,14 +46,11 @@
  * then settles between them, within the noise.  Last, every row above 1
  * (rounding, or that compromise) is scaled down to 1.
  *
- * F and the variances are rows of `ff_real` (one word to change their
- * precision).  rad_options.raw_form_factors turns the step off.
+ * rad_options.raw_form_factors turns the step off.
  */
 #include "formfactor/formfactor.h"
 
 #include <string.h>
-
-typedef float ff_real; /* the element type of F's rows */
 
 enum { CLOSURE_RAYS = 256, BLOCK = 64 };
 
@@ -109,7 +106,7 @@ static rad_result closure_rays(rad_context *ctx, const rad_ff_request *req, doub
 }
 
 /* Step 1: A_i F_ij and A_j F_ji combined with weights density[i], [j]. */
-static void symmetrize(const rad_mesh *mesh, const double *density, ff_real *F, ff_real *var)
+static void symmetrize(const rad_mesh *mesh, const double *density, double *F, double *var)
 {
     size_t n = mesh->element_count;
     for (size_t i = 0; i < n; i++) {
@@ -119,21 +116,21 @@ static void symmetrize(const rad_mesh *mesh, const double *density, ff_real *F, 
             if (!(w > 0.0))
                 continue;
             double g = (wi * ai * F[i * n + j] + wj * aj * F[j * n + i]) / w;
-            F[i * n + j] = (ff_real)(g / ai);
-            F[j * n + i] = (ff_real)(g / aj);
+            F[i * n + j] = (g / ai);
+            F[j * n + i] = (g / aj);
             if (var) {
                 double v = (wi * wi * ai * ai * var[i * n + j] + wj * wj * aj * aj * var[j * n + i]) / (w * w);
-                var[i * n + j] = (ff_real)(v / (ai * ai));
-                var[j * n + i] = (ff_real)(v / (aj * aj));
+                var[i * n + j] = (v / (ai * ai));
+                var[j * n + i] = (v / (aj * aj));
             }
         }
     }
 }
 
 rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
-                          const void *shared, float *F_rows, float *var_rows, rad_ff_stats *stats)
+                          const void *shared, double *F_rows, double *var_rows, rad_ff_stats *stats)
 {
-    ff_real *F = F_rows, *var = var_rows;
+    double *F = F_rows, *var = var_rows;
     const rad_mesh *mesh = req->mesh;
     size_t n = mesh->element_count;
     double *work = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 4 * n, sizeof *work, "form factors: reciprocity");
@@ -175,7 +172,7 @@ rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const r
     }
     /* Step 2: x_i sum_j G_ij x_j = A_i t_i, by the symmetric Sinkhorn
      * iteration x_i <- sqrt(x_i A_i t_i / sum_j G_ij x_j).  Until the worst
-     * row is right to 1e-7 (float rounding of F), or while it still
+     * row is right to 1e-7 (far below the sampling noise), or while it still
      * improves (inconsistent targets of an open scene stall it). */
     for (size_t i = 0; i < n; i++) {
         target[i] = fmin(target[i], 1.0);
@@ -219,9 +216,9 @@ rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const r
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++) {
             double scale = x[i] * x[j];
-            F[i * n + j] = (ff_real)(F[i * n + j] * scale);
+            F[i * n + j] = (F[i * n + j] * scale);
             if (var)
-                var[i * n + j] = (ff_real)(var[i * n + j] * scale * scale);
+                var[i * n + j] = (var[i * n + j] * scale * scale);
         }
     if (n == 0)
         stats->closure_scale_min = stats->closure_scale_max = 1.0;

@@ -301,7 +301,7 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
 
     cJSON *mem = cJSON_AddObjectToObject(root, "memory_bytes");
     cJSON_AddNumberToObject(mem, "peak_resident", (double)rad_peak_memory_bytes());
-    cJSON_AddNumberToObject(mem, "form_factor_matrix", s->F ? (double)n * (double)n * sizeof(float) : 0.0);
+    cJSON_AddNumberToObject(mem, "form_factor_matrix", s->F ? (double)n * (double)n * sizeof(double) : 0.0);
     cJSON_AddNumberToObject(mem, "limit", s->options->max_memory_bytes);
     /* The allocator's figures: everything the engine itself holds in this
      * context, at its peak, and each stage's peak (docs/stats.md). */
@@ -406,6 +406,30 @@ static void vf_rows_free(vf_rows *r)
     memset(r, 0, sizeof *r);
 }
 
+/* A JSON array of doubles that read back as the same doubles: each in the
+ * fewest of 15, 16 or 17 significant digits that strtod returns exactly
+ * (cJSON's own numbers stop at 15 digits when they are within 2 ulp).
+ * NULL when memory runs out. */
+static cJSON *exact_array(const double *v, size_t count)
+{
+    cJSON *array = cJSON_CreateArray();
+    for (size_t k = 0; array && k < count; k++) {
+        char text[32];
+        for (int digits = 15; digits <= 17; digits++) {
+            snprintf(text, sizeof text, "%.*g", digits, v[k]);
+            if (strtod(text, NULL) == v[k])
+                break;
+        }
+        cJSON *item = cJSON_CreateRaw(text);
+        if (!item) {
+            cJSON_Delete(array);
+            return NULL;
+        }
+        cJSON_AddItemToArray(array, item);
+    }
+    return array;
+}
+
 static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bool elements, vf_rows *r)
 {
     memset(r, 0, sizeof *r);
@@ -413,12 +437,13 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
     r->count = elements ? n : S;
     bool with_err = s->F_variance != NULL;
     double bytes = (double)r->count * (double)r->count * sizeof *r->F * (with_err ? 2.0 : 1.0);
-    if (bytes > s->options->max_memory_bytes)
+    double held = (double)n * (double)n * sizeof *s->F; /* F itself, beside the table */
+    if (bytes + held > s->options->max_memory_bytes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "view factors: the %zu x %zu table needs %.2f GiB, above the memory limit "
-                        "of %.2f GiB (rad_options.max_memory_bytes); use surface-level view factors or fewer "
-                        "rad_options.target_elements",
-                        r->count, r->count, bytes / 1073741824.0,
+                        "view factors: the %zu x %zu table needs %.2f GiB beside the %.2f GiB form-factor "
+                        "matrix, above the memory limit of %.2f GiB (rad_options.max_memory_bytes); use "
+                        "surface-level view factors or fewer rad_options.target_elements",
+                        r->count, r->count, bytes / 1073741824.0, held / 1073741824.0,
                         s->options->max_memory_bytes / 1073741824.0);
     r->names = rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->names, "view factors: names");
     r->area = r->names ? rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->area, "view factors: areas") : NULL;
@@ -507,7 +532,7 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
             cJSON_AddNumberToObject(o, "area", rows.area[a]);
             cJSON_AddNumberToObject(o, "row_sum", sum);
             cJSON_AddItemToArray(list, o);
-            cJSON_AddItemToArray(F, cJSON_CreateDoubleArray(rows.F + a * N, (int)N));
+            cJSON_AddItemToArray(F, exact_array(rows.F + a * N, N));
             if (E)
                 cJSON_AddItemToArray(E, cJSON_CreateDoubleArray(rows.err + a * N, (int)N));
         }
@@ -550,7 +575,7 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
             for (size_t a = 0; a < N; a++)
                 for (size_t b = 0; b < N; b++)
                     if (rows.F[a * N + b] != 0.0)
-                        fprintf(f.file, "%zu %zu %.9g\n", a + 1, b + 1, rows.F[a * N + b]);
+                        fprintf(f.file, "%zu %zu %.17g\n", a + 1, b + 1, rows.F[a * N + b]);
         }
         if (r == RAD_OK)
             r = rad_atomic_commit(ctx, &f);

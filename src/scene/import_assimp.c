@@ -17,8 +17,15 @@
  *    leniently and reports no line numbers, so a light pre-scan of the OBJ
  *    and MTL text checks vertex coordinates, face indices and Kd/Ke first
  *    (obj_prescan.c);
- *  - it stores coordinates and colours as float (ai_real): decimal_of()
- *    maps them back to the decimal the file most likely held;
+ *  - it stores coordinates and colours as float (ai_real, as Debian builds
+ *    it), so an OBJ coordinate 0.1234567891 would arrive with 7 digits:
+ *    an OBJ's positions and its materials' Kd and Ke are read with strtod
+ *    by the pre-scan instead, and assimp reads a text whose `v` statements
+ *    hold each vertex's index (obj_prescan.c, import_obj_exact_positions),
+ *    so that it still gives the structure (objects, groups, materials,
+ *    faces) and every face corner finds its exact position; glTF
+ *    positions and colours are floats by the spec, and decimal_of() maps
+ *    them back to the decimal the file most likely held;
  *  - it ignores KHR_materials_emissive_strength, turns the glTF camera's
  *    yfov into an approximate horizontal angle and copies the camera node's
  *    translation into aiCamera::mPosition (counting it twice): the glTF
@@ -136,6 +143,8 @@ typedef struct converter {
     int *note_of;                /* aiMaterial index -> its note; -1 = none; NULL: no notes */
     struct note_use *uses;       /* which surfaces use a noted material */
     size_t use_count, use_capacity;
+    const import_obj_positions *positions;       /* OBJ: the exact positions; else NULL */
+    const import_material_names *materials_exact; /* OBJ: exact Kd and Ke; else NULL */
 } converter;
 
 /* A surface that uses a material with a note. */
@@ -183,6 +192,14 @@ static int convert_material(converter *cv, unsigned index)
         emission[0] = M_PI * decimal_of(color.r) * strength;
         emission[1] = M_PI * decimal_of(color.g) * strength;
         emission[2] = M_PI * decimal_of(color.b) * strength;
+    }
+    /* An MTL's Kd and Ke as the file writes them, not as assimp's floats. */
+    const import_material_name *exact = import_material_find(cv->materials_exact, name.data);
+    for (int c = 0; exact && c < 3; c++) {
+        if (exact->has_kd)
+            reflectance[c] = exact->kd[c];
+        if (exact->has_ke)
+            emission[c] = M_PI * exact->ke[c];
     }
     cv->material_of[index] = rad_scene_builder_material(cv->builder, name.data, reflectance,
                                                         emission);
@@ -315,6 +332,27 @@ static rad_result notes_name_surfaces(converter *cv)
     return r;
 }
 
+/* A vertex of assimp's mesh as a position: for an OBJ the exact one whose
+ * index assimp carries in its coordinates (import_obj_exact_positions);
+ * false if it carries none (which the rewritten text rules out). */
+static bool exact_position(const converter *cv, const struct aiVector3D *vertex, vec3 *position)
+{
+    if (!cv->positions) {
+        *position = vec3_of(vertex);
+        return true;
+    }
+    double low = vertex->x, high = vertex->y, limit = (double)(1u << IMPORT_OBJ_INDEX_BITS);
+    if (!(low >= 0.0 && low < limit && high >= 0.0 && high < limit && low == floor(low) &&
+          high == floor(high) && vertex->z == 0))
+        return false;
+    size_t k = (size_t)low + ((size_t)high << IMPORT_OBJ_INDEX_BITS);
+    if (k >= cv->positions->count)
+        return false;
+    const double *xyz = &cv->positions->xyz[3 * k];
+    *position = v3(xyz[0], xyz[1], xyz[2]);
+    return true;
+}
+
 static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigned mesh_index,
                                const affine *world)
 {
@@ -355,8 +393,12 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
                 return rad_fail(cv->ctx, RAD_ERROR_PARSE,
                                 "%s: mesh '%s': face references vertex %u of %u", cv->name,
                                 mesh->mName.data, v, mesh->mNumVertices);
-            cv->face[mirrored ? face->mNumIndices - 1 - i : i] =
-                affine_point(world, vec3_of(&mesh->mVertices[v]));
+            vec3 position;
+            if (!exact_position(cv, &mesh->mVertices[v], &position))
+                return rad_fail(cv->ctx, RAD_ERROR_PARSE,
+                                "%s: mesh '%s': vertex %u is not one of the file's %zu", cv->name,
+                                mesh->mName.data, v, cv->positions->count);
+            cv->face[mirrored ? face->mNumIndices - 1 - i : i] = affine_point(world, position);
         }
         rad_result r = rad_scene_builder_polygon(cv->builder, surface, material, cv->face,
                                                  face->mNumIndices, 0);
@@ -553,6 +595,10 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
 
     rad_result r = RAD_OK;
     converter cv = {.ctx = ctx, .name = name, .ai = ai, .notes = &in->notes};
+    if (!gltf) {
+        cv.positions = &in->positions;
+        cv.materials_exact = &in->materials_exact;
+    }
     cv.gltf_materials = cJSON_GetObjectItemCaseSensitive(json, "materials");
     if (!ai->mRootNode || ai->mNumMeshes == 0) {
         r = rad_fail(ctx, RAD_ERROR_INVALID_SCENE, "%s: scene is empty (no polygons)", name);

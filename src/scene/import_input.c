@@ -5,6 +5,8 @@
  *    scene file --read (at most limit / 20 bytes)--> bytes --content--> OBJ | glTF | GLB
  *    OBJ: pre-scan; every `mtllib` name read and pre-scanned, in order,
  *         each file once --> the libraries' text, one after the other
+ *    OBJ: positions read exactly, `v` lines rewritten as vertex indices
+ *         (obj_prescan.c, import_obj_exact_positions)
  *    --> import_input: what assimp is served from memory (assimp_io.c)
  *
  * The format.  assimp 5.2 picks its reader by the file's extension when
@@ -28,7 +30,9 @@
  * corners).  So no more than limit / 20 bytes are read, the file and its
  * libraries together: a regular file larger than that is refused by its
  * size, unread, and a stream (a FIFO, /dev/zero) when it has given that
- * much.
+ * much.  An OBJ's exact positions (24 bytes a vertex) and the text
+ * assimp reads in its place (each `v` line at most 22 bytes) are the
+ * allocator's, and the file's own text is freed once they are made.
  *
  * The libraries.  `mtllib a.mtl b.mtl` names two (the OBJ format separates
  * names by blanks; assimp 5.2 would open "a.mtl b.mtl"); a line whose whole
@@ -91,6 +95,8 @@ void import_input_free(import_input *in)
     rad_free(in->alias);
     rad_free(in->owned[0]);
     rad_free(in->owned[1]);
+    import_obj_positions_free(&in->positions);
+    import_material_names_free(&in->materials_exact);
     import_notes_free(&in->notes);
     memset(in, 0, sizeof *in);
 }
@@ -386,6 +392,20 @@ static rad_result check_materials(rad_context *ctx, const char *path, const char
     return r == RAD_OK ? import_obj_check_usemtl(ctx, path, text, size, names) : r;
 }
 
+/* The OBJ's exact positions and the text assimp reads instead of `in`'s
+ * (obj_prescan.c); the text read is freed, it is not needed again. */
+static rad_result exact_positions(rad_context *ctx, const char *name, import_input *in)
+{
+    rad_result r = import_obj_exact_positions(ctx, name, in->data, in->size, &in->positions);
+    if (r != RAD_OK)
+        return r;
+    rad_free(in->owned[0]);
+    in->owned[0] = NULL;
+    in->data = in->positions.text;
+    in->size = in->positions.size;
+    return RAD_OK;
+}
+
 /* ---- the two ways in ---- */
 
 rad_result import_input_read_file(rad_context *ctx, const char *path, import_file_log *log,
@@ -437,8 +457,10 @@ rad_result import_input_read_file(rad_context *ctx, const char *path, import_fil
     }
     rad_free(l.all.text);
     rad_free(l.seen);
-    import_material_names_free(&l.names);
+    in->materials_exact = l.names;
     import_obj_scan_free(&scan);
+    if (r == RAD_OK)
+        r = exact_positions(ctx, path, in);
     if (r != RAD_OK)
         import_input_free(in);
     return r;
@@ -498,8 +520,10 @@ rad_result import_input_from_memory(rad_context *ctx, const char *name, const ch
             r = RAD_ERROR_OUT_OF_MEMORY;
         }
     }
-    import_material_names_free(&names);
+    in->materials_exact = names;
     import_obj_scan_free(&scan);
+    if (r == RAD_OK)
+        r = exact_positions(ctx, name, in);
     if (r != RAD_OK)
         import_input_free(in);
     return r;

@@ -94,12 +94,37 @@ rad_result import_obj_prescan(rad_context *ctx, const char *path, const char *te
                               import_obj_scan *scan);
 void import_obj_scan_free(import_obj_scan *scan);
 
+/* The OBJ's vertex positions as the file writes them, for assimp keeps
+ * them as float (Debian's assimp is built with float ai_real), and the
+ * text assimp is served instead, whose every `v` statement is rewritten as
+ * "v LOW HIGH 0": its 0-based index k = LOW + HIGH x 2^24, each part an
+ * integer below 2^24, so exact in float.  assimp copies a position to
+ * every face corner that names it, so each corner of its meshes gives the
+ * index of the exact position back (import_assimp.c).  OBJ only. */
+typedef struct import_obj_positions {
+    double *xyz;  /* 3 per `v` statement, in file order; x/w etc. for "v x y z w" (rad_alloc'd) */
+    size_t count;
+    char *text;   /* the OBJ text with its `v` statements rewritten (rad_alloc'd) */
+    size_t size;
+} import_obj_positions;
+
+#define IMPORT_OBJ_INDEX_BITS 24
+
+/* Read the positions of the pre-scanned OBJ text [text, text + size) with
+ * strtod and make the text assimp reads.  RAD_ERROR_OUT_OF_MEMORY (`out`
+ * then empty) or RAD_OK. */
+rad_result import_obj_exact_positions(rad_context *ctx, const char *path, const char *text,
+                                      size_t size, import_obj_positions *out);
+void import_obj_positions_free(import_obj_positions *positions);
+
 /* The materials the libraries of one OBJ define: where each name is. */
 typedef struct import_material_name {
     char *name;     /* as `newmtl` gives it, the rest of its line (rad_alloc'd) */
     size_t library; /* index into import_material_names.libraries */
     int line;
     size_t order;   /* definition order */
+    bool has_kd, has_ke; /* Kd / Ke given (the last of each counts, as in assimp) */
+    double kd[3], ke[3]; /* as strtod reads them: assimp keeps only floats */
 } import_material_name;
 
 typedef struct import_material_names {
@@ -124,6 +149,10 @@ rad_result import_material_names_check(rad_context *ctx, import_material_names *
 rad_result import_obj_check_usemtl(rad_context *ctx, const char *path, const char *text,
                                    size_t size, const import_material_names *names);
 void import_material_names_free(import_material_names *names);
+/* The material called `name` (names sorted by import_material_names_check),
+ * or NULL.  Cannot fail. */
+const import_material_name *import_material_find(const import_material_names *names,
+                                                 const char *name);
 
 /* ---- import_input.c ---- */
 
@@ -157,6 +186,8 @@ typedef struct import_input {
     size_t materials_size;
     import_notes notes;    /* what the pre-scans found unused, said after a load (unused.c) */
     char *owned[2];        /* the blocks above that are ours (rad_free) */
+    import_obj_positions positions; /* OBJ: the exact positions; `data` is then its text */
+    import_material_names materials_exact; /* OBJ: every library's materials, Kd and Ke exact */
 } import_input;
 
 /* Read the scene file `path` once (within the memory limit: a file or

@@ -453,8 +453,8 @@ static rad_result add_material_name(rad_context *ctx, import_material_names *nam
         names->entries = entries;
         names->capacity = grown;
     }
-    names->entries[names->count] =
-        (import_material_name){name, names->library_count - 1, line, names->count};
+    names->entries[names->count] = (import_material_name){
+        .name = name, .library = names->library_count - 1, .line = line, .order = names->count};
     names->count++;
     names->sorted = false;
     return RAD_OK;
@@ -767,6 +767,9 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
             memcpy(is_kd ? extras->kd : extras->ke, values, sizeof values);
             *(is_kd ? &extras->has_kd : &extras->has_ke) = true;
         }
+        import_material_name *entry = &names->entries[names->count - 1]; /* this material */
+        memcpy(is_kd ? entry->kd : entry->ke, values, sizeof values);
+        *(is_kd ? &entry->has_kd : &entry->has_ke) = true;
     }
     if (r == RAD_OK && extras && seen_newmtl)
         r = note_mtl_material(ctx, path, name, material, extras, notes);
@@ -843,6 +846,20 @@ rad_result import_obj_check_usemtl(rad_context *ctx, const char *path, const cha
     return RAD_OK;
 }
 
+const import_material_name *import_material_find(const import_material_names *names,
+                                                 const char *name)
+{
+    if (!names || names->count == 0)
+        return NULL;
+    if (names->sorted)
+        return bsearch(name, names->entries, names->count, sizeof *names->entries,
+                       compare_name_to_entry);
+    for (size_t i = 0; i < names->count; i++)
+        if (strcmp(names->entries[i].name, name) == 0)
+            return &names->entries[i];
+    return NULL;
+}
+
 void import_material_names_free(import_material_names *names)
 {
     for (size_t i = 0; i < names->count; i++)
@@ -852,4 +869,75 @@ void import_material_names_free(import_material_names *names)
     rad_free(names->entries);
     rad_free(names->libraries);
     memset(names, 0, sizeof *names);
+}
+
+/* ---- the exact positions (assimp reads them as float) ---- */
+
+/* Read a `v` statement's numbers, the rest of its line [p, end), which
+ * the pre-scan has checked: 3, 4 or 6 finite numbers. */
+static void read_position(const char *p, const char *end, double xyz[3])
+{
+    char token[TOKEN_SIZE];
+    double value[6] = {0, 0, 0, 1, 0, 0};
+    int count = 0;
+    while (count < 6 && next_token(&p, end, token) > 0)
+        value[count++] = strtod(token, NULL);
+    double w = count == 4 ? value[3] : 1.0; /* x y z w: homogeneous, as assimp reads it */
+    for (int k = 0; k < 3; k++)
+        xyz[k] = w == 1.0 ? value[k] : value[k] / w;
+}
+
+rad_result import_obj_exact_positions(rad_context *ctx, const char *path, const char *text,
+                                      size_t size, import_obj_positions *out)
+{
+    memset(out, 0, sizeof *out);
+    char token[TOKEN_SIZE];
+    const char *p, *end;
+    /* First pass: how many positions, and the rewritten text's size. */
+    size_t count = 0, bytes = 0;
+    text_lines lines = text_lines_of(text, size);
+    const char *start = lines.next;
+    while (next_line(&lines, &p, &end)) {
+        next_token(&p, end, token);
+        if (strcmp(token, "v") == 0) {
+            bytes += (size_t)snprintf(NULL, 0, "v %zu %zu 0\n", count & ((1u << IMPORT_OBJ_INDEX_BITS) - 1),
+                                      count >> IMPORT_OBJ_INDEX_BITS);
+            count++;
+        } else {
+            bytes += (size_t)(lines.next - start);
+        }
+        start = lines.next;
+    }
+    out->xyz = rad_alloc(ctx, RAD_MEM_SCENE, count ? 3 * count : 1, sizeof *out->xyz, path);
+    out->text = out->xyz ? rad_alloc(ctx, RAD_MEM_SCENE, bytes + 1, 1, path) : NULL;
+    if (!out->text) {
+        import_obj_positions_free(out);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    /* Second pass: read them, write the text. */
+    lines = text_lines_of(text, size);
+    start = lines.next;
+    char *at = out->text;
+    while (next_line(&lines, &p, &end)) {
+        next_token(&p, end, token);
+        if (strcmp(token, "v") == 0) {
+            size_t k = out->count++;
+            read_position(p, end, &out->xyz[3 * k]);
+            at += snprintf(at, bytes + 1 - (size_t)(at - out->text), "v %zu %zu 0\n",
+                           k & ((1u << IMPORT_OBJ_INDEX_BITS) - 1), k >> IMPORT_OBJ_INDEX_BITS);
+        } else {
+            memcpy(at, start, (size_t)(lines.next - start));
+            at += lines.next - start;
+        }
+        start = lines.next;
+    }
+    out->size = (size_t)(at - out->text);
+    return RAD_OK;
+}
+
+void import_obj_positions_free(import_obj_positions *positions)
+{
+    rad_free(positions->xyz);
+    rad_free(positions->text);
+    memset(positions, 0, sizeof *positions);
 }

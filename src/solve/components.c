@@ -68,9 +68,9 @@ static size_t label_components(const rad_system *sys, size_t *parent, size_t *si
         size[i] = 1;
     }
     for (size_t i = 0; i < n && sets > 1; i++) {
-        const float *Fi = sys->F + i * n;
+        const double *Fi = sys->F + i * n;
         for (size_t j = 0; j < n; j++)
-            if (j != i && Fi[j] > 0.0f && join(parent, size, i, j) != SIZE_MAX)
+            if (j != i && Fi[j] > 0.0 && join(parent, size, i, j) != SIZE_MAX)
                 sets--;
     }
     size_t count = 0;
@@ -194,14 +194,14 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
     /* One block (the usual case), or no room for a copy of the largest
      * block beside F (splitting is an optimisation): solve as a whole. */
     double limit = sys->max_memory > 0.0 ? sys->max_memory : rad_memory_limit(ctx);
-    double copy_bytes = 4.0 * (double)largest * (double)largest + 80.0 * (double)largest;
-    if (multi < 2 || 4.0 * (double)n * (double)n + copy_bytes > limit) {
+    double copy_bytes = 8.0 * (double)largest * (double)largest + 80.0 * (double)largest;
+    if (multi < 2 || 8.0 * (double)n * (double)n + copy_bytes > limit) {
         groups_free(&g);
         return solver->solve(ctx, sys, p, B, stats);
     }
 
     double t0 = rad_seconds();
-    float *F_sub = rad_alloc(ctx, RAD_MEM_SOLVER, largest * largest, sizeof *F_sub, "solve: components: block of F");
+    double *F_sub = rad_alloc(ctx, RAD_MEM_SOLVER, largest * largest, sizeof *F_sub, "solve: components: block of F");
     double *vectors = rad_alloc(ctx, RAD_MEM_SOLVER, 10 * largest, sizeof *vectors, "solve: components: block vectors");
     double *row = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *row, "solve: components: row residuals");
     if (!F_sub || !vectors || !row) {
@@ -257,8 +257,8 @@ rad_result rad_solve_by_components(rad_context *ctx, const rad_solver *solver, c
         double group_area = 0.0;
         for (size_t a = 0; a < m; a++) {
             size_t i = members[a];
-            const float *Fi = sys->F + i * n;
-            float *Fa = F_sub + a * m;
+            const double *Fi = sys->F + i * n;
+            double *Fa = F_sub + a * m;
             for (size_t b = 0; b < m; b++)
                 Fa[b] = Fi[members[b]];
             area[a] = sys->area[i];

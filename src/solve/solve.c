@@ -82,7 +82,7 @@ double rad_system_contraction(const rad_system *sys)
         /* The largest of sums each made in one order: thread-count independent. */
 #pragma omp parallel for schedule(static) reduction(max : rows) num_threads(rad_pass_threads(sys))
         for (size_t i = 0; i < n; i++) {
-            const float *Fi = sys->F + i * n;
+            const double *Fi = sys->F + i * n;
             double s = 0.0;
             for (size_t j = 0; j < n; j++)
                 s += Fi[j];

@@ -18,7 +18,7 @@ struct rad_vis;
 
 typedef struct rad_system {
     size_t n;
-    const float *F;           /* n x n, row i = factors from i */
+    const double *F;          /* n x n, row i = factors from i */
     const double *area;       /* n, m^2 */
     const double *reflectance;/* 3n, interleaved RGB */
     const double *emission;   /* 3n, W/m^2 */
@@ -154,7 +154,7 @@ static inline int rad_pass_threads(const rad_system *sys)
 }
 
 /* Irradiance gathered by one row: g[c] = sum_j F_ij B_jc (B interleaved RGB). */
-static inline void rad_gather(const float *F_row, const double *B, size_t n, double g[3])
+static inline void rad_gather(const double *F_row, const double *B, size_t n, double g[3])
 {
     double g0 = 0.0, g1 = 0.0, g2 = 0.0;
     for (size_t j = 0; j < n; j++) {

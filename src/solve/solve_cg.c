@@ -14,7 +14,7 @@
  *   - elements with rho_ic = 0 have B_i = E_i: they are eliminated (their
  *     search directions are held at zero, so their known values act only
  *     through the right-hand side of the others);
- *   - F is float and reciprocity holds only to its rounding (and to the
+ *   - reciprocity holds only to the rounding of F (and to the
  *     form-factor method's own error), so CG runs on the symmetric part
  *
  *         M_ij = (A_i / rho_i) delta_ij - (A_i F_ij + A_j F_ji) / 2,
@@ -74,7 +74,7 @@ typedef struct cg_state {
 static void multiply_rows(const cg_state *s, const double *v, double *out)
 {
     size_t n = s->n;
-    const float *F = s->sys->F;
+    const double *F = s->sys->F;
 #pragma omp parallel for schedule(static) num_threads(s->threads)
     for (size_t i = 0; i < n; i++)
         rad_gather(F + i * n, v, n, out + 3 * i);
@@ -85,14 +85,14 @@ static void multiply_rows(const cg_state *s, const double *v, double *out)
 static void multiply_columns(const cg_state *s, const double *v, double *out)
 {
     size_t n = s->n;
-    const float *F = s->sys->F;
+    const double *F = s->sys->F;
     size_t blocks = (n + COLUMNS - 1) / COLUMNS;
 #pragma omp parallel for schedule(static) num_threads(s->threads)
     for (size_t b = 0; b < blocks; b++) {
         size_t i0 = b * COLUMNS, i1 = i0 + COLUMNS < n ? i0 + COLUMNS : n, m = i1 - i0;
         double acc0[COLUMNS] = {0}, acc1[COLUMNS] = {0}, acc2[COLUMNS] = {0};
         for (size_t j = 0; j < n; j++) {
-            const float *Fj = F + j * n + i0;
+            const double *Fj = F + j * n + i0;
             double w0 = v[3 * j], w1 = v[3 * j + 1], w2 = v[3 * j + 2];
             for (size_t k = 0; k < m; k++) {
                 double f = Fj[k];

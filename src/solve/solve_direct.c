@@ -7,7 +7,7 @@
  *
  * O(n^3) time and 8 n^2 bytes, but no tolerance: the answer is exact up to
  * double rounding, so it is the reference the iterative solvers are tested
- * against.  K_c is built from the float F in double, so the system solved
+ * against.  K_c is built from F as it is stored, so the system solved
  * is the engine's own; channels with the same reflectance everywhere (grey
  * scenes) share one factorisation.  K is written column-major, as LAPACK
  * keeps it, so LAPACKE makes no transposed copy of its own.  Above the
@@ -61,7 +61,7 @@ static void build_matrix(const rad_system *sys, const double *rho, size_t stride
         for (size_t i0 = 0; i0 < n; i0 += TILE) {
             size_t i1 = i0 + TILE < n ? i0 + TILE : n;
             for (size_t i = i0; i < i1; i++) {
-                const float *Fi = sys->F + i * n;
+                const double *Fi = sys->F + i * n;
                 double r = rho[stride * i];
                 for (size_t j = j0; j < j1; j++)
                     K[j * n + i] = (i == j ? 1.0 : 0.0) - r * (double)Fi[j];
@@ -138,15 +138,17 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
 {
     size_t n = sys->n;
     double t0 = rad_seconds();
-    /* K, the right-hand sides (up to 3 columns) and the pivots. */
-    double needed = 8.0 * (double)n * (double)n + 24.0 * (double)n + 4.0 * (double)n;
+    /* K, the right-hand sides (up to 3 columns) and the pivots, beside F
+     * (8 n^2 bytes too), which is held while K is built from it. */
+    double needed = 16.0 * (double)n * (double)n + 24.0 * (double)n + 4.0 * (double)n;
     double limit = sys->max_memory > 0.0 ? sys->max_memory : rad_memory_limit(ctx);
     if (needed > limit || n > (size_t)INT_MAX) {
         char need_text[32], limit_text[32];
         format_bytes(needed, need_text, sizeof need_text);
         format_bytes(limit, limit_text, sizeof limit_text);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                        "solve: the direct solver's LU of the %zu x %zu system needs %s (8 n^2 bytes), "
+                        "solve: the direct solver's LU of the %zu x %zu system needs %s (8 n^2 bytes "
+                        "beside F's 8 n^2), "
                         "above the memory limit of %s (rad_options.max_memory_bytes); use an iterative solver "
                         "(rad_options.solver: gauss-seidel, jacobi or conjugate-gradient) or fewer elements",
                         n, n, need_text, limit_text);
@@ -230,6 +232,6 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
 const rad_solver rad_solver_direct = {
     "direct",
     "LU factorisation (LAPACK dgesv) per colour channel: exact, the reference; O(n^3) time, "
-    "8 n^2 bytes (refused above rad_options.max_memory_bytes)",
+    "8 n^2 bytes beside F (refused above rad_options.max_memory_bytes)",
     direct,
 };

@@ -39,7 +39,7 @@ static rad_result gauss_seidel(rad_context *ctx, const rad_system *sys, const ra
         double change = 0.0;
         for (size_t i = 0; i < n; i++) {
             double g[3];
-            const float *Fi = sys->F + i * n;
+            const double *Fi = sys->F + i * n;
             rad_gather(Fi, B, n, g);
             const double *rho = sys->reflectance + 3 * i, *E = sys->emission + 3 * i;
             double fii = Fi[i]; /* nonzero only for concave elements */

@@ -87,7 +87,7 @@ static rad_result southwell(rad_context *ctx, const rad_system *sys, const rad_s
             break;
         /* Shoot w dB_i (overshooting for w > 1: Southwell over-relaxation);
          * B_i keeps its value, the rest of dB_i stays unshot (negative). */
-        const float *Fi = sys->F + best * n;
+        const double *Fi = sys->F + best * n;
         double s0 = w * dB[3 * best], s1 = w * dB[3 * best + 1], s2 = w * dB[3 * best + 2];
         double ai = sys->area[best];
         for (size_t j = 0; j < n; j++) {

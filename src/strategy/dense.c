@@ -2,7 +2,7 @@
  * dense.c -- the classic method: the full n x n form-factor matrix by one
  * of the methods in the form-factor table, then the linear system
  * (I - P F) B = E by one of the solvers in the solver table (Cohen &
- * Wallace 1993, ch. 4-5).  Memory grows as 4 n^2 bytes, so it is the
+ * Wallace 1993, ch. 4-5).  Memory grows as 8 n^2 bytes, so it is the
  * strategy for up to some 10^4 elements, and the one that can write view
  * factors.
  */
@@ -13,8 +13,8 @@
 
 typedef struct dense_state {
     rad_meshed base;           /* mesh, visibility, elements, stats */
-    float *F;                  /* n x n */
-    float *F_variance;         /* n x n, or NULL */
+    double *F;                 /* n x n */
+    double *F_variance;        /* n x n, or NULL */
 } dense_state;
 
 static bool dense_solver_info(size_t index, const char **name, const char **description)
@@ -46,7 +46,7 @@ static rad_result check_ff_scratch(rad_context *ctx, const rad_options *o, size_
         per_thread += 3.0 * R * R * 8.0; /* depth (float) and item (uint32) per pixel */
         option = "rad_options.hemicube_resolution";
     }
-    double matrix = 4.0 * (double)n * (double)n;
+    double matrix = 8.0 * (double)n * (double)n;
     double scratch = per_thread * (threads > 0 ? threads : 1);
     if (option && matrix <= o->max_memory_bytes && matrix + scratch > o->max_memory_bytes)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,

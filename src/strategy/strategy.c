@@ -264,7 +264,7 @@ rad_result rad_view_surface_view_factors(rad_context *ctx, const rad_solution_vi
     for (size_t i = 0; i < n; i++) {
         uint32_t si = v->mesh->elements[i].surface;
         area[si] += v->area[i];
-        const float *Fi = v->F + i * n;
+        const double *Fi = v->F + i * n;
         double *row = F + (size_t)si * S;
         for (size_t j = 0; j < n; j++)
             row[v->mesh->elements[j].surface] += v->area[i] * Fi[j];

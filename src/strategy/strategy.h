@@ -46,8 +46,8 @@ typedef struct rad_solution_view {
     const double *reflectance;      /* 3n, RGB */
     const double *emission;         /* 3n, W/m^2 */
     const double *radiosity;        /* 3n, W/m^2: E before solving, the iterate during */
-    const float *F;                 /* n x n; NULL where the strategy stores none */
-    const float *F_variance;        /* n x n for sampling methods that estimate it, else NULL */
+    const double *F;                 /* n x n; NULL where the strategy stores none */
+    const double *F_variance;        /* n x n for sampling methods that estimate it, else NULL */
     const rad_ff_stats *ff;
     const rad_solve_stats *solve;
     const rad_hier_stats *hier;     /* hierarchical only, else NULL */
