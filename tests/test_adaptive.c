@@ -16,9 +16,10 @@
  *   penumbra     along a line across the shadow edge, the smooth floor
  *                radiosity crosses half the unoccluded value within one
  *                finest element of the exact place
- *   mesh         restricted quadtrees: every T-vertex at the middle of its
- *                edge (neighbours one level apart at most); each element
- *                found at its own centre; the elements tile each patch
+ *   mesh         restricted quadtrees, of quads and (a triangular floor)
+ *                of triangles: every T-vertex at the middle of its edge
+ *                (neighbours one level apart at most); each element found
+ *                at its own centre; the elements tile each surface
  *   refinement   elements were split where the shadow edge is, and more
  *                levels or a lower threshold never give fewer elements; the
  *                budget is kept up to the balancing splits
@@ -277,17 +278,18 @@ static void test_penumbra(void **state)
     rad_solution_destroy(u);
 }
 
-static void test_mesh(void **state)
+/* The mesh of solution a: balanced (a T-vertex two levels apart would sit
+ * at t = 1/4 or 3/4: every one here is inside one patch), each element
+ * found at its own centre, the elements tiling each surface. */
+static void check_mesh(const rad_solution *a)
 {
-    (void)state;
-    rad_solution *a = adaptive(LEVELS, 0.0, 0);
     const rad_mesh *mesh = a->view.mesh;
     assert_non_null(mesh->tree);
     assert_true(mesh->tvertex_count > 0);
-    /* Balanced: a T-vertex two levels apart would sit at t = 1/4 or 3/4. */
     for (size_t k = 0; k < mesh->tvertex_count; k++)
         assert_true(fabs(mesh->tvertices[k].t - 0.5) < 1e-9);
-    double area[3] = {0, 0, 0};
+    const rad_scene *sc = a->scene;
+    double *area = calloc(sc->surface_count, sizeof *area);
     for (size_t i = 0; i < mesh->element_count; i++) {
         const rad_element *e = &mesh->elements[i];
         double u, v, ls, lt;
@@ -295,9 +297,41 @@ static void test_mesh(void **state)
         assert_int_equal(rad_mesh_locate(mesh, e->patch, u, v, &ls, &lt), i);
         area[e->surface] += e->area;
     }
-    for (size_t k = 0; k < scene->surface_count; k++)
-        assert_true(fabs(area[k] - scene->surfaces[k].area) < 1e-12 * scene->surfaces[k].area + 1e-15);
+    for (size_t k = 0; k < sc->surface_count; k++)
+        assert_true(fabs(area[k] - sc->surfaces[k].area) < 1e-12 * sc->surfaces[k].area);
+    free(area);
+}
+
+static void test_mesh(void **state)
+{
+    (void)state;
+    rad_solution *a = adaptive(LEVELS, 0.0, 0);
+    check_mesh(a);
     rad_solution_destroy(a);
+    /* Triangle quadtrees (corner and medial children): the floor as one
+     * triangle, its shadow edge crossing it. */
+    rad_scene_builder *b = rad_scene_builder_create(ctx, "triangle floor");
+    const double grey[3] = {0.5, 0.5, 0.5}, black[3] = {0, 0, 0}, light[3] = {EMISSION, EMISSION, EMISSION};
+    int m_grey = rad_scene_builder_material(b, "grey", grey, black);
+    int m_light = rad_scene_builder_material(b, "light", black, light);
+    const vec3 floor[3] = {{-1, -1, 0}, {1, -1, 0}, {-1, 1, 0}};
+    const vec3 plate[4] = {{-0.3, -0.3, 0.5}, {0.3, -0.3, 0.5}, {0.3, 0.3, 0.5}, {-0.3, 0.3, 0.5}};
+    const vec3 lamp[4] = {{-0.05, -0.05, 1.5}, {-0.05, 0.05, 1.5}, {0.05, 0.05, 1.5}, {0.05, -0.05, 1.5}};
+    assert_int_equal(rad_scene_builder_polygon(b, rad_scene_builder_surface(b, "floor"), m_grey, floor, 3, 0), RAD_OK);
+    assert_int_equal(rad_scene_builder_polygon(b, rad_scene_builder_surface(b, "plate"), m_grey, plate, 4, 0), RAD_OK);
+    assert_int_equal(rad_scene_builder_polygon(b, rad_scene_builder_surface(b, "light"), m_light, lamp, 4, 0),
+                     RAD_OK);
+    rad_scene *tri = NULL;
+    assert_int_equal(rad_scene_builder_finish(b, &tri), RAD_OK);
+    rad_options o = {.mesh_size = BASE, .adaptive_levels = LEVELS};
+    rad_solution *t = NULL;
+    assert_int_equal(rad_solution_create(ctx, tri, &o, &t), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, t), RAD_OK);
+    assert_int_equal(t->view.mesh->patches[0].corner_count, 3);
+    assert_true(t->view.adaptive->split > 0);
+    check_mesh(t);
+    rad_solution_destroy(t);
+    rad_scene_destroy(tri);
 }
 
 static void test_refinement(void **state)
