@@ -546,8 +546,10 @@ static rad_result score_elements(rad_context *ctx, const rad_adaptive *a, const 
                 /* The emitters too: what one element pair's shadow rays
                  * estimate (rad_ff_rays: a few per pair) is the visible
                  * part of the whole emitter element, so a large emitter
-                 * leaves the penumbra noisy however fine its receivers. */
-#pragma omp critical(adaptive_emitter)
+                 * leaves the penumbra noisy however fine its receivers.
+                 * (A max, so the order is free; unnamed, because a named
+                 * critical section is a symbol the library would export.) */
+#pragma omp critical
                 for (int k = 0; k < marked; k++)
                     emitter_score[varied[k]] = fmax(emitter_score[varied[k]], varying);
             }
