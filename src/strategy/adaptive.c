@@ -313,10 +313,12 @@ rad_result rad_adaptive_create(rad_context *ctx, rad_meshed *m, rad_adaptive **o
     memset(a, 0, sizeof *a);
     size_t P = m->mesh->patch_count;
     a->root = rad_alloc(ctx, RAD_MEM_MESH, P ? P : 1, sizeof *a->root, "adaptive: roots");
-    rad_result r = a->root ? grow(ctx, a, P) : RAD_ERROR_OUT_OF_MEMORY;
+    rad_result r = a->root ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
     int levels = m->options->adaptive_levels;
     for (size_t p = 0; r == RAD_OK && p < P; p++) {
         const rad_patch *pa = &m->mesh->patches[p];
+        if ((r = grow(ctx, a, 1)) != RAD_OK)
+            break;
         ad_node *n = &a->nodes[a->count];
         memset(n, 0, sizeof *n);
         memcpy(n->corner, pa->corner, sizeof n->corner);
@@ -339,8 +341,6 @@ rad_result rad_adaptive_create(rad_context *ctx, rad_meshed *m, rad_adaptive **o
                 if (!a->nodes[k].first_child && a->nodes[k].level == d)
                     r = split(ctx, a, (uint32_t)k);
     }
-    if (r == RAD_OK)
-        r = grow(ctx, a, 0);
     if (r != RAD_OK) {
         rad_adaptive_destroy(a);
         return r;
