@@ -22,7 +22,8 @@
  *                at its own centre; the elements tile each surface
  *   refinement   elements were split where the shadow edge is, and more
  *                levels or a lower threshold never give fewer elements; the
- *                budget is kept up to the balancing splits
+ *                budget (and the memory limit's cap on it) is kept up to
+ *                the balancing splits
  *   determinism  1 and 2 threads give bit-identical radiosities
  *   options      the non-dense solvers refuse it, naming the field
  */
@@ -363,6 +364,15 @@ static void test_refinement(void **state)
     rad_solution_destroy(a1);
     rad_solution_destroy(a3);
     rad_solution_destroy(low);
+    /* The memory limit caps the budget where the matrix (16 n^2 bytes at
+     * most) would not fit: 10 MiB, 809 elements (with no other solution
+     * alive: the limit counts the context's memory). */
+    rad_solution *small = solve_with(ctx, (rad_options){.mesh_size = BASE, .adaptive_levels = 3,
+                                                        .max_memory_bytes = 10485760.0});
+    size_t fits = (size_t)sqrt(10485760.0 / 16.0);
+    assert_true(small->view.n > small->view.adaptive->initial_elements);
+    assert_true(small->view.n <= fits + 3 * small->view.adaptive->balanced + 3);
+    rad_solution_destroy(small);
 }
 
 static void test_determinism(void **state)

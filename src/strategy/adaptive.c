@@ -587,6 +587,13 @@ rad_result rad_adaptive_refine(rad_context *ctx, rad_adaptive *a, rad_meshed *m,
 {
     const rad_options *o = m->options;
     size_t budget = o->adaptive_max_elements ? o->adaptive_max_elements : 4 * a->stats.initial_elements;
+    /* Within the memory limit: a matrix of n^2 doubles and as many
+     * variances (16 n^2 bytes, the most any form-factor method keeps), so a
+     * refinement that cannot be coupled is not made and the last solution
+     * stays. */
+    double fits = floor(sqrt(o->max_memory_bytes / 16.0));
+    if (fits < (double)budget)
+        budget = (size_t)fits;
     double ff_seconds = m->seconds.form_factors, solve_seconds = m->seconds.solve;
     rad_result r = RAD_OK;
     a->stats.rounds = 0;
