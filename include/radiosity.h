@@ -383,6 +383,16 @@ typedef struct rad_options {
                                      the source's radiosity variation: fewer links per
                                      element, per-surface means ~3x less accurate */
 
+    /* Adaptive subdivision (the dense solvers): after the solve, elements
+     * whose radiosity differs from a neighbour's by more than
+     * adaptive_threshold times the scene's mean radiosity, or across which
+     * the shadow rays to an emitter disagree, are split into four, the
+     * neighbours kept within one level, and the system coupled and solved
+     * again; up to adaptive_levels rounds (docs/methods.md). */
+    int adaptive_levels;          /* splits below the starting mesh; 0 = off */
+    double adaptive_threshold;    /* 0 = 0.1 */
+    size_t adaptive_max_elements; /* element budget; 0 = 4 x the starting mesh's */
+
     uint64_t seed;                /* all sampling is seeded per element pair: results do
                                      not depend on the thread count */
     double max_memory_bytes;      /* 0 = the context's limit (rad_context_options); else a

@@ -122,16 +122,18 @@ typedef struct scenario {
     const char *form_factors;
     int hemicube_resolution, samples, closure_correction;
     bool view_factors;           /* the strategy keeps F */
+    int adaptive_levels;
 } scenario;
 
 static const scenario scenarios[] = {
-    {"loading", NULL, NULL, 0, 0, 0, false},
-    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true},
-    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true},
-    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true},
-    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true},
-    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false},
-    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false},
+    {"loading", NULL, NULL, 0, 0, 0, false, 0},
+    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0},
+    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0},
+    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0},
+    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0},
+    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2},
+    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0},
+    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from
@@ -188,6 +190,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
         o.hemicube_resolution = sc->hemicube_resolution;
         o.samples = sc->samples;
         o.closure_correction = sc->closure_correction;
+        o.adaptive_levels = sc->adaptive_levels;
         o.record_history = 1;
         o.epsilon = 1e-3;
         o.seed = 1;

@@ -82,8 +82,14 @@ static int on_strategy_step(void *user, const rad_solve_step *step, bool display
     rad_solution *s = user;
     if (s->options.record_history && !history_push(s, step))
         return 1;
-    if (displayable && s->options.on_step)
+    if (displayable && s->options.on_step) {
+        /* Adaptive subdivision remeshes between solves: the view anew, and
+         * point values made again on demand. */
+        refresh_view(s);
+        rad_free(s->point_values);
+        s->point_values = NULL;
         return s->options.on_step(s->options.on_step_user, s, step);
+    }
     return 0;
 }
 

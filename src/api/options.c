@@ -100,6 +100,18 @@ static const rad_option_info solution_rows[] = {
      .default_text = "sources",
      .help = "hierarchical: split links on the receiver, visibility and the source's radiosity "
              "(sources), or on the first two only (classic: fewer links, ~3x the per-surface error)"},
+    {SOLUTION(adaptive_levels), .type = RAD_OPTION_INT, .min = 0.0, .max = 12.0, .default_value = 0.0,
+     .default_text = "0 (off)",
+     .help = "dense solvers: after solving, split elements where the radiosity changes or a shadow "
+             "edge crosses, up to this many levels (and rounds of coupling and solving) below the "
+             "starting mesh"},
+    {SOLUTION(adaptive_threshold), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1e3,
+     .default_value = 0.1, .default_text = "0.1",
+     .help = "adaptive: split an element whose radiosity differs from a neighbour's, or whose "
+             "shadowed emitter would add, more than this times the mean radiosity"},
+    {SOLUTION(adaptive_max_elements), .type = RAD_OPTION_SIZE, .min = 1.0, .max = 1e8, .default_value = NAN,
+     .default_text = "4 x the starting mesh's",
+     .help = "adaptive: stop splitting at this many elements (balancing neighbours may add a few)"},
     {SOLUTION(seed), .type = RAD_OPTION_UINT64, UINT64_RANGE, .default_value = 0.0, .default_text = "0",
      .help = "seed of all sampling; results do not depend on the thread count"},
     {SOLUTION(max_memory_bytes), .type = RAD_OPTION_BYTES, .min = 0.0, .min_open = true, .max = INFINITY,
@@ -369,6 +381,12 @@ rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_opti
     o.form_factors = names->form_factors;
     o.solver = names->solver;
     o.visibility = names->visibility;
+    const rad_strategy *strategy = rad_strategy_for_solver(o.solver);
+    if (o.adaptive_levels > 0 && strategy && strcmp(strategy->name, "dense") != 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "rad_options.adaptive_levels subdivides the mesh of the dense solvers; solver '%s' "
+                        "(%s) makes its own",
+                        o.solver, strategy->name);
     *out = o;
     return RAD_OK;
 }

@@ -175,6 +175,15 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
     cJSON_AddNumberToObject(mesh, "vertices", (double)s->mesh->vertex_count);
     cJSON_AddNumberToObject(mesh, "t_vertices", (double)s->mesh->tvertex_count);
     cJSON_AddNumberToObject(mesh, "mesh_size_m", s->mesh->mesh_size);
+    if (s->adaptive) {
+        cJSON *ad = cJSON_AddObjectToObject(mesh, "adaptive");
+        cJSON_AddNumberToObject(ad, "levels", s->options->adaptive_levels);
+        cJSON_AddNumberToObject(ad, "threshold", s->options->adaptive_threshold);
+        cJSON_AddNumberToObject(ad, "initial_elements", (double)s->adaptive->initial_elements);
+        cJSON_AddNumberToObject(ad, "rounds", s->adaptive->rounds);
+        cJSON_AddNumberToObject(ad, "split", (double)s->adaptive->split);
+        cJSON_AddNumberToObject(ad, "balanced", (double)s->adaptive->balanced);
+    }
     cJSON_AddNumberToObject(root, "elements", (double)n);
 
     cJSON *ff = cJSON_AddObjectToObject(root, "form_factors");

@@ -15,6 +15,7 @@ typedef struct dense_state {
     rad_meshed base;           /* mesh, visibility, elements, stats */
     double *F;                 /* n x n */
     double *F_variance;        /* n x n, or NULL */
+    rad_adaptive *adaptive;    /* rad_options.adaptive_levels > 0: the quadtrees, else NULL */
 } dense_state;
 
 static bool dense_solver_info(size_t index, const char **name, const char **description)
@@ -64,9 +65,38 @@ static void dense_destroy(void *state)
     if (!st)
         return;
     rad_meshed_free(&st->base);
+    rad_adaptive_destroy(st->adaptive);
     rad_free(st->F);
     rad_free(st->F_variance);
     rad_free(st);
+}
+
+/* F (and its variances) for the current mesh, the old ones freed (the
+ * adaptive mesh's coupling hook too). */
+static rad_result dense_couple(rad_context *ctx, void *state)
+{
+    dense_state *st = state;
+    rad_meshed *m = &st->base;
+    const rad_options *o = m->options;
+    const rad_scene *scene = m->scene;
+    rad_free(st->F);
+    rad_free(st->F_variance);
+    st->F = st->F_variance = NULL;
+    /* An open scene is refused the closure correction before F where the
+     * rays show it, after F (rad_form_factors) where only F can. */
+    double *escape = NULL, escaped = 0.0;
+    rad_result r = rad_strategy_check_closed(ctx, scene, o, m->mesh, m->vis, &escape, &escaped);
+    if (r == RAD_OK)
+        r = check_ff_scratch(ctx, o, m->mesh->element_count, m->threads);
+    if (r == RAD_OK) {
+        rad_ff_request req = {m->mesh, m->vis, o->seed, o->shadow_rays, o->hemicube_resolution, o->samples,
+                              o->near_field, escape, scene->source, o->raw_form_factors != 0};
+        r = rad_form_factors(ctx, rad_ff_find(o->form_factors), &req, o->max_memory_bytes,
+                             o->closure_correction != 0, &st->F, &st->F_variance, &m->ff_stats);
+        m->seconds.form_factors = m->ff_stats.seconds;
+    }
+    rad_free(escape);
+    return r;
 }
 
 static rad_result dense_create(rad_context *ctx, const rad_scene *scene, const rad_options *o, void **out)
@@ -81,20 +111,10 @@ static rad_result dense_create(rad_context *ctx, const rad_scene *scene, const r
         rad_free(st);
         return r;
     }
-    /* An open scene is refused the closure correction before F where the
-     * rays show it, after F (rad_form_factors) where only F can. */
-    double *escape = NULL, escaped = 0.0;
-    r = rad_strategy_check_closed(ctx, scene, o, m->mesh, m->vis, &escape, &escaped);
+    if (o->adaptive_levels > 0)
+        r = rad_adaptive_create(ctx, m, &st->adaptive);
     if (r == RAD_OK)
-        r = check_ff_scratch(ctx, o, m->mesh->element_count, m->threads);
-    if (r == RAD_OK) {
-        rad_ff_request req = {m->mesh, m->vis, o->seed, o->shadow_rays, o->hemicube_resolution, o->samples,
-                              o->near_field, escape, scene->source, o->raw_form_factors != 0};
-        r = rad_form_factors(ctx, rad_ff_find(o->form_factors), &req, o->max_memory_bytes,
-                             o->closure_correction != 0, &st->F, &st->F_variance, &m->ff_stats);
-        m->seconds.form_factors = m->ff_stats.seconds;
-    }
-    rad_free(escape);
+        r = dense_couple(ctx, st);
     if (r != RAD_OK) {
         dense_destroy(st);
         return r;
@@ -103,7 +123,7 @@ static rad_result dense_create(rad_context *ctx, const rad_scene *scene, const r
     return RAD_OK;
 }
 
-static rad_result dense_solve(rad_context *ctx, void *state, const rad_step_hook *hook)
+static rad_result dense_solve_mesh(rad_context *ctx, void *state, const rad_step_hook *hook)
 {
     dense_state *st = state;
     rad_meshed *m = &st->base;
@@ -120,12 +140,25 @@ static rad_result dense_solve(rad_context *ctx, void *state, const rad_step_hook
     return r;
 }
 
+/* Solve; with adaptive subdivision, then refine, couple and solve again. */
+static rad_result dense_solve(rad_context *ctx, void *state, const rad_step_hook *hook)
+{
+    dense_state *st = state;
+    rad_result r = dense_solve_mesh(ctx, st, hook);
+    if (r == RAD_OK && st->adaptive) {
+        rad_adaptive_hooks h = {dense_couple, dense_solve_mesh, st};
+        r = rad_adaptive_refine(ctx, st->adaptive, &st->base, &h, hook);
+    }
+    return r;
+}
+
 static void dense_view(const void *state, rad_solution_view *v)
 {
     const dense_state *st = state;
     rad_meshed_view(&st->base, v);
     v->F = st->F;
     v->F_variance = st->F_variance;
+    v->adaptive = rad_adaptive_get_stats(st->adaptive);
 }
 
 const rad_strategy rad_strategy_dense = {

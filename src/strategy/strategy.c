@@ -226,6 +226,7 @@ void rad_meshed_view(const rad_meshed *m, rad_solution_view *v)
     v->ff = &m->ff_stats;
     v->solve = &m->solve_stats;
     v->hier = NULL;
+    v->adaptive = NULL;
     v->solved = m->solved;
     v->seconds.mesh = m->seconds.mesh;
     v->seconds.visibility = m->seconds.visibility;

@@ -51,6 +51,7 @@ typedef struct rad_solution_view {
     const rad_ff_stats *ff;
     const rad_solve_stats *solve;
     const rad_hier_stats *hier;     /* hierarchical only, else NULL */
+    const struct rad_adaptive_stats *adaptive; /* dense with adaptive subdivision, else NULL */
     bool solved;
     rad_phase_seconds seconds;
     uint64_t render_rays;
@@ -162,6 +163,44 @@ void rad_meshed_end(rad_meshed *m, rad_result r, double t0);
 
 /* The view of a meshed strategy (F and F_variance left NULL). */
 void rad_meshed_view(const rad_meshed *m, rad_solution_view *v);
+
+/* ---- adaptive subdivision of a dense mesh (adaptive.c) ---- */
+
+/* The quadtrees of an adaptive mesh and what the rounds did. */
+typedef struct rad_adaptive rad_adaptive;
+
+typedef struct rad_adaptive_stats {
+    size_t initial_elements;        /* the uniform quadtrees' leaves */
+    size_t elements;                /* leaves now */
+    int rounds;                     /* refinements made (each followed by a coupling and a solve) */
+    size_t split;                   /* leaves split for their gradient or visibility */
+    size_t balanced;                /* leaves split to keep neighbours within one level */
+} rad_adaptive_stats;
+
+/* What adaptive.c asks of the strategy after each refinement: couplings
+ * for the meshed base's new mesh (the old ones freed), and a solve on it
+ * from B = E.  A failure ends the refinement with that result. */
+typedef struct rad_adaptive_hooks {
+    rad_result (*couple)(rad_context *ctx, void *state);
+    rad_result (*solve)(rad_context *ctx, void *state, const rad_step_hook *hook);
+    void *state;
+} rad_adaptive_hooks;
+
+/* Replace m's grid mesh (kept inside as the base) by uniform quadtrees of
+ * its patches at about the grid's element count, with its ray structure
+ * and element arrays (m->options->adaptive_levels > 0).  On failure *out is
+ * NULL and m is as it was. */
+rad_result rad_adaptive_create(rad_context *ctx, rad_meshed *m, rad_adaptive **out);
+/* Up to adaptive_levels rounds after a solve: score the elements, split
+ * the worst within the budget (adaptive_max_elements), balance, remesh,
+ * couple and solve through `h`.  Ends early when nothing needs splitting.
+ * On failure m holds the last complete mesh (RAD_ERROR_INTERRUPTED when
+ * cancelled). */
+rad_result rad_adaptive_refine(rad_context *ctx, rad_adaptive *a, rad_meshed *m, const rad_adaptive_hooks *h,
+                               const rad_step_hook *hook);
+void rad_adaptive_destroy(rad_adaptive *a);
+/* NULL for NULL. */
+const rad_adaptive_stats *rad_adaptive_get_stats(const rad_adaptive *a);
 
 /* ---- questions answered from a view (strategy.c) ---- */
 
