@@ -453,10 +453,11 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
      * instead when no --solver is given: the view factors (a matrix's F),
      * progress images (elements that stay put while solving), and the
      * uniform mesh's and the matrix's own options, which hierarchical would
-     * ignore. */
+     * ignore (adaptive subdivision among them). */
     if (!s->solve.solver &&
         (s->command == CLI_VIEWFACTORS || s->progress_dir || s->solve.target_elements != 0 ||
-         s->solve.mesh_size != 0.0 || s->solve.form_factors))
+         s->solve.mesh_size != 0.0 || s->solve.form_factors || s->solve.adaptive_levels != 0 ||
+         s->solve.adaptive_threshold != 0.0 || s->solve.adaptive_max_elements != 0))
         s->solve.solver = "gauss-seidel";
     if (!s->output)
         s->output = default_output(s->command);

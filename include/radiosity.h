@@ -351,7 +351,9 @@ typedef struct rad_options {
                                      of each pair are combined (reciprocity) and rows held
                                      to their measured closure, so energy is conserved */
 
-    const char *solver;           /* NULL = "hierarchical" */
+    const char *solver;           /* NULL = "hierarchical", or "gauss-seidel" when mesh_size,
+                                     target_elements, form_factors or an adaptive_* field is
+                                     set (options of the uniform mesh and the matrix) */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */

@@ -406,7 +406,7 @@ static void test_diverged_solution_refused(void **state)
     assert_int_equal(rad_scene_load_memory(ctx, "copies.obj", copies, strlen(copies), copies_mtl,
                                            strlen(copies_mtl), &scene),
                      RAD_OK);
-    rad_options c = {.target_elements = 16, .form_factors = "analytic", .max_iterations = 200};
+    rad_options c = {.target_elements = 16, .form_factors = "analytic", .solver = "gauss-seidel", .max_iterations = 200};
     assert_int_equal(rad_solution_create(ctx, scene, &c, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_NUMERICAL);
     assert_non_null(strstr(rad_context_error(ctx), "the solution diverged"));

@@ -68,8 +68,8 @@ static const rad_option_info solution_rows[] = {
              "makes it reciprocal and holds its rows to their measured closure (energy conservation)"},
     {SOLUTION(solver), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_SOLVER, .default_value = NAN,
      .default_text = "hierarchical",
-     .help = "solver (the program without one: gauss-seidel for view factors, progress images, "
-             "an element count, a mesh size or a form-factor method)"},
+     .help = "solver (without one: gauss-seidel where an element count, a mesh size, a form-factor "
+             "method or adaptive subdivision is given, and for view factors and progress images)"},
     {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0, .max_open = true,
      .default_value = 1e-6, .default_text = "1e-6",
      .help = "stop when the residual (unaccounted power / emitted power) falls below this"},
@@ -362,6 +362,11 @@ static rad_result resolve_field(rad_context *ctx, const rad_option_info *row, ra
 rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_options *out, rad_method_names *names)
 {
     rad_options o = in ? *in : (rad_options){0};
+    /* No solver named: hierarchical, unless an option of the uniform mesh
+     * or of the matrix is given (hierarchical would ignore it). */
+    if (!o.solver && (o.mesh_size != 0.0 || o.target_elements != 0 || o.form_factors || o.adaptive_levels != 0 ||
+                      o.adaptive_threshold != 0.0 || o.adaptive_max_elements != 0))
+        o.solver = "gauss-seidel";
     for (size_t i = 0; i < COUNT(solution_rows); i++) {
         rad_result r = resolve_field(ctx, &solution_rows[i], &o);
         if (r != RAD_OK)
