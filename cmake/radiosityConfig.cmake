@@ -2,14 +2,15 @@
 #
 #   radiosity::radiosity         the shared library; needs nothing else
 #   radiosity::radiosity_static  the static library; its dependencies (Embree 3,
-#                                OpenMP, assimp, cJSON, LAPACKE, OpenBLAS) are
+#                                OpenMP, assimp, cJSON; LAPACKE and OpenBLAS are
+#                                opened at run time by the direct solver) are
 #                                found here, so their development files must be
 #                                installed (on Debian: scripts/setup.sh's list)
 include(CMakeFindDependencyMacro)
 find_dependency(embree 3)
 find_dependency(OpenMP COMPONENTS C)
 find_dependency(PkgConfig)
-foreach(rad_dependency ASSIMP=assimp CJSON=libcjson LAPACKE=lapacke OPENBLAS=openblas)
+foreach(rad_dependency ASSIMP=assimp CJSON=libcjson)
   string(REPLACE "=" ";" rad_dependency "${rad_dependency}")
   list(GET rad_dependency 0 rad_prefix)
   list(GET rad_dependency 1 rad_module)

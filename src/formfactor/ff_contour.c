@@ -121,6 +121,7 @@ typedef struct edge {
 typedef struct pair_frame {
     vec3 D;            /* c_j - c_i, m */
     double inv_r0sq;   /* 1 / r0^2, 1/m^2 */
+    double rel;        /* the outer quadrature's shortest piece, relative to its edge */
 } pair_frame;
 
 /* A convex element clipped by one plane has at most one vertex more. */
@@ -278,11 +279,17 @@ static double edge_pair(const edge *p, const edge *q, const pair_frame *f)
                phi(-b0, delta, f->inv_r0sq) + phi(-b1, delta, f->inv_r0sq) - 0.5 * a1 * (b1 - b0);
     }
     int budget = PIECE_BUDGET;
-    return c * outer_integral(q, 0.0, q->len, p, f, 1e-7 * q->len, &budget);
+    return c * outer_integral(q, 0.0, q->len, p, f, f->rel * q->len, &budget);
 }
 
 double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const vec3 *poly_j,
                             size_t n_j, vec3 normal_j, double plane_tol)
+{
+    return rad_polygon_coupling_to(poly_i, n_i, normal_i, poly_j, n_j, normal_j, plane_tol, 1e-7);
+}
+
+double rad_polygon_coupling_to(const vec3 *poly_i, size_t n_i, vec3 normal_i, const vec3 *poly_j,
+                               size_t n_j, vec3 normal_j, double plane_tol, double rel)
 {
     if (n_i < 3 || n_j < 3 || n_i > 4 || n_j > 4)
         return 0.0;
@@ -313,6 +320,7 @@ double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const
      * down to ~ (size / distance)^2 of themselves, keep their digits (the
      * error grows like (distance / size)^2 x 1e-16, not its cube). */
     pair_frame f;
+    f.rel = rel;
     f.D = v3_sub(cj, ci);
     double r0sq = v3_dot(f.D, f.D);
     f.inv_r0sq = r0sq > 0.0 ? 1.0 / r0sq : 1.0 / (scale * scale);

@@ -284,6 +284,12 @@ double rad_ff_visibility(const rad_ff_request *req, uint32_t i, uint32_t j, doub
  * Cannot fail; 0 for polygons that do not face each other. */
 double rad_polygon_coupling(const vec3 *poly_i, size_t n_i, vec3 normal_i, const vec3 *poly_j,
                             size_t n_j, vec3 normal_j, double plane_tol);
+/* As rad_polygon_coupling, with the outer quadrature's pieces no shorter
+ * than rel x their edge (rad_polygon_coupling: 1e-7): near a shared
+ * vertex, where the integrand is singular, the last piece's error is about
+ * rel ln(1/rel) of the edge's share.  Cannot fail. */
+double rad_polygon_coupling_to(const vec3 *poly_i, size_t n_i, vec3 normal_i, const vec3 *poly_j,
+                               size_t n_j, vec3 normal_j, double plane_tol, double rel);
 
 /* rad_polygon_coupling of elements i and j of the mesh.  Cannot fail. */
 double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);

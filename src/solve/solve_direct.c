@@ -37,9 +37,88 @@
 #include "solve/solve.h"
 
 #include <cblas.h>
+#include <dlfcn.h>
 #include <lapacke.h>
 #include <limits.h>
+#include <pthread.h>
 #include <stdlib.h>
+#include <string.h>
+
+/* ---- LAPACK and BLAS, loaded when first needed ----
+ *
+ * OpenBLAS starts its own pool of threads when it is loaded, and they spin
+ * (sched_yield) for about 0.1 s before they sleep.  Linked into the
+ * program, that happened on every run, whatever the solver, and took a
+ * core from the rest of a 0.2 s render of the Cornell box.  Only this
+ * solver needs the libraries (its own threads do the parallel work, with
+ * OpenBLAS held to one), so they are opened here on first use: the
+ * headers give the types, dlopen the code.  Debian's sonames. */
+#define RAD_OPENBLAS_SONAME "libopenblas.so.0"
+#define RAD_LAPACKE_SONAME "liblapacke.so.3"
+
+typedef lapack_int (*getrf_fn)(int, lapack_int, lapack_int, double *, lapack_int, lapack_int *);
+typedef lapack_int (*laswp_fn)(int, lapack_int, double *, lapack_int, lapack_int, lapack_int, const lapack_int *,
+                               lapack_int);
+typedef lapack_int (*getrs_fn)(int, char, lapack_int, lapack_int, const double *, lapack_int, const lapack_int *,
+                               double *, lapack_int);
+typedef void (*trsm_fn)(enum CBLAS_ORDER, enum CBLAS_SIDE, enum CBLAS_UPLO, enum CBLAS_TRANSPOSE, enum CBLAS_DIAG,
+                        blasint, blasint, double, const double *, blasint, double *, blasint);
+typedef void (*gemm_fn)(enum CBLAS_ORDER, enum CBLAS_TRANSPOSE, enum CBLAS_TRANSPOSE, blasint, blasint, blasint,
+                        double, const double *, blasint, const double *, blasint, double, double *, blasint);
+typedef int (*get_threads_fn)(void);
+typedef void (*set_threads_fn)(int);
+
+static struct {
+    getrf_fn getrf;
+    laswp_fn laswp;
+    getrs_fn getrs;
+    trsm_fn trsm;
+    gemm_fn gemm;
+    get_threads_fn get_threads;
+    set_threads_fn set_threads;
+    char error[256];      /* "" when loaded */
+} lapack;
+
+static pthread_once_t lapack_once = PTHREAD_ONCE_INIT;
+
+/* dlsym's object pointer as a function pointer (copied: ISO C has no cast
+ * between the two). */
+static bool find_symbol(void *library, const char *name, void *fn, size_t size)
+{
+    void *symbol = library ? dlsym(library, name) : NULL;
+    if (!symbol) {
+        if (!lapack.error[0])
+            snprintf(lapack.error, sizeof lapack.error, "%s not found (%s)", name,
+                     library ? "missing symbol" : "library not loaded");
+        return false;
+    }
+    memcpy(fn, &symbol, size);
+    return true;
+}
+
+static void lapack_load(void)
+{
+    void *blas = dlopen(RAD_OPENBLAS_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (!blas) {
+        const char *why = dlerror();
+        snprintf(lapack.error, sizeof lapack.error, "%s", why ? why : RAD_OPENBLAS_SONAME " not found");
+        return;
+    }
+    void *lapacke = dlopen(RAD_LAPACKE_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (!lapacke) {
+        const char *why = dlerror();
+        snprintf(lapack.error, sizeof lapack.error, "%s", why ? why : RAD_LAPACKE_SONAME " not found");
+        return;
+    }
+    find_symbol(lapacke, "LAPACKE_dgetrf_work", &lapack.getrf, sizeof lapack.getrf);
+    find_symbol(lapacke, "LAPACKE_dlaswp_work", &lapack.laswp, sizeof lapack.laswp);
+    find_symbol(lapacke, "LAPACKE_dgetrs_work", &lapack.getrs, sizeof lapack.getrs);
+    find_symbol(blas, "cblas_dtrsm", &lapack.trsm, sizeof lapack.trsm);
+    find_symbol(blas, "cblas_dgemm", &lapack.gemm, sizeof lapack.gemm);
+    find_symbol(blas, "openblas_get_num_threads", &lapack.get_threads, sizeof lapack.get_threads);
+    find_symbol(blas, "openblas_set_num_threads", &lapack.set_threads, sizeof lapack.set_threads);
+    /* The libraries stay loaded for the life of the process. */
+}
 
 /* 64 x 64 doubles: one tile of K and of F stay in L1/L2 during the transposition. */
 enum { TILE = 64 };
@@ -80,7 +159,7 @@ static rad_result factor(rad_context *ctx, const rad_system *sys, double *K, lap
     for (size_t k0 = 0; k0 < n; k0 += PANEL) {
         size_t nb = n - k0 < PANEL ? n - k0 : PANEL;
         double *panel = K + k0 + k0 * n;
-        lapack_int info = LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, (lapack_int)(n - k0), (lapack_int)nb, panel, ld,
+        lapack_int info = lapack.getrf(LAPACK_COL_MAJOR, (lapack_int)(n - k0), (lapack_int)nb, panel, ld,
                                               pivots + k0);
         if (info != 0)
             /* rho_i sum_j F_ij < 1 makes K strictly diagonally dominant, so
@@ -97,14 +176,14 @@ static rad_result factor(rad_context *ctx, const rad_system *sys, double *K, lap
             if (j0 == k0)
                 continue;
             double *columns = K + j0 * n;
-            LAPACKE_dlaswp_work(LAPACK_COL_MAJOR, (lapack_int)width, columns, ld, (lapack_int)k0 + 1,
+            lapack.laswp(LAPACK_COL_MAJOR, (lapack_int)width, columns, ld, (lapack_int)k0 + 1,
                                 (lapack_int)(k0 + nb), pivots, 1);
             if (j0 < k0)
                 continue; /* left of the panel: L, only swapped */
-            cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasUnit, (blasint)nb,
+            lapack.trsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasUnit, (blasint)nb,
                         (blasint)width, 1.0, panel, (blasint)n, columns + k0, (blasint)n);
             if (k0 + nb < n)
-                cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (blasint)(n - k0 - nb), (blasint)width,
+                lapack.gemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (blasint)(n - k0 - nb), (blasint)width,
                             (blasint)nb, -1.0, panel + nb, (blasint)n, columns + k0, (blasint)n, 1.0,
                             columns + k0 + nb, (blasint)n);
         }
@@ -158,6 +237,10 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
         stats->converged = true;
         return RAD_OK;
     }
+    pthread_once(&lapack_once, lapack_load);
+    if (lapack.error[0])
+        return rad_fail(ctx, RAD_ERROR_INTERNAL, "solve: direct: cannot load LAPACK: %s (Debian: liblapacke, libopenblas0)",
+                        lapack.error);
     double *K = rad_alloc(ctx, RAD_MEM_SOLVER, n * n, sizeof *K, "solve: direct: LU matrix");
     double *rhs = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *rhs, "solve: direct: right-hand sides");
     lapack_int *pivots = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *pivots, "solve: direct: pivots");
@@ -172,8 +255,8 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
      * Two direct solves at once in one process may restore it while the
      * other runs; OpenBLAS's threaded dgemm and dtrsm then split columns,
      * not sums, so even that changes no bit. */
-    int blas_threads = openblas_get_num_threads();
-    openblas_set_num_threads(1);
+    int blas_threads = lapack.get_threads();
+    lapack.set_threads(1);
 
     rad_result result = RAD_OK;
     bool solved[3] = {false, false, false};
@@ -191,7 +274,7 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
         result = factor(ctx, sys, K, pivots, c);
         if (result != RAD_OK)
             break;
-        lapack_int info = LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', (lapack_int)n, m, K, (lapack_int)n, pivots,
+        lapack_int info = lapack.getrs(LAPACK_COL_MAJOR, 'N', (lapack_int)n, m, K, (lapack_int)n, pivots,
                                               rhs, (lapack_int)n);
         if (info != 0) {
             result = rad_fail(ctx, RAD_ERROR_INTERNAL, "solve: direct: LAPACK dgetrs failed (info %d)", (int)info);
@@ -205,7 +288,7 @@ static rad_result direct(rad_context *ctx, const rad_system *sys, const rad_solv
         if (rad_cancelled(ctx) && !(solved[0] && solved[1] && solved[2]))
             result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: direct: interrupted after channel %d", c);
     }
-    openblas_set_num_threads(blas_threads > 0 ? blas_threads : 1);
+    lapack.set_threads(blas_threads > 0 ? blas_threads : 1);
     rad_free(K);
     rad_free(rhs);
     rad_free(pivots);
