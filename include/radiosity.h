@@ -244,7 +244,8 @@ RAD_API rad_result rad_scene_generate_office(rad_context *ctx, const rad_office_
  * in `mtllib`), one `o` per surface (its name, blanks replaced by '_'),
  * Kd = reflectance, Ke = emitted radiance = E / pi.  Coordinates are written
  * in the shortest decimal that parses back to the same double (the loader
- * reads them through assimp's float); the camera is not written.  Both
+ * reads them exactly); the camera, which OBJ cannot hold, is written as a
+ * comment ("# radiosity camera: ...") that the OBJ loader reads back.  Both
  * files go to temporary names first and are renamed only when both are
  * complete, so a failure leaves neither (they are an output set, below:
  * a path that is a symbolic link, a device or /dev/stdout is treated as

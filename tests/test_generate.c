@@ -439,6 +439,9 @@ static void test_obj_round_trip(void **state)
         }
     }
     assert_true(exact >= s->position_count * 9 / 10); /* most are exact */
+    /* The generator's camera (in room 0) comes back from its comment, exactly. */
+    assert_true(s->has_camera && back->has_camera);
+    assert_memory_equal(&back->camera, &s->camera, sizeof s->camera);
     /* Those ulps move areas by ~1e-9 relative (measured 0.7e-9 to 2.6e-9). */
     assert_true(fabs(area_back - area) <= 1e-8 * area);
     for (size_t i = 0; i < s->surface_count; i++)
@@ -448,6 +451,27 @@ static void test_obj_round_trip(void **state)
     rad_scene_destroy(s);
     remove(path);
     remove(mtl);
+
+    /* A camera comment that is not whole or not usable stays a comment. */
+    static const char *const comments[] = {
+        "# radiosity camera: 1 2 3  0 0 0  0 1 0  40\n",      /* kept */
+        "# radiosity camera: 1 2 3  0 0 0  0 1 0\n",          /* nine numbers */
+        "# radiosity camera: 1 2 3  1 2 3  0 1 0  40\n",      /* looks at itself */
+        "# radiosity camera: 1 2 3  0 0 0  0 1 0  180\n",     /* no field of view */
+        "# radiosity camera: 1 2 nan  0 0 0  0 1 0  40\n",    /* not finite */
+        "# radiosity camera: 1 2 3  0 0 0  0 1 0  40 x\n",    /* more than ten */
+    };
+    for (size_t k = 0; k < sizeof comments / sizeof comments[0]; k++) {
+        char text[512];
+        snprintf(text, sizeof text, "%smtllib m.mtl\nusemtl lamp\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", comments[k]);
+        static const char lamp[] = "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
+        rad_scene *c = NULL;
+        assert_int_equal(rad_scene_load_memory(ctx, "c.obj", text, strlen(text), lamp, strlen(lamp), &c), RAD_OK);
+        assert_int_equal(c->has_camera, k == 0);
+        if (k == 0)
+            assert_true(c->camera.position[2] == 3.0 && c->camera.vfov_degrees == 40.0);
+        rad_scene_destroy(c);
+    }
 }
 
 static void test_obj_write_failure_leaves_nothing(void **state)

@@ -624,6 +624,8 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
         rad_scene_builder_camera(cv.builder, &facts.camera);
     else if (!gltf && ai->mNumCameras > 0 && ai->mCameras[0])
         convert_camera(&cv);
+    else if (cv.positions && cv.positions->has_camera)
+        rad_scene_builder_camera(cv.builder, &cv.positions->camera); /* an OBJ's camera comment */
     r = rad_scene_builder_finish(cv.builder, out);
     cv.builder = NULL;
 

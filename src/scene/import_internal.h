@@ -106,6 +106,8 @@ typedef struct import_obj_positions {
     size_t count;
     char *text;   /* the OBJ text with its `v` statements rewritten (rad_alloc'd) */
     size_t size;
+    bool has_camera;    /* a RAD_OBJ_CAMERA_COMMENT line, well formed */
+    rad_camera camera;
 } import_obj_positions;
 
 #define IMPORT_OBJ_INDEX_BITS 24

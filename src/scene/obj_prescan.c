@@ -887,6 +887,41 @@ static void read_position(const char *p, const char *end, double xyz[3])
         xyz[k] = w == 1.0 ? value[k] : value[k] / w;
 }
 
+/* A camera comment (RAD_OBJ_CAMERA_COMMENT and ten numbers) on the line
+ * [line, end): kept when every number reads and the camera is usable (a
+ * finite position apart from its look-at point, a field of view in (0,
+ * 180) degrees); anything else stays a comment. */
+static void read_camera_comment(const char *line, const char *end, import_obj_positions *out)
+{
+    size_t prefix = strlen(RAD_OBJ_CAMERA_COMMENT);
+    if ((size_t)(end - line) <= prefix || memcmp(line, RAD_OBJ_CAMERA_COMMENT, prefix) != 0)
+        return;
+    char buffer[512];
+    size_t n = (size_t)(end - line) - prefix;
+    if (n >= sizeof buffer)
+        return;
+    memcpy(buffer, line + prefix, n);
+    buffer[n] = '\0';
+    double v[10];
+    char *at = buffer;
+    for (int k = 0; k < 10; k++) {
+        char *next;
+        v[k] = strtod(at, &next);
+        if (next == at || !isfinite(v[k]))
+            return;
+        at = next;
+    }
+    while (*at == ' ' || *at == '\t' || *at == '\r')
+        at++;
+    vec3 position = v3(v[0], v[1], v[2]), look = v3(v[3], v[4], v[5]), up = v3(v[6], v[7], v[8]);
+    if (*at != '\0' || !(v3_length(v3_sub(look, position)) > 0.0) || !(v3_length(up) > 0.0) ||
+        !(v[9] > 0.0 && v[9] < 180.0))
+        return;
+    rad_camera c = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]}, v[9]};
+    out->camera = c;
+    out->has_camera = true;
+}
+
 rad_result import_obj_exact_positions(rad_context *ctx, const char *path, const char *text,
                                       size_t size, import_obj_positions *out)
 {
@@ -919,7 +954,10 @@ rad_result import_obj_exact_positions(rad_context *ctx, const char *path, const 
     start = lines.next;
     char *at = out->text;
     while (next_line(&lines, &p, &end)) {
+        const char *line = p;
         next_token(&p, end, token);
+        if (token[0] == '#' && !out->has_camera)
+            read_camera_comment(line, end, out);
         if (strcmp(token, "v") == 0) {
             size_t k = out->count++;
             read_position(p, end, &out->xyz[3 * k]);

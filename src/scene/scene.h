@@ -79,6 +79,12 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
                                      const vec3 *vertices, size_t vertex_count, int line);
 void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera);
 
+/* An OBJ's camera, as a comment (OBJ has none): the prefix, then position,
+ * look-at point, up vector and vertical field of view in degrees, ten
+ * numbers.  Written by rad_scene_write_obj, read back by the OBJ loader. */
+#define RAD_OBJ_CAMERA_COMMENT "# radiosity camera:"
+
+
 /* Validate and produce the scene; the builder is consumed (destroyed) either
  * way.  Fails on an empty scene. */
 rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out);

@@ -130,6 +130,14 @@ static rad_result write_obj_body(rad_context *ctx, const rad_scene *scene, FILE 
     fputs("# ", obj);
     write_comment_text(obj, scene->source);
     fprintf(obj, ": %zu surfaces, %zu polygons; metres, y up\n", surfaces, polygons);
+    if (scene->has_camera) {
+        /* OBJ has no camera: a comment the loader reads back
+         * (obj_prescan.c, import_obj_exact_positions), other readers skip. */
+        const rad_camera *c = &scene->camera;
+        fprintf(obj, "%s %.17g %.17g %.17g  %.17g %.17g %.17g  %.17g %.17g %.17g  %.17g\n", RAD_OBJ_CAMERA_COMMENT,
+                c->position[0], c->position[1], c->position[2], c->look_at[0], c->look_at[1], c->look_at[2],
+                c->up[0], c->up[1], c->up[2], c->vfov_degrees);
+    }
     fprintf(obj, "mtllib %s\n", mtl_name);
     size_t written = 0; /* vertices so far: OBJ indices are 1 + this */
     for (size_t s = 0; s < surfaces; s++) {
