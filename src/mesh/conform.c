@@ -452,6 +452,7 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
     int piece_cap = 16;
     piece *pieces = rad_alloc(ctx, RAD_MEM_MESH, (size_t)piece_cap, sizeof *pieces, "mesh: patch pieces");
     if (!pieces) {
+        rad_free(lines);
         rad_free(cuts.items);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
