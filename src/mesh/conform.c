@@ -32,7 +32,7 @@
  * New corners are interpolated along the piece's own 3D edges, so the
  * pieces tile the patch exactly and the two pieces of a cut share their
  * new corners bit for bit.  A bent quad (corners off one plane by more
- * than the tolerance) is left whole: its pieces could not tile its
+ * than 1e-6 of its size) is left whole: its pieces could not tile its
  * bilinear surface.  Pairs are found through a uniform grid of cells
  * (the cell size chosen so that the patches make a bounded number of cell
  * entries; a patch that would fill too many cells is tested against every
@@ -465,17 +465,22 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
         size_t c0 = c;
         while (c < cuts.count && cuts.items[c].patch == i)
             c++;
-        /* A bent quad (its corners off one plane by more than the
-         * tolerance: the Cornell box's walls, 3 mm) is not cut: pieces
-         * with corners on its edges would not tile its bilinear surface. */
+        /* A bent quad (corners off one plane by more than 1e-6 of its
+         * longest edge, float round-off's scale: the Cornell box's walls,
+         * 3 mm in 0.55 m, or two triangles merged within 2 degrees) is not
+         * cut: pieces with corners on its edges would not tile its
+         * bilinear surface (their areas missed it by 6e-7). */
         vec3 centre = v3(0, 0, 0);
-        for (uint32_t k = 0; k < p->corner_count; k++)
+        double longest = 0.0;
+        for (uint32_t k = 0; k < p->corner_count; k++) {
             centre = v3_add(centre, p->corner[k]);
+            longest = fmax(longest, v3_length(v3_sub(p->corner[(k + 1) % p->corner_count], p->corner[k])));
+        }
         centre = v3_scale(centre, 1.0 / p->corner_count);
         double bend = 0.0;
         for (uint32_t k = 0; k < p->corner_count; k++)
             bend = fmax(bend, fabs(v3_dot(p->normal, v3_sub(p->corner[k], centre))));
-        if (c == c0 || bend > tol) {
+        if (c == c0 || bend > 1e-6 * longest) {
             if (!list_push(ctx, &out, &nout, &cap, p))
                 r = RAD_ERROR_OUT_OF_MEMORY;
             continue;
