@@ -70,6 +70,22 @@ static void shuffle_strata(int *perm, int n, rad_rng *rng)
     }
 }
 
+/* The ray from p (on a) to q (on b) into *ray, when each end is in front
+ * of the other's plane; returns 1 if written, else 0.  Ends behind each
+ * other's planes carry no energy (a cosine is <= 0): they say nothing
+ * about occlusion, so they are not cast. */
+static int add_facing_ray(const rad_ff_end *a, const rad_ff_end *b, vec3 p, vec3 q, rad_ray *ray)
+{
+    vec3 d = v3_sub(q, p);
+    if (!(v3_dot(a->normal, d) > 0.0 && v3_dot(b->normal, d) < 0.0))
+        return 0;
+    ray->origin = p;
+    ray->direction = d;
+    ray->tnear = 0.0;
+    ray->tfar = 1.0;
+    return 1;
+}
+
 /* The part of the polygon c[0..n) strictly in front of the plane through
  * o with normal `normal` (Sutherland-Hodgman); returns its corner count
  * (0 when nothing is in front). */
@@ -118,17 +134,8 @@ static int facing_part_rays(const rad_ff_end *a, const rad_ff_end *b, int count,
     if (na == 0 || nb == 0)
         return 0;
     int pairs = na * nb < count ? na * nb : count;
-    for (int k = 0; k < pairs; k++) {
-        vec3 p = pa[k % na], q = pb[(k / na + k) % nb];
-        vec3 d = v3_sub(q, p);
-        if (!(v3_dot(a->normal, d) > 0.0 && v3_dot(b->normal, d) < 0.0))
-            continue;
-        rays[m].origin = p;
-        rays[m].direction = d;
-        rays[m].tnear = 0.0;
-        rays[m].tfar = 1.0;
-        m++;
-    }
+    for (int k = 0; k < pairs; k++)
+        m += add_facing_ray(a, b, pa[k % na], pb[(k / na + k) % nb], &rays[m]);
     return m;
 }
 
@@ -160,17 +167,7 @@ int rad_ff_pairs(const rad_ff_end *a, const rad_ff_end *b, int count, rad_rng *r
         double v1 = ((si / side) + rad_rng_uniform(rng)) / side;
         double u2 = ((sj % side) + rad_rng_uniform(rng)) / side;
         double v2 = ((sj / side) + rad_rng_uniform(rng)) / side;
-        vec3 p = end_point(a, u1, v1), q = end_point(b, u2, v2);
-        vec3 d = v3_sub(q, p);
-        /* Ends behind each other's planes carry no energy (a cosine is
-         * <= 0): they say nothing about occlusion, so they are not cast. */
-        if (!(v3_dot(a->normal, d) > 0.0 && v3_dot(b->normal, d) < 0.0))
-            continue;
-        rays[m].origin = p;
-        rays[m].direction = d;
-        rays[m].tnear = 0.0;
-        rays[m].tfar = 1.0;
-        m++;
+        m += add_facing_ray(a, b, end_point(a, u1, v1), end_point(b, u2, v2), &rays[m]);
     }
     return m > 0 ? m : facing_part_rays(a, b, count, rays);
 }
