@@ -228,6 +228,7 @@ typedef struct run_outputs {
     rad_output_set *set;
     const char *main;      /* the image, view-factor or mesh file: its temporary */
     const char *stats, *history;
+    const char *gebhart;   /* thermal --gebhart: its temporary */
 } run_outputs;
 
 /* Plan the outputs and name the scene file as an input.  Returns -1 to go
@@ -235,7 +236,8 @@ typedef struct run_outputs {
  * alias, an unknown format), 1 when it cannot be written. */
 static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
 {
-    rad_output_kind kind = s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS
+    rad_output_kind kind = s->command == CLI_THERMAL       ? RAD_OUTPUT_THERMAL
+                           : s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS
                            : s->command == CLI_SOLVE     ? RAD_OUTPUT_SOLUTION
                            : s->command == CLI_EXPORT    ? RAD_OUTPUT_MESH
                            : s->command == CLI_BAKE      ? RAD_OUTPUT_BAKE
@@ -243,8 +245,12 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
     rad_result r = rad_output_set_create(ctx, &o->set);
     if (r == RAD_OK && s->scene_path)
         r = rad_output_set_add_input(ctx, o->set, s->scene_path);
+    if (r == RAD_OK && s->bc)
+        r = rad_output_set_add_input(ctx, o->set, s->bc);
     if (r == RAD_OK)
         r = rad_output_set_add(ctx, o->set, s->output, kind, &o->main);
+    if (r == RAD_OK && s->gebhart)
+        r = rad_output_set_add(ctx, o->set, s->gebhart, RAD_OUTPUT_THERMAL, &o->gebhart);
     /* bake: the first atlas's lightmaps (there is always one); others are
      * added when the packing knows them. */
     static const char *const lightmap_ext[2] = {"hdr", "png"};
@@ -258,7 +264,7 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
     }
     if (r == RAD_OK && s->stats)
         r = rad_output_set_add(ctx, o->set, s->stats, RAD_OUTPUT_FILE, &o->stats);
-    if (r == RAD_OK && s->history && s->command != CLI_VIEWFACTORS)
+    if (r == RAD_OK && s->history && s->command != CLI_VIEWFACTORS && s->command != CLI_THERMAL)
         r = rad_output_set_add(ctx, o->set, s->history, RAD_OUTPUT_FILE, &o->history);
     if (r == RAD_OK)
         return -1;
@@ -311,6 +317,46 @@ static int write_solution(rad_context *ctx, const settings *s, rad_solution *sol
     return cancel_signal ? interrupted_status() : 0;
 }
 
+/* The thermal command after the form factors: solve the net-radiation
+ * equations for the conditions, write the figures (and the Gebhart
+ * factors, the stats) as one output set, print the balance.  Returns the
+ * exit status. */
+static int run_thermal(rad_context *ctx, const settings *s, const rad_scene *scene, const rad_solution *sol,
+                       const rad_thermal_conditions *bc, run_outputs *out, progress_state *progress, double t0)
+{
+    rad_thermal_options to = {s->solve.solver, s->thermal_tolerance, s->solve.max_iterations};
+    rad_thermal *heat = NULL;
+    rad_result r = rad_thermal_solve(ctx, sol, bc, &to, &heat);
+    progress_end(progress);
+    if (r == RAD_OK) {
+        begin_saving(ctx);
+        r = rad_thermal_write(ctx, heat, out->main, s->element_level);
+    }
+    if (r == RAD_OK && s->gebhart)
+        r = rad_thermal_write_gebhart(ctx, heat, out->gebhart);
+    if (r == RAD_OK && s->stats)
+        r = rad_thermal_write_stats(ctx, heat, out->stats);
+    if (r == RAD_OK) {
+        fflush(stdout);
+        r = rad_output_set_commit(ctx, out->set);
+    }
+    if (r != RAD_OK) {
+        rad_thermal_destroy(heat);
+        return fail(ctx, r);
+    }
+    if (!s->quiet) {
+        rad_thermal_balance b;
+        double residual = rad_thermal_get_balance(heat, &b);
+        char full[PATH_MAX];
+        printf("wrote %s (%zu surfaces, %zu elements, residual %.2g, %.1f s)\n", where(s->output, full),
+               rad_scene_surface_count(scene), rad_solution_element_count(sol), residual, now_seconds() - t0);
+        printf("balance: sum Q = %.6g W, to the environment %.6g W, imbalance %.3g W (%.2g of sum |Q| = %.6g W)\n",
+               b.net_power, b.environment_power, b.imbalance, b.relative_imbalance, b.power_scale);
+    }
+    rad_thermal_destroy(heat);
+    return cancel_signal ? interrupted_status() : 0;
+}
+
 int main(int argc, char **argv)
 {
     /* Every command's flags come from the one table in options.c;
@@ -320,6 +366,17 @@ int main(int argc, char **argv)
     int status = parse_args(argc, argv, &s);
     if (status >= 0)
         return status;
+    if (s.command == CLI_THERMAL && !s.bc) {
+        fprintf(stderr, "radiosity: thermal needs --bc FILE.json: the surfaces' emissivities and temperatures or "
+                        "heat fluxes (see radiosity thermal --help)\n");
+        return EXIT_USAGE;
+    }
+    if (s.command == CLI_THERMAL &&
+        (strcmp(s.solve.solver, "hierarchical") == 0 || strcmp(s.solve.solver, "shooting") == 0)) {
+        fprintf(stderr, "radiosity: --solver %s keeps no form-factor matrix: thermal takes direct, gauss-seidel, "
+                        "jacobi, southwell or conjugate-gradient (see radiosity thermal --help)\n", s.solve.solver);
+        return EXIT_USAGE;
+    }
     install_signal_handlers();
 
     progress_state progress = {0};
@@ -351,6 +408,7 @@ int main(int argc, char **argv)
     rad_scene *scene = NULL;
     rad_solution *sol = NULL;
     rad_image *image = NULL;
+    rad_thermal_conditions *bc = NULL;
     run_outputs out = {0};
     rad_result r = RAD_OK;
 
@@ -390,6 +448,10 @@ int main(int argc, char **argv)
     if (status >= 0)
         goto done;
     status = 1;
+    if (s.command == CLI_THERMAL && rad_thermal_conditions_load_file(ctx, scene, s.bc, &bc) != RAD_OK) {
+        status = fail(ctx, RAD_ERROR_PARSE); /* a bad file: before any work */
+        goto done;
+    }
     if (s.camera) {
         /* The library owns the camera syntax (docs/cli.md).  Its messages
          * begin "camera: "; with "--" before them they name our flag. */
@@ -410,7 +472,7 @@ int main(int argc, char **argv)
         status = s.camera ? EXIT_USAGE : 1;
         goto done;
     }
-    if (s.command != CLI_VIEWFACTORS && !s.quiet && !s.scene_path)
+    if (s.command != CLI_VIEWFACTORS && s.command != CLI_THERMAL && !s.quiet && !s.scene_path)
         printf("radiosity: no scene given, %s the built-in Cornell box\n",
                s.command == CLI_EXPORT ? "exporting" : s.command == CLI_BAKE ? "baking" : "rendering");
 
@@ -448,6 +510,12 @@ int main(int argc, char **argv)
     }
     if (r != RAD_OK) {
         status = fail(ctx, r);
+        goto done;
+    }
+
+    if (s.command == CLI_THERMAL) {
+        /* 4-5. the net-radiation solve on F, its figures */
+        status = run_thermal(ctx, &s, scene, sol, bc, &out, &progress, t0);
         goto done;
     }
 
@@ -561,6 +629,7 @@ int main(int argc, char **argv)
     status = cancel_signal ? interrupted_status() : 0;
 
 done:
+    rad_thermal_conditions_destroy(bc);
     rad_output_set_destroy(out.set);
     rad_image_destroy(image);
     rad_solution_destroy(sol);

@@ -47,6 +47,9 @@ static const command_def COMMANDS[] = {
     {CLI_BAKE, "bake", "bake [SCENE|SOLUTION.radsol] [options]",
      "solve the scene (or load the solution) and write lightmaps (HDR, RGBM PNG) with the glTF lit mesh "
      "that uses them (docs/formats.md)"},
+    {CLI_THERMAL, "thermal", "thermal [SCENE] --bc BC.json [options]",
+     "radiative heat exchange between grey diffuse surfaces with given temperatures or heat fluxes: "
+     "radiosity, net flux, net power and the unknown temperatures per surface (docs/thermal.md)"},
 };
 #define COMMAND_COUNT (sizeof COMMANDS / sizeof COMMANDS[0])
 
@@ -63,8 +66,10 @@ const char *cli_command_name(int command)
 /* The commands that solve (render, export, solve), and those that also
  * mesh and couple (viewfactors). */
 #define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
-#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
-#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE)
+#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_THERMAL)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE | CLI_THERMAL)
+/* The solver's own flags, for the commands that solve B and for thermal's net-radiation solve. */
+#define RST (RS | CLI_THERMAL)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
 #define RENDER(field_) .target = CLI_TO_RENDER, .field = #field_
 #define OFFICE(field_) .target = CLI_TO_OFFICE, .field = #field_
@@ -95,6 +100,14 @@ static const cli_flag FLAGS[] = {
     {"output", 'o', "FILE", CLI_BAKE, OWN(output, RAD_OPTION_STRING),
      .own.help = "output lit mesh: .glb or .gltf; the lightmaps FILE_lightmapK.hdr and .png beside it",
      .own.default_text = "lightmapped.glb"},
+    {"output", 'o', "FILE", CLI_THERMAL, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output heat exchange per surface (or element, --level): .csv or .json (docs/thermal.md)",
+     .own.default_text = "heat.csv"},
+    {"bc", 0, "FILE.json", CLI_THERMAL, OWN(bc, RAD_OPTION_STRING),
+     .own.help = "boundary conditions: each surface's emissivity and temperature, heat flux or adiabatic, "
+                 "and the environment temperature (docs/thermal.md); required"},
+    {"gebhart", 0, "FILE", CLI_THERMAL, OWN(gebhart, RAD_OPTION_STRING),
+     .own.help = "also write the Gebhart factors between surfaces: .csv or .json"},
     {"texels-per-metre", 0, "N", CLI_BAKE, OWN(texels_per_metre, RAD_OPTION_DOUBLE), .own.min = 0.0,
      .own.max = 1e6, .own.min_open = true, .own.default_text = "10",
      .own.help = "lightmap texels per metre of surface"},
@@ -110,6 +123,10 @@ static const cli_flag FLAGS[] = {
     {"elements", 0, "N", RV, SOLVE(target_elements)},
     {"form-factors", 0, "NAME", RV, SOLVE(form_factors)},
     {"solver", 0, "NAME", RS, SOLVE(solver)},
+    {"solver", 0, "NAME", CLI_THERMAL, OWN(thermal_solver, RAD_OPTION_METHOD), .own.methods = RAD_METHOD_SOLVER,
+     .own.default_text = "direct",
+     .own.help = "linear solver of the net-radiation equations, on the form-factor matrix (not hierarchical "
+                 "or shooting)"},
     {"visibility", 0, "NAME", RV, SOLVE(visibility)},
     {"shadow-rays", 0, "N", RV, SOLVE(shadow_rays)},
     {"hemicube-res", 0, "N", RV, SOLVE(hemicube_resolution)},
@@ -122,12 +139,17 @@ static const cli_flag FLAGS[] = {
     {"adaptive-elements", 0, "N", RS, SOLVE(adaptive_max_elements)},
     {"level", 0, "WHICH", CLI_VIEWFACTORS, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
      .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
+    {"level", 0, "WHICH", CLI_THERMAL, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
+     .own.default_text = "surface", .own.help = "heat exchange per surface or per element"},
     {"epsilon", 0, "X", RS, SOLVE(epsilon)},
     {"min-area", 0, "A", RS, SOLVE(min_area)},
     {"clustering", 0, "WHEN", RS, SOLVE(clustering)},
     {"oracle", 0, "WHICH", RS, SOLVE(classic_oracle)},
     {"tolerance", 0, "X", RS, SOLVE(tolerance)},
-    {"max-iterations", 0, "N", RS, SOLVE(max_iterations)},
+    {"tolerance", 0, "X", CLI_THERMAL, OWN(thermal_tolerance, RAD_OPTION_DOUBLE), .own.min = 0.0, .own.max = 1.0,
+     .own.min_open = true, .own.max_open = true, .own.default_text = "1e-10",
+     .own.help = "stop the net-radiation solve when its residual (relative to sum A |E|) falls below"},
+    {"max-iterations", 0, "N", RST, SOLVE(max_iterations)},
     {"unshot-tolerance", 0, "X", RS, SOLVE(unshot_tolerance)},
     {"relaxation", 0, "W", RS, SOLVE(relaxation)},
     {"history", 0, "FILE.csv", RS, OWN(history, RAD_OPTION_STRING),
@@ -398,7 +420,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         if (!f && !known)
             bad = usage_error(e, "unknown option '%s'", arg);
         else if (!f && !s->command)
-            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export, bake or generate", arg);
+            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export, bake, thermal or generate", arg);
         else if (!f)
             bad = usage_error(e, "%s does not apply to %s", arg, cli_command_name(s->command));
         else if (f->metavar && !value && i + 1 >= argc)
@@ -428,7 +450,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render, solve, viewfactors, export, bake or generate");
+        usage_error(e, "no command given: use render, solve, viewfactors, export, bake, thermal or generate");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
@@ -439,6 +461,10 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         usage_error(e, "--atlas-size: expected a power of two, got %d", s->atlas_size);
         return CLI_USAGE_ERROR;
     }
+    /* thermal solves on the form-factor matrix: a linear solver of the
+     * table, LU by default (exact, and thermal scenes are small). */
+    if (s->command == CLI_THERMAL)
+        s->solve.solver = s->thermal_solver ? s->thermal_solver : "direct";
     if (s->every && !s->progress_dir) {
         usage_error(e, "--every needs --progress-images DIR");
         return CLI_USAGE_ERROR;

@@ -24,6 +24,8 @@
 
 /* The commands, as bits: a flag lists those that take it. */
 enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32 };
+/* thermal: radiative heat exchange (docs/thermal.md) */
+enum { CLI_THERMAL = 128 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -48,7 +50,7 @@ typedef struct cli_settings {
     const char *history;
     const char *progress_dir;
     int every;
-    int element_level;        /* viewfactors: 0 surfaces, 1 elements */
+    int element_level;        /* viewfactors, thermal: 0 surfaces, 1 elements */
     rad_options solve;
     rad_render_options render;
     rad_office_options office;
@@ -58,6 +60,10 @@ typedef struct cli_settings {
     double texels_per_metre;  /* bake: 0 = the library's default */
     int atlas_size;           /* bake: 0 = the library's default */
     int lightmap_quantity;    /* bake: rad_lightmap_quantity */
+    const char *bc;           /* thermal: the boundary-condition file */
+    const char *gebhart;      /* thermal: where the Gebhart factors go, or NULL */
+    const char *thermal_solver; /* thermal --solver (also made the solution's); NULL = direct */
+    double thermal_tolerance; /* thermal --tolerance; 0 = the library's default */
 } cli_settings;
 
 /* Where a flag's value goes. */

@@ -706,6 +706,7 @@ typedef enum rad_output_kind {
     RAD_OUTPUT_VIEW_FACTORS = 2, /* .json, .csv, .mtx (rad_solution_write_view_factors) */
     RAD_OUTPUT_MESH = 3,         /* .glb, .gltf, .ply (rad_solution_write_mesh) */
     RAD_OUTPUT_BAKE = 4,         /* .glb, .gltf (rad_solution_bake) */
+    RAD_OUTPUT_THERMAL = 8,      /* .csv, .json (rad_thermal_write, rad_thermal_write_gebhart) */
     RAD_OUTPUT_SOLUTION = 16     /* .radsol (rad_solution_save) */
 } rad_output_kind;
 
@@ -800,6 +801,189 @@ RAD_API rad_result rad_solution_bake(rad_context *ctx, const rad_solution *solut
  * name's length, 0 for a NULL path or extension.  For planning outputs:
  * the first atlas always exists. */
 RAD_API size_t rad_bake_image_path(const char *path, size_t atlas, const char *extension, char *out, size_t size);
+
+/* ------------------------------------------------------------------------
+ * Radiative heat exchange (docs/thermal.md): the same equation in a thermal
+ * engineer's terms.  Each surface is grey and diffuse with an emissivity
+ * eps in (0, 1], and has a known temperature T, a known net heat flux q
+ * or none (adiabatic, q = 0); what escapes an open scene meets an
+ * environment at T_env.  The net-radiation equations
+ *
+ *     known T:  J_i = eps_i sigma T_i^4 + (1 - eps_i) G_i
+ *     known q:  J_i = q_i + G_i
+ *     G_i = sum_j F_ij J_j + (1 - sum_j F_ij) sigma T_env^4
+ *
+ * are solved on a solution's elements and form factors with a linear
+ * solver of the table, giving per element and per surface the radiosity J,
+ * irradiation G, net flux q = J - G (W/m^2, leaving the surface), net power
+ * Q = A q (W) and the temperatures not given.  sigma = RAD_SIGMA.
+ *
+ *     rad_solution_create(ctx, scene, &(rad_options){.solver = "direct"}, &sol);
+ *     rad_thermal_conditions_load_file(ctx, scene, "bc.json", &bc);
+ *     rad_thermal_solve(ctx, sol, bc, NULL, &heat);
+ *     rad_thermal_write(ctx, heat, "heat.csv", false);
+ *
+ * Temperatures in kelvin, fluxes in W/m^2, powers in W (docs/units.md).
+ * ---------------------------------------------------------------------- */
+
+/* Stefan-Boltzmann constant, W m^-2 K^-4 (CODATA 2018; exact in SI since 2019). */
+#define RAD_SIGMA 5.670374419e-8
+
+typedef enum rad_thermal_condition {
+    RAD_THERMAL_UNSET = 0,         /* no condition given (refused by rad_thermal_solve) */
+    RAD_THERMAL_TEMPERATURE = 1,   /* value: T, K, finite, >= 0 */
+    RAD_THERMAL_HEAT_FLUX = 2,     /* value: net flux leaving the surface, W/m^2, finite */
+    RAD_THERMAL_ADIABATIC = 3      /* q = 0: a re-radiating surface (value unused) */
+} rad_thermal_condition;
+
+typedef struct rad_thermal_surface {
+    rad_thermal_condition condition;
+    double value;                  /* K or W/m^2, as the condition says */
+    double emissivity;             /* (0, 1]; 0 = from the scene: 1 - the mean over RGB of
+                                      each element's reflectance (a View3D file's
+                                      emissivities arrive so) */
+} rad_thermal_surface;
+
+/* The conditions of every surface of one scene, and T_env.  Made empty
+ * (every surface RAD_THERMAL_UNSET, T_env = 0 K) or from a file. */
+typedef struct rad_thermal_conditions rad_thermal_conditions;
+
+/* Empty conditions for `scene`, which must outlive them.  Fails with
+ * RAD_ERROR_OUT_OF_MEMORY; NULL ctx, scene or out: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_thermal_conditions_create(rad_context *ctx, const rad_scene *scene,
+                                                 rad_thermal_conditions **out);
+
+/* Read a boundary-condition file (JSON, docs/thermal.md) for `scene`:
+ *
+ *     {"environment_temperature": 3,
+ *      "default": {"emissivity": 0.9, "adiabatic": true},
+ *      "surfaces": {"floor": {"emissivity": 0.8, "temperature": 1200},
+ *                   "lid": {"heat_flux": -5000}}}
+ *
+ * Every surface of the scene needs a condition, from "surfaces" or
+ * "default".  Fails with RAD_ERROR_PARSE and one line naming the file and
+ * the key ("bc.json: surfaces.floor.emissivity: must be in (0, 1], got
+ * 1.5"): not JSON, an unknown key or surface name, a name given twice, a
+ * value of the wrong type or out of range (emissivity outside (0, 1], a
+ * negative or non-finite temperature), both a temperature and a heat flux,
+ * a surface without a condition; RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY.
+ * The file is read within the memory limit.  On failure *out is NULL.
+ * NULL ctx, scene, path or out: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_thermal_conditions_load_file(rad_context *ctx, const rad_scene *scene, const char *path,
+                                                    rad_thermal_conditions **out);
+/* The same from `size` bytes at `data`; `name` stands for the file in
+ * messages. */
+RAD_API rad_result rad_thermal_conditions_load_memory(rad_context *ctx, const rad_scene *scene, const char *name,
+                                                      const void *data, size_t size,
+                                                      rad_thermal_conditions **out);
+
+/* Set one surface's condition (a copy).  Fails with
+ * RAD_ERROR_INVALID_ARGUMENT for a surface out of range, an unknown
+ * condition, a value or emissivity out of range (as the file's), or a NULL
+ * ctx, conditions or surface_condition. */
+RAD_API rad_result rad_thermal_conditions_set(rad_context *ctx, rad_thermal_conditions *conditions,
+                                              size_t surface, const rad_thermal_surface *surface_condition);
+/* Set T_env in K (finite, >= 0; else RAD_ERROR_INVALID_ARGUMENT, as for a
+ * NULL ctx or conditions). */
+RAD_API rad_result rad_thermal_conditions_set_environment(rad_context *ctx, rad_thermal_conditions *conditions,
+                                                          double kelvin);
+/* A surface's condition into *out; false (nothing written) for a surface
+ * out of range or a NULL argument. */
+RAD_API bool rad_thermal_conditions_get(const rad_thermal_conditions *conditions, size_t surface,
+                                        rad_thermal_surface *out);
+/* T_env, K.  NULL: NaN. */
+RAD_API double rad_thermal_conditions_environment(const rad_thermal_conditions *conditions);
+/* NULL: no-op. */
+RAD_API void rad_thermal_conditions_destroy(rad_thermal_conditions *conditions);
+
+typedef struct rad_thermal_options {
+    const char *solver;            /* a linear solver of the table (rad_method_info); NULL =
+                                      "direct" (LU: exact, the reference) */
+    double tolerance;              /* the solver's residual, relative to sum A |E|; 0 = 1e-10 */
+    int max_iterations;            /* iterative solvers; 0 = automatic (rad_options') */
+} rad_thermal_options;
+
+/* The heat exchange solved for one solution's elements. */
+typedef struct rad_thermal rad_thermal;
+
+/* Solve the net-radiation equations on `solution`'s elements and form
+ * factors (a solution made with a dense solver: "direct", "gauss-seidel",
+ * ...; it need not be solved, and its scene needs no emitter) for
+ * `conditions` (of the solution's scene).  The result borrows the solution,
+ * which must outlive it and not be solved again meanwhile.  A group of
+ * surfaces that exchange radiation with heat fluxes only and nothing
+ * escaping (under 1e-3 of their radiation) has no unique temperatures:
+ * refused.  Fails with RAD_ERROR_INVALID_ARGUMENT (a surface without a
+ * condition, such a closed group, a flux no temperature gives, options out
+ * of range, a solution without form factors: hierarchical or matrix-free),
+ * RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INTERRUPTED, or as the solver.  NULL
+ * ctx, solution, conditions or out: RAD_ERROR_INVALID_ARGUMENT.  `options`
+ * may be NULL (defaults). */
+RAD_API rad_result rad_thermal_solve(rad_context *ctx, const rad_solution *solution,
+                                     const rad_thermal_conditions *conditions, const rad_thermal_options *options,
+                                     rad_thermal **out);
+/* NULL: no-op. */
+RAD_API void rad_thermal_destroy(rad_thermal *thermal);
+
+/* One surface's or element's figures. */
+typedef struct rad_thermal_values {
+    double area;                   /* m^2 */
+    double emissivity;             /* surface: area-weighted mean */
+    double temperature;            /* K; surface: (area-weighted mean of T^4)^(1/4) */
+    double radiosity;              /* J, W/m^2; surface: area-weighted mean */
+    double irradiation;            /* G, W/m^2; surface: area-weighted mean */
+    double heat_flux;              /* q, W/m^2, leaving; surface: Q / area */
+    double heat;                   /* Q = A q, W, leaving; surface: sum over its elements */
+    rad_thermal_condition condition;
+} rad_thermal_values;
+
+/* The figures of surface `surface` (numbered as the scene's) or element
+ * `element` (as the solution's) into *out; false (nothing written) when
+ * out of range or for a NULL argument. */
+RAD_API bool rad_thermal_surface_values(const rad_thermal *thermal, size_t surface, rad_thermal_values *out);
+RAD_API bool rad_thermal_element_values(const rad_thermal *thermal, size_t element, rad_thermal_values *out);
+
+/* The energy balance.  With reciprocal factors the surfaces' net power is
+ * what leaves for the environment: net_power = environment_power (both 0 in
+ * a closed enclosure); `imbalance` is their difference, the form factors'
+ * reciprocity error plus the solve's. */
+typedef struct rad_thermal_balance {
+    double net_power;              /* sum_i Q_i, W */
+    double environment_power;      /* sum_i A_i (1 - sum_j F_ij)(J_i - sigma T_env^4), W */
+    double imbalance;              /* net_power - environment_power, W */
+    double power_scale;            /* sum_i |Q_i|, W */
+    double relative_imbalance;     /* imbalance / power_scale; 0 when that is 0 */
+} rad_thermal_balance;
+
+/* The balance into *out, and the solver's residual as the return value.
+ * NULL thermal: NaN (out, if not NULL, all NaN). */
+RAD_API double rad_thermal_get_balance(const rad_thermal *thermal, rad_thermal_balance *out);
+
+/* Gebhart factors between the scene's S surfaces (Gebhart 1961): G[s * S + t]
+ * is the fraction of surface s's emission absorbed by t after any number
+ * of diffuse reflections (rows sum to 1 in a closed enclosure; eps_s A_s
+ * G_st = eps_t A_t G_ts), from the result's emissivities, by its solver, S / 3
+ * solves.  `G` holds S * S doubles.  Fails with RAD_ERROR_OUT_OF_MEMORY,
+ * RAD_ERROR_INTERRUPTED, or as the solver; NULL ctx, thermal or G:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_thermal_gebhart(rad_context *ctx, const rad_thermal *thermal, double *G);
+
+/* Write the figures, by extension (docs/thermal.md): .csv, one row per
+ * surface (or per element when `elements`), or .json (surfaces, and
+ * elements when asked, with T_env and the balance).  Atomic like the other
+ * writers.  Fails with RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY; an unknown
+ * extension or a NULL ctx, thermal or path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_thermal_write(rad_context *ctx, const rad_thermal *thermal, const char *path,
+                                     bool elements);
+/* The solution's stats (rad_solution_write_stats) with a "thermal" object:
+ * solver, residual, T_env and the balance (docs/stats.md).  Fails as that
+ * does; NULL ctx, thermal or path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_thermal_write_stats(rad_context *ctx, const rad_thermal *thermal, const char *path);
+
+/* Write the Gebhart factors: .csv (a header row of surface names, then one
+ * row per emitting surface) or .json ({"surfaces": [...], "G": [[...]]}).
+ * Fails as rad_thermal_gebhart and rad_thermal_write. */
+RAD_API rad_result rad_thermal_write_gebhart(rad_context *ctx, const rad_thermal *thermal, const char *path);
 
 /* ------------------------------------------------------------------------
  * Method registries

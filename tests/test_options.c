@@ -281,7 +281,7 @@ static cli_action parse(const char *first, ...)
 /* The first command that takes a flag. */
 static const char *command_of(const cli_flag *f)
 {
-    for (int bit = CLI_RENDER; bit <= CLI_BAKE; bit <<= 1)
+    for (int bit = CLI_RENDER; bit <= CLI_THERMAL; bit <<= 1)
         if (f->commands & bit)
             return cli_command_name(bit);
     return NULL;
@@ -391,8 +391,8 @@ static void test_words_and_methods(void **state)
             for (size_t i = 0; rad_method_info(o->methods, i, &name, &description); i++) {
                 /* --progress-images is refused with hierarchical; no need here. */
                 assert_int_equal(parse_flag(f, name), CLI_RUN);
-                assert_string_equal(*(const char *const *)(const void *)((const char *)&settings.solve + o->offset),
-                                    name);
+                const char *base = f->target == CLI_TO_SOLVE ? (const char *)&settings.solve : (const char *)&settings;
+                assert_string_equal(*(const char *const *)(const void *)(base + o->offset), name);
             }
         } else {
             continue;
@@ -464,7 +464,7 @@ static void test_generate_takes_the_shared_parser(void **state)
     assert_int_equal(parse("viewfactors", NULL), CLI_RUN);
     assert_string_equal(settings.output, "viewfactors.json");
     assert_int_equal(parse("--rooms", "3", NULL), CLI_USAGE_ERROR);
-    assert_string_equal(err, "--rooms needs a command: render, solve, viewfactors, export, bake or generate");
+    assert_string_equal(err, "--rooms needs a command: render, solve, viewfactors, export, bake, thermal or generate");
 }
 
 /* ---- --help, the man page, the messages ---- */

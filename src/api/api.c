@@ -496,9 +496,8 @@ rad_result rad_solution_load_memory(rad_context *ctx, const char *name, const vo
     return RAD_OK;
 }
 
-/* The whole file at `path` in a block of the context (rad_free it), within
- * its memory limit: a regular file by its size, a stream as it comes. */
-static rad_result read_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size)
+/* As solution.h says. */
+rad_result rad_read_whole_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size)
 {
     *data = NULL;
     *size = 0;
@@ -511,7 +510,7 @@ static rad_result read_file(rad_context *ctx, const char *path, unsigned char **
         fclose(f);
         return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: Is a directory", path);
     }
-    unsigned char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, "solution file");
+    unsigned char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, "input file");
     size_t used = 0;
     while (buffer) {
         size_t got = fread(buffer + used, 1, capacity - used, f);
@@ -525,7 +524,7 @@ static rad_result read_file(rad_context *ctx, const char *path, unsigned char **
             }
             break;
         }
-        unsigned char *grown = rad_realloc(ctx, RAD_MEM_SCENE, buffer, 2 * capacity, 1, "solution file");
+        unsigned char *grown = rad_realloc(ctx, RAD_MEM_SCENE, buffer, 2 * capacity, 1, "input file");
         if (!grown)
             rad_free(buffer);
         buffer = grown;
@@ -551,7 +550,7 @@ rad_result rad_solution_load_file(rad_context *ctx, const char *path, rad_scene 
     unsigned char *data;
     size_t size;
     double t = rad_seconds();
-    rad_result r = read_file(ctx, path, &data, &size);
+    rad_result r = rad_read_whole_file(ctx, path, &data, &size);
     if (r != RAD_OK)
         return r;
     r = rad_solution_load_memory(ctx, path, data, size, scene, out);

@@ -81,9 +81,22 @@ double rad_srgb_encode(double linear);
  * output memory (rad_free it); NULL when out of memory. */
 char *rad_utf8_clean(rad_context *ctx, const char *text);
 
+/* A CSV field: quoted (with doubled quotes) when it holds a comma, quote or
+ * line break (RFC 4180), or begins or ends with a blank (which readers
+ * that trim would lose).  Cannot fail. */
+void rad_csv_field(FILE *f, const char *text);
+
 /* The stats JSON of a solution (docs/stats.md); `partial` marks an
  * interrupted run. */
 rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *view, const char *path, bool partial);
+
+/* The same with `extra` adding its own members to the root object (a
+ * cJSON object) before it is written; a failure it returns (out of
+ * memory) is the writer's. */
+struct cJSON;
+typedef rad_result (*rad_stats_extra_fn)(rad_context *ctx, struct cJSON *root, const void *user);
+rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *view, const char *path, bool partial,
+                                 rad_stats_extra_fn extra, const void *user);
 
 /* The solution file (strategy/saved.h): the view's scene, mesh and values
  * with the vertex values the renderer uses (3 per mesh vertex), written
@@ -179,5 +192,14 @@ rad_result rad_write_bake(rad_context *ctx, const rad_solution_view *view, const
 
 /* The convergence history as CSV: iteration, seconds, residual, unshot. */
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path);
+
+/* The heat exchange's figures (rad_thermal_write) and its Gebhart factors
+ * G (S x S; rad_thermal_write_gebhart), by extension .csv or .json
+ * (thermal_write.c; docs/thermal.md). */
+rad_result rad_write_thermal(rad_context *ctx, const rad_thermal *thermal, const char *path, bool elements);
+rad_result rad_write_gebhart(rad_context *ctx, const rad_thermal *thermal, const double *G, const char *path);
+/* The solution's stats with a "thermal" object (rad_thermal_write_stats). */
+rad_result rad_write_thermal_stats(rad_context *ctx, const rad_solution_view *view, const rad_thermal *thermal,
+                                   const char *path);
 
 #endif /* RAD_OUTPUT_H */

@@ -155,6 +155,12 @@ rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *
 
 rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const char *path, bool partial)
 {
+    return rad_write_stats_extra(ctx, s, path, partial, NULL, NULL);
+}
+
+rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, const char *path, bool partial,
+                                 rad_stats_extra_fn extra, const void *user)
+{
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", path);
@@ -320,6 +326,8 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *s, const c
         cJSON_AddNumberToObject(by_category, rad_memory_category_name((rad_memory_category)c),
                                 (double)rad_memory_peak(ctx, (rad_memory_category)c));
 
+    if (r == RAD_OK && extra)
+        r = extra(ctx, root, user);
     if (r == RAD_OK)
         r = write_json(ctx, root, path);
     cJSON_Delete(root);
@@ -350,10 +358,8 @@ static rad_result surface_std_errors(rad_context *ctx, const rad_solution_view *
     return RAD_OK;
 }
 
-/* A CSV field: quoted (with doubled quotes) when it holds a comma, quote or
- * line break (RFC 4180), or begins or ends with a blank (which readers
- * that trim would lose). */
-static void csv_field(FILE *f, const char *text)
+/* As output.h says. */
+void rad_csv_field(FILE *f, const char *text)
 {
     size_t len = strlen(text);
     bool blank_edge = len > 0 && (strchr(" \t", text[0]) || strchr(" \t", text[len - 1]));
@@ -556,11 +562,11 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
             fputs("from,area_m2", f.file);
             for (size_t b = 0; b < N; b++) {
                 fputc(',', f.file);
-                csv_field(f.file, rows.names[b]);
+                rad_csv_field(f.file, rows.names[b]);
             }
             fputc('\n', f.file);
             for (size_t a = 0; a < N; a++) {
-                csv_field(f.file, rows.names[a]);
+                rad_csv_field(f.file, rows.names[a]);
                 fprintf(f.file, ",%.17g", rows.area[a]);
                 for (size_t b = 0; b < N; b++)
                     fprintf(f.file, ",%.17g", rows.F[a * N + b]);

@@ -72,10 +72,10 @@ static rad_result check_determined(rad_context *ctx, const rad_thermal_system *s
             char name[320];
             element_name(sys, i, name, sizeof name);
             result = rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                              "thermal: %s and the surfaces it exchanges radiation with form a closed "
+                              "%s: %s and the surfaces it exchanges radiation with form a closed "
                               "enclosure (%.2g of their radiation escapes, below %.0e) with heat fluxes "
                               "only: their temperatures are undetermined; give one of them a temperature",
-                              name, fraction, RAD_THERMAL_CLOSED_ESCAPE);
+                              sys->source ? sys->source : "thermal", name, fraction, RAD_THERMAL_CLOSED_ESCAPE);
         }
     }
     rad_free(parent);
@@ -145,7 +145,9 @@ rad_result rad_thermal_solve_system(rad_context *ctx, const rad_thermal_system *
     memcpy(B, E, 3 * n * sizeof *B);
     rad_system lin = {.n = n, .F = sys->F, .area = sys->area, .reflectance = rho, .emission = E,
                       .threads = sys->threads, .max_memory = sys->max_memory};
+    double t0 = rad_seconds();
     r = solver->solve(ctx, &lin, p, B, st);
+    st->seconds = rad_seconds() - t0;
     if (r != RAD_OK)
         goto done;
 
@@ -174,10 +176,10 @@ rad_result rad_thermal_solve_system(rad_context *ctx, const rad_thermal_system *
                 char name[320];
                 element_name(sys, i, name, sizeof name);
                 r = rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                             "thermal: %s: a heat flux of %.6g W/m^2 needs more than its emissivity %.6g "
+                             "%s: %s: a heat flux of %.6g W/m^2 needs more than its emissivity %.6g "
                              "times its irradiation %.6g W/m^2 can absorb (the flux leaving it must be at "
                              "least -eps G): no temperature gives it",
-                             name, sys->value[i], sys->emissivity[i], g);
+                             sys->source ? sys->source : "thermal", name, sys->value[i], sys->emissivity[i], g);
                 break;
             }
             out->temperature[i] = t4 > 0.0 ? pow(t4 / RAD_SIGMA, 0.25) : 0.0;
@@ -199,7 +201,7 @@ done:
     return r;
 }
 
-rad_result rad_thermal_gebhart(rad_context *ctx, const rad_thermal_system *sys, size_t S, const rad_solver *solver,
+rad_result rad_thermal_gebhart_factors(rad_context *ctx, const rad_thermal_system *sys, size_t S, const rad_solver *solver,
                                const rad_solve_params *p, double *G)
 {
     size_t n = sys->n;

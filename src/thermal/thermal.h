@@ -55,8 +55,7 @@
 
 #include "solve/solve.h"
 
-/* Stefan-Boltzmann constant, W m^-2 K^-4 (CODATA 2018; exact in SI since 2019). */
-#define RAD_SIGMA 5.670374419e-8
+/* sigma: RAD_SIGMA (radiosity.h). */
 
 /* A group of elements with heat fluxes only is refused as closed when less
  * than this fraction of its area-weighted radiation escapes (sum_i A_i
@@ -77,6 +76,7 @@ typedef struct rad_thermal_system {
      * (either may be NULL: elements are then named by number). */
     const uint32_t *surface;
     const char *const *surface_names;
+    const char *source;             /* the conditions' file, or NULL: prefixes messages */
     int threads;
     double max_memory;              /* bytes the solver may hold; 0 = the context's limit */
 } rad_thermal_system;
@@ -89,13 +89,7 @@ typedef struct rad_thermal_fields {
     double *temperature;            /* K: given, or found for the known-q rows */
 } rad_thermal_fields;
 
-typedef struct rad_thermal_balance {
-    double net_power;               /* sum_i Q_i, W */
-    double environment_power;       /* sum_i A_i (1 - S_i)(J_i - sigma T_env^4), W */
-    double imbalance;               /* net_power - environment_power, W */
-    double power_scale;             /* sum_i |Q_i|, W */
-    double relative_imbalance;      /* imbalance / power_scale (0 when power_scale is 0) */
-} rad_thermal_balance;
+/* The balance: rad_thermal_balance (radiosity.h). */
 
 /* Solve the system with `solver` (NULL = "direct") under `p` into `out`;
  * `balance` and `stats` (either may be NULL) receive the figures.  Fails
@@ -113,7 +107,47 @@ rad_result rad_thermal_solve_system(rad_context *ctx, const rad_thermal_system *
  * read, T_env neither: radiation that escapes is lost), three emitting
  * surfaces per solve.  A surface of no element gets a zero row.  Fails
  * with RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INTERRUPTED, or as the solver. */
-rad_result rad_thermal_gebhart(rad_context *ctx, const rad_thermal_system *sys, size_t S, const rad_solver *solver,
+rad_result rad_thermal_gebhart_factors(rad_context *ctx, const rad_thermal_system *sys, size_t S, const rad_solver *solver,
                                const rad_solve_params *p, double *G);
+
+/* ---- the objects behind the public handles (radiosity.h) ---- */
+
+struct rad_thermal_conditions {
+    rad_context *ctx;               /* made in: its memory is accounted there */
+    const rad_scene *scene;         /* borrowed */
+    size_t surface_count;
+    rad_thermal_surface *surfaces;  /* surface_count */
+    double environment_temperature; /* K */
+    char *source;                   /* the file's name, or NULL when set by calls */
+};
+
+/* Parse a boundary-condition file's text (conditions.c; docs/thermal.md)
+ * into *out.  Errors name `name` and the key; RAD_ERROR_PARSE. */
+rad_result rad_thermal_conditions_parse(rad_context *ctx, const rad_scene *scene, const char *name,
+                                        const char *text, size_t size, rad_thermal_conditions **out);
+
+/* Whether a condition is acceptable; on failure *why says what (for the
+ * caller's message, which names where it came from). */
+bool rad_thermal_surface_valid(const rad_thermal_surface *s, char *why, size_t size);
+
+struct rad_thermal {
+    rad_context *ctx;               /* made in */
+    const rad_solution *solution;   /* borrowed: must outlive it */
+    const rad_scene *scene;         /* the solution's, borrowed */
+    const struct rad_mesh *mesh;    /* the solution's elements, borrowed */
+    const double *F;                /* the solution's n x n factors, borrowed */
+    rad_thermal_system sys;         /* its arrays below, F borrowed */
+    const rad_solver *solver;
+    rad_solve_params params;
+    rad_solve_stats stats;
+    double *emissivity, *value;     /* n */
+    unsigned char *known_temperature; /* n */
+    uint32_t *surface;              /* n */
+    const char **surface_names;     /* S, the scene's */
+    rad_thermal_fields fields;      /* n each */
+    rad_thermal_values *surfaces;   /* S */
+    rad_thermal_condition *element_condition; /* n */
+    rad_thermal_balance balance;
+};
 
 #endif /* RAD_THERMAL_H */
