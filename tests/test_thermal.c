@@ -330,10 +330,373 @@ static void test_undetermined(void **state)
     rad_context_destroy(ctx);
 }
 
+/* ---- through the library: a closed unit cube, floor against the other five faces ---- */
+
+/* The unit cube as "floor" (y = 0) and "walls" (the other five faces, one
+ * surface), normals inwards, material Kd rho_floor / rho_walls and Ke as
+ * given (W/(m^2 sr)); written to NAME.obj in the work folder. */
+static void write_box(const char *name, double rho_floor, double ke_floor, double rho_walls, double ke_walls,
+                      char *path, size_t size)
+{
+    snprintf(path, size, "%s/%s.obj", cli_workdir(), name);
+    char mtl[600];
+    snprintf(mtl, sizeof mtl, "%s/%s.mtl", cli_workdir(), name);
+    FILE *m = fopen(mtl, "w");
+    assert_non_null(m);
+    fprintf(m, "newmtl f\nKd %.17g %.17g %.17g\nKe %.17g %.17g %.17g\n", rho_floor, rho_floor, rho_floor, ke_floor,
+            ke_floor, ke_floor);
+    fprintf(m, "newmtl w\nKd %.17g %.17g %.17g\nKe %.17g %.17g %.17g\n", rho_walls, rho_walls, rho_walls, ke_walls,
+            ke_walls, ke_walls);
+    fclose(m);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "mtllib %s.mtl\n"
+               "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\n"
+               "o floor\nusemtl f\nf 1 4 3 2\n"
+               "o walls\nusemtl w\nf 5 6 7 8\nf 1 5 8 4\nf 2 3 7 6\nf 1 2 6 5\nf 4 8 7 3\n",
+            name);
+    fclose(f);
+}
+
+typedef struct box_run {
+    rad_context *ctx;
+    rad_scene *scene;
+    rad_solution *sol;
+} box_run;
+
+static void box_open(box_run *b, const char *path, double mesh_size, int closure)
+{
+    b->ctx = context();
+    assert_int_equal(rad_scene_load_file(b->ctx, path, &b->scene), RAD_OK);
+    rad_options o = {.solver = "direct", .mesh_size = mesh_size, .closure_correction = closure};
+    assert_int_equal(rad_solution_create(b->ctx, b->scene, &o, &b->sol), RAD_OK);
+}
+
+static void box_close(box_run *b)
+{
+    rad_solution_destroy(b->sol);
+    rad_scene_destroy(b->scene);
+    rad_context_destroy(b->ctx);
+}
+
+static rad_thermal *box_solve(box_run *b, const char *bc)
+{
+    rad_thermal_conditions *c = NULL;
+    if (rad_thermal_conditions_load_memory(b->ctx, b->scene, "bc.json", bc, strlen(bc), &c) != RAD_OK)
+        fail_msg("%s", rad_context_error(b->ctx));
+    rad_thermal *t = NULL;
+    if (rad_thermal_solve(b->ctx, b->sol, c, NULL, &t) != RAD_OK)
+        fail_msg("%s", rad_context_error(b->ctx));
+    rad_thermal_conditions_destroy(c);
+    return t;
+}
+
+/* Black walls at T2 make the walls' radiosity uniform, sigma T2^4, so the
+ * floor of the meshed box has the two-surface answer exactly:
+ * q = eps1 sigma (T1^4 - T2^4) on every element.  What the engine's F
+ * adds is its closure error (the floor's rows sum to 1 - 2e-6 here). */
+static void test_box_through_library(void **state)
+{
+    (void)state;
+    char path[600];
+    write_box("box", 0.5, 0.0, 0.5, 0.0, path, sizeof path);
+    box_run b;
+    box_open(&b, path, 0.25, 0);
+    rad_thermal *t = box_solve(&b, "{\"surfaces\": {\"floor\": {\"emissivity\": 0.8, \"temperature\": 1000},"
+                                   " \"walls\": {\"emissivity\": 1, \"temperature\": 500}}}");
+    double q = 0.8 * RAD_SIGMA * (pow(1000.0, 4) - pow(500.0, 4));
+    rad_thermal_values floor, walls;
+    assert_true(rad_thermal_surface_values(t, 0, &floor) && rad_thermal_surface_values(t, 1, &walls));
+    cli_assert_relative(floor.heat_flux, q, 1e-4, "floor q");
+    cli_assert_relative(floor.area, 1.0, 1e-12, "floor area");
+    cli_assert_relative(walls.area, 5.0, 1e-12, "walls area");
+    cli_assert_relative(walls.heat, -q, 1e-4, "walls Q");
+    assert_int_equal(floor.condition, RAD_THERMAL_TEMPERATURE);
+    for (size_t i = 0; i < rad_solution_element_count(b.sol); i++) {
+        rad_thermal_values v;
+        assert_true(rad_thermal_element_values(t, i, &v));
+        if (rad_solution_element_surface(b.sol, i) == 0)
+            cli_assert_relative(v.heat_flux, q, 1e-4, "floor element q");
+        else
+            cli_assert_relative(v.radiosity, RAD_SIGMA * pow(500.0, 4), 1e-12, "black wall J");
+    }
+    rad_thermal_balance bal;
+    double residual = rad_thermal_get_balance(t, &bal);
+    assert_true(residual < 1e-10);
+    assert_true(fabs(bal.relative_imbalance) < 1e-9);
+    /* Closed: next to nothing leaves (the factors' closure error only). */
+    assert_true(fabs(bal.net_power) < 1e-4 * bal.power_scale);
+    rad_thermal_destroy(t);
+
+    /* The floor's flux given: its temperature back, to the same error. */
+    char bc[400];
+    snprintf(bc, sizeof bc, "{\"surfaces\": {\"floor\": {\"emissivity\": 0.8, \"heat_flux\": %.17g},"
+                            " \"walls\": {\"emissivity\": 1, \"temperature\": 500}}}", q);
+    t = box_solve(&b, bc);
+    assert_true(rad_thermal_surface_values(t, 0, &floor));
+    cli_assert_relative(floor.temperature, 1000.0, 1e-5, "floor T from q");
+    assert_int_equal(floor.condition, RAD_THERMAL_HEAT_FLUX);
+
+    /* Gebhart factors: rows sum to the factors' closure, and
+     * eps_s A_s G_st = eps_t A_t G_ts (the analytic F is reciprocal). */
+    double G[4];
+    assert_int_equal(rad_thermal_gebhart(b.ctx, t, G), RAD_OK);
+    assert_true(fabs(G[0] + G[1] - 1.0) < 1e-4 && fabs(G[2] + G[3] - 1.0) < 1e-4);
+    cli_assert_relative(0.8 * 1.0 * G[1], 1.0 * 5.0 * G[2], 1e-9, "Gebhart reciprocity");
+    assert_true(G[0] < 1e-12); /* the flat floor cannot see itself */
+    rad_thermal_destroy(t);
+
+    /* Everything adiabatic or a flux in the closed box: refused, naming the file. */
+    rad_thermal_conditions *c = NULL;
+    const char *closed = "{\"surfaces\": {\"floor\": {\"heat_flux\": 100}, \"walls\": {\"adiabatic\": true}}}";
+    assert_int_equal(rad_thermal_conditions_load_memory(b.ctx, b.scene, "bc.json", closed, strlen(closed), &c),
+                     RAD_OK);
+    assert_int_equal(rad_thermal_solve(b.ctx, b.sol, c, NULL, &t), RAD_ERROR_INVALID_ARGUMENT);
+    assert_null(t);
+    assert_non_null(strstr(rad_context_error(b.ctx), "bc.json: "));
+    assert_non_null(strstr(rad_context_error(b.ctx), "closed enclosure"));
+    rad_thermal_conditions_destroy(c);
+    box_close(&b);
+}
+
+/* Known temperatures everywhere and no environment: the thermal J is the
+ * engine's own B for E = eps sigma T^4 and rho = 1 - eps on the same F
+ * (the emissivities here come from the materials, 1 - Kd). */
+static void test_agrees_with_the_radiosity_solve(void **state)
+{
+    (void)state;
+    double eps_f = 0.7, eps_w = 0.4, T_f = 900.0, T_w = 450.0;
+    char path[600];
+    write_box("box_emit", 1.0 - eps_f, eps_f * RAD_SIGMA * pow(T_f, 4) / M_PI, 1.0 - eps_w,
+              eps_w * RAD_SIGMA * pow(T_w, 4) / M_PI, path, sizeof path);
+    box_run b;
+    box_open(&b, path, 0.34, 0);
+    rad_thermal *t = box_solve(&b, "{\"surfaces\": {\"floor\": {\"temperature\": 900}, \"walls\": {\"temperature\":"
+                                   " 450}}}");
+    assert_int_equal(rad_solution_solve(b.ctx, b.sol), RAD_OK);
+    size_t n = rad_solution_element_count(b.sol);
+    assert_true(n > 50);
+    for (size_t i = 0; i < n; i++) {
+        double B[3];
+        rad_thermal_values v;
+        assert_true(rad_solution_element_values(b.sol, i, NULL, NULL, B));
+        assert_true(rad_thermal_element_values(t, i, &v));
+        cli_assert_relative(v.emissivity, rad_solution_element_surface(b.sol, i) == 0 ? eps_f : eps_w, 1e-12, "eps");
+        cli_assert_relative(v.radiosity, B[0], 1e-9, "J = B");
+    }
+    rad_thermal_destroy(t);
+    box_close(&b);
+}
+
+/* ---- bad boundary-condition files: one line naming the file and the key ---- */
+
+static void test_bad_conditions(void **state)
+{
+    (void)state;
+    char path[600];
+    write_box("box_bad", 0.5, 0.0, 0.5, 0.0, path, sizeof path);
+    rad_context *ctx = context();
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_OK);
+    static const struct {
+        const char *text, *message;
+    } bad[] = {
+        {"{\"surfaces\": {\"floor\": {\"temperature\": 300}", "bc.json:1: not valid JSON"},
+        {"[1, 2]", "bc.json: must be a JSON object"},
+        {"{\"surfaces\": {\"floor\": {\"temperature\": 300}, \"roof\": {\"temperature\": 3}}}",
+         "bc.json: surfaces.roof: the scene"},
+        {"{\"surfaces\": {\"floor\": {\"temperature\": 300}}}",
+         "bc.json: surfaces: the scene's surface 'walls' has no condition"},
+        {"{\"surfaces\": {\"floor\": {\"emissivity\": 1.5, \"temperature\": 300}}, \"default\": {\"adiabatic\": true}}",
+         "bc.json: surfaces.floor.emissivity: must be in (0, 1], got 1.5"},
+        {"{\"default\": {\"emissivity\": 0, \"adiabatic\": true}}", "bc.json: default.emissivity: must be in (0, 1]"},
+        {"{\"default\": {\"temperature\": -1}}", "bc.json: default.temperature: must be finite and >= 0 K"},
+        {"{\"default\": {\"temperature\": 1e999}}", "bc.json: default.temperature: must be finite"},
+        {"{\"default\": {\"heat_flux\": -1e999}}", "bc.json: default.heat_flux: must be finite"},
+        {"{\"default\": {\"temperature\": 300, \"heat_flux\": 5}}",
+         "bc.json: default: more than one of temperature, heat_flux and adiabatic"},
+        {"{\"default\": {\"emisivity\": 0.5, \"temperature\": 300}}", "bc.json: default.emisivity: unknown key"},
+        {"{\"default\": {\"emissivity\": 0.5}}", "bc.json: default: no condition"},
+        {"{\"default\": {\"adiabatic\": \"yes\"}}", "bc.json: default.adiabatic: must be true or false"},
+        {"{\"default\": {\"temperature\": \"300\"}}", "bc.json: default.temperature: must be a number"},
+        {"{\"default\": {\"temperature\": 300}, \"surfaces\": {\"floor\": {\"adiabatic\": true}, \"floor\": "
+         "{\"adiabatic\": true}}}",
+         "bc.json: surfaces.floor: given twice"},
+        {"{\"default\": {\"adiabatic\": true}, \"environment_temperature\": -3}",
+         "bc.json: environment_temperature: must be a finite number >= 0 K"},
+        {"{\"default\": {\"adiabatic\": true}, \"environment\": 3}", "bc.json: environment: unknown key"},
+        {"{\"default\": {\"adiabatic\": true}} x", "bc.json:1: text after the JSON object"},
+    };
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+        rad_thermal_conditions *c = (rad_thermal_conditions *)&c; /* must come back NULL */
+        rad_result r = rad_thermal_conditions_load_memory(ctx, scene, "bc.json", bad[k].text, strlen(bad[k].text), &c);
+        if (r != RAD_ERROR_PARSE || c != NULL || strncmp(rad_context_error(ctx), bad[k].message, strlen(bad[k].message)))
+            fail_msg("case %zu: result %d, message '%s', expected '%s'", k, (int)r, rad_context_error(ctx),
+                     bad[k].message);
+    }
+    /* A default fills in; "adiabatic": false says nothing; the calls check as the file does. */
+    const char *good = "{\"environment_temperature\": 3, \"default\": {\"emissivity\": 0.3, \"adiabatic\": true},"
+                       " \"surfaces\": {\"floor\": {\"adiabatic\": false, \"temperature\": 350}}}";
+    rad_thermal_conditions *c = NULL;
+    assert_int_equal(rad_thermal_conditions_load_memory(ctx, scene, "bc.json", good, strlen(good), &c), RAD_OK);
+    rad_thermal_surface s;
+    assert_true(rad_thermal_conditions_get(c, 1, &s));
+    assert_int_equal(s.condition, RAD_THERMAL_ADIABATIC);
+    assert_true(s.emissivity == 0.3);
+    assert_true(rad_thermal_conditions_get(c, 0, &s));
+    assert_true(s.condition == RAD_THERMAL_TEMPERATURE && s.value == 350.0 && s.emissivity == 0.0);
+    assert_true(rad_thermal_conditions_environment(c) == 3.0);
+    s = (rad_thermal_surface){RAD_THERMAL_TEMPERATURE, -2.0, 0.5};
+    assert_int_equal(rad_thermal_conditions_set(ctx, c, 0, &s), RAD_ERROR_INVALID_ARGUMENT);
+    s = (rad_thermal_surface){RAD_THERMAL_HEAT_FLUX, 10.0, 1.01};
+    assert_int_equal(rad_thermal_conditions_set(ctx, c, 0, &s), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_thermal_conditions_set(ctx, c, 2, &s), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_thermal_conditions_set_environment(ctx, c, NAN), RAD_ERROR_INVALID_ARGUMENT);
+    rad_thermal_conditions_destroy(c);
+    /* Unset conditions are refused at the solve; a missing file names itself. */
+    assert_int_equal(rad_thermal_conditions_create(ctx, scene, &c), RAD_OK);
+    rad_solution *sol = NULL;
+    rad_options o = {.solver = "direct", .mesh_size = 0.5};
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &sol), RAD_OK);
+    rad_thermal *t = NULL;
+    assert_int_equal(rad_thermal_solve(ctx, sol, c, NULL, &t), RAD_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rad_context_error(ctx), "surface 'floor' has no condition"));
+    rad_thermal_conditions_destroy(c);
+    assert_int_equal(rad_thermal_conditions_load_file(ctx, scene, "/nonexistent/bc.json", &c), RAD_ERROR_IO);
+    assert_non_null(strstr(rad_context_error(ctx), "/nonexistent/bc.json"));
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
+/* ---- the command ---- */
+
+/* One CSV row's numeric field `column` (0-based) of the row whose first
+ * field is `name`; NAN when absent. */
+static double csv_value(const char *text, const char *name, int column)
+{
+    size_t len = strlen(name);
+    for (const char *line = text; line && *line; line = strchr(line, '\n'), line = line ? line + 1 : NULL) {
+        if (strncmp(line, name, len) != 0 || line[len] != ',')
+            continue;
+        const char *p = line;
+        for (int k = 0; k < column; k++) {
+            p = strchr(p, ',');
+            if (!p)
+                return NAN;
+            p++;
+        }
+        return strtod(p, NULL);
+    }
+    return NAN;
+}
+
+static void test_command(void **state)
+{
+    (void)state;
+    const char *dir = cli_workdir();
+    char cmd_args[2048];
+    /* The furnace of docs/thermal.md: the roof gives 30 kW/m^2 x 2 m^2 to
+     * the hearth at 700 K through adiabatic walls. */
+    snprintf(cmd_args, sizeof cmd_args,
+             "thermal %s/furnace.obj --bc %s/furnace_bc.json --mesh-size 0.25 -o %s/heat.csv --gebhart %s/g.json "
+             "--stats %s/stats.json",
+             RAD_TEST_DATA, RAD_TEST_DATA, dir, dir, dir);
+    assert_int_equal(cli_run("%s", cmd_args), 0);
+    char path[600];
+    snprintf(path, sizeof path, "%s/heat.csv", dir);
+    char *csv = cli_read_text(path);
+    assert_non_null(csv);
+    assert_true(strncmp(csv, "surface,condition,area_m2,emissivity,temperature_K,radiosity_W_m2,irradiation_W_m2,"
+                             "heat_flux_W_m2,heat_W\n", 105) == 0);
+    cli_assert_relative(csv_value(csv, "roof", 8), 60000.0, 1e-12, "roof Q");
+    cli_assert_relative(csv_value(csv, "hearth", 8), -60000.0, 1e-4, "hearth Q");
+    assert_true(fabs(csv_value(csv, "walls", 8)) < 1e-6);
+    cli_assert_relative(csv_value(csv, "hearth", 4), 700.0, 1e-12, "hearth T");
+    cli_assert_relative(csv_value(csv, "walls", 3), 0.6, 1e-12, "walls eps from the material");
+    double roof_T = csv_value(csv, "roof", 4), walls_T = csv_value(csv, "walls", 4);
+    assert_true(roof_T > walls_T && walls_T > 700.0); /* heat flows roof -> walls -> hearth */
+    free(csv);
+    snprintf(path, sizeof path, "%s/stats.json", dir);
+    cJSON *stats = cli_read_json(path);
+    assert_non_null(stats);
+    assert_true(fabs(cli_stats_number(stats, "thermal", "relative_imbalance")) < 1e-9);
+    cli_assert_relative(cli_stats_number(stats, "thermal", "power_scale_W"), 120000.0, 1e-4, "sum |Q|");
+    cJSON_Delete(stats);
+    snprintf(path, sizeof path, "%s/g.json", dir);
+    cJSON *g = cli_read_json(path);
+    assert_non_null(g);
+    const cJSON *rows = cJSON_GetObjectItem(g, "G");
+    assert_int_equal(cJSON_GetArraySize(rows), 3);
+    for (int k = 0; k < 3; k++) {
+        double sum = 0.0;
+        const cJSON *x;
+        cJSON_ArrayForEach(x, cJSON_GetArrayItem(rows, k)) sum += x->valuedouble;
+        cli_assert_relative(sum, 1.0, 1e-4, "Gebhart row sum");
+    }
+    cJSON_Delete(g);
+
+    /* Per element, as JSON: every element listed, the balance there too. */
+    snprintf(cmd_args, sizeof cmd_args,
+             "thermal %s/furnace.obj --bc %s/furnace_bc.json --mesh-size 0.5 --level element -o %s/heat.json "
+             "--solver gauss-seidel", RAD_TEST_DATA, RAD_TEST_DATA, dir);
+    assert_int_equal(cli_run("%s", cmd_args), 0);
+    snprintf(path, sizeof path, "%s/heat.json", dir);
+    cJSON *heat = cli_read_json(path);
+    assert_non_null(heat);
+    const cJSON *elements = cJSON_GetObjectItem(heat, "elements_list");
+    assert_int_equal(cJSON_GetArraySize(elements), (int)cJSON_GetObjectItem(heat, "elements")->valuedouble);
+    assert_true(cJSON_GetArraySize(elements) == 4 * 2 * 2 + 2 * 4 * 2 + 2 * 2 * 2); /* 0.5 m elements */
+    double roof = 0.0;
+    const cJSON *e;
+    cJSON_ArrayForEach(e, elements) if (strcmp(cJSON_GetObjectItem(e, "name")->valuestring, "roof") == 0) roof +=
+        cJSON_GetObjectItem(e, "heat_W")->valuedouble;
+    cli_assert_relative(roof, 60000.0, 1e-8, "roof Q over elements (gauss-seidel)");
+    assert_true(fabs(cli_stats_number(heat, "balance", "relative_imbalance")) < 1e-8);
+    cJSON_Delete(heat);
+
+    /* Refusals: no --bc (usage), a bad file (named; no output written). */
+    snprintf(path, sizeof path, "%s/none.csv", dir);
+    assert_int_equal(cli_run("thermal %s/furnace.obj -o %s", RAD_TEST_DATA, path), 2);
+    char bc[600], errors[600];
+    snprintf(bc, sizeof bc, "%s/bad_bc.json", dir);
+    FILE *f = fopen(bc, "w");
+    assert_non_null(f);
+    fputs("{\"default\": {\"adiabatic\": true}, \"surfaces\": {\"hearth\": {\"emissivity\": 2, \"temperature\": 300}}}",
+          f);
+    fclose(f);
+    snprintf(errors, sizeof errors, "%s/errors.txt", dir);
+    assert_int_equal(cli_run_capture(errors, "thermal %s/furnace.obj --bc %s -o %s", RAD_TEST_DATA, bc, path), 1);
+    char *text = cli_read_text(errors);
+    assert_non_null(text);
+    assert_non_null(strstr(text, "bad_bc.json: surfaces.hearth.emissivity: must be in (0, 1], got 2"));
+    free(text);
+    assert_null(fopen(path, "r"));
+    assert_int_equal(cli_run("thermal %s/furnace.obj --bc %s/furnace_bc.json -o %s/heat.mtx", RAD_TEST_DATA,
+                             RAD_TEST_DATA, dir), 2);
+    assert_int_equal(cli_run("thermal %s/furnace.obj --bc %s/furnace_bc.json --solver hierarchical -o %s",
+                             RAD_TEST_DATA, RAD_TEST_DATA, path), 2);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    return cli_setup("thermal");
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    return cli_teardown();
+}
+
 int main(int argc, char **argv)
 {
-    (void)argc;
-    (void)argv;
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_thermal PATH_TO_RADIOSITY\n");
+        return 2;
+    }
+    cli_set_binary(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_two_surface_enclosure),
         cmocka_unit_test(test_reradiating_wall),
@@ -341,6 +704,10 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_energy_balance),
         cmocka_unit_test(test_gebhart),
         cmocka_unit_test(test_undetermined),
+        cmocka_unit_test(test_box_through_library),
+        cmocka_unit_test(test_agrees_with_the_radiosity_solve),
+        cmocka_unit_test(test_bad_conditions),
+        cmocka_unit_test(test_command),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return cmocka_run_group_tests(tests, setup, teardown);
 }
