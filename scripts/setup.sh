@@ -59,7 +59,7 @@ if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
   CC=clang-14 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRADIOSITY_FUZZ=ON \
     -DRADIOSITY_BENCH=OFF >/dev/null
   cmake --build build-fuzz -j "$(nproc)" --target fuzz_obj fuzz_mtl fuzz_gltf fuzz_glb fuzz_camera \
-    fuzz_cli_options fuzz_solve fuzz_solution 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make' || true
+    fuzz_cli_options fuzz_solve fuzz_solution fuzz_thermal_bc 2>&1 | grep -Ev '^\[ *[0-9]+%\]|^gmake|^make' || true
   test -x build-fuzz/fuzz/fuzz_obj || { echo "setup: fuzz build failed" >&2; exit 1; }
   echo "setup: built the fuzzers in build-fuzz/fuzz/"
 fi
