@@ -95,7 +95,7 @@ static void clear_outputs(void)
 
 /* ---- one run: the outputs its writers finished ---- */
 
-#define MAX_OUTPUTS 12
+#define MAX_OUTPUTS 16
 
 typedef struct outputs {
     const char *written[MAX_OUTPUTS]; /* names in the output folder */
@@ -173,6 +173,39 @@ static rad_result run_loading(rad_context *ctx, outputs *out)
     return r;
 }
 
+/* The heat exchange on a dense solution's F (docs/thermal.md): conditions
+ * from memory, the solve, every writer. */
+static rad_result run_thermal(rad_context *ctx, const rad_scene *scene, const rad_solution *s, outputs *out)
+{
+    static const char bc[] = "{\"default\": {\"emissivity\": 0.7, \"adiabatic\": true}, \"surfaces\": "
+                             "{\"ceiling\": {\"temperature\": 600}, \"floor\": {\"heat_flux\": -100}}}";
+    rad_thermal_conditions *c = NULL;
+    rad_thermal *t = NULL;
+    char path[512];
+    rad_result r = rad_thermal_conditions_load_memory(ctx, scene, "bc.json", bc, strlen(bc), &c);
+    if (r == RAD_OK)
+        r = rad_thermal_solve(ctx, s, c, NULL, &t);
+    if (r == RAD_OK) {
+        output_path("heat.csv", path, sizeof path);
+        r = write_done(rad_thermal_write(ctx, t, path, false), out, "heat.csv");
+    }
+    if (r == RAD_OK) {
+        output_path("heat.json", path, sizeof path);
+        r = write_done(rad_thermal_write(ctx, t, path, true), out, "heat.json");
+    }
+    if (r == RAD_OK) {
+        output_path("gebhart.csv", path, sizeof path);
+        r = write_done(rad_thermal_write_gebhart(ctx, t, path), out, "gebhart.csv");
+    }
+    if (r == RAD_OK) {
+        output_path("thermal_stats.json", path, sizeof path);
+        r = write_done(rad_thermal_write_stats(ctx, t, path), out, "thermal_stats.json");
+    }
+    rad_thermal_destroy(t);
+    rad_thermal_conditions_destroy(c);
+    return r;
+}
+
 /* A strategy: solve, every accessor that allocates, render, every writer. */
 static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *out)
 {
@@ -232,6 +265,8 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
         output_path("history.csv", path, sizeof path);
         r = write_done(rad_solution_write_history(ctx, s, path), out, "history.csv");
     }
+    if (r == RAD_OK && sc->view_factors)
+        r = run_thermal(ctx, scene, s, out);
     static const char *const meshes[] = {"lit.glb", "lit.gltf", "lit.ply"};
     for (size_t k = 0; k < 3 && r == RAD_OK; k++) {
         output_path(meshes[k], path, sizeof path);
