@@ -24,6 +24,7 @@
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 struct rad_scene_builder {
     rad_context *ctx;
@@ -205,6 +206,7 @@ int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
     rad_surface *s = &surfaces[b->surface_count];
     s->name = rad_strdup(b->ctx, RAD_MEM_SCENE, name, b->source);
     s->area = 0.0;
+    s->obstruction = false;
     if (!s->name)
         return -1;
     /* Grow the table to keep it under half full, then insert. */
@@ -458,6 +460,12 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
     return RAD_OK;
 }
 
+void rad_scene_builder_surface_obstruction(rad_scene_builder *b, int surface)
+{
+    if (b && surface >= 0 && (size_t)surface < b->surface_count)
+        b->surfaces[surface].obstruction = true;
+}
+
 void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera)
 {
     if (!b)
@@ -593,7 +601,17 @@ rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **o
     if (!ctx || !path || !out)
         return rad_null_argument(ctx, __func__);
     double start = rad_seconds();
-    rad_result r = rad_import_assimp_file(ctx, path, out);
+    /* View3D's .vs3, by its extension or its first record. */
+    char head[512];
+    size_t head_size = 0;
+    struct stat st;
+    FILE *peek = stat(path, &st) == 0 && S_ISREG(st.st_mode) ? fopen(path, "rb") : NULL;
+    if (peek) { /* regular files only: a FIFO's bytes are read once */
+        head_size = fread(head, 1, sizeof head, peek);
+        fclose(peek);
+    }
+    rad_result r = rad_vs3_detect(path, head, head_size) ? rad_import_vs3_file(ctx, path, out)
+                                                          : rad_import_assimp_file(ctx, path, out);
     if (r == RAD_OK)
         (*out)->load_seconds = rad_seconds() - start;
     return r;
@@ -609,7 +627,9 @@ rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void 
     if (!ctx || !name || !out || (!data && size > 0) || (!mtl && mtl_size > 0))
         return rad_null_argument(ctx, __func__);
     double start = rad_seconds();
-    rad_result r = rad_import_assimp_memory(ctx, name, data, size, mtl, mtl_size, out);
+    rad_result r = rad_vs3_detect(name, data, size)
+                       ? rad_import_vs3_memory(ctx, name, data, size, out)
+                       : rad_import_assimp_memory(ctx, name, data, size, mtl, mtl_size, out);
     if (r == RAD_OK)
         (*out)->load_seconds = rad_seconds() - start;
     return r;
