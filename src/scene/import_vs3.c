@@ -246,6 +246,10 @@ static rad_result parse_surface(vs3_reader *r, int kind, char **w, int count, in
     }
     if (s->vertex[3] == 0)
         s->vertex_count = 3;
+    for (int a = 0; a < s->vertex_count; a++)
+        for (int b = a + 1; b < s->vertex_count; b++)
+            if (s->vertex[a] == s->vertex[b])
+                return parse_error(r, line, "surface %d repeats vertex %d", number, s->vertex[a]);
     s->emissivity = 1.0;
     if (short_obstruction) {
         snprintf(s->name, sizeof s->name, "obstruction-%d", number);
