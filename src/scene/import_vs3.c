@@ -478,7 +478,7 @@ static rad_result build_scene(vs3_reader *r, rad_scene **out)
         }
         double rho = 1.0 - s->emissivity;
         double reflectance[3] = {rho, rho, rho}, emission[3] = {0.0, 0.0, 0.0};
-        char material[160];
+        char material[192];
         snprintf(material, sizeof material, "%s (emissivity %.17g)", s->name, s->emissivity);
         int mat = rad_scene_builder_material(b, material, reflectance, emission);
         if (mat < 0) { /* rho is in [0, 1): only memory can fail */
