@@ -203,6 +203,37 @@ static void test_combined(void **state)
     assert_float_equal(v.F[1][0], exact, VF_TOL);
 }
 
+static void test_script_f(void **state)
+{
+    (void)state;
+    vf_file v;
+    run_vs3("cube_two", "", &v);
+    /* A two-surface enclosure (the floor, and the five other faces combined,
+     * F_12 = 1): Hottel's closed form A1 SF_12 = 1 / ((1 - e1)/(e1 A1) +
+     * 1/(A1 F_12) + (1 - e2)/(e2 A2)), rows summing to the emissivities. */
+    assert_int_equal(v.emit, 1);
+    assert_int_equal(v.n, 2);
+    assert_float_equal(v.area[1], 5.0, 1e-12);
+    double e1 = 0.5, e2 = 0.8, A1 = 1.0, A2 = 5.0;
+    double sf12 = 1.0 / ((1.0 - e1) / (e1 * A1) + 1.0 / A1 + (1.0 - e2) / (e2 * A2)) / A1;
+    assert_float_equal(v.F[0][1], sf12, VF_TOL);
+    assert_float_equal(v.F[0][0], e1 - sf12, VF_TOL);
+    assert_float_equal(v.F[1][0], A1 * sf12 / A2, VF_TOL);
+    assert_float_equal(v.F[1][1], e2 - A1 * sf12 / A2, VF_TOL);
+    assert_float_equal(v.emissivity[1], 0.8, 1e-12);
+    /* Six faces, one of emissivity 0.9: reciprocal, rows sum to e_i. */
+    run_vs3("cube_emit", "", &v);
+    for (int i = 0; i < 6; i++) {
+        double sum = 0.0;
+        for (int j = 0; j < 6; j++) {
+            sum += v.F[i][j];
+            assert_float_equal(v.F[i][j], v.F[j][i], 1e-6);
+        }
+        assert_float_equal(sum, v.emissivity[i], 6 * 5e-7);
+    }
+    assert_float_equal(v.emissivity[1], 0.9, 1e-12);
+}
+
 /* The exact unit-cube matrix (opposite faces k, k+3). */
 static void cube_matrix(double *F)
 {
@@ -363,7 +394,8 @@ static void test_bad_files(void **state)
     expect_error(HEAD "S 1 1 2 3 4 0 0 0.5 a\nS 2 1 2 4 0 0 0 0.5 a\n", 8, "already surface 1");
     expect_error(HEAD "S 1 1 2 3 4 0 0 0.5 a\nM 2 4 3 2 1 1 0 0.5 m\n", 8, "mask");
     expect_error(HEAD "S 1 1 2 3 4 0 0 0.5 a\nS 2 1 2 3 0 0 2 0.5 b\n", 8, "earlier surface");
-    expect_error("T x\nC encl=1 emit=1\nF 3\n", 2, "script-F");
+    expect_error("T x\nC emit=1\nF 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 2 0 0\n"
+                 "S 1 1 2 3 0 0 0 0.5 a\nS 2 2 4 3 0 0 1 0.6 b\n", 9, "emissivity 0.6 differs");
     expect_error("T x\nC row=2\nF 3\n", 2, "not supported");
     expect_error("T x\nC bogus=1\nF 3\n", 2, "unknown control");
     expect_error("T x\nF 3a\n", 2, "only F 3");
@@ -401,6 +433,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_blocker),
         cmocka_unit_test(test_window_and_null),
         cmocka_unit_test(test_combined),
+        cmocka_unit_test(test_script_f),
         cmocka_unit_test(test_smooth_exact_unchanged),
         cmocka_unit_test(test_smooth_perturbed),
         cmocka_unit_test(test_smooth_unequal_areas),

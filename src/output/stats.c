@@ -572,8 +572,13 @@ rad_result rad_write_view_factors_with(rad_context *ctx, const rad_solution_view
         if (r == RAD_OK) {
             for (size_t a = 0; a < N; a++)
                 emissivity[a] = rad_surface_emissivity(s->scene, rows.kept[a]);
-            r = rad_view3d_write_header(ctx, f.file, format,
-                                        s->scene->view3d.present ? s->scene->view3d.enclosure : 0, N, rows.area);
+            int emit = s->scene->view3d.present && s->scene->view3d.emittances;
+            if (emit) /* after the smoothing, as View3D normalises before IntFac */
+                r = rad_vf_script_f(ctx, N, emissivity, rows.F);
+            if (r == RAD_OK)
+                r = rad_view3d_write_header(ctx, f.file, format,
+                                            s->scene->view3d.present ? s->scene->view3d.enclosure : 0, emit, N,
+                                            rows.area);
             for (size_t a = 0; a < N && r == RAD_OK; a++)
                 rad_view3d_write_row(f.file, format, rows.F + a * N, N);
             if (r == RAD_OK) {

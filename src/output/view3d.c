@@ -23,12 +23,12 @@
 
 #include "formfactor/formfactor.h"
 
-rad_result rad_view3d_write_header(rad_context *ctx, FILE *f, int format, int enclosure, size_t n,
-                                   const double *area)
+rad_result rad_view3d_write_header(rad_context *ctx, FILE *f, int format, int enclosure, int emittances,
+                                   size_t n, const double *area)
 {
     char header[64];
-    int len = snprintf(header, sizeof header, "radiosity %s %d %d 0 %zu", RAD_VERSION_STRING, format,
-                       enclosure, n);
+    int len = snprintf(header, sizeof header, "radiosity %s %d %d %d %zu", RAD_VERSION_STRING, format,
+                       enclosure, emittances, n);
     /* View3D's readers take the first line with fgets(35): it must fit. */
     if (len < 0 || len > 30)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "View3D file: %zu surfaces do not fit its header", n);
@@ -77,6 +77,69 @@ void rad_view3d_write_end(FILE *f, int format, const double *emissivity, size_t 
     }
     if (format == 0)
         fputc('\n', f);
+}
+
+rad_result rad_vf_script_f(rad_context *ctx, size_t n, const double *emissivity, double *F)
+{
+    /* Radiosity of a grey diffuse enclosure, J = eps E + rho F J, gives the
+     * power emitted by i and absorbed by j per unit black-body exitance:
+     * A_i SF_ij = A_i eps_i [F (I - rho F)^-1]_ij eps_j (Hottel & Sarofim
+     * 1967, total exchange areas).  M = I - rho F is inverted by Gauss-Jordan
+     * with partial pivoting; rho < 1 keeps it regular (F rows sum <= 1). */
+    double *M = rad_alloc(ctx, RAD_MEM_OUTPUT, n ? n * n : 1, sizeof *M, "script-F: system");
+    double *X = M ? rad_alloc(ctx, RAD_MEM_OUTPUT, n ? n * n : 1, sizeof *X, "script-F: inverse") : NULL;
+    double *row = X ? rad_alloc(ctx, RAD_MEM_OUTPUT, n ? n : 1, sizeof *row, "script-F: row") : NULL;
+    if (!row) {
+        rad_free(M);
+        rad_free(X);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++) {
+            M[i * n + j] = (i == j ? 1.0 : 0.0) - (1.0 - emissivity[i]) * F[i * n + j];
+            X[i * n + j] = i == j ? 1.0 : 0.0;
+        }
+    for (size_t k = 0; k < n; k++) {
+        size_t p = k;
+        for (size_t i = k + 1; i < n; i++)
+            if (fabs(M[i * n + k]) > fabs(M[p * n + k]))
+                p = i;
+        for (size_t j = 0; j < n && p != k; j++) {
+            double t = M[k * n + j];
+            M[k * n + j] = M[p * n + j];
+            M[p * n + j] = t;
+            t = X[k * n + j];
+            X[k * n + j] = X[p * n + j];
+            X[p * n + j] = t;
+        }
+        double pivot = M[k * n + k];
+        for (size_t j = 0; j < n; j++) {
+            M[k * n + j] /= pivot;
+            X[k * n + j] /= pivot;
+        }
+        for (size_t i = 0; i < n; i++) {
+            double f = M[i * n + k];
+            if (i == k || f == 0.0)
+                continue;
+            for (size_t j = 0; j < n; j++) {
+                M[i * n + j] -= f * M[k * n + j];
+                X[i * n + j] -= f * X[k * n + j];
+            }
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        for (size_t j = 0; j < n; j++) {
+            double v = 0.0;
+            for (size_t k = 0; k < n; k++)
+                v += F[i * n + k] * X[k * n + j];
+            row[j] = emissivity[i] * v * emissivity[j];
+        }
+        memcpy(F + i * n, row, n * sizeof *row);
+    }
+    rad_free(M);
+    rad_free(X);
+    rad_free(row);
+    return RAD_OK;
 }
 
 double rad_surface_emissivity(const rad_scene *scene, size_t surface)

@@ -11,8 +11,12 @@
 /* View3D's header line (format 0 text, 1 binary; docs/formats.md) and
  * the areas (m^2).  Fails (RAD_ERROR_INVALID_ARGUMENT) only when n does
  * not fit the 30-character header. */
-rad_result rad_view3d_write_header(rad_context *ctx, FILE *f, int format, int enclosure, size_t n,
-                                   const double *area);
+rad_result rad_view3d_write_header(rad_context *ctx, FILE *f, int format, int enclosure, int emittances,
+                                   size_t n, const double *area);
+/* Hottel's script-F factors (View3D's emit=1) from view factors F (n x n,
+ * in place) and emissivities in (0, 1]: rows then sum to eps_i in an
+ * enclosure.  Fails only for memory (F unchanged). */
+rad_result rad_vf_script_f(rad_context *ctx, size_t n, const double *emissivity, double *F);
 /* One row of factors, F[i][0..n-1].  Cannot fail (errors show at commit). */
 void rad_view3d_write_row(FILE *f, int format, const double *row, size_t n);
 /* The closing line: the emissivities.  Cannot fail. */

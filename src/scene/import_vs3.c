@@ -21,6 +21,7 @@
  *                      View3D reports the base without the sub-surface's area
  *     N, base b        a hole in surface b, no surface of its own
  *     S, cmb c         its polygon added to surface c: one output surface
+ *     C emit=1         the .vf holds Hottel's script-F factors (output/view3d.c)
  *     O                a surface flagged obstruction-only: it blocks rays,
  *                      the view-factor outputs leave it out
  *     M (mask)         refused: View3D keeps a mask as a surface facing its
@@ -167,9 +168,7 @@ static rad_result parse_control(vs3_reader *r, char *text, int line)
         } else if (strcasecmp(key, "emit") == 0) {
             if (!parse_int(value, 0, 1, &i))
                 return parse_error(r, line, "emit '%s' is not 0 or 1", value);
-            if (i)
-                return parse_error(r, line, "emit=1 (Hottel's script-F factors) is not supported: "
-                                            "the output holds view factors; use emit=0");
+            r->control.emittances = i;
         } else if (strcasecmp(key, "out") == 0) {
             if (!parse_int(value, 0, 1, &i))
                 return parse_error(r, line, "out '%s' is not 0 (text) or 1 (binary)", value);
@@ -434,6 +433,10 @@ static rad_result check_relations(vs3_reader *r)
             if (c->combine)
                 return parse_error(r, s->line, "surface %d: cmb %d is itself combined (combine every part "
                                                "with the lowest-numbered one)", i, s->combine);
+            if (r->control.emittances && s->emissivity != c->emissivity)
+                return parse_error(r, s->line, "surface %d: emissivity %g differs from that of surface %d (%g) "
+                                               "it is combined with: with emit=1 a surface has one emissivity",
+                                   i, s->emissivity, s->combine, c->emissivity);
         }
     }
     /* Names are the output's labels: one each (null surfaces have none). */

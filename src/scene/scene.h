@@ -31,6 +31,7 @@ typedef struct rad_view3d_control {
     bool present;
     int enclosure;            /* encl: 1 = the surfaces form an enclosure */
     int out_format;           /* out: 0 = text, 1 = binary */
+    int emittances;           /* emit: 1 = the .vf holds Hottel's script-F factors */
 } rad_view3d_control;
 
 typedef struct rad_polygon {
