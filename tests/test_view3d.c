@@ -110,6 +110,35 @@ static void test_parallel_squares(void **state)
     assert_float_equal(v.emissivity[1], 0.5, 1e-12);
 }
 
+static void test_binary(void **state)
+{
+    (void)state;
+    char out[512];
+    snprintf(out, sizeof out, "%s/binary.vf", cli_workdir());
+    assert_int_equal(cli_run("viewfactors %sparallel_binary.vs3 -o %s --elements 400", DATA, out), 0);
+    /* out=1: a 32-byte header ending in CR LF, then float32 areas, rows
+     * and emissivities, nothing more (View3D's SaveF1). */
+    FILE *f = fopen(out, "rb");
+    assert_non_null(f);
+    char header[33] = {0};
+    assert_int_equal(fread(header, 1, 32, f), 32);
+    assert_memory_equal(header + 30, "\r\n", 2);
+    int format = -1, encl = -1, emit = -1, n = -1;
+    assert_int_equal(sscanf(header, "%*s %*s %d %d %d %d", &format, &encl, &emit, &n), 4);
+    assert_int_equal(format, 1);
+    assert_int_equal(n, 2);
+    float values[2 + 4 + 2];
+    assert_int_equal(fread(values, sizeof *values, 8, f), 8);
+    assert_int_equal(fgetc(f), EOF);
+    fclose(f);
+    assert_float_equal(values[0], 1.0, 1e-6);
+    assert_float_equal(values[2 + 1], parallel_rectangles(1.0, 1.0, 1.0), 2e-6);
+    assert_float_equal(values[2 + 2], parallel_rectangles(1.0, 1.0, 1.0), 2e-6);
+    assert_float_equal(values[2 + 0], 0.0, 0.0);
+    assert_float_equal(values[6], 0.9, 1e-6);
+    assert_float_equal(values[7], 0.5, 1e-6);
+}
+
 static void test_perpendicular(void **state)
 {
     (void)state;
@@ -427,6 +456,7 @@ int main(int argc, char **argv)
     cli_set_binary(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parallel_squares),
+        cmocka_unit_test(test_binary),
         cmocka_unit_test(test_perpendicular),
         cmocka_unit_test(test_cube_enclosure),
         cmocka_unit_test(test_obstruction),
