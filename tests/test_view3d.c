@@ -220,6 +220,28 @@ static void test_window_and_null(void **state)
     assert_float_equal(h.F[0][1], w.F[0][2], 2e-6);
 }
 
+static void test_mask(void **state)
+{
+    (void)state;
+    vf_file m, h;
+    run_vs3("mask", "", &m);
+    run_vs3("null", "", &h);
+    /* View3D's mask: the wall keeps its whole area (4 m^2), its factors are
+     * those of the open part (the null case's wall, 3 m^2) times 3/4, plus
+     * 1/4 to the mask; the mask sees only the wall; the facing wall sees
+     * the open part only, and not the mask. */
+    assert_int_equal(m.n, 3);
+    assert_float_equal(m.area[0], 4.0, 1e-5);
+    assert_float_equal(m.area[1], 1.0, 1e-5);
+    assert_float_equal(m.F[0][1], 0.25, 1e-6);
+    assert_float_equal(m.F[0][2], 0.75 * h.F[0][1], 2e-6);
+    assert_float_equal(m.F[1][0], 1.0, 0.0);
+    assert_float_equal(m.F[1][2], 0.0, 0.0);
+    assert_float_equal(m.F[2][1], 0.0, 0.0);
+    assert_float_equal(m.F[2][0], h.F[1][0], 2e-6);
+    assert_float_equal(m.emissivity[1], 0.6, 1e-12);
+}
+
 static void test_combined(void **state)
 {
     (void)state;
@@ -421,7 +443,9 @@ static void test_bad_files(void **state)
     expect_error(HEAD "V 5 0.5 0.5 0.5\nS 1 1 2 5 4 0 0 0.5 a\n", 8, "not planar");
     expect_error(HEAD "V 5 0.2 0.2 0\nS 1 1 2 5 4 0 0 0.5 a\n", 8, "not convex");
     expect_error(HEAD "S 1 1 2 3 4 0 0 0.5 a\nS 2 1 2 4 0 0 0 0.5 a\n", 8, "already surface 1");
-    expect_error(HEAD "S 1 1 2 3 4 0 0 0.5 a\nM 2 4 3 2 1 1 0 0.5 m\n", 8, "mask");
+    expect_error(HEAD "V 5 .2 .2 0\nV 6 .8 .2 0\nV 7 .8 .8 0\nS 1 1 2 3 4 0 0 0.5 a\nM 2 5 6 7 0 1 0 0.5 m\n",
+                 11, "must face its base");
+    expect_error(HEAD "S 1 1 2 3 4 0 0 0.5 a\nM 2 4 3 2 1 0 0 0.5 m\n", 8, "needs a base");
     expect_error(HEAD "S 1 1 2 3 4 0 0 0.5 a\nS 2 1 2 3 0 0 2 0.5 b\n", 8, "earlier surface");
     expect_error("T x\nC emit=1\nF 3\nV 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 2 0 0\n"
                  "S 1 1 2 3 0 0 0 0.5 a\nS 2 2 4 3 0 0 1 0.6 b\n", 9, "emissivity 0.6 differs");
@@ -462,6 +486,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_obstruction),
         cmocka_unit_test(test_blocker),
         cmocka_unit_test(test_window_and_null),
+        cmocka_unit_test(test_mask),
         cmocka_unit_test(test_combined),
         cmocka_unit_test(test_script_f),
         cmocka_unit_test(test_smooth_exact_unchanged),

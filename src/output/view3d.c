@@ -154,6 +154,26 @@ rad_result rad_vf_adjust(rad_context *ctx, const rad_scene *scene, char **names,
                          size_t *count, size_t *kept, const rad_view_factor_options *o)
 {
     size_t S = *count, n = 0;
+    /* View3D's masks (its View3D() and post-processing): the mask's row is 1
+     * to its base and 0 elsewhere, nothing else sees it; the base is
+     * reported with its whole area, its rows those of the part the mask
+     * leaves open (the engine's base has a hole there) scaled by that part's
+     * share, plus A_mask / A_base to the mask.  Several masks on one base,
+     * one after the other. */
+    for (size_t m = 0; m < S; m++) {
+        if (!scene->surfaces[m].mask)
+            continue;
+        size_t b = scene->surfaces[m].mask_base;
+        double whole = area[b] + area[m], share = area[b] / whole;
+        for (size_t j = 0; j < S; j++) {
+            F[b * S + j] *= share;
+            F[m * S + j] = 0.0;
+            F[j * S + m] = 0.0;
+        }
+        F[b * S + m] = area[m] / whole;
+        F[m * S + b] = 1.0;
+        area[b] = whole;
+    }
     /* Obstruction-only surfaces out; the rows and columns of the others kept. */
     for (size_t i = 0; i < S; i++)
         if (!scene->surfaces[i].obstruction)

@@ -24,9 +24,11 @@
  *     C emit=1         the .vf holds Hottel's script-F factors (output/view3d.c)
  *     O                a surface flagged obstruction-only: it blocks rays,
  *                      the view-factor outputs leave it out
- *     M (mask)         refused: View3D keeps a mask as a surface facing its
- *                      base with F(mask, base) = 1, which the engine's
- *                      coplanar geometry cannot reproduce
+ *     M, base b        a hole in surface b, filled by the mask's polygon
+ *                      (it blocks rays, one element); the outputs report
+ *                      b with its whole area and the mask as View3D does:
+ *                      F(mask, b) = 1, F(b, mask) = A_mask / A_b, nothing
+ *                      else sees the mask (output/view3d.c)
  *
  *   A hole H (convex) in a convex piece P is cut as P minus H = the union of
  *   P clipped inside edges 0..k-1 of H and outside edge k, k = 0..m-1:
@@ -266,11 +268,9 @@ static rad_result parse_surface(vs3_reader *r, int kind, char **w, int count, in
     }
     if (kind == VS3_OBSTRUCTION && (s->base || s->combine))
         return parse_error(r, line, "obstruction surface %d: base and cmb must be 0", number);
-    if (kind == VS3_MASK)
-        return parse_error(r, line, "mask surface %d (M) is not supported: use N (null) for a hole in "
-                                    "the base, or an S sub-surface", number);
-    if (kind == VS3_NULL && s->base == 0)
-        return parse_error(r, line, "null surface %d needs a base surface", number);
+    if ((kind == VS3_NULL || kind == VS3_MASK) && s->base == 0)
+        return parse_error(r, line, "%s surface %d needs a base surface", kind == VS3_NULL ? "null" : "mask",
+                           number);
     if (kind != VS3_OBSTRUCTION && r->surface_count > 0 &&
         r->surfaces[r->surface_count - 1].kind == VS3_OBSTRUCTION)
         return parse_error(r, line, "surface %d follows an obstruction surface: obstruction surfaces (O) "
@@ -352,6 +352,9 @@ static rad_result cut_hole(vs3_reader *r, int hole_number)
     if (h->kind == VS3_RADIATING && v3_dot(h->normal, base->normal) <= 0.0)
         return parse_error(r, h->line, "sub-surface %d faces away from its base %d (it must face the same way)",
                            hole_number, h->base);
+    if (h->kind == VS3_MASK && v3_dot(h->normal, base->normal) >= 0.0)
+        return parse_error(r, h->line, "mask surface %d must face its base %d (the opposite way to it)",
+                           hole_number, h->base);
     vec3 hp[4];
     for (int k = 0; k < h->vertex_count; k++) {
         hp[k] = r->vertices[h->vertex[k] - 1];
@@ -419,8 +422,12 @@ static rad_result check_relations(vs3_reader *r)
                 return parse_error(r, s->line, "surface %d: base %d is not another surface (1 to %d)", i,
                                    s->base, n);
             vs3_surface *b = &r->surfaces[s->base - 1];
-            if (b->kind == VS3_NULL)
-                return parse_error(r, s->line, "surface %d: base %d is a null surface", i, s->base);
+            if (b->kind == VS3_NULL || b->kind == VS3_MASK)
+                return parse_error(r, s->line, "surface %d: base %d is a %s surface", i, s->base,
+                                   b->kind == VS3_NULL ? "null" : "mask");
+            if ((s->kind == VS3_NULL || s->kind == VS3_MASK) && (b->kind != VS3_RADIATING || s->base > i))
+                return parse_error(r, s->line, "%s surface %d: its base must be an earlier S surface",
+                                   s->kind == VS3_NULL ? "null" : "mask", i);
             if (b->kind == VS3_RADIATING && s->base > i)
                 return parse_error(r, s->line, "sub-surface %d must come after its base %d", i, s->base);
         }
@@ -478,6 +485,12 @@ static rad_result build_scene(vs3_reader *r, rad_scene **out)
             }
             if (s->kind == VS3_OBSTRUCTION)
                 rad_scene_builder_surface_obstruction(b, s->scene_surface);
+            if (s->kind == VS3_MASK) {
+                const vs3_surface *base = &r->surfaces[s->base - 1];
+                rad_scene_builder_surface_mask(
+                    b, s->scene_surface,
+                    base->combine ? r->surfaces[base->combine - 1].scene_surface : base->scene_surface);
+            }
         }
         double rho = 1.0 - s->emissivity;
         double reflectance[3] = {rho, rho, rho}, emission[3] = {0.0, 0.0, 0.0};

@@ -207,6 +207,8 @@ int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
     s->name = rad_strdup(b->ctx, RAD_MEM_SCENE, name, b->source);
     s->area = 0.0;
     s->obstruction = false;
+    s->mask = false;
+    s->mask_base = 0;
     if (!s->name)
         return -1;
     /* Grow the table to keep it under half full, then insert. */
@@ -466,6 +468,14 @@ void rad_scene_builder_surface_obstruction(rad_scene_builder *b, int surface)
         b->surfaces[surface].obstruction = true;
 }
 
+void rad_scene_builder_surface_mask(rad_scene_builder *b, int surface, int base)
+{
+    if (b && surface >= 0 && (size_t)surface < b->surface_count && base >= 0 && (size_t)base < b->surface_count) {
+        b->surfaces[surface].mask = true;
+        b->surfaces[surface].mask_base = (uint32_t)base;
+    }
+}
+
 void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera)
 {
     if (!b)
@@ -539,6 +549,11 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
         b->surfaces[kept].area = 0.0;
         surface_map[i] = (uint32_t)kept++;
     }
+    for (size_t i = 0; i < kept; i++) /* a mask's base, renumbered */
+        if (b->surfaces[i].mask) {
+            b->surfaces[i].mask_base = surface_map[b->surfaces[i].mask_base];
+            b->surfaces[i].mask = b->surfaces[i].mask_base != UINT32_MAX;
+        }
     b->surface_count = kept;
     kept = 0;
     for (size_t i = 0; i < b->material_count; i++) {

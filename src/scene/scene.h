@@ -22,6 +22,8 @@ typedef struct rad_surface {
     char *name;            /* OBJ o/g name, glTF node name; unique in the scene */
     double area;           /* m^2, sum of its polygons */
     bool obstruction;      /* View3D 'O' surface: blocks rays, not in the view-factor output */
+    bool mask;             /* View3D 'M' surface: covers part of surface mask_base (facing it) */
+    uint32_t mask_base;    /* the masked surface, when mask */
 } rad_surface;
 
 /* What a View3D .vs3 file's control line asks of the view-factor output
@@ -94,6 +96,11 @@ void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera);
  * blocks rays like any surface, and the view-factor outputs leave it out.
  * Cannot fail. */
 void rad_scene_builder_surface_obstruction(rad_scene_builder *b, int surface);
+/* Mark surface `surface` a View3D mask of surface `base` (both indices
+ * rad_scene_builder_surface gave): its polygons fill a hole cut in the
+ * base, block rays like an obstruction, and the surface-level outputs give
+ * it View3D's factors (F(mask, base) = 1; output/view3d.c).  Cannot fail. */
+void rad_scene_builder_surface_mask(rad_scene_builder *b, int surface, int base);
 
 /* An OBJ's camera, as a comment (OBJ has none): the prefix, then position,
  * look-at point, up vector and vertical field of view in degrees, ten
