@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "cli_support.h"
+#include "core/core.h"
 #include "radiosity.h"
 
 #define DATA RAD_TEST_DATA "/view3d/"
@@ -471,6 +472,66 @@ static void test_bad_files(void **state)
     free(text);
 }
 
+/* Every allocation of the View3D path failing in turn (SQLite's sweep, as
+ * test_alloc): loading with a sub-surface, a null surface, a mask, a
+ * combined surface and an obstruction; the .vf with script-F; the sparse
+ * .mtx with smoothing.  Each run ends with RAD_ERROR_OUT_OF_MEMORY and gives
+ * all its memory back; the last succeeds. */
+static const char sweep_vs3[] =
+    "T sweep\nC encl=1 emit=1\nF 3\n"
+    "V 1 0 0 0\nV 2 2 0 0\nV 3 2 2 0\nV 4 0 2 0\nV 5 0 0 1\nV 6 2 0 1\nV 7 2 2 1\nV 8 0 2 1\n"
+    "V 9 .2 .2 0\nV 10 .6 .2 0\nV 11 .6 .6 0\nV 12 .2 .6 0\nV 13 1 1 0\nV 14 1.5 1 0\nV 15 1.5 1.5 0\n"
+    "V 16 1 .2 0\nV 17 1.5 .2 0\nV 18 1.5 .6 0\nV 19 1 .6 0\nV 20 1 1 .5\nV 21 1.4 1 .5\nV 22 1.4 1.4 .5\n"
+    "S 1 1 2 3 4 0 0 0.9 floor\nS 2 9 10 11 12 1 0 0.8 window\nN 3 13 15 14 0 1 0 0.9 hole\n"
+    "M 4 16 19 18 17 1 0 0.7 mask\nS 5 5 8 7 6 0 0 0.9 ceiling\nS 6 1 5 6 2 0 0 0.9 wall-a\n"
+    "S 7 2 6 7 3 0 6 0.9 wall-b\nO 8 20 22 21 0\nE\n";
+
+static rad_result sweep_once(uint64_t fail_at, const char *folder)
+{
+    rad_context *ctx = NULL;
+    rad_context_options co = {0};
+    co.threads = 1;
+    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
+    rad_context_fail_allocation(ctx, fail_at);
+    rad_scene *scene = NULL;
+    rad_solution *sol = NULL;
+    rad_result r = rad_scene_load_memory(ctx, "sweep.vs3", sweep_vs3, sizeof sweep_vs3 - 1, NULL, 0, &scene);
+    rad_options o = {0};
+    o.target_elements = 60;
+    if (r == RAD_OK)
+        r = rad_solution_create(ctx, scene, &o, &sol);
+    char path[512];
+    if (r == RAD_OK) {
+        snprintf(path, sizeof path, "%s/sweep.vf", folder);
+        r = rad_solution_write_view_factors_with(ctx, sol, path, NULL);
+    }
+    if (r == RAD_OK) {
+        rad_view_factor_options vo = {0};
+        vo.smooth = RAD_SMOOTH_ENCLOSURE;
+        vo.sparse_threshold = 1e-3;
+        snprintf(path, sizeof path, "%s/sweep.mtx", folder);
+        r = rad_solution_write_view_factors_with(ctx, sol, path, &vo);
+    }
+    if (r != RAD_OK && r != RAD_ERROR_OUT_OF_MEMORY)
+        fail_msg("allocation %llu: %s", (unsigned long long)fail_at, rad_context_error(ctx));
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+    assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+    rad_context_destroy(ctx);
+    return r;
+}
+
+static void test_allocation_sweep(void **state)
+{
+    (void)state;
+    assert_int_equal(sweep_once(0, cli_workdir()), RAD_OK);
+    uint64_t k = 1;
+    for (; k < 100000; k++)
+        if (sweep_once(k, cli_workdir()) == RAD_OK)
+            break;
+    assert_true(k > 20); /* the path does allocate, and every failure was reported */
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -494,6 +555,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_smooth_unequal_areas),
         cmocka_unit_test(test_sparse_threshold),
         cmocka_unit_test(test_bad_files),
+        cmocka_unit_test(test_allocation_sweep),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

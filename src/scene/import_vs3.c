@@ -63,7 +63,7 @@ enum { VS3_RADIATING, VS3_MASK, VS3_NULL, VS3_OBSTRUCTION };
 
 typedef struct vs3_piece {
     vec3 v[VS3_PIECE_MAX];
-    int n;
+    int n;                 /* VS3_PIECE_MAX + 1: too many corners */
 } vs3_piece;
 
 typedef struct vs3_surface {
@@ -315,19 +315,41 @@ static rad_result check_polygon(vs3_reader *r, vs3_surface *s, int number)
     return RAD_OK;
 }
 
-/* Clip convex polygon `in` to the side of the plane through `a` with
- * normal `side` where dot(x - a, side) >= 0. */
-static void clip(const vs3_piece *in, vec3 a, vec3 side, vs3_piece *out)
+/* Clip convex polygon `in` to the side of the plane through `a` with unit
+ * normal `side` where dot(x - a, side) >= 0.  Corners within `tol` (m) of
+ * the plane count as on it, and a corner within `tol` of the one before is
+ * dropped: holes sharing an edge line (two windows in a row) would
+ * otherwise leave doubled corners that the scene refuses as a polygon
+ * touching itself. */
+static void clip(const vs3_piece *in, vec3 a, vec3 side, double tol, vs3_piece *out)
 {
     out->n = 0;
+    vec3 v[2 * VS3_PIECE_MAX];
+    int n = 0;
     for (int k = 0; k < in->n; k++) {
         vec3 p = in->v[k], q = in->v[(k + 1) % in->n];
         double dp = v3_dot(v3_sub(p, a), side), dq = v3_dot(v3_sub(q, a), side);
-        if (dp >= 0.0 && out->n < VS3_PIECE_MAX)
-            out->v[out->n++] = p;
-        if (((dp > 0.0 && dq < 0.0) || (dp < 0.0 && dq > 0.0)) && out->n < VS3_PIECE_MAX)
-            out->v[out->n++] = v3_lerp(p, q, dp / (dp - dq));
+        if (fabs(dp) <= tol)
+            dp = 0.0;
+        if (fabs(dq) <= tol)
+            dq = 0.0;
+        if (dp >= 0.0)
+            v[n++] = p;
+        if ((dp > 0.0 && dq < 0.0) || (dp < 0.0 && dq > 0.0))
+            v[n++] = v3_lerp(p, q, dp / (dp - dq));
     }
+    for (int k = 0; k < n; k++) {
+        vec3 prev = out->n ? out->v[out->n - 1] : v[n - 1];
+        if (v3_length(v3_sub(v[k], prev)) <= tol && (out->n || n > 1))
+            continue;
+        if (out->n == VS3_PIECE_MAX) { /* more corners than a piece holds: refused by the caller */
+            out->n = VS3_PIECE_MAX + 1;
+            return;
+        }
+        out->v[out->n++] = v[k];
+    }
+    while (out->n > 1 && v3_length(v3_sub(out->v[out->n - 1], out->v[0])) <= tol)
+        out->n--;
 }
 
 static double piece_area(const vs3_piece *p)
@@ -349,6 +371,9 @@ static rad_result cut_hole(vs3_reader *r, int hole_number)
     for (int k = 0; k < base->vertex_count; k++)
         size = fmax(size, v3_length(v3_sub(bp[(k + 1) % base->vertex_count], bp[k])));
     double tol = 1e-6 * size; /* as the planarity test */
+    /* 1e-9 of the base's size: corners this near a cut are on it (rounding
+     * of the cuts before), far below any hole View3D's floats can place. */
+    double clip_tol = 1e-9 * size;
     if (h->kind == VS3_RADIATING && v3_dot(h->normal, base->normal) <= 0.0)
         return parse_error(r, h->line, "sub-surface %d faces away from its base %d (it must face the same way)",
                            hole_number, h->base);
@@ -385,12 +410,11 @@ static rad_result cut_hole(vs3_reader *r, int hole_number)
         bool first = true;
         for (int e = 0; e < m; e++) {
             vs3_piece out;
-            clip(&inside, corner[e], v3_scale(inward[e], -1.0), &out);
+            clip(&inside, corner[e], v3_scale(inward[e], -1.0), clip_tol, &out);
+            if (out.n > VS3_PIECE_MAX)
+                return parse_error(r, h->line, "base surface %d is cut by too many sub-surfaces", h->base);
             /* 1e-12 of the base: slivers of the clipping's rounding. */
             if (piece_area(&out) > 1e-12 * base_area) {
-                if (out.n >= VS3_PIECE_MAX)
-                    return parse_error(r, h->line, "base surface %d is cut by too many sub-surfaces",
-                                       h->base);
                 if (first) {
                     base->pieces[p] = out;
                     first = false;
@@ -402,7 +426,9 @@ static rad_result cut_hole(vs3_reader *r, int hole_number)
                 }
             }
             vs3_piece next;
-            clip(&inside, corner[e], inward[e], &next);
+            clip(&inside, corner[e], inward[e], clip_tol, &next);
+            if (next.n > VS3_PIECE_MAX)
+                return parse_error(r, h->line, "base surface %d is cut by too many sub-surfaces", h->base);
             inside = next;
         }
         if (first) /* the piece lies inside the hole */
