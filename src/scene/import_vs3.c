@@ -568,7 +568,7 @@ static rad_result parse(vs3_reader *r, const char *text, size_t size)
         memcpy(buffer, start, length);
         buffer[length] = '\0';
         char *c = buffer;
-        while (*c == ' ' || *c == '\t' || *c == '\r')
+        while (*c && strchr(" \t\r\f\v", *c)) /* the blanks split_words splits at */
             c++;
         if (!*c || *c == '!' || *c == '/')
             continue;
@@ -593,8 +593,8 @@ static rad_result parse(vs3_reader *r, const char *text, size_t size)
         }
         char *w[12];
         int count = split_words(c, w, 12);
-        if (strlen(w[0]) != 1)
-            return parse_error(r, line, "unknown record '%.20s'", w[0]);
+        if (count == 0 || strlen(w[0]) != 1)
+            return parse_error(r, line, "unknown record '%.20s'", count ? w[0] : c);
         rad_result res = RAD_OK;
         switch (kind) {
         case 'F':
