@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -376,6 +377,46 @@ static void test_smooth_unequal_areas(void **state)
     rad_context_destroy(ctx);
 }
 
+static void test_smooth_large(void **state)
+{
+    (void)state;
+    /* 300 surfaces of seven sizes, every pair seeing each other, factors
+     * far from reciprocal (independent random rows closing to 0.999): the
+     * smoothing must still give reciprocity to rounding and rows to 1e-12. */
+    enum { N = 300 };
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    double *F = malloc(N * N * sizeof *F), area[N];
+    assert_non_null(F);
+    uint64_t seed = 12345;
+    for (int i = 0; i < N; i++) {
+        area[i] = 1.0 + (double)(i % 7);
+        double sum = 0.0;
+        for (int j = 0; j < N; j++) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            F[i * N + j] = i == j ? 0.0 : (double)(seed >> 40) + 1.0;
+            sum += F[i * N + j];
+        }
+        for (int j = 0; j < N; j++)
+            F[i * N + j] /= sum * 1.001;
+    }
+    rad_smooth_report rep;
+    assert_int_equal(rad_view_factors_smooth(ctx, N, area, F, true, &rep), RAD_OK);
+    assert_true(rep.reciprocity_before > 0.1);
+    assert_true(rep.reciprocity_after < 1e-15);
+    assert_true(rep.row_error_after < 1e-12);
+    for (int i = 0; i < N; i++) {
+        double sum = 0.0;
+        for (int j = 0; j < N; j++) {
+            assert_true(F[i * N + j] >= 0.0);
+            sum += F[i * N + j];
+        }
+        assert_float_equal(sum, 1.0, 1e-12);
+    }
+    free(F);
+    rad_context_destroy(ctx);
+}
+
 static void test_sparse_threshold(void **state)
 {
     (void)state;
@@ -553,6 +594,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_smooth_exact_unchanged),
         cmocka_unit_test(test_smooth_perturbed),
         cmocka_unit_test(test_smooth_unequal_areas),
+        cmocka_unit_test(test_smooth_large),
         cmocka_unit_test(test_sparse_threshold),
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_allocation_sweep),
