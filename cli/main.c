@@ -360,6 +360,23 @@ int main(int argc, char **argv)
         goto done;
     status = 1;
 
+    /* View-factor adjustments that cannot apply are refused before the work. */
+    if (s.command == CLI_VIEWFACTORS) {
+        const char *dot = strrchr(output, '.');
+        bool vf = dot && strcmp(dot, ".vf") == 0, mtx = dot && strcmp(dot, ".mtx") == 0;
+        if (s.element_level && (s.smooth || s.sparse_threshold > 0.0 || vf)) {
+            fprintf(stderr, "radiosity: --level element: element factors are written as computed; --smooth, "
+                            "--sparse-threshold and .vf files are for surface-level factors\n");
+            status = EXIT_USAGE;
+            goto done;
+        }
+        if (s.sparse_threshold > 0.0 && !mtx) {
+            fprintf(stderr, "radiosity: --sparse-threshold: the output must be Matrix Market (-o F.mtx)\n");
+            status = EXIT_USAGE;
+            goto done;
+        }
+    }
+
     /* 1. load: a scene, or for render and export a solution file (by its
      * signature), which is solved already */
     double t0 = now_seconds();

@@ -447,6 +447,12 @@ static void test_sparse_threshold(void **state)
     check_closed(F, area, 6, 1e-12);
     for (int i = 0; i < 6; i++)
         assert_float_equal(F[i * 6 + (i + 1) % 6], 0.25, 1e-12);
+    /* Options that cannot apply: usage errors before any work. */
+    snprintf(line, sizeof line, "%s/cube.json", cli_workdir());
+    assert_int_equal(cli_run_capture(errors, "viewfactors %scube.vs3 -o %s --sparse-threshold 0.1", DATA, line), 2);
+    assert_int_equal(cli_run_capture(errors, "viewfactors %scube.vs3 -o %s --level element --smooth open", DATA,
+                                     out), 2);
+    assert_int_not_equal(access(line, F_OK), 0);
     /* A threshold that leaves nothing: refused, nothing written. */
     unlink(out);
     assert_int_not_equal(cli_run_capture(errors, "viewfactors %scube.vs3 -o %s --elements 400 "

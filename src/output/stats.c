@@ -540,11 +540,11 @@ rad_result rad_write_view_factors_with(rad_context *ctx, const rad_solution_view
                         "%s: unknown view-factor format (use .json, .csv, .mtx or .vf)", path);
     if (elements && (options->smooth || options->sparse_threshold > 0.0 || strcmp(ext, "vf") == 0))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: element-level factors are written as computed: smoothing, sparse thresholds "
-                        "and View3D files are for surface-level factors", path);
+                        "view factors: element-level factors are written as computed: smoothing, sparse "
+                        "thresholds and View3D files (.vf) are for surface-level factors");
     if (options->sparse_threshold > 0.0 && strcmp(ext, "mtx") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: a sparse threshold is for Matrix Market output (.mtx)", path);
+                        "view factors: a sparse threshold is for Matrix Market output (.mtx)");
     rad_view_factor_options vo = *options;
     /* View3D normalises an enclosure (encl=1) before writing its file. */
     bool view3d = strcmp(ext, "vf") == 0;
