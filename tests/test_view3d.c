@@ -377,6 +377,34 @@ static void test_smooth_unequal_areas(void **state)
     rad_context_destroy(ctx);
 }
 
+static void test_smooth_arguments(void **state)
+{
+    (void)state;
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
+    double area[2] = {1.0, 2.0}, F[4] = {0.0, 0.5, 0.25, 0.0};
+    assert_int_equal(rad_view_factors_smooth(NULL, 2, area, F, true, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_view_factors_smooth(ctx, 2, NULL, F, true, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_view_factors_smooth(ctx, 0, NULL, NULL, true, NULL), RAD_OK);
+    /* Two plates of areas 1 and 2 that see only each other cannot both
+     * close (A1 F12 = 1 and A2 F21 = 2): refused, F kept. */
+    assert_int_equal(rad_view_factors_smooth(ctx, 2, area, F, true, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_float_equal(F[1], 0.5, 0.0);
+    /* ... but their measured sums can be kept (open: a singular system, its
+     * null vector changing no factor). */
+    assert_int_equal(rad_view_factors_smooth(ctx, 2, area, F, false, NULL), RAD_OK);
+    assert_float_equal(F[1], 0.5, 1e-15);
+    assert_float_equal(F[2], 0.25, 1e-15);
+    /* Two equal facing plates close with F = 1: the least change does that. */
+    double equal[2] = {1.0, 1.0}, G[4] = {0.0, 0.2, 0.2, 0.0};
+    assert_int_equal(rad_view_factors_smooth(ctx, 2, equal, G, true, NULL), RAD_OK);
+    assert_float_equal(G[1], 1.0, 1e-15);
+    F[1] = -0.1;
+    assert_int_equal(rad_view_factors_smooth(ctx, 2, area, F, false, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_solution_write_view_factors_with(NULL, NULL, "x.vf", NULL), RAD_ERROR_INVALID_ARGUMENT);
+    rad_context_destroy(ctx);
+}
+
 static void test_smooth_large(void **state)
 {
     (void)state;
@@ -600,6 +628,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_smooth_exact_unchanged),
         cmocka_unit_test(test_smooth_perturbed),
         cmocka_unit_test(test_smooth_unequal_areas),
+        cmocka_unit_test(test_smooth_arguments),
         cmocka_unit_test(test_smooth_large),
         cmocka_unit_test(test_sparse_threshold),
         cmocka_unit_test(test_bad_files),

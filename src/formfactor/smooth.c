@@ -31,42 +31,55 @@
 
 #include <string.h>
 
-/* Solve M x = b in place by Gaussian elimination with partial pivoting
- * (M is n x n, row-major, destroyed).  False when a pivot is below
- * `tiny` (singular: the targets cannot be met on this pattern). */
-static bool solve_dense(double *M, double *b, size_t n, double tiny)
+/* Solve M x = b (M n x n row-major, destroyed; b destroyed) by Gaussian
+ * elimination to row echelon form with partial pivoting.  M may be
+ * singular: a column without a pivot above `tiny` is a free unknown, set to
+ * 0 (the system of a group of surfaces that see only the other group,
+ * two facing plates, is singular, its null vector +1 on one side and -1
+ * on the other changing no factor).  `col` holds n indices of scratch.
+ * False when the system is inconsistent: a row left without a pivot whose
+ * right-hand side exceeds `consistent` (the targets cannot be met). */
+static bool solve_dense(double *M, double *b, double *x, size_t *col, size_t n, double tiny,
+                        double consistent)
 {
-    for (size_t k = 0; k < n; k++) {
-        size_t p = k;
-        for (size_t i = k + 1; i < n; i++)
+    size_t rows = 0; /* pivot rows found so far */
+    for (size_t k = 0; k < n && rows < n; k++) {
+        size_t p = rows;
+        for (size_t i = rows + 1; i < n; i++)
             if (fabs(M[i * n + k]) > fabs(M[p * n + k]))
                 p = i;
         if (!(fabs(M[p * n + k]) > tiny))
-            return false;
-        if (p != k) {
+            continue; /* a free unknown */
+        if (p != rows) {
             for (size_t j = 0; j < n; j++) {
-                double t = M[k * n + j];
-                M[k * n + j] = M[p * n + j];
+                double t = M[rows * n + j];
+                M[rows * n + j] = M[p * n + j];
                 M[p * n + j] = t;
             }
-            double t = b[k];
-            b[k] = b[p];
+            double t = b[rows];
+            b[rows] = b[p];
             b[p] = t;
         }
-        for (size_t i = k + 1; i < n; i++) {
-            double f = M[i * n + k] / M[k * n + k];
+        for (size_t i = rows + 1; i < n; i++) {
+            double f = M[i * n + k] / M[rows * n + k];
             if (f == 0.0)
                 continue;
             for (size_t j = k; j < n; j++)
-                M[i * n + j] -= f * M[k * n + j];
-            b[i] -= f * b[k];
+                M[i * n + j] -= f * M[rows * n + j];
+            b[i] -= f * b[rows];
         }
+        col[rows++] = k;
     }
-    for (size_t k = n; k-- > 0;) {
-        double v = b[k];
-        for (size_t j = k + 1; j < n; j++)
-            v -= M[k * n + j] * b[j];
-        b[k] = v / M[k * n + k];
+    for (size_t i = rows; i < n; i++)
+        if (!(fabs(b[i]) <= consistent))
+            return false;
+    for (size_t k = 0; k < n; k++)
+        x[k] = 0.0;
+    for (size_t r = rows; r-- > 0;) {
+        double v = b[r];
+        for (size_t j = col[r] + 1; j < n; j++)
+            v -= M[r * n + j] * x[j];
+        x[col[r]] = v / M[r * n + col[r]];
     }
     return true;
 }
@@ -123,10 +136,14 @@ rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double 
     double *M = g0 ? rad_alloc(ctx, RAD_MEM_OUTPUT, n * n, sizeof *M, "smoothing: system") : NULL;
     double *lambda = M ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *lambda, "smoothing: multipliers") : NULL;
     double *target = lambda ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *target, "smoothing: targets") : NULL;
-    if (!target) {
+    double *rhs = target ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *rhs, "smoothing: system") : NULL;
+    size_t *col = rhs ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *col, "smoothing: system") : NULL;
+    if (!col) {
         rad_free(g0);
         rad_free(M);
         rad_free(lambda);
+        rad_free(target);
+        rad_free(rhs);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     for (size_t i = 0; i < n; i++) {
@@ -135,6 +152,8 @@ rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double 
             rad_free(M);
             rad_free(lambda);
             rad_free(target);
+            rad_free(rhs);
+            rad_free(col);
             return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "smoothing: row %zu's target %g is not in [0, 1]",
                             i, targets[i]);
         }
@@ -155,15 +174,17 @@ rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double 
                 M[i * n + j] = g0[i * n + j];
             }
             M[i * n + i] += s;
-            lambda[i] = s - area[i] * target[i];
+            rhs[i] = s - area[i] * target[i];
         }
-        /* 1e-14 of the largest area: below it a pivot is rounding, the row
-         * has no factor left to change (a surface that sees nothing, or a
-         * pattern on which the targets cannot be met). */
+        /* Pivots below 1e-12 of the largest area are rounding (elimination
+         * of n rows of sums of areas loses ~n 1e-16 of them); a row without
+         * a pivot whose sum is off by 1e-10 of it is a sum that cannot be
+         * met (a surface that sees nothing, two that see only each other
+         * with different areas and the sums of an enclosure). */
         double big = 0.0;
         for (size_t i = 0; i < n; i++)
             big = fmax(big, area[i]);
-        if (!solve_dense(M, lambda, n, 1e-14 * big)) {
+        if (!solve_dense(M, rhs, lambda, col, n, 1e-12 * big, 1e-10 * big)) {
             result = rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                               "smoothing: the row sums cannot be met by changing the non-zero factors "
                               "(a surface that sees nothing, or two that see only each other with "
@@ -207,6 +228,8 @@ rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double 
     rad_free(M);
     rad_free(lambda);
     rad_free(target);
+    rad_free(rhs);
+    rad_free(col);
     if (report)
         *report = rep;
     return result;
