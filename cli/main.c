@@ -418,6 +418,23 @@ int main(int argc, char **argv)
         goto done;
     status = 1;
 
+    /* View-factor adjustments that cannot apply are refused before the work. */
+    if (s.command == CLI_VIEWFACTORS) {
+        const char *dot = strrchr(output, '.');
+        bool vf = dot && strcmp(dot, ".vf") == 0, mtx = dot && strcmp(dot, ".mtx") == 0;
+        if (s.element_level && (s.smooth || s.sparse_threshold > 0.0 || vf)) {
+            fprintf(stderr, "radiosity: --level element: element factors are written as computed; --smooth, "
+                            "--sparse-threshold and .vf files are for surface-level factors\n");
+            status = EXIT_USAGE;
+            goto done;
+        }
+        if (s.sparse_threshold > 0.0 && !mtx) {
+            fprintf(stderr, "radiosity: --sparse-threshold: the output must be Matrix Market (-o F.mtx)\n");
+            status = EXIT_USAGE;
+            goto done;
+        }
+    }
+
     /* 1. load: a scene, or for render and export a solution file (by its
      * signature), which is solved already */
     double t0 = now_seconds();
@@ -522,7 +539,28 @@ int main(int argc, char **argv)
     if (s.command == CLI_VIEWFACTORS) {
         /* 5. view factors */
         begin_saving(ctx);
-        r = rad_solution_write_view_factors(ctx, sol, out.main, s.element_level);
+        rad_view_factor_options vo = {0};
+        rad_smooth_report report;
+        size_t nonzeros = 0;
+        double dropped = 0.0;
+        vo.elements = s.element_level != 0;
+        vo.smooth = (rad_smoothing)s.smooth;
+        vo.sparse_threshold = s.sparse_threshold;
+        vo.report = &report;
+        vo.nonzeros = &nonzeros;
+        vo.dropped = &dropped;
+        memset(&report, 0, sizeof report);
+        report.row_error_before = -1.0; /* stays negative when no smoothing ran */
+        r = rad_solution_write_view_factors_with(ctx, sol, out.main, &vo);
+        if (r == RAD_OK && !s.quiet && report.row_error_before >= 0.0)
+            printf("smoothing: max |row sum - target| %.3g -> %.3g, max reciprocity error %.3g -> %.3g, "
+                   "change max %.3g rms %.3g (relative)%s\n",
+                   report.row_error_before, report.row_error_after, report.reciprocity_before,
+                   report.reciprocity_after, report.max_relative_change, report.rms_relative_change,
+                   report.clamped ? ", some factors held at 0" : "");
+        if (r == RAD_OK && !s.quiet && s.sparse_threshold > 0.0)
+            printf("sparse: %zu non-zeros, at most %.3g of a row's factors dropped and rebalanced\n", nonzeros,
+                   dropped);
         if (r == RAD_OK && s.stats)
             r = rad_solution_write_stats(ctx, sol, out.stats, 0);
         if (r == RAD_OK)

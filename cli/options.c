@@ -78,6 +78,8 @@ const char *cli_command_name(int command)
 #define ACTION(action_) .target = CLI_TO_ACTION, .action = action_
 
 static const rad_option_word level_words[] = {{"surface", 0}, {"element", 1}, {NULL, 0}};
+static const rad_option_word smooth_words[] = {{"enclosure", RAD_SMOOTH_ENCLOSURE}, {"open", RAD_SMOOTH_OPEN},
+                                               {NULL, 0}};
 static const rad_option_word lightmap_words[] = {{"radiosity", RAD_LIGHTMAP_RADIOSITY},
                                                  {"irradiance", RAD_LIGHTMAP_IRRADIANCE},
                                                  {NULL, 0}};
@@ -87,7 +89,7 @@ static const cli_flag FLAGS[] = {
      .own.help = "output image: .png (exposed, sRGB), .hdr or .pfm (linear)",
      .own.default_text = "radiosity.png"},
     {"output", 'o', "FILE", CLI_VIEWFACTORS, OWN(output, RAD_OPTION_STRING),
-     .own.help = "output view factors: .json, .csv or .mtx (docs/formats.md)",
+     .own.help = "output view factors: .json, .csv, .mtx or .vf (View3D's file) (docs/formats.md)",
      .own.default_text = "viewfactors.json"},
     {"output", 'o', "FILE", CLI_EXPORT, OWN(output, RAD_OPTION_STRING),
      .own.help = "output lit mesh: .glb or .gltf (glTF 2.0) or .ply (docs/formats.md)",
@@ -141,6 +143,13 @@ static const cli_flag FLAGS[] = {
      .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
     {"level", 0, "WHICH", CLI_THERMAL, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
      .own.default_text = "surface", .own.help = "heat exchange per surface or per element"},
+    {"smooth", 0, "WHICH", CLI_VIEWFACTORS, OWN(smooth, RAD_OPTION_ENUM), .own.words = smooth_words,
+     .own.help = "least-squares enclosure smoothing of the surface factors written: reciprocal, rows summing "
+                 "to 1 (enclosure) or to their measured sums (open) (docs/methods.md)"},
+    {"sparse-threshold", 0, "X", CLI_VIEWFACTORS, OWN(sparse_threshold, RAD_OPTION_DOUBLE), .own.min = 0.0,
+     .own.max = 1.0, .own.min_open = true, .own.max_open = true,
+     .own.help = "with -o F.mtx: pairs of factors below X dropped, the rest rebalanced so reciprocity and "
+                 "the row sums still hold"},
     {"epsilon", 0, "X", RS, SOLVE(epsilon)},
     {"min-area", 0, "A", RS, SOLVE(min_area)},
     {"clustering", 0, "WHEN", RS, SOLVE(clustering)},

@@ -51,6 +51,8 @@ typedef struct cli_settings {
     const char *progress_dir;
     int every;
     int element_level;        /* viewfactors, thermal: 0 surfaces, 1 elements */
+    int smooth;               /* viewfactors: rad_smoothing (--smooth) */
+    double sparse_threshold;  /* viewfactors: .mtx factors below it dropped, 0 = none */
     rad_options solve;
     rad_render_options render;
     rad_office_options office;

@@ -1079,6 +1079,68 @@ RAD_API bool rad_option_lookup_word(const rad_option_info *option, const char *t
  * length it wanted (0 for a NULL row). */
 RAD_API size_t rad_option_range_text(const rad_option_info *option, char *text, size_t size);
 
+/* ------------------------------------------------------------------------
+ * Factors for thermal solvers: enclosure smoothing, sparse and View3D
+ * outputs (docs/formats.md "View3D", docs/methods.md "Enclosure smoothing").
+ * ---------------------------------------------------------------------- */
+
+/* What a smoothing did: the worst row error (|sum_j F_ij - target|, the
+ * target 1 in an enclosure) and reciprocity error (|A_i F_ij - A_j F_ji|
+ * over the larger of the two) before and after, and the relative change of
+ * the non-zero factors (max and RMS).  `clamped`: factors held at 0. */
+typedef struct rad_smooth_report {
+    double row_error_before, row_error_after;
+    double reciprocity_before, reciprocity_after;
+    double max_relative_change, rms_relative_change;
+    size_t clamped;
+} rad_smooth_report;
+
+/* Enclosure smoothing of an n x n surface view-factor matrix F (row-major,
+ * F[i * n + j] from i to j) with areas `area` (m^2), in place: the weighted
+ * least-squares change (weights 1 / (A_i F_ij)) that makes A_i F_ij =
+ * A_j F_ji and each row sum 1 (`enclosure` true) or its measured sum
+ * (false, at most 1), every factor kept >= 0; zero factors (F_ii of a
+ * planar surface) stay 0.  O(n^3) time, 2 n^2 doubles.  `report` (may be
+ * NULL) is filled.  Fails with RAD_ERROR_INVALID_ARGUMENT when a factor is
+ * not in [0, 1], an area not positive, or the sums cannot be met on the
+ * non-zero pattern (F unchanged); RAD_ERROR_OUT_OF_MEMORY.  NULL ctx, area
+ * or F (n > 0): RAD_ERROR_INVALID_ARGUMENT.  Thread-safe for distinct F. */
+RAD_API rad_result rad_view_factors_smooth(rad_context *ctx, size_t n, const double *area, double *F,
+                                           bool enclosure, rad_smooth_report *report);
+
+typedef enum rad_smoothing {
+    RAD_SMOOTH_NONE = 0,
+    RAD_SMOOTH_ENCLOSURE = 1, /* rows sum to 1 */
+    RAD_SMOOTH_OPEN = 2       /* rows keep their measured sums */
+} rad_smoothing;
+
+/* How rad_solution_write_view_factors_with adjusts the surface-level
+ * factors it writes (0 everywhere: as rad_solution_write_view_factors). */
+typedef struct rad_view_factor_options {
+    bool elements;            /* element-to-element factors (no adjustment allowed) */
+    rad_smoothing smooth;     /* enclosure smoothing of the written matrix */
+    /* .mtx: factors below it (both F_ij and F_ji) dropped and the rest
+     * smoothed on the kept pattern to the rows' sums before the drop (to 1
+     * with RAD_SMOOTH_ENCLOSURE); 0 = keep all. */
+    double sparse_threshold;
+    rad_smooth_report *report;/* filled when a smoothing ran (may be NULL) */
+    size_t *nonzeros;         /* the factors written as non-zero (may be NULL) */
+    double *dropped;          /* sparse: the largest row's factor mass dropped (may be NULL) */
+} rad_view_factor_options;
+
+/* As rad_solution_write_view_factors, with `options` (NULL: all 0), and one
+ * more format: .vf, View3D's view-factor file (text, or binary when the
+ * scene is a .vs3 whose control line says out=1), surfaces only.  Surfaces
+ * marked obstruction-only by a .vs3 are left out of every surface-level
+ * output.  A .vs3 with encl=1 is smoothed as an enclosure in .vf, as
+ * View3D normalises it, unless `smooth` says otherwise.  Fails as
+ * rad_solution_write_view_factors, and with RAD_ERROR_INVALID_ARGUMENT for
+ * a smoothing that cannot be met (nothing written) or options with
+ * element-level factors. */
+RAD_API rad_result rad_solution_write_view_factors_with(rad_context *ctx, const rad_solution *solution,
+                                                        const char *path,
+                                                        const rad_view_factor_options *options);
+
 #ifdef __cplusplus
 }
 #endif

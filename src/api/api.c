@@ -611,6 +611,24 @@ rad_result rad_solution_write_view_factors(rad_context *ctx, const rad_solution 
     return rad_write_view_factors(ctx, &s->view, path, elements);
 }
 
+rad_result rad_solution_write_view_factors_with(rad_context *ctx, const rad_solution *s, const char *path,
+                                                const rad_view_factor_options *options)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_view_factor_options o = {0};
+    if (options)
+        o = *options;
+    if (o.smooth != RAD_SMOOTH_NONE && o.smooth != RAD_SMOOTH_ENCLOSURE && o.smooth != RAD_SMOOTH_OPEN)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "view factors: smooth %d is not a rad_smoothing", (int)o.smooth);
+    if (!(o.sparse_threshold >= 0.0 && o.sparse_threshold < 1.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "view factors: sparse threshold %g is not in [0, 1)",
+                        o.sparse_threshold);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+    return rad_write_view_factors_with(ctx, &s->view, path, &o);
+}
+
 rad_result rad_solution_write_mesh(rad_context *ctx, const rad_solution *s, const char *path, double exposure)
 {
     rad_api_enter(ctx);

@@ -125,9 +125,9 @@ static rad_result check_format(rad_context *ctx, const char *path, rad_output_ki
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: unknown image format (use .png, .hdr or .pfm)", path);
     if (kind == RAD_OUTPUT_VIEW_FACTORS && strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 &&
-        strcmp(ext, "mtx") != 0)
+        strcmp(ext, "mtx") != 0 && strcmp(ext, "vf") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: unknown view-factor format (use .json, .csv or .mtx)", path);
+                        "%s: unknown view-factor format (use .json, .csv, .mtx or .vf)", path);
     if (kind == RAD_OUTPUT_SOLUTION && strcmp(ext, "radsol") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: a solution file is named .radsol (docs/formats.md)", path);

@@ -28,7 +28,10 @@ static uint32_t cells_for(double length, double h)
 
 static void size_patch(rad_patch *p, double h)
 {
-    if (p->corner_count == 4) {
+    if (p->obstruction) {
+        p->nu = p->nv = 1;
+        p->element_count = 1;
+    } else if (p->corner_count == 4) {
         double lu = fmax(v3_length(v3_sub(p->corner[1], p->corner[0])),
                          v3_length(v3_sub(p->corner[2], p->corner[3])));
         double lv = fmax(v3_length(v3_sub(p->corner[3], p->corner[0])),

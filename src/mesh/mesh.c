@@ -83,9 +83,19 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
         return r;
     }
 
+    /* An obstruction-only surface (View3D 'O') or mask ('M') blocks rays
+     * through its patches; its factors are not wanted (a mask's are set:
+     * output/view3d.c), so each patch is one element. */
+    for (size_t i = 0; i < mesh->patch_count; i++) {
+        const rad_surface *surface = &scene->surfaces[mesh->patches[i].surface];
+        mesh->patches[i].obstruction = surface->obstruction || surface->mask;
+    }
     double total_area = 0.0;
-    for (size_t i = 0; i < scene->polygon_count; i++)
-        total_area += scene->polygons[i].area;
+    for (size_t i = 0; i < scene->polygon_count; i++) {
+        const rad_surface *surface = &scene->surfaces[scene->polygons[i].surface];
+        if (!surface->obstruction && !surface->mask)
+            total_area += scene->polygons[i].area;
+    }
     double h = o.mesh_size > 0.0 ? o.mesh_size
                                  : mesh_size_for_target(mesh->patches, mesh->patch_count,
                                                         total_area, (double)o.target_elements);

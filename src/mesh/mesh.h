@@ -37,6 +37,7 @@ typedef struct rad_patch {
     uint32_t first_element;  /* elements of this patch are contiguous */
     uint32_t element_count;
     uint32_t tree_root;      /* leaf meshes (rad_mesh.tree != NULL): the patch's quadtree */
+    bool obstruction;        /* of an obstruction-only or mask surface: one element, it only blocks rays */
 } rad_patch;
 
 typedef struct rad_element {

@@ -108,6 +108,10 @@ rad_result rad_write_solution(rad_context *ctx, const rad_solution_view *view, c
  * surface-level or, with `elements`, element-level.  Fails without F. */
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *view, const char *path,
                                   bool elements);
+/* The same with options (rad_solution_write_view_factors_with; view3d.c):
+ * .vf as well, smoothing, sparse thresholds.  `options` is not NULL. */
+rad_result rad_write_view_factors_with(rad_context *ctx, const rad_solution_view *view, const char *path,
+                                       const rad_view_factor_options *options);
 
 /* The lit mesh by the path's extension (.glb, .gltf, .ply; docs/formats.md):
  * vertices with their radiosity B (W/m^2) and display colour, the radiance

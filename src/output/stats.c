@@ -14,6 +14,7 @@
  * end a line or forge one.
  */
 #include "output/output.h"
+#include "output/view3d.h"
 
 #include <cjson/cJSON.h>
 #include <inttypes.h>
@@ -408,6 +409,7 @@ typedef struct vf_rows {
     double *area;
     double *F;      /* count x count */
     double *err;    /* count x count standard errors, or NULL */
+    size_t *kept;   /* surface level: the scene surface of each row (view3d.c) */
 } vf_rows;
 
 static void vf_rows_free(vf_rows *r)
@@ -418,6 +420,7 @@ static void vf_rows_free(vf_rows *r)
     rad_free(r->area);
     rad_free(r->F);
     rad_free(r->err);
+    rad_free(r->kept);
     memset(r, 0, sizeof *r);
 }
 
@@ -445,7 +448,8 @@ static cJSON *exact_array(const double *v, size_t count)
     return array;
 }
 
-static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bool elements, vf_rows *r)
+static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bool elements,
+                                const rad_view_factor_options *o, vf_rows *r)
 {
     memset(r, 0, sizeof *r);
     size_t n = s->n, S = s->scene->surface_count;
@@ -481,6 +485,19 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
             if (!r->names[k])
                 result = RAD_ERROR_OUT_OF_MEMORY;
         }
+        /* Thermal outputs: obstruction surfaces out, smoothing, sparsity (view3d.c). */
+        r->kept = result == RAD_OK ? rad_alloc(ctx, RAD_MEM_OUTPUT, S ? S : 1, sizeof *r->kept, "view factors")
+                                   : NULL;
+        if (result == RAD_OK && !r->kept)
+            result = RAD_ERROR_OUT_OF_MEMORY;
+        if (result == RAD_OK)
+            result = rad_vf_adjust(ctx, s->scene, r->names, r->area, r->F, &r->count, r->kept, o);
+        if (result == RAD_OK && r->err) {
+            size_t N = r->count;
+            for (size_t a = 0; a < N; a++)
+                for (size_t b = 0; b < N; b++)
+                    r->err[a * N + b] = r->err[r->kept[a] * S + r->kept[b]];
+        }
     } else {
         size_t *seen = rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *seen, "view factors: names");
         if (!seen)
@@ -512,20 +529,75 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
                                   bool elements)
 {
+    rad_view_factor_options o = {0};
+    o.elements = elements;
+    return rad_write_view_factors_with(ctx, s, path, &o);
+}
+
+rad_result rad_write_view_factors_with(rad_context *ctx, const rad_solution_view *s, const char *path,
+                                       const rad_view_factor_options *options)
+{
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);
-    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0)
+    bool elements = options->elements;
+    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0 &&
+        strcmp(ext, "vf") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: unknown view-factor format (use .json, .csv or .mtx)", path);
+                        "%s: unknown view-factor format (use .json, .csv, .mtx or .vf)", path);
+    if (elements && (options->smooth || options->sparse_threshold > 0.0 || strcmp(ext, "vf") == 0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "view factors: element-level factors are written as computed: smoothing, sparse "
+                        "thresholds and View3D files (.vf) are for surface-level factors");
+    if (options->sparse_threshold > 0.0 && strcmp(ext, "mtx") != 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "view factors: a sparse threshold is for Matrix Market output (.mtx)");
+    rad_view_factor_options vo = *options;
+    /* View3D normalises an enclosure (encl=1) before writing its file. */
+    bool view3d = strcmp(ext, "vf") == 0;
+    if (view3d && vo.smooth == RAD_SMOOTH_NONE && s->scene->view3d.present && s->scene->view3d.enclosure)
+        vo.smooth = RAD_SMOOTH_ENCLOSURE;
     if (!s->F)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: no view factors: solver '%s' computes no form-factor matrix", path,
                         s->options->solver);
     vf_rows rows;
-    rad_result r = vf_rows_build(ctx, s, elements, &rows);
+    rad_result r = vf_rows_build(ctx, s, elements, &vo, &rows);
     if (r != RAD_OK)
         return r;
     size_t N = rows.count;
+    if (vo.nonzeros) {
+        *vo.nonzeros = 0;
+        for (size_t k = 0; k < N * N; k++)
+            *vo.nonzeros += rows.F[k] != 0.0;
+    }
+    if (view3d) {
+        int format = s->scene->view3d.present ? s->scene->view3d.out_format : 0;
+        double *emissivity = rad_alloc(ctx, RAD_MEM_OUTPUT, N ? N : 1, sizeof *emissivity, "view factors");
+        rad_atomic_file f;
+        r = emissivity ? rad_atomic_open(ctx, path, &f) : RAD_ERROR_OUT_OF_MEMORY;
+        if (r == RAD_OK) {
+            for (size_t a = 0; a < N; a++)
+                emissivity[a] = rad_surface_emissivity(s->scene, rows.kept[a]);
+            int emit = s->scene->view3d.present && s->scene->view3d.emittances;
+            if (emit) /* after the smoothing, as View3D normalises before IntFac */
+                r = rad_vf_script_f(ctx, N, emissivity, rows.F);
+            if (r == RAD_OK)
+                r = rad_view3d_write_header(ctx, f.file, format,
+                                            s->scene->view3d.present ? s->scene->view3d.enclosure : 0, emit, N,
+                                            rows.area);
+            for (size_t a = 0; a < N && r == RAD_OK; a++)
+                rad_view3d_write_row(f.file, format, rows.F + a * N, N);
+            if (r == RAD_OK) {
+                rad_view3d_write_end(f.file, format, emissivity, N);
+                r = rad_atomic_commit(ctx, &f);
+            } else {
+                rad_atomic_abort(&f);
+            }
+        }
+        rad_free(emissivity);
+        vf_rows_free(&rows);
+        return r;
+    }
     if (strcmp(ext, "json") == 0) {
         cJSON *root = cJSON_CreateObject();
         r = add_text(ctx, root, "scene", s->scene->source);

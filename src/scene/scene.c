@@ -24,6 +24,7 @@
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 struct rad_scene_builder {
     rad_context *ctx;
@@ -205,6 +206,9 @@ int rad_scene_builder_surface(rad_scene_builder *b, const char *name)
     rad_surface *s = &surfaces[b->surface_count];
     s->name = rad_strdup(b->ctx, RAD_MEM_SCENE, name, b->source);
     s->area = 0.0;
+    s->obstruction = false;
+    s->mask = false;
+    s->mask_base = 0;
     if (!s->name)
         return -1;
     /* Grow the table to keep it under half full, then insert. */
@@ -458,6 +462,20 @@ rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int mate
     return RAD_OK;
 }
 
+void rad_scene_builder_surface_obstruction(rad_scene_builder *b, int surface)
+{
+    if (b && surface >= 0 && (size_t)surface < b->surface_count)
+        b->surfaces[surface].obstruction = true;
+}
+
+void rad_scene_builder_surface_mask(rad_scene_builder *b, int surface, int base)
+{
+    if (b && surface >= 0 && (size_t)surface < b->surface_count && base >= 0 && (size_t)base < b->surface_count) {
+        b->surfaces[surface].mask = true;
+        b->surfaces[surface].mask_base = (uint32_t)base;
+    }
+}
+
 void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera)
 {
     if (!b)
@@ -531,6 +549,11 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
         b->surfaces[kept].area = 0.0;
         surface_map[i] = (uint32_t)kept++;
     }
+    for (size_t i = 0; i < kept; i++) /* a mask's base, renumbered */
+        if (b->surfaces[i].mask) {
+            b->surfaces[i].mask_base = surface_map[b->surfaces[i].mask_base];
+            b->surfaces[i].mask = b->surfaces[i].mask_base != UINT32_MAX;
+        }
     b->surface_count = kept;
     kept = 0;
     for (size_t i = 0; i < b->material_count; i++) {
@@ -593,7 +616,17 @@ rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **o
     if (!ctx || !path || !out)
         return rad_null_argument(ctx, __func__);
     double start = rad_seconds();
-    rad_result r = rad_import_assimp_file(ctx, path, out);
+    /* View3D's .vs3, by its extension or its first record. */
+    char head[512];
+    size_t head_size = 0;
+    struct stat st;
+    FILE *peek = stat(path, &st) == 0 && S_ISREG(st.st_mode) ? fopen(path, "rb") : NULL;
+    if (peek) { /* regular files only: a FIFO's bytes are read once */
+        head_size = fread(head, 1, sizeof head, peek);
+        fclose(peek);
+    }
+    rad_result r = rad_vs3_detect(path, head, head_size) ? rad_import_vs3_file(ctx, path, out)
+                                                          : rad_import_assimp_file(ctx, path, out);
     if (r == RAD_OK)
         (*out)->load_seconds = rad_seconds() - start;
     return r;
@@ -609,7 +642,9 @@ rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void 
     if (!ctx || !name || !out || (!data && size > 0) || (!mtl && mtl_size > 0))
         return rad_null_argument(ctx, __func__);
     double start = rad_seconds();
-    rad_result r = rad_import_assimp_memory(ctx, name, data, size, mtl, mtl_size, out);
+    rad_result r = rad_vs3_detect(name, data, size)
+                       ? rad_import_vs3_memory(ctx, name, data, size, out)
+                       : rad_import_assimp_memory(ctx, name, data, size, mtl, mtl_size, out);
     if (r == RAD_OK)
         (*out)->load_seconds = rad_seconds() - start;
     return r;

@@ -21,7 +21,20 @@ typedef struct rad_material {
 typedef struct rad_surface {
     char *name;            /* OBJ o/g name, glTF node name; unique in the scene */
     double area;           /* m^2, sum of its polygons */
+    bool obstruction;      /* View3D 'O' surface: blocks rays, not in the view-factor output */
+    bool mask;             /* View3D 'M' surface: covers part of surface mask_base (facing it) */
+    uint32_t mask_base;    /* the masked surface, when mask */
 } rad_surface;
+
+/* What a View3D .vs3 file's control line asks of the view-factor output
+ * (scene/import_vs3.c, docs/formats.md "View3D"); present is false for
+ * every other format. */
+typedef struct rad_view3d_control {
+    bool present;
+    int enclosure;            /* encl: 1 = the surfaces form an enclosure */
+    int out_format;           /* out: 0 = text, 1 = binary */
+    int emittances;           /* emit: 1 = the .vf holds Hottel's script-F factors */
+} rad_view3d_control;
 
 typedef struct rad_polygon {
     uint32_t first_index;  /* into rad_scene.indices */
@@ -50,6 +63,7 @@ struct rad_scene {
     rad_camera camera;
     char **inputs;            /* the files read to make it (rad_scene_input_path) */
     size_t input_count;
+    rad_view3d_control view3d; /* a .vs3 file's control line */
 };
 
 /* Take over a list of malloc'd paths as the scene's inputs (freeing any it
@@ -78,6 +92,15 @@ const char *rad_scene_builder_surface_name(const rad_scene_builder *b, int surfa
 rad_result rad_scene_builder_polygon(rad_scene_builder *b, int surface, int material,
                                      const vec3 *vertices, size_t vertex_count, int line);
 void rad_scene_builder_camera(rad_scene_builder *b, const rad_camera *camera);
+/* Mark surface `surface` obstruction-only (View3D 'O'): it is meshed and
+ * blocks rays like any surface, and the view-factor outputs leave it out.
+ * Cannot fail. */
+void rad_scene_builder_surface_obstruction(rad_scene_builder *b, int surface);
+/* Mark surface `surface` a View3D mask of surface `base` (both indices
+ * rad_scene_builder_surface gave): its polygons fill a hole cut in the
+ * base, block rays like an obstruction, and the surface-level outputs give
+ * it View3D's factors (F(mask, base) = 1; output/view3d.c).  Cannot fail. */
+void rad_scene_builder_surface_mask(rad_scene_builder *b, int surface, int base);
 
 /* An OBJ's camera, as a comment (OBJ has none): the prefix, then position,
  * look-at point, up vector and vertical field of view in degrees, ten
@@ -96,6 +119,14 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
 rad_result rad_import_assimp_memory(rad_context *ctx, const char *name, const void *data,
                                     size_t size, const void *mtl, size_t mtl_size,
                                     rad_scene **out);
+
+/* View3D's .vs3 vertex/surface format (scene/import_vs3.c). */
+rad_result rad_import_vs3_memory(rad_context *ctx, const char *name, const char *text, size_t size,
+                                 rad_scene **out);
+rad_result rad_import_vs3_file(rad_context *ctx, const char *path, rad_scene **out);
+/* True when a file's name ends in .vs3 (any case) or its text begins, after
+ * blank and comment lines, with a View3D title or control line ("T ", "C "). */
+bool rad_vs3_detect(const char *name, const char *text, size_t size);
 
 /* ---- queries used downstream ---- */
 
