@@ -503,20 +503,34 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
     return result;
 }
 
+/* Surface-level or element-level view factors, from `given` (a table made
+ * elsewhere, taken over and freed here) or, when NULL, from the view's F. */
+static rad_result write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
+                                     bool elements, vf_rows *given);
+
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
                                   bool elements)
 {
+    return write_view_factors(ctx, s, path, elements, NULL);
+}
+
+static rad_result write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
+                                     bool elements, vf_rows *given)
+{
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);
-    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0)
+    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0) {
+        if (given)
+            vf_rows_free(given);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: unknown view-factor format (use .json, .csv or .mtx)", path);
-    if (!s->F)
+    }
+    if (!s->F && !given)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: no view factors: solver '%s' computes no form-factor matrix", path,
                         s->options->solver);
     vf_rows rows;
-    rad_result r = vf_rows_build(ctx, s, elements, &rows);
+    rad_result r = given ? (rows = *given, RAD_OK) : vf_rows_build(ctx, s, elements, &rows);
     if (r != RAD_OK)
         return r;
     size_t N = rows.count;
@@ -591,6 +605,39 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, 
     }
     vf_rows_free(&rows);
     return r;
+}
+
+/* ---- for the streamed view factors (vf_stream.c) ---- */
+
+void rad_write_csv_field(FILE *f, const char *text)
+{
+    csv_field(f, text);
+}
+
+void rad_write_json_string(FILE *f, const char *text)
+{
+    json_string(f, text);
+}
+
+rad_result rad_write_surface_view_factors(rad_context *ctx, const rad_solution_view *view, double *F,
+                                          const char *path)
+{
+    size_t S = view->scene->surface_count;
+    vf_rows rows = {S, NULL, NULL, F, NULL};
+    rows.names = rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *rows.names, "view factors: names");
+    rows.area = rows.names ? rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *rows.area, "view factors: areas") : NULL;
+    rad_result r = rows.area ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t k = 0; k < S && r == RAD_OK; k++) {
+        rows.names[k] = rad_utf8_clean(ctx, view->scene->surfaces[k].name);
+        rows.area[k] = view->scene->surfaces[k].area;
+        if (!rows.names[k])
+            r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    if (r != RAD_OK) {
+        vf_rows_free(&rows);
+        return r;
+    }
+    return write_view_factors(ctx, view, path, false, &rows);
 }
 
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path)
