@@ -17,6 +17,9 @@
 #include "generate.h"
 #include "options.h"
 #include "radiosity.h"
+#ifdef RADIOSITY_MPI
+#include "mpi_ranks.h"
+#endif
 
 #include <errno.h>
 #include <limits.h>
@@ -311,7 +314,64 @@ static int write_solution(rad_context *ctx, const settings *s, rad_solution *sol
     return cancel_signal ? interrupted_status() : 0;
 }
 
-int main(int argc, char **argv)
+/* ---- view factors in row blocks (rad_scene_stream_view_factors) ---- */
+
+/* Rank 0 (or the only process): stream when asked (--block-rows, several
+ * ranks) or when the dense matrix would pass the memory limit.  Returns
+ * -1 when the dense route is to be taken, else the exit status. */
+static int stream_view_factors(rad_context *ctx, const settings *s, const rad_scene *scene, run_outputs *out,
+                               progress_state *progress, const rad_stream_ranks *ranks, double t0)
+{
+    bool forced = s->block_rows > 0 || ranks->size > 1;
+    if (!forced && s->stats)
+        return -1; /* the stats file describes a solution: the dense route */
+    if (forced && s->stats) {
+        fprintf(stderr, "radiosity: --stats: view factors in row blocks (--block-rows, mpirun) write no stats "
+                        "file; their diagnostics are printed\n");
+        return EXIT_USAGE;
+    }
+    rad_stream_options so = {s->block_rows, s->element_level, !forced, ranks->size > 1 ? ranks : NULL};
+    rad_stream_stats st;
+    rad_result r = rad_scene_stream_view_factors(ctx, scene, &s->solve, &so, out->main, &st);
+    progress_end(progress);
+    if (r == RAD_OK && !st.streamed)
+        return -1;
+    if (r == RAD_ERROR_INTERRUPTED) {
+        fprintf(stderr, "radiosity: interrupted while computing form factors; nothing written\n");
+        return interrupted_status();
+    }
+    begin_saving(ctx);
+    if (r == RAD_OK)
+        r = rad_output_set_commit(ctx, out->set);
+    if (r != RAD_OK)
+        return fail(ctx, r);
+    char full[PATH_MAX];
+    if (!s->quiet)
+        printf("wrote %s (%zu surfaces, %zu elements in %zu block%s of %zu rows on %d process%s; row sums "
+               "%.6g to %.6g, reciprocity %.2g; %.1f s)\n",
+               where(s->output, full), rad_scene_surface_count(scene), st.elements, st.blocks, st.blocks == 1 ? "" : "s", st.block_rows,
+               ranks->size, ranks->size == 1 ? "" : "es", st.row_sum_min, st.row_sum_max, st.reciprocity_max,
+               now_seconds() - t0);
+    return cancel_signal ? interrupted_status() : 0;
+}
+
+/* Ranks above 0: load the scene, make their blocks, send them to rank 0. */
+static int stream_rank(rad_context *ctx, const settings *s, const rad_stream_ranks *ranks)
+{
+    rad_scene *scene = NULL;
+    rad_result r = s->scene_path ? rad_scene_load_file(ctx, s->scene_path, &scene)
+                                 : rad_scene_create_cornell_box(ctx, &scene);
+    rad_stream_options so = {s->block_rows, s->element_level, 0, ranks};
+    rad_stream_stats st;
+    if (r == RAD_OK)
+        r = rad_scene_stream_view_factors(ctx, scene, &s->solve, &so, NULL, &st);
+    rad_scene_destroy(scene);
+    if (r == RAD_ERROR_INTERRUPTED)
+        return interrupted_status();
+    return r == RAD_OK ? 0 : fail(ctx, r);
+}
+
+static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 {
     /* Every command's flags come from the one table in options.c;
      * generate runs in generate.c, render, solve, viewfactors and export below. */
@@ -320,6 +380,14 @@ int main(int argc, char **argv)
     int status = parse_args(argc, argv, &s);
     if (status >= 0)
         return status;
+    if (ranks->size > 1 && s.command != CLI_VIEWFACTORS) {
+        if (ranks->rank == 0)
+            fprintf(stderr, "radiosity: under mpirun only `radiosity viewfactors` spreads its work over the "
+                            "ranks (docs/performance.md); run %s as one process\n", cli_command_name(s.command));
+        return EXIT_USAGE;
+    }
+    if (ranks->rank > 0)
+        s.quiet = 1; /* rank 0 speaks for the job */
     install_signal_handlers();
 
     progress_state progress = {0};
@@ -339,6 +407,12 @@ int main(int argc, char **argv)
         return 1;
     }
     cancel_context = ctx;
+    if (ranks->rank > 0) {
+        status = stream_rank(ctx, &s, ranks);
+        cancel_context = NULL;
+        rad_context_destroy(ctx);
+        return status;
+    }
     if (s.command == CLI_GENERATE) {
         status = cli_generate(&s, ctx);
         cancel_context = NULL;
@@ -427,6 +501,15 @@ int main(int argc, char **argv)
         }
         s.solve.on_step = on_step;
         s.solve.on_step_user = &prog;
+    }
+
+    /* 2-3'. view factors too large for the dense matrix, or asked in row
+     * blocks: mesh and stream them (no solution) */
+    if (s.command == CLI_VIEWFACTORS) {
+        status = stream_view_factors(ctx, &s, scene, &out, &progress, ranks, t0);
+        if (status >= 0)
+            goto done;
+        status = 1;
     }
 
     /* 2-3. mesh, visibility, form factors (a loaded solution has them) */
@@ -567,5 +650,21 @@ done:
     rad_scene_destroy(scene);
     cancel_context = NULL;
     rad_context_destroy(ctx);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    rad_stream_ranks ranks = {0, 1, NULL, NULL, NULL};
+#ifdef RADIOSITY_MPI
+    if (cli_mpi_start(&argc, &argv, &ranks) < 0) {
+        fprintf(stderr, "radiosity: MPI did not start\n");
+        return 1;
+    }
+#endif
+    int status = run(argc, argv, &ranks);
+#ifdef RADIOSITY_MPI
+    cli_mpi_stop(status);
+#endif
     return status;
 }

@@ -122,6 +122,11 @@ static const cli_flag FLAGS[] = {
     {"adaptive-elements", 0, "N", RS, SOLVE(adaptive_max_elements)},
     {"level", 0, "WHICH", CLI_VIEWFACTORS, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
      .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
+    {"block-rows", 0, "N", CLI_VIEWFACTORS, OWN(block_rows, RAD_OPTION_SIZE), .own.min = 1.0, .own.max = 1e9,
+     .own.default_text = "automatic",
+     .own.help = "make the factors N element rows at a time, never the whole matrix (memory O(n) beyond a "
+                 "block; each pair across blocks evaluated twice); without it, only when the matrix would "
+                 "pass the memory limit (docs/formats.md, streamed view factors)"},
     {"epsilon", 0, "X", RS, SOLVE(epsilon)},
     {"min-area", 0, "A", RS, SOLVE(min_area)},
     {"clustering", 0, "WHEN", RS, SOLVE(clustering)},

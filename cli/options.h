@@ -49,6 +49,8 @@ typedef struct cli_settings {
     const char *progress_dir;
     int every;
     int element_level;        /* viewfactors: 0 surfaces, 1 elements */
+    size_t block_rows;        /* viewfactors: rows per streamed block; 0 = stream only when the
+                                 dense matrix does not fit (rad_stream_options) */
     rad_options solve;
     rad_render_options render;
     rad_office_options office;

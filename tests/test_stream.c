@@ -260,7 +260,7 @@ static void test_identity_hemicube_raw(void **state)
 static void test_memory_limit(void **state)
 {
     (void)state;
-    rad_options o = box_options("analytic", 600);
+    rad_options o = box_options("analytic", 400);
     rad_solution *sol = write_dense(&o, "limit");
     size_t n = rad_solution_element_count(sol);
     rad_solution_destroy(sol);

@@ -87,13 +87,18 @@ static rad_result take_block(rad_context *ctx, const rad_vf_sink *sink, void *st
     return RAD_OK;
 }
 
-/* The rows per block: as asked, else what fits in 1/8 of the limit. */
-static size_t block_rows(const rad_stream_options *so, size_t n, double limit)
+/* The rows per block: as asked, else what fits in 1/8 of the limit, and
+ * with several ranks at most a quarter of a rank's share, so that every
+ * rank gets blocks and the last ones do not leave the others idle long. */
+static size_t block_rows(const rad_stream_options *so, size_t n, double limit, int size)
 {
     size_t rows = so->block_rows;
     if (rows == 0) {
         double fit = limit / 8.0 / (8.0 * (double)(n ? n : 1));
         rows = fit < 1.0 ? 1 : fit > (double)n ? n : (size_t)fit;
+        size_t share = (n + 4 * (size_t)size - 1) / (4 * (size_t)size);
+        if (size > 1 && rows > share)
+            rows = share;
     }
     return rows > n ? n : rows ? rows : 1;
 }
@@ -152,7 +157,7 @@ rad_result rad_scene_stream_view_factors(rad_context *ctx, const rad_scene *scen
     view.threads = m.threads;
 
     /* 2. blocks: made here or received, handed to the sink in order */
-    size_t rows = block_rows(so, n, o.max_memory_bytes);
+    size_t rows = block_rows(so, n, o.max_memory_bytes, size);
     st->block_rows = rows;
     st->block_bytes = 8.0 * (double)(rows * n + RAD_STREAM_TALLY);
     st->row_sum_min = n ? INFINITY : 0.0;
