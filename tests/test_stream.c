@@ -12,7 +12,8 @@
  *                 dense run's, and rows of the closed Cornell box sum to 1
  *   memory        a limit below the dense matrix streams automatically
  *                 (only_if_needed) where the dense route fails; above it
- *                 nothing is streamed
+ *                 nothing is streamed, not even refused; what cannot
+ *                 stream is refused only where the stream is needed
  *   refusals      the balance step, the closure correction, adaptive
  *                 subdivision and element-level JSON: refused, no file
  *   cancellation  cancelled mid-stream: interrupted, no output, no
@@ -278,6 +279,19 @@ static void test_memory_limit(void **state)
     assert_int_equal(rad_scene_stream_view_factors(ctx, box, &o, &so, in_folder("none.mtx"), &st), RAD_OK);
     assert_int_equal(st.streamed, 0);
     assert_int_equal(access(in_folder("none.mtx"), F_OK), -1);
+    /* What cannot stream is the dense route's where that fits, and refused,
+     * saying why the stream was taken, where it does not. */
+    rad_options sampled = o;
+    sampled.form_factors = "hemicube";
+    rad_stream_options json = {0, 1, 1, NULL};
+    assert_int_equal(rad_scene_stream_view_factors(ctx, box, &sampled, &json, in_folder("e.json"), &st), RAD_OK);
+    assert_int_equal(st.streamed, 0);
+    sampled.max_memory_bytes = tight.max_memory_bytes;
+    assert_int_equal(rad_scene_stream_view_factors(ctx, box, &sampled, &json, in_folder("e.json"), &st),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rad_context_error(ctx), "element-level JSON"));
+    assert_non_null(strstr(rad_context_error(ctx), "passes the memory limit"));
+    assert_int_equal(access(in_folder("e.json"), F_OK), -1);
 }
 
 static void expect_refusal(const rad_options *o, int elements, const char *name, const char *words)

@@ -44,7 +44,7 @@ static rad_result check_disk(rad_context *ctx, const char *path, double need)
 /* The refusals that do not need the mesh. */
 static rad_result check_request(rad_context *ctx, const rad_options *o, const rad_ff_method *method,
                                 const rad_ff_request *req, const char *path, bool elements, bool writes,
-                                const rad_vf_sink **sink)
+                                const char *why, const rad_vf_sink **sink)
 {
     *sink = NULL;
     if (writes) {
@@ -54,8 +54,8 @@ static rad_result check_request(rad_context *ctx, const rad_options *o, const ra
         if (!*sink && elements && strcmp(ext, "json") == 0)
             return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                             "%s: element-level JSON is not written in row blocks (each row's sum comes before "
-                            "all the rows): use .csv or .mtx",
-                            path);
+                            "all the rows): use .csv or .mtx%s",
+                            path, why);
         if (!*sink)
             return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                             "%s: unknown view-factor format (use .json, .csv or .mtx)", path);
@@ -63,8 +63,8 @@ static rad_result check_request(rad_context *ctx, const rad_options *o, const ra
     if (o->adaptive_levels > 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "view factors in row blocks: adaptive subdivision refines the mesh between solves of "
-                        "the whole matrix; leave rad_options.adaptive_levels at 0");
-    return rad_ff_rows_check(ctx, method, req, o->closure_correction != 0);
+                        "the whole matrix; leave rad_options.adaptive_levels at 0%s", why);
+    return rad_ff_rows_check(ctx, method, req, o->closure_correction != 0, why);
 }
 
 /* Rank 0's part of a block: diagnostics and the sink, row by row. */
@@ -125,7 +125,10 @@ rad_result rad_scene_stream_view_factors(rad_context *ctx, const rad_scene *scen
     const rad_vf_sink *sink = NULL;
     rad_ff_request req = {NULL, NULL, o.seed, o.shadow_rays, o.hemicube_resolution, o.samples, o.near_field,
                           NULL, scene->source, o.raw_form_factors != 0};
-    r = check_request(ctx, &o, method, &req, path, elements, rank == 0, &sink);
+    /* Refused before the mesh is made, except where the dense route may
+     * still be taken (only_if_needed): then once the stream is decided. */
+    bool decided = !so->only_if_needed || size > 1;
+    r = decided ? check_request(ctx, &o, method, &req, path, elements, rank == 0, "", &sink) : RAD_OK;
     if (r != RAD_OK)
         return r;
 
@@ -142,6 +145,18 @@ rad_result rad_scene_stream_view_factors(rad_context *ctx, const rad_scene *scen
     if (so->only_if_needed && size == 1 && dense <= o.max_memory_bytes) {
         rad_meshed_free(&m);
         return RAD_OK;
+    }
+    if (!decided) {
+        /* Say why the stream was taken: the caller did not ask for it. */
+        char why[160];
+        snprintf(why, sizeof why,
+                 " (the dense matrix of %zu elements, %.2f GiB, passes the memory limit of %.2f GiB: the factors "
+                 "are made in row blocks)", n, dense / 1073741824.0, o.max_memory_bytes / 1073741824.0);
+        r = check_request(ctx, &o, method, &req, path, elements, rank == 0, why, &sink);
+        if (r != RAD_OK) {
+            rad_meshed_free(&m);
+            return r;
+        }
     }
     st->streamed = 1;
     req.mesh = m.mesh;

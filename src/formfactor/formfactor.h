@@ -315,9 +315,9 @@ typedef struct rad_ff_rows rad_ff_rows;
  * A sampled method's balance step (unless req->raw) and the closure
  * correction rescale every row by all the others: both need the whole
  * matrix, so both are refused (RAD_ERROR_INVALID_ARGUMENT, naming the
- * way out).  Cannot fail otherwise. */
+ * way out, the message ending with `why`).  Cannot fail otherwise. */
 rad_result rad_ff_rows_check(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
-                             bool close);
+                             bool close, const char *why);
 
 /* Prepare `method` for blocks of rows (its shared tables, every thread's
  * scratch).  req must outlive *out.  Fails for memory (*out NULL). */

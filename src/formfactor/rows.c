@@ -46,18 +46,18 @@ struct rad_ff_rows {
 };
 
 rad_result rad_ff_rows_check(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
-                             bool close)
+                             bool close, const char *why)
 {
     if ((method->flags & RAD_FF_BALANCE) && !req->raw)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "view factors in row blocks: method '%s' samples, and its balance step (reciprocity "
                         "and closure) needs the whole matrix; use a pair method (analytic, contour, hybrid), "
-                        "or keep its raw estimate (rad_options.raw_form_factors)",
-                        method->name);
+                        "or keep its raw estimate (rad_options.raw_form_factors)%s",
+                        method->name, why);
     if (close)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "view factors in row blocks: the closure correction rescales every row by all the "
-                        "others and needs the whole matrix; leave rad_options.closure_correction off");
+                        "others and needs the whole matrix; leave rad_options.closure_correction off%s", why);
     return RAD_OK;
 }
 
