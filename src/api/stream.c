@@ -28,17 +28,21 @@ static rad_result check_disk(rad_context *ctx, const char *path, double need)
         return RAD_OK;
     char *folder = rad_path_folder(path);
     struct statvfs fs;
-    bool known = folder && statvfs(folder, &fs) == 0;
-    rad_free(folder);
-    if (!known)
-        return RAD_OK;
+    if (!folder)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "view factors: out of memory");
+    if (statvfs(folder, &fs) != 0) {
+        rad_free(folder);
+        return RAD_OK; /* no file system to ask: the writes will tell */
+    }
     double space = (double)fs.f_bavail * (double)fs.f_frsize;
-    if (need > space)
-        return rad_fail(ctx, RAD_ERROR_IO,
-                        "%s: the element-level view factors need about %.1f GB more, and its file system has "
-                        "%.1f GB free: refused (surface level writes S^2 numbers)",
-                        path, need / 1e9, space / 1e9);
-    return RAD_OK;
+    rad_result r = RAD_OK;
+    if (need > space) /* the folder, not the path: a caller's temporary name means nothing */
+        r = rad_fail(ctx, RAD_ERROR_IO,
+                     "view factors: the element-level rows need about %.1f GB more in %s, whose file system has "
+                     "%.1f GB free: refused (surface level writes S^2 numbers)",
+                     need / 1e9, folder, space / 1e9);
+    rad_free(folder);
+    return r;
 }
 
 /* The refusals that do not need the mesh. */
@@ -53,9 +57,9 @@ static rad_result check_request(rad_context *ctx, const rad_options *o, const ra
         rad_path_extension(path, ext, sizeof ext);
         if (!*sink && elements && strcmp(ext, "json") == 0)
             return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                            "%s: element-level JSON is not written in row blocks (each row's sum comes before "
-                            "all the rows): use .csv or .mtx%s",
-                            path, why);
+                            "view factors: element-level JSON is not written in row blocks (each row's sum "
+                            "comes before all the rows): use .csv or .mtx%s",
+                            why);
         if (!*sink)
             return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                             "%s: unknown view-factor format (use .json, .csv or .mtx)", path);
