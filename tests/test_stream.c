@@ -199,7 +199,7 @@ static dense_ff dense_stats(rad_solution *sol)
 
 static void check_identity(const char *method, int raw)
 {
-    rad_options o = box_options(method, 120);
+    rad_options o = box_options(method, 100);
     o.raw_form_factors = raw;
     rad_solution *sol = write_dense(&o, method);
     size_t n = rad_solution_element_count(sol);
@@ -261,7 +261,7 @@ static void test_identity_hemicube_raw(void **state)
 static void test_memory_limit(void **state)
 {
     (void)state;
-    rad_options o = box_options("analytic", 400);
+    rad_options o = box_options("analytic", 300);
     rad_solution *sol = write_dense(&o, "limit");
     size_t n = rad_solution_element_count(sol);
     rad_solution_destroy(sol);
