@@ -17,6 +17,9 @@
 #include "generate.h"
 #include "options.h"
 #include "radiosity.h"
+#ifdef RADIOSITY_MPI
+#include "mpi_ranks.h"
+#endif
 
 #include <errno.h>
 #include <limits.h>
@@ -357,7 +360,104 @@ static int run_thermal(rad_context *ctx, const settings *s, const rad_scene *sce
     return cancel_signal ? interrupted_status() : 0;
 }
 
-int main(int argc, char **argv)
+/* ---- view factors: what the thermal flags ask of the file, and what it took ---- */
+
+typedef struct factor_report {
+    rad_smooth_report smoothing; /* row_error_before stays negative when no smoothing ran */
+    size_t nonzeros;
+    double dropped;
+} factor_report;
+
+static rad_view_factor_options factor_options(const settings *s, factor_report *rep)
+{
+    memset(rep, 0, sizeof *rep);
+    rep->smoothing.row_error_before = -1.0;
+    rad_view_factor_options vo = {0};
+    vo.elements = s->element_level != 0;
+    vo.smooth = (rad_smoothing)s->smooth;
+    vo.sparse_threshold = s->sparse_threshold;
+    vo.report = &rep->smoothing;
+    vo.nonzeros = &rep->nonzeros;
+    vo.dropped = &rep->dropped;
+    return vo;
+}
+
+static void print_factor_report(const settings *s, const factor_report *rep)
+{
+    const rad_smooth_report *m = &rep->smoothing;
+    if (s->quiet)
+        return;
+    if (m->row_error_before >= 0.0)
+        printf("smoothing: max |row sum - target| %.3g -> %.3g, max reciprocity error %.3g -> %.3g, "
+               "change max %.3g rms %.3g (relative)%s\n",
+               m->row_error_before, m->row_error_after, m->reciprocity_before, m->reciprocity_after,
+               m->max_relative_change, m->rms_relative_change, m->clamped ? ", some factors held at 0" : "");
+    if (s->sparse_threshold > 0.0)
+        printf("sparse: %zu non-zeros, at most %.3g of a row's factors dropped and rebalanced\n", rep->nonzeros,
+               rep->dropped);
+}
+
+/* ---- view factors in row blocks (rad_scene_stream_view_factors) ---- */
+
+/* Rank 0 (or the only process): stream when asked (--block-rows, several
+ * ranks) or when the dense matrix would pass the memory limit.  Returns
+ * -1 when the dense route is to be taken, else the exit status. */
+static int stream_view_factors(rad_context *ctx, const settings *s, const rad_scene *scene, run_outputs *out,
+                               progress_state *progress, const rad_stream_ranks *ranks, double t0)
+{
+    bool forced = s->block_rows > 0 || ranks->size > 1;
+    if (!forced && s->stats)
+        return -1; /* the stats file describes a solution: the dense route */
+    if (forced && s->stats) {
+        fprintf(stderr, "radiosity: --stats: view factors in row blocks (--block-rows, mpirun) write no stats "
+                        "file; their diagnostics are printed\n");
+        return EXIT_USAGE;
+    }
+    factor_report rep;
+    rad_view_factor_options vo = factor_options(s, &rep);
+    rad_stream_options so = {s->block_rows, s->element_level, !forced, ranks->size > 1 ? ranks : NULL, &vo};
+    rad_stream_stats st;
+    rad_result r = rad_scene_stream_view_factors(ctx, scene, &s->solve, &so, out->main, &st);
+    progress_end(progress);
+    if (r == RAD_OK && !st.streamed)
+        return -1;
+    if (r == RAD_ERROR_INTERRUPTED) {
+        fprintf(stderr, "radiosity: interrupted while computing form factors; nothing written\n");
+        return interrupted_status();
+    }
+    begin_saving(ctx);
+    if (r == RAD_OK)
+        r = rad_output_set_commit(ctx, out->set);
+    if (r != RAD_OK)
+        return fail(ctx, r);
+    print_factor_report(s, &rep);
+    char full[PATH_MAX];
+    if (!s->quiet)
+        printf("wrote %s (%zu surfaces, %zu elements in %zu block%s of %zu rows on %d process%s; row sums "
+               "%.6g to %.6g, reciprocity %.2g; %.1f s)\n",
+               where(s->output, full), rad_scene_surface_count(scene), st.elements, st.blocks, st.blocks == 1 ? "" : "s", st.block_rows,
+               ranks->size, ranks->size == 1 ? "" : "es", st.row_sum_min, st.row_sum_max, st.reciprocity_max,
+               now_seconds() - t0);
+    return cancel_signal ? interrupted_status() : 0;
+}
+
+/* Ranks above 0: load the scene, make their blocks, send them to rank 0. */
+static int stream_rank(rad_context *ctx, const settings *s, const rad_stream_ranks *ranks)
+{
+    rad_scene *scene = NULL;
+    rad_result r = s->scene_path ? rad_scene_load_file(ctx, s->scene_path, &scene)
+                                 : rad_scene_create_cornell_box(ctx, &scene);
+    rad_stream_options so = {s->block_rows, s->element_level, 0, ranks, NULL};
+    rad_stream_stats st;
+    if (r == RAD_OK)
+        r = rad_scene_stream_view_factors(ctx, scene, &s->solve, &so, NULL, &st);
+    rad_scene_destroy(scene);
+    if (r == RAD_ERROR_INTERRUPTED)
+        return interrupted_status();
+    return r == RAD_OK ? 0 : fail(ctx, r);
+}
+
+static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 {
     /* Every command's flags come from the one table in options.c;
      * generate runs in generate.c, render, solve, viewfactors and export below. */
@@ -377,6 +477,14 @@ int main(int argc, char **argv)
                         "jacobi, southwell or conjugate-gradient (see radiosity thermal --help)\n", s.solve.solver);
         return EXIT_USAGE;
     }
+    if (ranks->size > 1 && s.command != CLI_VIEWFACTORS) {
+        if (ranks->rank == 0)
+            fprintf(stderr, "radiosity: under mpirun only `radiosity viewfactors` spreads its work over the "
+                            "ranks (docs/performance.md); run %s as one process\n", cli_command_name(s.command));
+        return EXIT_USAGE;
+    }
+    if (ranks->rank > 0)
+        s.quiet = 1; /* rank 0 speaks for the job */
     install_signal_handlers();
 
     progress_state progress = {0};
@@ -396,6 +504,12 @@ int main(int argc, char **argv)
         return 1;
     }
     cancel_context = ctx;
+    if (ranks->rank > 0) {
+        status = stream_rank(ctx, &s, ranks);
+        cancel_context = NULL;
+        rad_context_destroy(ctx);
+        return status;
+    }
     if (s.command == CLI_GENERATE) {
         status = cli_generate(&s, ctx);
         cancel_context = NULL;
@@ -508,6 +622,15 @@ int main(int argc, char **argv)
         s.solve.on_step_user = &prog;
     }
 
+    /* 2-3'. view factors too large for the dense matrix, or asked in row
+     * blocks: mesh and stream them (no solution) */
+    if (s.command == CLI_VIEWFACTORS) {
+        status = stream_view_factors(ctx, &s, scene, &out, &progress, ranks, t0);
+        if (status >= 0)
+            goto done;
+        status = 1;
+    }
+
     /* 2-3. mesh, visibility, form factors (a loaded solution has them) */
     r = saved ? RAD_OK : rad_solution_create(ctx, scene, &s.solve, &sol);
     progress_end(&progress);
@@ -539,28 +662,11 @@ int main(int argc, char **argv)
     if (s.command == CLI_VIEWFACTORS) {
         /* 5. view factors */
         begin_saving(ctx);
-        rad_view_factor_options vo = {0};
-        rad_smooth_report report;
-        size_t nonzeros = 0;
-        double dropped = 0.0;
-        vo.elements = s.element_level != 0;
-        vo.smooth = (rad_smoothing)s.smooth;
-        vo.sparse_threshold = s.sparse_threshold;
-        vo.report = &report;
-        vo.nonzeros = &nonzeros;
-        vo.dropped = &dropped;
-        memset(&report, 0, sizeof report);
-        report.row_error_before = -1.0; /* stays negative when no smoothing ran */
+        factor_report rep;
+        rad_view_factor_options vo = factor_options(&s, &rep);
         r = rad_solution_write_view_factors_with(ctx, sol, out.main, &vo);
-        if (r == RAD_OK && !s.quiet && report.row_error_before >= 0.0)
-            printf("smoothing: max |row sum - target| %.3g -> %.3g, max reciprocity error %.3g -> %.3g, "
-                   "change max %.3g rms %.3g (relative)%s\n",
-                   report.row_error_before, report.row_error_after, report.reciprocity_before,
-                   report.reciprocity_after, report.max_relative_change, report.rms_relative_change,
-                   report.clamped ? ", some factors held at 0" : "");
-        if (r == RAD_OK && !s.quiet && s.sparse_threshold > 0.0)
-            printf("sparse: %zu non-zeros, at most %.3g of a row's factors dropped and rebalanced\n", nonzeros,
-                   dropped);
+        if (r == RAD_OK)
+            print_factor_report(&s, &rep);
         if (r == RAD_OK && s.stats)
             r = rad_solution_write_stats(ctx, sol, out.stats, 0);
         if (r == RAD_OK)
@@ -674,5 +780,21 @@ done:
     rad_scene_destroy(scene);
     cancel_context = NULL;
     rad_context_destroy(ctx);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    rad_stream_ranks ranks = {0, 1, NULL, NULL, NULL};
+#ifdef RADIOSITY_MPI
+    if (cli_mpi_start(&argc, &argv, &ranks) < 0) {
+        fprintf(stderr, "radiosity: MPI did not start\n");
+        return 1;
+    }
+#endif
+    int status = run(argc, argv, &ranks);
+#ifdef RADIOSITY_MPI
+    cli_mpi_stop(status);
+#endif
     return status;
 }

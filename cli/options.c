@@ -150,6 +150,11 @@ static const cli_flag FLAGS[] = {
      .own.max = 1.0, .own.min_open = true, .own.max_open = true,
      .own.help = "with -o F.mtx: pairs of factors below X dropped, the rest rebalanced so reciprocity and "
                  "the row sums still hold"},
+    {"block-rows", 0, "N", CLI_VIEWFACTORS, OWN(block_rows, RAD_OPTION_SIZE), .own.min = 1.0, .own.max = 1e9,
+     .own.default_text = "automatic",
+     .own.help = "make the factors N element rows at a time, never the whole matrix (memory O(n) beyond a "
+                 "block; each pair across blocks evaluated twice); without it, only when the matrix would "
+                 "pass the memory limit (docs/formats.md, streamed view factors)"},
     {"epsilon", 0, "X", RS, SOLVE(epsilon)},
     {"min-area", 0, "A", RS, SOLVE(min_area)},
     {"clustering", 0, "WHEN", RS, SOLVE(clustering)},

@@ -53,6 +53,8 @@ typedef struct cli_settings {
     int element_level;        /* viewfactors, thermal: 0 surfaces, 1 elements */
     int smooth;               /* viewfactors: rad_smoothing (--smooth) */
     double sparse_threshold;  /* viewfactors: .mtx factors below it dropped, 0 = none */
+    size_t block_rows;        /* viewfactors: rows per streamed block; 0 = stream only when the
+                                 dense matrix does not fit (rad_stream_options) */
     rad_options solve;
     rad_render_options render;
     rad_office_options office;

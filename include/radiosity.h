@@ -673,6 +673,104 @@ RAD_API rad_result rad_solution_write_mesh(rad_context *ctx, const rad_solution 
                                            const char *path, double exposure);
 
 /* ------------------------------------------------------------------------
+ * View factors in row blocks: scenes whose n x n matrix (8 n^2 bytes:
+ * 80 GB at 10^5 elements) does not fit in memory.
+ *
+ *     rad_stream_options so = {0};             // blocks sized automatically
+ *     rad_stream_stats st;
+ *     rad_scene_stream_view_factors(ctx, scene, &options, &so, "vf.json", &st);
+ *
+ * Rows of F are made a block at a time ([r0, r1), block_rows x n doubles)
+ * and handed to the output, then the block is reused: memory is O(n)
+ * beyond one block.  The output is byte for byte what
+ * rad_solution_write_view_factors writes from the dense matrix: a pair
+ * method evaluates each pair as the dense loop does, (i < j) with that
+ * pair's own random numbers, so reciprocity stays exact across blocks; the
+ * pairs between a block and the rows before it are evaluated once more
+ * (about twice the dense loop's pair evaluations for small blocks, none
+ * extra for one block of n rows).  What streams (docs/formats.md,
+ * "Streamed view factors"): surface level as .json, .csv, .mtx (an S x S
+ * sum, written at the end); element level as .csv and .mtx.  Refused
+ * (RAD_ERROR_INVALID_ARGUMENT): element-level .json (each row's sum comes
+ * before all the rows), a sampled method's balance step (hemicube,
+ * hemisphere, montecarlo without rad_options.raw_form_factors), the
+ * closure correction and adaptive subdivision: each needs the whole
+ * matrix.  Standard errors of sampled methods are not written.  An
+ * element-level output that would not fit on its file system (estimated
+ * before the first row and again after the first block) is refused
+ * (RAD_ERROR_IO) and nothing is left.
+ * ---------------------------------------------------------------------- */
+
+/* Processes sharing the blocks (an MPI job: `mpirun -np N radiosity
+ * viewfactors`; the program supplies the messages, the library needs no
+ * MPI).  Block b is made by rank b % size; rank 0 receives the others'
+ * blocks in order and writes the one output, so the file does not depend
+ * on the number of ranks.  Each rank loads and meshes the scene itself
+ * (the mesh is deterministic).  A message is a block's rows followed by
+ * RAD_STREAM_TALLY doubles (its counts and reciprocity).  The callbacks
+ * are called on the calling thread; nonzero from either fails the call
+ * with RAD_ERROR_IO (the program should then end the job: the other ranks
+ * wait for rank 0). */
+enum { RAD_STREAM_TALLY = 5 };
+typedef struct rad_stream_ranks {
+    int rank;                 /* this process, 0 .. size - 1; rank 0 writes the output */
+    int size;                 /* processes; 0 or 1: this one alone */
+    /* Rank 0: fill data with `count` doubles sent by rank `from`. */
+    int (*receive)(void *user, int from, double *data, size_t count);
+    /* Ranks above 0: send `count` doubles to rank 0. */
+    int (*send)(void *user, const double *data, size_t count);
+    void *user;
+} rad_stream_ranks;
+
+/* Zero-initialisable: 0 means the default. */
+typedef struct rad_stream_options {
+    size_t block_rows;        /* element rows per block; 0 = as many as fit in 1/8 of the memory
+                                 limit (at least 1, at most n) */
+    int elements;             /* nonzero: element-to-element factors (.csv, .mtx), else surface level */
+    int only_if_needed;       /* nonzero: when the dense matrix (and the element table the dense
+                                 writer copies it into) fits under the memory limit, write nothing
+                                 and return RAD_OK with stats->streamed = 0, for the caller to take
+                                 the dense route; ignored with more than one rank */
+    const rad_stream_ranks *ranks; /* NULL: this process alone */
+    /* Surface level: obstruction surfaces left out, smoothing, sparse
+     * threshold, as rad_solution_write_view_factors_with (NULL: none; its
+     * `elements` is ignored).  Element rows are written as computed. */
+    const struct rad_view_factor_options *factors;
+} rad_stream_options;
+
+/* What a streamed run did (rank 0 sees every block; other ranks their own). */
+typedef struct rad_stream_stats {
+    int streamed;             /* 0: only_if_needed found that the dense route fits */
+    size_t elements;          /* n */
+    size_t block_rows;        /* rows per block */
+    size_t blocks;            /* blocks made or received */
+    uint64_t pairs;           /* element pairs evaluated, as the dense loop counts them */
+    uint64_t pairs_again;     /* pairs evaluated a second time (the price of the blocks) */
+    uint64_t rays;            /* shadow / visibility rays */
+    double row_sum_min, row_sum_max, row_sum_mean; /* over the element rows */
+    double diagonal_max;      /* largest F_ii */
+    double reciprocity_max;   /* max |A_i F_ij - A_j F_ji| / max(...) over the pairs evaluated
+                                 (row methods: pairs within one block) */
+    double block_bytes;       /* the block's memory, bytes */
+    double mesh_seconds;      /* mesh and ray structure */
+    double seconds;           /* form factors and writing */
+} rad_stream_stats;
+
+/* Mesh `scene` under `options` (NULL: defaults; the solver is not used)
+ * and write its view factors to `path` (by extension, as
+ * rad_solution_write_view_factors; ignored, and may be NULL, on ranks
+ * above 0) in row blocks.  Atomic: the file appears complete or not at
+ * all.  Threads: the context's, within each block.  Polls cancellation
+ * (RAD_ERROR_INTERRUPTED, nothing written) and reports progress as
+ * "form factors".  *stats is filled (zeroed first).  Fails with
+ * RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY; the refusals above, an unknown
+ * extension or a NULL ctx, scene, stream or stats (or path on rank 0):
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_stream_view_factors(rad_context *ctx, const rad_scene *scene,
+                                                 const rad_options *options, const rad_stream_options *stream,
+                                                 const char *path, rad_stream_stats *stats);
+
+/* ------------------------------------------------------------------------
  * Output sets: the files of one run, written all together or not at all.
  *
  *     rad_output_set *set;

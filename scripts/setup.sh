@@ -15,7 +15,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(build-essential g++ cmake pkg-config libembree-dev libassimp-dev libstb-dev
-          libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev)
+          libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev
+          libopenmpi-dev openmpi-bin)
 if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
   packages+=(clang-14 libclang-rt-14-dev libomp-14-dev)
 fi

@@ -267,6 +267,21 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     }
     if (r == RAD_OK && sc->view_factors)
         r = run_thermal(ctx, scene, s, out);
+    /* Streamed view factors (api/stream.c): element rows in blocks of 5 to
+     * Matrix Market (a temporary joined at the end) and CSV, surfaces to JSON. */
+    static const char *const streamed[] = {"stream.mtx", "stream.csv", "stream.json"};
+    bool streams = sc->view_factors && !sc->closure_correction && !sc->adaptive_levels &&
+                   strcmp(sc->form_factors, "analytic") == 0;
+    for (size_t k = 0; k < 3 && r == RAD_OK && streams; k++) {
+        rad_options o = {0};
+        o.target_elements = 48;
+        o.epsilon = 1e-3;
+        o.seed = 1;
+        rad_stream_options so = {5, k < 2, 0, NULL, NULL};
+        rad_stream_stats st;
+        output_path(streamed[k], path, sizeof path);
+        r = write_done(rad_scene_stream_view_factors(ctx, scene, &o, &so, path, &st), out, streamed[k]);
+    }
     static const char *const meshes[] = {"lit.glb", "lit.gltf", "lit.ply"};
     for (size_t k = 0; k < 3 && r == RAD_OK; k++) {
         output_path(meshes[k], path, sizeof path);

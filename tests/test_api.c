@@ -268,6 +268,16 @@ static void test_null_solution(void **state)
                    "rad_solution_write_view_factors");
     assert_false(file_exists(vf));
 
+    rad_stream_options so = {0};
+    rad_stream_stats st;
+    const char *fn = "rad_scene_stream_view_factors";
+    assert_invalid(rad_scene_stream_view_factors(NULL, f->scene, NULL, &so, vf, &st), NULL, fn);
+    assert_invalid(rad_scene_stream_view_factors(ctx, NULL, NULL, &so, vf, &st), ctx, fn);
+    assert_invalid(rad_scene_stream_view_factors(ctx, f->scene, NULL, NULL, vf, &st), ctx, fn);
+    assert_invalid(rad_scene_stream_view_factors(ctx, f->scene, NULL, &so, NULL, &st), ctx, fn);
+    assert_invalid(rad_scene_stream_view_factors(ctx, f->scene, NULL, &so, vf, NULL), ctx, fn);
+    assert_false(file_exists(vf));
+
     const char *lit = temp_path("lit.glb");
     assert_invalid(rad_solution_write_mesh(NULL, s, lit, 0.0), NULL, "rad_solution_write_mesh");
     assert_invalid(rad_solution_write_mesh(ctx, NULL, lit, 0.0), ctx, "rad_solution_write_mesh");

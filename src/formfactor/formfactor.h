@@ -299,4 +299,48 @@ double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double
 rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double *F, const double *targets,
                          rad_smooth_report *report);
 
+/* ---- rows in blocks, without the n x n matrix (rows.c) ---- */
+
+/* What one block of rows cost and what its pairs say. */
+typedef struct rad_ff_block_stats {
+    uint64_t rays;            /* shadow / visibility rays cast */
+    uint64_t pairs;           /* pairs (i < j) evaluated for the first time: summed over the
+                                 blocks, the dense loop's count */
+    uint64_t pairs_again;     /* pair methods: pairs (j < r0 <= i) evaluated again for the
+                                 lower triangle, which an earlier block evaluated too */
+    uint64_t near_pairs;      /* hybrid: pairs given to the exact method */
+    double reciprocity_max;   /* as rad_ff_stats, over the pairs this block evaluated (pair
+                                 methods: all its pairs i < j; row methods: both ends in it) */
+} rad_ff_block_stats;
+
+typedef struct rad_ff_rows rad_ff_rows;
+
+/* Can `method` stream under `req` (close: the closure correction asked)?
+ * A sampled method's balance step (unless req->raw) and the closure
+ * correction rescale every row by all the others: both need the whole
+ * matrix, so both are refused (RAD_ERROR_INVALID_ARGUMENT, naming the
+ * way out, the message ending with `why`).  Cannot fail otherwise. */
+rad_result rad_ff_rows_check(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
+                             bool close, const char *why);
+
+/* Prepare `method` for blocks of rows (its shared tables, every thread's
+ * scratch).  req must outlive *out.  Fails for memory (*out NULL). */
+rad_result rad_ff_rows_create(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
+                              rad_ff_rows **out);
+void rad_ff_rows_destroy(rad_ff_rows *rows);
+
+/* Rows [r0, r1) of F into block ((r1 - r0) x n doubles, row-major; zeroed
+ * here), bit for bit the rows rad_form_factors makes without the balance
+ * and closure steps: a pair method's kernel is always called as (i < j),
+ * with that pair's own random numbers, so a pair seen from two blocks
+ * gives the same factors and A_i F_ij = A_j F_ji holds across blocks as
+ * in the dense matrix.  Pairs with both rows in the block are evaluated
+ * once; a pair (j < r0, i) is evaluated again (its row j went out with
+ * an earlier block): over many blocks about twice the dense loop's pair
+ * evaluations.  Rows in parallel (ctx->threads); polls rad_cancelled
+ * (RAD_ERROR_INTERRUPTED, the block incomplete); reports progress as
+ * `done` + rows finished of `total`.  Cannot fail otherwise. */
+rad_result rad_ff_rows_block(rad_context *ctx, rad_ff_rows *rows, size_t r0, size_t r1, double *block,
+                             uint64_t done, uint64_t total, rad_ff_block_stats *stats);
+
 #endif /* RAD_FORMFACTOR_H */

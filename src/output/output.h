@@ -113,6 +113,54 @@ rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *vie
 rad_result rad_write_view_factors_with(rad_context *ctx, const rad_solution_view *view, const char *path,
                                        const rad_view_factor_options *options);
 
+/* ---- streamed view factors: rows in blocks, never the n x n matrix
+ * (vf_stream.c; the writers' helpers in stats.c) ---- */
+
+/* A JSON string literal (the Matrix Market comments), as the view-factor
+ * writers write names (CSV fields: rad_csv_field).  Cannot fail (errors
+ * show in the stream). */
+void rad_write_json_string(FILE *f, const char *text);
+
+/* The surface-level view factors F (S x S, made by the caller: taken over
+ * and freed, also on failure) written as rad_write_view_factors writes
+ * them (.json, .csv, .mtx, .vf), with `options` (NULL: none; its
+ * `elements` is ignored); the view needs scene, options, n and ff. */
+rad_result rad_write_surface_view_factors(rad_context *ctx, const rad_solution_view *view, double *F,
+                                          const char *path, const rad_view_factor_options *options);
+
+/* What a row sink is told at the start. */
+typedef struct rad_vf_stream_info {
+    const rad_solution_view *view; /* scene, options, mesh, n, area, ff (F NULL) */
+    const char *path;              /* the output, written atomically */
+    const rad_view_factor_options *factors; /* surface level: adjustments, smoothing (NULL: none) */
+} rad_vf_stream_info;
+
+/* Where streamed rows go: one entry per output, chosen by the path's
+ * extension and the level (rad_vf_sink_find).  begin opens (nothing
+ * visible at `path` until end commits); row receives element row i (n
+ * doubles, F_ij from element i to every j), rows in order 0 .. n-1,
+ * once each; end with commit writes what remains and puts the file in
+ * place, without it removes every temporary; both free the state, which
+ * is NULL after a failed begin.  Each fails through rad_fail. */
+typedef struct rad_vf_sink {
+    const char *extension;         /* the path's, lower case */
+    bool elements;                 /* element-level rows (else surface level) */
+    rad_result (*begin)(rad_context *ctx, const rad_vf_stream_info *info, void **state);
+    rad_result (*row)(rad_context *ctx, void *state, size_t i, const double *F_row);
+    rad_result (*end)(rad_context *ctx, void *state, bool commit);
+    /* Optional: the bytes rows [rows, n) will still need on the output's
+     * file system (temporaries and the final copy counted), extrapolated
+     * from what rows [0, rows) took; with rows = 0 a lower bound.  Cannot
+     * fail. */
+    double (*estimate)(const void *state, size_t rows, size_t n);
+} rad_vf_sink;
+
+extern const rad_vf_sink *const rad_vf_sinks[]; /* NULL-terminated */
+
+/* The sink for `path`'s extension at the level asked; NULL if none
+ * streams it. */
+const rad_vf_sink *rad_vf_sink_find(const char *path, bool elements);
+
 /* The lit mesh by the path's extension (.glb, .gltf, .ply; docs/formats.md):
  * vertices with their radiosity B (W/m^2) and display colour, the radiance
  * B/pi times `exposure` (0 = the automatic rule over the vertices). */

@@ -448,6 +448,34 @@ static cJSON *exact_array(const double *v, size_t count)
     return array;
 }
 
+/* The surface level's rows once F (and err) hold the S x S table: names,
+ * areas, then the thermal outputs' adjustments (obstruction surfaces out,
+ * smoothing, sparsity: view3d.c), which may drop rows.  r->count = S. */
+static rad_result surface_rows_finish(rad_context *ctx, const rad_solution_view *s, const rad_view_factor_options *o,
+                                      vf_rows *r)
+{
+    size_t S = s->scene->surface_count;
+    r->names = rad_alloc(ctx, RAD_MEM_OUTPUT, S ? S : 1, sizeof *r->names, "view factors: names");
+    r->area = r->names ? rad_alloc(ctx, RAD_MEM_OUTPUT, S ? S : 1, sizeof *r->area, "view factors: areas") : NULL;
+    r->kept = r->area ? rad_alloc(ctx, RAD_MEM_OUTPUT, S ? S : 1, sizeof *r->kept, "view factors") : NULL;
+    if (!r->kept)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t k = 0; k < S; k++) {
+        r->names[k] = rad_utf8_clean(ctx, s->scene->surfaces[k].name);
+        r->area[k] = s->scene->surfaces[k].area;
+        if (!r->names[k])
+            return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    rad_result result = rad_vf_adjust(ctx, s->scene, r->names, r->area, r->F, &r->count, r->kept, o);
+    if (result == RAD_OK && r->err) {
+        size_t N = r->count;
+        for (size_t a = 0; a < N; a++)
+            for (size_t b = 0; b < N; b++)
+                r->err[a * N + b] = r->err[r->kept[a] * S + r->kept[b]];
+    }
+    return result;
+}
+
 static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bool elements,
                                 const rad_view_factor_options *o, vf_rows *r)
 {
@@ -464,10 +492,14 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
                         "surface-level view factors or fewer rad_options.target_elements",
                         r->count, r->count, bytes / 1073741824.0, held / 1073741824.0,
                         s->options->max_memory_bytes / 1073741824.0);
-    r->names = rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->names, "view factors: names");
-    r->area = r->names ? rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->area, "view factors: areas") : NULL;
-    r->F = r->area ? rad_alloc(ctx, RAD_MEM_OUTPUT, r->count * r->count, sizeof *r->F, "view factors: table")
-                   : NULL;
+    if (elements) { /* the surface level names its rows in surface_rows_finish */
+        r->names = rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->names, "view factors: names");
+        r->area = r->names ? rad_alloc(ctx, RAD_MEM_OUTPUT, r->count, sizeof *r->area, "view factors: areas")
+                           : NULL;
+    }
+    r->F = !elements || r->area
+               ? rad_alloc(ctx, RAD_MEM_OUTPUT, r->count * r->count, sizeof *r->F, "view factors: table")
+               : NULL;
     if (r->F && with_err)
         r->err = rad_alloc(ctx, RAD_MEM_OUTPUT, r->count * r->count, sizeof *r->err, "view factors: errors");
     if (!r->F || (with_err && !r->err)) {
@@ -479,25 +511,8 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
         result = rad_view_surface_view_factors(ctx, s, r->F);
         if (result == RAD_OK && with_err)
             result = surface_std_errors(ctx, s, r->err);
-        for (size_t k = 0; k < S && result == RAD_OK; k++) {
-            r->names[k] = rad_utf8_clean(ctx, s->scene->surfaces[k].name);
-            r->area[k] = s->scene->surfaces[k].area;
-            if (!r->names[k])
-                result = RAD_ERROR_OUT_OF_MEMORY;
-        }
-        /* Thermal outputs: obstruction surfaces out, smoothing, sparsity (view3d.c). */
-        r->kept = result == RAD_OK ? rad_alloc(ctx, RAD_MEM_OUTPUT, S ? S : 1, sizeof *r->kept, "view factors")
-                                   : NULL;
-        if (result == RAD_OK && !r->kept)
-            result = RAD_ERROR_OUT_OF_MEMORY;
         if (result == RAD_OK)
-            result = rad_vf_adjust(ctx, s->scene, r->names, r->area, r->F, &r->count, r->kept, o);
-        if (result == RAD_OK && r->err) {
-            size_t N = r->count;
-            for (size_t a = 0; a < N; a++)
-                for (size_t b = 0; b < N; b++)
-                    r->err[a * N + b] = r->err[r->kept[a] * S + r->kept[b]];
-        }
+            result = surface_rows_finish(ctx, s, o, r);
     } else {
         size_t *seen = rad_alloc(ctx, RAD_MEM_OUTPUT, S, sizeof *seen, "view factors: names");
         if (!seen)
@@ -526,42 +541,63 @@ static rad_result vf_rows_build(rad_context *ctx, const rad_solution_view *s, bo
     return result;
 }
 
+/* Surface-level or element-level view factors, from `given` (a surface
+ * level S x S table made elsewhere, in its F only: taken over and freed
+ * here) or, when NULL, from the view's F. */
+static rad_result write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
+                                     const rad_view_factor_options *options, vf_rows *given);
+
 rad_result rad_write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
                                   bool elements)
 {
     rad_view_factor_options o = {0};
     o.elements = elements;
-    return rad_write_view_factors_with(ctx, s, path, &o);
+    return write_view_factors(ctx, s, path, &o, NULL);
 }
 
 rad_result rad_write_view_factors_with(rad_context *ctx, const rad_solution_view *s, const char *path,
                                        const rad_view_factor_options *options)
 {
+    return write_view_factors(ctx, s, path, options, NULL);
+}
+
+static rad_result write_view_factors(rad_context *ctx, const rad_solution_view *s, const char *path,
+                                     const rad_view_factor_options *options, vf_rows *given)
+{
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);
     bool elements = options->elements;
-    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0 &&
-        strcmp(ext, "vf") != 0)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: unknown view-factor format (use .json, .csv, .mtx or .vf)", path);
-    if (elements && (options->smooth || options->sparse_threshold > 0.0 || strcmp(ext, "vf") == 0))
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "view factors: element-level factors are written as computed: smoothing, sparse "
-                        "thresholds and View3D files (.vf) are for surface-level factors");
-    if (options->sparse_threshold > 0.0 && strcmp(ext, "mtx") != 0)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "view factors: a sparse threshold is for Matrix Market output (.mtx)");
+    const char *refusal = NULL;
+    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 && strcmp(ext, "mtx") != 0 && strcmp(ext, "vf") != 0)
+        refusal = "unknown view-factor format (use .json, .csv, .mtx or .vf)";
+    else if (elements && (options->smooth || options->sparse_threshold > 0.0 || strcmp(ext, "vf") == 0))
+        refusal = "element-level factors are written as computed: smoothing, sparse thresholds and View3D "
+                  "files (.vf) are for surface-level factors";
+    else if (options->sparse_threshold > 0.0 && strcmp(ext, "mtx") != 0)
+        refusal = "a sparse threshold is for Matrix Market output (.mtx)";
+    if (refusal || (!s->F && !given)) {
+        if (given)
+            vf_rows_free(given);
+        if (refusal)
+            return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: %s", path, refusal);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: no view factors: solver '%s' computes no "
+                        "form-factor matrix", path, s->options->solver);
+    }
     rad_view_factor_options vo = *options;
     /* View3D normalises an enclosure (encl=1) before writing its file. */
     bool view3d = strcmp(ext, "vf") == 0;
     if (view3d && vo.smooth == RAD_SMOOTH_NONE && s->scene->view3d.present && s->scene->view3d.enclosure)
         vo.smooth = RAD_SMOOTH_ENCLOSURE;
-    if (!s->F)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: no view factors: solver '%s' computes no form-factor matrix", path,
-                        s->options->solver);
     vf_rows rows;
-    rad_result r = vf_rows_build(ctx, s, elements, &vo, &rows);
+    rad_result r;
+    if (given) {
+        rows = *given;
+        r = surface_rows_finish(ctx, s, &vo, &rows);
+        if (r != RAD_OK)
+            vf_rows_free(&rows);
+    } else {
+        r = vf_rows_build(ctx, s, elements, &vo, &rows);
+    }
     if (r != RAD_OK)
         return r;
     size_t N = rows.count;
@@ -669,6 +705,22 @@ rad_result rad_write_view_factors_with(rad_context *ctx, const rad_solution_view
     }
     vf_rows_free(&rows);
     return r;
+}
+
+/* ---- for the streamed view factors (vf_stream.c) ---- */
+
+void rad_write_json_string(FILE *f, const char *text)
+{
+    json_string(f, text);
+}
+
+rad_result rad_write_surface_view_factors(rad_context *ctx, const rad_solution_view *view, double *F,
+                                          const char *path, const rad_view_factor_options *options)
+{
+    vf_rows rows = {.count = view->scene->surface_count, .F = F};
+    rad_view_factor_options o = options ? *options : (rad_view_factor_options){0};
+    o.elements = false;
+    return write_view_factors(ctx, view, path, &o, &rows);
 }
 
 rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size_t count, const char *path)
