@@ -47,6 +47,9 @@ static const command_def COMMANDS[] = {
     {CLI_BAKE, "bake", "bake [SCENE|SOLUTION.radsol] [options]",
      "solve the scene (or load the solution) and write lightmaps (HDR, RGBM PNG) with the glTF lit mesh "
      "that uses them (docs/formats.md)"},
+    {CLI_VIEW, "view", "view [SCENE|SOLUTION.radsol] [options]",
+     "open a window that shows the solution as the solver refines it (progressive), or with --offscreen "
+     "draw one frame with OpenGL without a window (docs/viewer.md; an optional build part)"},
 };
 #define COMMAND_COUNT (sizeof COMMANDS / sizeof COMMANDS[0])
 
@@ -64,7 +67,10 @@ const char *cli_command_name(int command)
  * mesh and couple (viewfactors). */
 #define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
 #define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
-#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE | CLI_VIEW)
+/* The same with the viewer, which solves (and meshes) as render does. */
+#define RSW (RS | CLI_VIEW)
+#define RVW (RV | CLI_VIEW)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
 #define RENDER(field_) .target = CLI_TO_RENDER, .field = #field_
 #define OFFICE(field_) .target = CLI_TO_OFFICE, .field = #field_
@@ -95,6 +101,13 @@ static const cli_flag FLAGS[] = {
     {"output", 'o', "FILE", CLI_BAKE, OWN(output, RAD_OPTION_STRING),
      .own.help = "output lit mesh: .glb or .gltf; the lightmaps FILE_lightmapK.hdr and .png beside it",
      .own.default_text = "lightmapped.glb"},
+    {"output", 'o', "FILE", CLI_VIEW, OWN(output, RAD_OPTION_STRING),
+     .own.help = "with --offscreen: the frame, .png (exposed, sRGB), .hdr or .pfm (linear)",
+     .own.default_text = "view.png"},
+    {"offscreen", 0, NULL, CLI_VIEW, OWN(offscreen, RAD_OPTION_FLAG),
+     .own.help = "draw one frame with OpenGL (EGL, no window or display needed) to --output and exit"},
+    {"no-ambient", 0, NULL, CLI_VIEW, OWN(no_ambient, RAD_OPTION_FLAG),
+     .own.help = "show the radiosity without the ambient term of the unshot light (shooting)"},
     {"texels-per-metre", 0, "N", CLI_BAKE, OWN(texels_per_metre, RAD_OPTION_DOUBLE), .own.min = 0.0,
      .own.max = 1e6, .own.min_open = true, .own.default_text = "10",
      .own.help = "lightmap texels per metre of surface"},
@@ -106,55 +119,55 @@ static const cli_flag FLAGS[] = {
     {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
     {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
     {"closed-doors", 0, NULL, CLI_GENERATE, OFFICE(closed_doors)},
-    {"mesh-size", 0, "L", RV, SOLVE(mesh_size)},
-    {"elements", 0, "N", RV, SOLVE(target_elements)},
-    {"form-factors", 0, "NAME", RV, SOLVE(form_factors)},
-    {"solver", 0, "NAME", RS, SOLVE(solver)},
-    {"visibility", 0, "NAME", RV, SOLVE(visibility)},
-    {"shadow-rays", 0, "N", RV, SOLVE(shadow_rays)},
-    {"hemicube-res", 0, "N", RV, SOLVE(hemicube_resolution)},
-    {"ff-samples", 0, "N", RV, SOLVE(samples)},
-    {"near-field", 0, "X", RV, SOLVE(near_field)},
-    {"closure-correction", 0, NULL, RV, SOLVE(closure_correction)},
-    {"raw-form-factors", 0, NULL, RV, SOLVE(raw_form_factors)},
-    {"adaptive", 0, "LEVELS", RS, SOLVE(adaptive_levels)},
-    {"adaptive-threshold", 0, "X", RS, SOLVE(adaptive_threshold)},
-    {"adaptive-elements", 0, "N", RS, SOLVE(adaptive_max_elements)},
+    {"mesh-size", 0, "L", RVW, SOLVE(mesh_size)},
+    {"elements", 0, "N", RVW, SOLVE(target_elements)},
+    {"form-factors", 0, "NAME", RVW, SOLVE(form_factors)},
+    {"solver", 0, "NAME", RSW, SOLVE(solver)},
+    {"visibility", 0, "NAME", RVW, SOLVE(visibility)},
+    {"shadow-rays", 0, "N", RVW, SOLVE(shadow_rays)},
+    {"hemicube-res", 0, "N", RVW, SOLVE(hemicube_resolution)},
+    {"ff-samples", 0, "N", RVW, SOLVE(samples)},
+    {"near-field", 0, "X", RVW, SOLVE(near_field)},
+    {"closure-correction", 0, NULL, RVW, SOLVE(closure_correction)},
+    {"raw-form-factors", 0, NULL, RVW, SOLVE(raw_form_factors)},
+    {"adaptive", 0, "LEVELS", RSW, SOLVE(adaptive_levels)},
+    {"adaptive-threshold", 0, "X", RSW, SOLVE(adaptive_threshold)},
+    {"adaptive-elements", 0, "N", RSW, SOLVE(adaptive_max_elements)},
     {"level", 0, "WHICH", CLI_VIEWFACTORS, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
      .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
-    {"epsilon", 0, "X", RS, SOLVE(epsilon)},
-    {"min-area", 0, "A", RS, SOLVE(min_area)},
-    {"clustering", 0, "WHEN", RS, SOLVE(clustering)},
-    {"oracle", 0, "WHICH", RS, SOLVE(classic_oracle)},
-    {"tolerance", 0, "X", RS, SOLVE(tolerance)},
-    {"max-iterations", 0, "N", RS, SOLVE(max_iterations)},
-    {"unshot-tolerance", 0, "X", RS, SOLVE(unshot_tolerance)},
-    {"relaxation", 0, "W", RS, SOLVE(relaxation)},
+    {"epsilon", 0, "X", RSW, SOLVE(epsilon)},
+    {"min-area", 0, "A", RSW, SOLVE(min_area)},
+    {"clustering", 0, "WHEN", RSW, SOLVE(clustering)},
+    {"oracle", 0, "WHICH", RSW, SOLVE(classic_oracle)},
+    {"tolerance", 0, "X", RSW, SOLVE(tolerance)},
+    {"max-iterations", 0, "N", RSW, SOLVE(max_iterations)},
+    {"unshot-tolerance", 0, "X", RSW, SOLVE(unshot_tolerance)},
+    {"relaxation", 0, "W", RSW, SOLVE(relaxation)},
     {"history", 0, "FILE.csv", RS, OWN(history, RAD_OPTION_STRING),
      .own.help = "write the convergence history: iteration, seconds, residual, unshot power"},
     {"progress-images", 0, "DIR", CLI_RENDER, OWN(progress_dir, RAD_OPTION_STRING),
      .own.help = "write the image every --every iterations while solving (progressive display)"},
     {"every", 0, "K", CLI_RENDER, OWN(every, RAD_OPTION_INT), .own.min = 1.0, .own.max = INT_MAX,
      .own.default_text = "1", .own.help = "with --progress-images: every K iterations"},
-    {"width", 0, "W", CLI_RENDER, RENDER(width)},
-    {"height", 0, "H", CLI_RENDER, RENDER(height)},
+    {"width", 0, "W", CLI_RENDER | CLI_VIEW, RENDER(width)},
+    {"height", 0, "H", CLI_RENDER | CLI_VIEW, RENDER(height)},
     {"samples", 0, "N", CLI_RENDER, RENDER(samples)},
-    {"camera", 0, "P,L[,U[,FOV]]", CLI_RENDER, OWN(camera, RAD_OPTION_STRING),
+    {"camera", 0, "P,L[,U[,FOV]]", CLI_RENDER | CLI_VIEW, OWN(camera, RAD_OPTION_STRING),
      .own.help = "camera: position px,py,pz, look-at point lx,ly,lz, up ux,uy,uz (0,1,0), "
                  "vertical field of view in degrees (40)",
      .own.default_text = "the scene's camera, else framed automatically"},
-    {"exposure", 0, "X", CLI_RENDER, RENDER(exposure)},
+    {"exposure", 0, "X", CLI_RENDER | CLI_VIEW, RENDER(exposure)},
     {"exposure", 0, "X", CLI_EXPORT | CLI_BAKE, RENDER(exposure),
      .help = "multiplier on radiance for the display colours (glTF COLOR_0, PLY red/green/blue)"},
-    {"flat", 0, NULL, CLI_RENDER, RENDER(shading), .word = "flat",
+    {"flat", 0, NULL, CLI_RENDER | CLI_VIEW, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
-    {"seed", 0, "S", RV, SOLVE(seed)},
-    {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
+    {"seed", 0, "S", RVW, SOLVE(seed)},
+    {"threads", 0, "N", RVW, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
      .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},
     {"stats", 0, "FILE.json", RV, OWN(stats, RAD_OPTION_STRING),
      .own.help = "write run statistics as JSON (docs/stats.md)"},
-    {"max-memory", 0, "SIZE", RV, SOLVE(max_memory_bytes)},
-    {"read-outside-scene-folder", 0, NULL, RV, OWN(read_outside, RAD_OPTION_FLAG),
+    {"max-memory", 0, "SIZE", RVW, SOLVE(max_memory_bytes)},
+    {"read-outside-scene-folder", 0, NULL, RVW, OWN(read_outside, RAD_OPTION_FLAG),
      .own.help = "let the scene refer to files outside its folder (by default an mtllib, glTF "
                  "buffer or image that resolves outside the scene file's folder is refused)"},
     {"quiet", 'q', NULL, ALL, OWN(quiet, RAD_OPTION_FLAG), .own.help = "print nothing but errors"},
@@ -398,7 +411,8 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         if (!f && !known)
             bad = usage_error(e, "unknown option '%s'", arg);
         else if (!f && !s->command)
-            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export, bake or generate", arg);
+            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export, bake, generate or view",
+                              arg);
         else if (!f)
             bad = usage_error(e, "%s does not apply to %s", arg, cli_command_name(s->command));
         else if (f->metavar && !value && i + 1 >= argc)
@@ -428,7 +442,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render, solve, viewfactors, export, bake or generate");
+        usage_error(e, "no command given: use render, solve, viewfactors, export, bake, generate or view");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
@@ -454,6 +468,10 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
      * progress images (elements that stay put while solving), and the
      * uniform mesh's and the matrix's own options, which hierarchical would
      * ignore (adaptive subdivision among them). */
+    /* The window shows progressive refinement: shooting, unless another
+     * solver is asked for (an off-screen frame solves as render does). */
+    if (!s->solve.solver && s->command == CLI_VIEW && !s->offscreen && s->solve.adaptive_levels == 0)
+        s->solve.solver = "shooting";
     if (!s->solve.solver &&
         (s->command == CLI_VIEWFACTORS || s->progress_dir || s->solve.target_elements != 0 ||
          s->solve.mesh_size != 0.0 || s->solve.form_factors || s->solve.adaptive_levels != 0 ||

@@ -23,7 +23,8 @@
 #include <stdio.h>
 
 /* The commands, as bits: a flag lists those that take it. */
-enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32 };
+enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32,
+       CLI_VIEW = 64 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -58,6 +59,8 @@ typedef struct cli_settings {
     double texels_per_metre;  /* bake: 0 = the library's default */
     int atlas_size;           /* bake: 0 = the library's default */
     int lightmap_quantity;    /* bake: rad_lightmap_quantity */
+    int offscreen;            /* view: one frame to --output, no window */
+    int no_ambient;           /* view: B without the ambient term while shooting */
 } cli_settings;
 
 /* Where a flag's value goes. */
