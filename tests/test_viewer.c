@@ -229,16 +229,23 @@ static rad_solution *progressive_run(rad_context *ctx, rad_scene **scene, bool a
     rad_solution *solution = cornell(ctx, scene, "shooting", 600, &slot, false);
     out->elements = rad_solution_element_count(solution);
     out->count = 0;
-    rv_progress *p = rv_progress_start(solution, &slot, 1, ambient, 0.0);
+    /* Held at its first step until the poll has seen it (the poll sees only
+     * the latest snapshot: without the pause it may miss the first). */
+    rv_progress *p = rv_progress_start(solution, &slot, 1, ambient, 0.0, true);
     assert_non_null(p);
     uint64_t generation = 0;
     double *element = malloc(3 * out->elements * sizeof *element);
+    bool held = true;
     for (;;) {
         rv_status status;
         if (rv_progress_take(p, &generation, element, NULL, &status) && out->count < MAX_SNAPSHOTS) {
             out->element[out->count] = malloc(3 * out->elements * sizeof *element);
             memcpy(out->element[out->count], element, 3 * out->elements * sizeof *element);
             out->iteration[out->count++] = status.step.iteration;
+        }
+        if (held && out->count > 0 && status.paused) {
+            rv_progress_pause(p, false);
+            held = false;
         }
         if (status.done && !rv_progress_take(p, &generation, NULL, NULL, NULL))
             break;
@@ -346,9 +353,8 @@ static void pause_and_stop_keep_a_solution(void **state)
     rv_step_slot slot = {NULL, NULL};
     rad_solution *solution = cornell(ctx, &scene, "shooting", 600, &slot, false);
     size_t n3 = 3 * rad_solution_element_count(solution);
-    rv_progress *p = rv_progress_start(solution, &slot, 1, true, 0.0);
+    rv_progress *p = rv_progress_start(solution, &slot, 1, true, 0.0, true); /* held at its first step */
     assert_non_null(p);
-    rv_progress_pause(p, true); /* held at its first step */
     uint64_t generation = 0;
     rv_status paused = wait_for(p, &generation, 1, true);
     sleep_ms(200);

@@ -139,7 +139,8 @@ static void progress_free(rv_progress *p)
     free(p);
 }
 
-rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int threads, bool ambient, double interval)
+rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int threads, bool ambient,
+                               double interval, bool paused)
 {
     rv_progress *p = calloc(1, sizeof *p);
     if (!p)
@@ -148,6 +149,7 @@ rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int t
     p->slot = slot;
     p->ambient = ambient;
     p->interval = interval;
+    p->pause = paused;
     p->elements = rad_solution_element_count(solution);
     p->vertices = rad_solution_vertex_count(solution);
     size_t ne = p->elements ? p->elements : 1, nv = p->vertices ? p->vertices : 1;

@@ -156,9 +156,11 @@ int rv_step_forward(void *slot, rad_solution *solution, const rad_solve_step *st
  * (`threads` worker threads).  A snapshot of the display values
  * (rad_solution_display_radiosity, `ambient` as given) is published after
  * a step when `interval` seconds have passed since the last (0: every
- * step), and when the solve ends.  The caller must not touch the solution
+ * step), and when the solve ends.  `paused`: held at its first step
+ * until rv_progress_pause(p, false).  The caller must not touch the solution
  * until rv_progress_finish.  NULL on failure (out of memory, no thread). */
-rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int threads, bool ambient, double interval);
+rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int threads, bool ambient,
+                               double interval, bool paused);
 /* Copy the latest snapshot out when it is newer than *generation (then
  * *generation is updated and true returned); never waits for a step.  The
  * arrays hold 3 per element / vertex of the mesh the solve started on;

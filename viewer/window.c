@@ -346,7 +346,7 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
     drawable_size(&w, &width, &height);
     w.camera = rv_start_camera(scene, a, w.renderer, (double)width / height);
     if (!saved) {
-        w.progress = rv_progress_start(solution, slot, rad_context_threads(ctx), w.ambient, 1.0 / 30.0);
+        w.progress = rv_progress_start(solution, slot, rad_context_threads(ctx), w.ambient, 1.0 / 30.0, false);
         if (!w.progress) {
             fprintf(stderr, "radiosity: view: cannot start the solver's thread\n");
             goto done;
