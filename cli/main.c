@@ -209,7 +209,8 @@ static int run_view(rad_context *ctx, const settings *s)
     rv_args a = {.input = s->scene_path, .solve = s->solve, .width = s->render.width,
                  .height = s->render.height, .camera = s->camera ? &camera : NULL,
                  .shading = s->render.shading, .exposure = s->render.exposure, .output = s->output,
-                 .offscreen = s->offscreen != 0, .no_ambient = s->no_ambient != 0, .quiet = s->quiet != 0};
+                 .offscreen = s->offscreen != 0, .no_ambient = s->no_ambient != 0, .keys = s->keys,
+                 .quiet = s->quiet != 0};
     return rv_main(ctx, &a);
 #else
     (void)ctx, (void)s;

@@ -108,6 +108,9 @@ static const cli_flag FLAGS[] = {
      .own.help = "draw one frame with OpenGL (EGL, no window or display needed) to --output and exit"},
     {"no-ambient", 0, NULL, CLI_VIEW, OWN(no_ambient, RAD_OPTION_FLAG),
      .own.help = "show the radiosity without the ambient term of the unshot light (shooting)"},
+    {"keys", 0, "K1,K2,...", CLI_VIEW, OWN(keys, RAD_OPTION_STRING),
+     .own.help = "keys the window presses itself, one a frame (SDL key names; \"wait\" holds until the "
+                 "solve ends): \"wait,p,c,q\" saves a screenshot, prints the camera and quits"},
     {"texels-per-metre", 0, "N", CLI_BAKE, OWN(texels_per_metre, RAD_OPTION_DOUBLE), .own.min = 0.0,
      .own.max = 1e6, .own.min_open = true, .own.default_text = "10",
      .own.help = "lightmap texels per metre of surface"},

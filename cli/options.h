@@ -61,6 +61,7 @@ typedef struct cli_settings {
     int lightmap_quantity;    /* bake: rad_lightmap_quantity */
     int offscreen;            /* view: one frame to --output, no window */
     int no_ambient;           /* view: B without the ambient term while shooting */
+    const char *keys;         /* view: keys the window presses itself */
 } cli_settings;
 
 /* Where a flag's value goes. */

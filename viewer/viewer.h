@@ -36,6 +36,7 @@ typedef struct rv_args {
     const char *output;           /* off-screen: the frame (.png exposed, .hdr, .pfm) */
     bool offscreen;               /* draw one frame without a window, to `output` */
     bool no_ambient;              /* progressive: show B without the ambient term */
+    const char *keys;             /* window: keys pressed one a frame ("wait,p,c,q"), for scripts */
     bool quiet;
 } rv_args;
 

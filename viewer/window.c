@@ -301,6 +301,29 @@ static void mouse(window_state *w, const SDL_MouseMotionEvent *m)
     }
 }
 
+/* The next key of a --keys script ("wait,p,c,q": comma-separated keys,
+ * named as SDL names them, "wait" holding until the solve ends); returns
+ * the rest of the script, NULL once done. */
+static const char *scripted_key(window_state *w, const char *script, bool *quit)
+{
+    if (!script || !*script)
+        return NULL;
+    const char *end = strchr(script, ',');
+    size_t length = end ? (size_t)(end - script) : strlen(script);
+    char name[32];
+    snprintf(name, sizeof name, "%.*s", (int)(length < sizeof name ? length : sizeof name - 1), script);
+    if (strcmp(name, "wait") == 0 && w->progress)
+        return script; /* not yet */
+    if (strcmp(name, "wait") != 0) {
+        SDL_Keycode k = SDL_GetKeyFromName(name);
+        if (k == SDLK_UNKNOWN)
+            say(w, "--keys: unknown key '%s'", name);
+        else
+            key(w, k, quit);
+    }
+    return end ? end + 1 : NULL;
+}
+
 int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, rad_solution *solution,
                   rv_step_slot *slot, bool saved)
 {
@@ -356,9 +379,14 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
         printf("radiosity view: %zu elements, OpenGL %s (%s); H prints the keys\n",
                rv_renderer_elements(w.renderer), (const char *)glGetString(GL_VERSION),
                (const char *)glGetString(GL_RENDERER));
-    bool quit = false;
+    bool quit = false, vsync = SDL_GL_GetSwapInterval() == 1, auto_pending = a->exposure == 0.0 && !saved;
+    const char *script = a->keys; /* --keys: pressed one a frame */
     Uint64 last = SDL_GetPerformanceCounter(), last_title = 0;
     while (!quit) {
+        /* Ctrl-C / SIGTERM reach the program's context (cli/main.c). */
+        if (rad_context_cancelled(ctx))
+            break;
+        script = scripted_key(&w, script, &quit);
         SDL_Event e;
         while (SDL_PollEvent(&e)) {
             if (e.type == SDL_QUIT)
@@ -375,8 +403,17 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
         last = t;
         held_keys(&w, fmin(seconds, 0.1));
         if (w.progress) {
-            if (rv_progress_take(w.progress, &w.generation, w.element_rgb, w.vertex_rgb, &w.status))
+            if (rv_progress_take(w.progress, &w.generation, w.element_rgb, w.vertex_rgb, &w.status)) {
                 rv_renderer_update(w.renderer, w.element_rgb, w.vertex_rgb);
+                /* The automatic exposure, provisional on B = E (only the
+                 * lights lit), is fixed on the first shot's picture, as
+                 * render --progress-images fixes it: from then on the
+                 * picture visibly brightens as light is shot. */
+                if (auto_pending) {
+                    auto_exposure(&w);
+                    auto_pending = false;
+                }
+            }
             if (w.status.done)
                 finish_solve(&w);
         }
@@ -389,6 +426,8 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
                      .wireframe = w.wireframe};
         rv_renderer_draw(w.renderer, &d);
         SDL_GL_SwapWindow(w.window);
+        if (!vsync)
+            SDL_Delay(10); /* no vertical sync: about 100 frames a second at most */
         if ((double)(t - last_title) / (double)SDL_GetPerformanceFrequency() > 0.25) {
             update_title(&w);
             last_title = t;
