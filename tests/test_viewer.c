@@ -20,6 +20,11 @@
  *   pause / stop          paused, the solver does not advance; stopped, the
  *                         iterate is the solution: consistent with the last
  *                         snapshot, saved and read back equal
+ *   the program           `radiosity view --offscreen` writes the frame at
+ *                         its size and refuses an unknown format; the window
+ *                         on SDL's off-screen driver, scripted by --keys,
+ *                         prints the --camera that gives its view back and
+ *                         saves a converged solution
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -35,6 +40,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -430,7 +436,105 @@ static void camera_orbit_and_text(void **state)
     rad_context_destroy(ctx);
 }
 
-int main(void)
+/* ---- the program: radiosity view (argv[1] is its path) ---- */
+
+static const char *program;
+static char workdir[64];
+
+/* Run `radiosity ARGS` in the work folder, stdout and stderr into files
+ * there; returns the exit status. */
+static int run_view(const char *environment, const char *args)
+{
+    char command[2048];
+    snprintf(command, sizeof command, "cd '%s' && %s '%s' view %s > out.txt 2> err.txt", workdir, environment,
+             program, args);
+    int status = system(command);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static char *read_file(const char *name, size_t *size)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%s", workdir, name);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    char *text = calloc(1, 1 << 20);
+    *size = fread(text, 1, (1 << 20) - 1, f);
+    fclose(f);
+    return text;
+}
+
+/* --offscreen writes the frame at the size asked (the PNG's header says). */
+static void cli_offscreen_frame(void **state)
+{
+    (void)state;
+    assert_int_equal(run_view("", "--offscreen -o frame.png --width 64 --height 48 --elements 300 "
+                                  "--solver gauss-seidel --threads 1 -q"),
+                     0);
+    size_t size = 0;
+    unsigned char *png = (unsigned char *)read_file("frame.png", &size);
+    assert_non_null(png);
+    assert_true(size > 33 && memcmp(png, "\x89PNG\r\n\x1a\n", 8) == 0);
+    unsigned width = (unsigned)png[16] << 24 | (unsigned)png[17] << 16 | (unsigned)png[18] << 8 | png[19];
+    unsigned height = (unsigned)png[20] << 24 | (unsigned)png[21] << 16 | (unsigned)png[22] << 8 | png[23];
+    assert_int_equal(width, 64);
+    assert_int_equal(height, 48);
+    free(png);
+    /* An unknown format: one line naming the file, no file. */
+    assert_int_not_equal(run_view("", "--offscreen -o frame.xyz --elements 300 --solver gauss-seidel -q"), 0);
+    size_t err_size = 0;
+    char *err = read_file("err.txt", &err_size);
+    assert_non_null(strstr(err, "frame.xyz"));
+    free(err);
+    char *none = read_file("frame.xyz", &size);
+    assert_null(none);
+}
+
+/* The window, driven by --keys on SDL's off-screen video driver (no X):
+ * it solves, prints the --camera of the view (the scene's, untouched:
+ * exactly), saves a solution that loads, converged, and quits. */
+static void cli_window_script(void **state)
+{
+    (void)state;
+    int status = run_view("SDL_VIDEODRIVER=offscreen", "--elements 300 --threads 1 --width 160 --height 120 "
+                                                       "--keys wait,c,s,p,q");
+    if (status == RV_EXIT_NO_DEVICE) {
+        printf("# the window could not open here: skipped\n");
+        return;
+    }
+    assert_int_equal(status, 0);
+    size_t size = 0;
+    char *out = read_file("out.txt", &size);
+    assert_non_null(out);
+    const char *line = strstr(out, "--camera ");
+    assert_non_null(line);
+    char text[512];
+    assert_int_equal(sscanf(line + 9, "%511s", text), 1);
+    rad_context *ctx = new_context(1);
+    rad_camera printed, expected;
+    assert_int_equal(rad_camera_from_string(ctx, text, &printed), RAD_OK);
+    rad_scene *box = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &box), RAD_OK);
+    assert_true(rad_scene_camera(box, &expected));
+    assert_memory_equal(&printed, &expected, sizeof printed);
+    char path[256];
+    snprintf(path, sizeof path, "%s/view.radsol", workdir);
+    rad_scene *scene = NULL;
+    rad_solution *solution = NULL;
+    assert_int_equal(rad_solution_load_file(ctx, path, &scene, &solution), RAD_OK);
+    assert_true(rad_solution_converged(solution));
+    char *png = read_file("view-0001.png", &size);
+    assert_non_null(png);
+    free(png);
+    free(out);
+    rad_solution_destroy(solution);
+    rad_scene_destroy(scene);
+    rad_scene_destroy(box);
+    rad_context_destroy(ctx);
+}
+
+int main(int argc, char **argv)
 {
     char why[256];
     offscreen = rv_offscreen_create(why, sizeof why);
@@ -447,6 +551,21 @@ int main(void)
         cmocka_unit_test(pause_and_stop_keep_a_solution),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    if (argc > 1) {
+        program = argv[1];
+        snprintf(workdir, sizeof workdir, "/tmp/test_viewer_cli_XXXXXX");
+        if (!mkdtemp(workdir))
+            return 1;
+        const struct CMUnitTest cli[] = {
+            cmocka_unit_test(cli_offscreen_frame),
+            cmocka_unit_test(cli_window_script),
+        };
+        failed += cmocka_run_group_tests_name("radiosity view", cli, NULL, NULL);
+        char command[128];
+        snprintf(command, sizeof command, "rm -rf '%s'", workdir);
+        if (system(command) != 0)
+            failed++;
+    }
     rv_offscreen_destroy(offscreen);
     return failed;
 }
