@@ -39,7 +39,7 @@ struct rv_progress {
     rad_context *ctx;               /* the worker's */
     rad_solution *solution;
     rv_step_slot *slot;
-    bool ambient;
+    bool ambient;                   /* under the lock */
     double interval;                /* s between snapshots */
     size_t elements, vertices;      /* of the mesh the solve began on */
     /* the worker's own arrays */
@@ -71,7 +71,10 @@ static void publish(rv_progress *p, const rad_solve_step *step)
 {
     bool same_mesh = rad_solution_element_count(p->solution) == p->elements &&
                      rad_solution_vertex_count(p->solution) == p->vertices;
-    bool computed = same_mesh && rad_solution_display_radiosity(p->ctx, p->solution, p->ambient, p->work_element,
+    pthread_mutex_lock(&p->lock);
+    bool ambient = p->ambient;
+    pthread_mutex_unlock(&p->lock);
+    bool computed = same_mesh && rad_solution_display_radiosity(p->ctx, p->solution, ambient, p->work_element,
                                                                 p->work_vertex) == RAD_OK;
     pthread_mutex_lock(&p->lock);
     if (computed) {
@@ -206,6 +209,13 @@ void rv_progress_pause(rv_progress *p, bool pause)
     pthread_mutex_lock(&p->lock);
     p->pause = pause;
     pthread_cond_broadcast(&p->wake);
+    pthread_mutex_unlock(&p->lock);
+}
+
+void rv_progress_ambient(rv_progress *p, bool ambient)
+{
+    pthread_mutex_lock(&p->lock);
+    p->ambient = ambient;
     pthread_mutex_unlock(&p->lock);
 }
 

@@ -169,6 +169,8 @@ rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int t
 bool rv_progress_take(rv_progress *p, uint64_t *generation, double *element_rgb, double *vertex_rgb,
                       rv_status *status);
 void rv_progress_pause(rv_progress *p, bool pause);
+/* The ambient term on or off from the next snapshot on. */
+void rv_progress_ambient(rv_progress *p, bool ambient);
 /* Ask the solve to stop after its current step; it keeps the iterate. */
 void rv_progress_stop(rv_progress *p);
 /* Wait for the worker to end; returns the solve's result and hands the

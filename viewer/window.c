@@ -227,8 +227,9 @@ static void key(window_state *w, SDL_Keycode k, bool *quit)
     case SDLK_l: w->shading = w->shading == RAD_SHADING_FLAT ? RAD_SHADING_SMOOTH : RAD_SHADING_FLAT; break;
     case SDLK_a:
         w->ambient = !w->ambient;
+        say(w, "ambient term %s", w->ambient ? "on" : "off");
         if (w->progress)
-            say(w, "%s", "the ambient switch applies from the next solve (restart the viewer)");
+            rv_progress_ambient(w->progress, w->ambient); /* from the next snapshot */
         else if (!rebuild(w))
             say(w, "cannot rebuild the buffers: %s", rad_context_error(w->ctx));
         break;
@@ -381,6 +382,7 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
                (const char *)glGetString(GL_RENDERER));
     bool quit = false, vsync = SDL_GL_GetSwapInterval() == 1, auto_pending = a->exposure == 0.0 && !saved;
     const char *script = a->keys; /* --keys: pressed one a frame */
+    GLsync in_flight = NULL;
     Uint64 last = SDL_GetPerformanceCounter(), last_title = 0;
     while (!quit) {
         /* Ctrl-C / SIGTERM reach the program's context (cli/main.c). */
@@ -424,8 +426,16 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
                      .output = w.false_colour ? RV_OUTPUT_FALSE_COLOUR : RV_OUTPUT_DISPLAY,
                      .exposure = w.exposure, .false_min = w.false_min, .false_max = w.false_max,
                      .wireframe = w.wireframe};
+        /* At most one frame in flight: without a vertical sync that blocks
+         * (SDL's off-screen driver, some X servers) a software renderer
+         * queues frames faster than it draws them, and memory grows. */
+        if (in_flight) {
+            glClientWaitSync(in_flight, GL_SYNC_FLUSH_COMMANDS_BIT, 1000000000u);
+            glDeleteSync(in_flight);
+        }
         rv_renderer_draw(w.renderer, &d);
         SDL_GL_SwapWindow(w.window);
+        in_flight = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
         if (!vsync)
             SDL_Delay(10); /* no vertical sync: about 100 frames a second at most */
         if ((double)(t - last_title) / (double)SDL_GetPerformanceFrequency() > 0.25) {
@@ -433,6 +443,8 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
             last_title = t;
         }
     }
+    if (in_flight)
+        glDeleteSync(in_flight);
     status = 0;
 done:
     if (w.progress) {
