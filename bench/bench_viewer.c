@@ -107,7 +107,7 @@ int main(int argc, char **argv)
             return 1;
         double display = now() - t0;
         t0 = now();
-        rv_renderer *r = rv_renderer_create(ctx, solution, element_rgb, vertex_rgb);
+        rv_renderer *r = rv_renderer_create(solution, element_rgb, vertex_rgb);
         glFinish();
         double build = now() - t0;
         if (!r)

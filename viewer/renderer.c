@@ -91,7 +91,9 @@ static const char *FRAGMENT_SHADER =
     "    colour = vec4(srgb(exposure * L.r), srgb(exposure * L.g), srgb(exposure * L.b), 1.0);\n"
     "}\n";
 
-static GLuint compile(rad_context *ctx, GLenum kind, const char *source)
+/* A compiled shader, or 0 with the driver's log on stderr (a driver that
+ * refuses GLSL 3.30 core: no context of ours reaches here without it). */
+static GLuint compile(GLenum kind, const char *source)
 {
     GLuint shader = glCreateShader(kind);
     glShaderSource(shader, 1, &source, NULL);
@@ -104,16 +106,15 @@ static GLuint compile(rad_context *ctx, GLenum kind, const char *source)
         fprintf(stderr, "radiosity: view: %s shader: %s\n", kind == GL_VERTEX_SHADER ? "vertex" : "fragment",
                 log);
         glDeleteShader(shader);
-        (void)ctx;
         return 0;
     }
     return shader;
 }
 
-static GLuint link_program(rad_context *ctx)
+static GLuint link_program(void)
 {
-    GLuint vs = compile(ctx, GL_VERTEX_SHADER, VERTEX_SHADER);
-    GLuint fs = vs ? compile(ctx, GL_FRAGMENT_SHADER, FRAGMENT_SHADER) : 0;
+    GLuint vs = compile(GL_VERTEX_SHADER, VERTEX_SHADER);
+    GLuint fs = vs ? compile(GL_FRAGMENT_SHADER, FRAGMENT_SHADER) : 0;
     if (!fs) {
         glDeleteShader(vs);
         return 0;
@@ -232,8 +233,7 @@ static bool upload_geometry(rv_renderer *r, const rad_solution *solution)
     return ok;
 }
 
-rv_renderer *rv_renderer_create(rad_context *ctx, const rad_solution *solution, const double *element_rgb,
-                                const double *vertex_rgb)
+rv_renderer *rv_renderer_create(const rad_solution *solution, const double *element_rgb, const double *vertex_rgb)
 {
     rv_renderer *r = calloc(1, sizeof *r);
     if (!r)
@@ -242,7 +242,7 @@ rv_renderer *rv_renderer_create(rad_context *ctx, const rad_solution *solution, 
     r->elements = rad_solution_element_count(solution);
     size_t most = r->vertices > r->elements ? r->vertices : r->elements;
     r->scratch = malloc((most ? most : 1) * 4 * sizeof *r->scratch);
-    r->program = link_program(ctx);
+    r->program = link_program();
     if (!r->scratch || !r->program) {
         rv_renderer_destroy(r);
         return NULL;

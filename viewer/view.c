@@ -97,7 +97,7 @@ static int offscreen_frame(rad_context *ctx, const rv_args *a, const rad_scene *
         fprintf(stderr, "radiosity: view: %s\n", rgb ? rad_context_error(ctx) : "out of memory");
         goto done;
     }
-    renderer = rv_renderer_create(ctx, solution, element_rgb, vertex_rgb);
+    renderer = rv_renderer_create(solution, element_rgb, vertex_rgb);
     if (!renderer) {
         fprintf(stderr, "radiosity: view: cannot build the OpenGL buffers\n");
         goto done;

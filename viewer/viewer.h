@@ -97,9 +97,9 @@ typedef struct rv_draw {
 /* Build the buffers for the solution's mesh (positions, vertex and element
  * colours, triangles, edges), colours from `element_rgb` / `vertex_rgb`
  * (W/m^2, 3 per element / vertex).  Reads the solution's mesh only: not
- * while it is being solved.  NULL on failure (message on the context). */
-rv_renderer *rv_renderer_create(rad_context *ctx, const rad_solution *solution, const double *element_rgb,
-                                const double *vertex_rgb);
+ * while it is being solved.  NULL when out of memory or when the driver
+ * refuses the shaders (its log printed on stderr). */
+rv_renderer *rv_renderer_create(const rad_solution *solution, const double *element_rgb, const double *vertex_rgb);
 void rv_renderer_destroy(rv_renderer *r);
 /* New colours for the same mesh (glBufferSubData of both colour buffers). */
 void rv_renderer_update(rv_renderer *r, const double *element_rgb, const double *vertex_rgb);

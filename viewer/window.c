@@ -153,7 +153,7 @@ static bool rebuild(window_state *w)
     double *element_rgb, *vertex_rgb;
     if (!rv_display_values(w->ctx, w->solution, w->ambient, &element_rgb, &vertex_rgb))
         return false;
-    rv_renderer *renderer = rv_renderer_create(w->ctx, w->solution, element_rgb, vertex_rgb);
+    rv_renderer *renderer = rv_renderer_create(w->solution, element_rgb, vertex_rgb);
     if (!renderer) {
         free(element_rgb);
         free(vertex_rgb);
