@@ -13,6 +13,9 @@
  *                 replaces it
  *   cancellation  an atomic flag: a cancelled context interrupts, with
  *                 nothing returned, and runs again once cleared
+ *   early end     on_step's RAD_STEP_FINISH keeps the iterate as a
+ *                 solution that saves; display values with and without
+ *                 the ambient term
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -325,6 +328,87 @@ static void test_cancellation_flag(void **state)
     assert_false(rad_context_cancelled(NULL));
 }
 
+/* on_step's answers: RAD_STEP_FINISH at step `finish_at` ends the solve
+ * with its iterate as the solution; 1 at `interrupt_at` interrupts it. */
+typedef struct step_stopper {
+    int finish_at, interrupt_at, last;
+} step_stopper;
+
+static int stop_at(void *user, rad_solution *solution, const rad_solve_step *step)
+{
+    step_stopper *s = user;
+    (void)solution;
+    s->last = step->iteration;
+    if (step->iteration == s->finish_at)
+        return RAD_STEP_FINISH;
+    return step->iteration == s->interrupt_at ? 1 : 0;
+}
+
+/* An interactive stop (the viewer's Backspace): the iterate of the step
+ * that said RAD_STEP_FINISH is the result, solved and not converged, and
+ * saves; any other nonzero answer still interrupts, and an interrupted
+ * solve is not saved.  The display values: without the ambient term the
+ * vertex values are rad_solution_vertex_radiosity's to the bit; with it,
+ * a partial shooting solution is brighter (the unshot light), never
+ * darker, while a converged Gauss-Seidel one is unchanged. */
+static void test_step_finish_keeps_the_iterate(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    const char *solvers[] = {"shooting", "gauss-seidel"};
+    for (int k = 0; k < 2; k++) {
+        step_stopper stopper = {.finish_at = 4};
+        rad_options o = {.solver = solvers[k], .target_elements = 300, .on_step = stop_at, .on_step_user = &stopper};
+        rad_solution *s = NULL;
+        assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+        assert_int_equal(stopper.last, 4);
+        assert_false(rad_solution_converged(s));
+        assert_non_null(strstr(rad_solution_warning(s), "after 4 iterations"));
+        char path[64];
+        snprintf(path, sizeof path, "/tmp/test_solution_finish_%d.radsol", k);
+        assert_int_equal(rad_solution_save(ctx, s, path), RAD_OK);
+        remove(path);
+
+        size_t nv = rad_solution_vertex_count(s), ne = rad_solution_element_count(s);
+        double *plain = malloc(3 * nv * sizeof *plain), *vertex = malloc(3 * nv * sizeof *vertex);
+        double *with = malloc(3 * ne * sizeof *with), *without = malloc(3 * ne * sizeof *without);
+        assert_int_equal(rad_solution_vertex_radiosity(ctx, s, plain), RAD_OK);
+        assert_int_equal(rad_solution_display_radiosity(ctx, s, false, without, vertex), RAD_OK);
+        assert_memory_equal(plain, vertex, 3 * nv * sizeof *plain);
+        assert_int_equal(rad_solution_display_radiosity(ctx, s, true, with, NULL), RAD_OK);
+        int brighter = 0;
+        for (size_t i = 0; i < 3 * ne; i++) {
+            assert_true(with[i] >= without[i]);
+            brighter += with[i] > without[i];
+        }
+        if (k == 0)
+            assert_true(brighter > 0); /* four shots leave light unshot */
+
+        /* Interrupted (1) instead: not a solution to save. */
+        stopper = (step_stopper){.interrupt_at = 2};
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_INTERRUPTED);
+        assert_int_equal(rad_solution_save(ctx, s, path), RAD_ERROR_INVALID_ARGUMENT);
+        /* And with no stop it converges: the early end left nothing behind. */
+        stopper = (step_stopper){0};
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+        assert_true(rad_solution_converged(s));
+        assert_string_equal(rad_solution_warning(s), "");
+        if (k == 1) {
+            assert_int_equal(rad_solution_display_radiosity(ctx, s, true, with, NULL), RAD_OK);
+            assert_int_equal(rad_solution_display_radiosity(ctx, s, false, without, NULL), RAD_OK);
+            assert_memory_equal(with, without, 3 * ne * sizeof *with); /* no ambient term */
+        }
+        free(plain);
+        free(vertex);
+        free(with);
+        free(without);
+        rad_solution_destroy(s);
+    }
+    rad_scene_destroy(scene);
+}
+
 /* Factors that make up power.  Monte Carlo at 16 samples on polygons that
  * touch at sharp angles (a fuzz_solve find) had rows summing to 3.4, and
  * Gauss-Seidel returned B = 1e5 (1e66 at other seeds) as a success; its
@@ -502,6 +586,7 @@ int main(void)
         cmocka_unit_test(test_first_error_kept_and_reported_once),
         cmocka_unit_test(test_unconverged_is_reported),
         cmocka_unit_test(test_cancellation_flag),
+        cmocka_unit_test(test_step_finish_keeps_the_iterate),
         cmocka_unit_test(test_diverged_solution_refused),
         cmocka_unit_test(test_point_radiosity),
     };
