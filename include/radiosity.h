@@ -923,6 +923,12 @@ RAD_API size_t rad_option_range_text(const rad_option_info *option, char *text, 
 RAD_API rad_result rad_solution_display_radiosity(rad_context *ctx, const rad_solution *solution,
                                                   bool ambient, double *element_rgb, double *vertex_rgb);
 
+/* The hierarchical solver's links after its last solve (the interactions
+ * it kept between nodes of its hierarchy: the status line's figure, as
+ * element_count is); 0 for the other solvers, before the first solve and
+ * for a NULL solution. */
+RAD_API size_t rad_solution_link_count(const rad_solution *solution);
+
 /* An image made from `width` x `height` RGB radiance triples (W/(m^2 sr),
  * row 0 at the top), copied: a program's own pictures (an OpenGL frame
  * read back) then go through rad_image_write_exposed like a rendered one,

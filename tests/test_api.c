@@ -278,6 +278,7 @@ static void test_null_solution(void **state)
     double xyz[3] = {7, 7, 7}, rgb3[3] = {7, 7, 7};
     size_t corners[4] = {7, 7, 7, 7};
     assert_int_equal(rad_solution_vertex_count(NULL), 0);
+    assert_int_equal(rad_solution_link_count(NULL), 0);
     assert_false(rad_solution_vertex_position(NULL, 0, xyz));
     assert_false(rad_solution_vertex_position(s, 0, NULL));
     assert_int_equal(rad_solution_element_vertices(NULL, 0, corners), 0);

@@ -30,6 +30,8 @@
 
 #include "radiosity.h"
 
+#include <cjson/cJSON.h>
+
 static rad_context *ctx;
 
 typedef struct error_log {
@@ -213,6 +215,7 @@ static void test_hierarchical_elements_are_leaves(void **state)
     rad_solution *s = NULL;
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     size_t patches = rad_solution_element_count(s);
+    assert_int_equal(rad_solution_link_count(s), 0); /* not solved yet */
     /* One element per patch: the polygons (coplanar triangle pairs merged
      * into quads), the floor cut along the blocks' footprints. */
     assert_true(patches >= rad_scene_surface_count(scene) && patches <= 2 * rad_scene_polygon_count(scene));
@@ -225,6 +228,23 @@ static void test_hierarchical_elements_are_leaves(void **state)
     for (size_t j = 0; j < rad_scene_surface_count(scene); j++)
         want += rad_scene_surface_area(scene, j);
     assert_true(fabs(total - want) < 1e-6 * want);
+    /* Its links: the stats file's count. */
+    const char *stats = "/tmp/test_solution_links.json";
+    assert_int_equal(rad_solution_write_stats(ctx, s, stats, false), RAD_OK);
+    FILE *f = fopen(stats, "rb");
+    assert_non_null(f);
+    static char text[1 << 20];
+    size_t size = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    remove(stats);
+    text[size] = '\0';
+    cJSON *json = cJSON_Parse(text);
+    const cJSON *links = cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(json, "solver"), "hierarchical"),
+                                             "links");
+    assert_true(cJSON_IsNumber(links));
+    assert_true(rad_solution_link_count(s) > 0);
+    assert_true((double)rad_solution_link_count(s) == links->valuedouble);
+    cJSON_Delete(json);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }

@@ -189,13 +189,17 @@ static void finish_solve(window_state *w)
 
 static void update_title(window_state *w)
 {
-    char title[512];
+    char title[512], links[48] = "";
     const rad_solve_step *s = &w->status.step;
+    /* The solution is read only when no solve is running. */
+    size_t link_count = w->progress ? 0 : rad_solution_link_count(w->solution);
+    if (link_count)
+        snprintf(links, sizeof links, " | %zu links", link_count);
     const char *state = w->progress ? (w->status.paused ? "paused" : "solving") : w->solved ? "solved" : "stopped";
     snprintf(title, sizeof title,
-             "radiosity view | %s | step %d | residual %.3g | unshot %.3g | %zu elements | "
+             "radiosity view | %s | step %d | residual %.3g | unshot %.3g | %zu elements%s | "
              "exposure %.3g%s%s | %s",
-             state, s->iteration, s->residual, s->unshot, rv_renderer_elements(w->renderer), w->exposure,
+             state, s->iteration, s->residual, s->unshot, rv_renderer_elements(w->renderer), links, w->exposure,
              w->false_colour ? " | false colour" : "", w->ambient ? "" : " | no ambient", w->message);
     SDL_SetWindowTitle(w->window, title);
 }

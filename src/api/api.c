@@ -751,3 +751,5 @@ rad_result rad_solution_display_radiosity(rad_context *ctx, const rad_solution *
         rad_free(display);
     return r;
 }
+
+size_t rad_solution_link_count(const rad_solution *s) { return s && s->view.hier ? s->view.hier->links : 0; }
