@@ -45,6 +45,7 @@ struct rv_progress {
     /* the worker's own arrays */
     double *work_element, *work_vertex;
     double last_publish;            /* s, monotonic */
+    double publish_cost;            /* s the last snapshot took */
     /* under the lock */
     double *snap_element, *snap_vertex;
     rv_status status;
@@ -69,6 +70,7 @@ static double now(void)
 /* Copy the worker's arrays into the snapshot (the mesh unchanged). */
 static void publish(rv_progress *p, const rad_solve_step *step)
 {
+    double start = now();
     bool same_mesh = rad_solution_element_count(p->solution) == p->elements &&
                      rad_solution_vertex_count(p->solution) == p->vertices;
     pthread_mutex_lock(&p->lock);
@@ -86,6 +88,7 @@ static void publish(rv_progress *p, const rad_solve_step *step)
         p->status.step = *step;
     pthread_mutex_unlock(&p->lock);
     p->last_publish = now();
+    p->publish_cost = p->last_publish - start;
 }
 
 static int on_step(void *user, rad_solution *solution, const rad_solve_step *step)
@@ -95,7 +98,11 @@ static int on_step(void *user, rad_solution *solution, const rad_solve_step *ste
     pthread_mutex_lock(&p->lock);
     bool pausing = p->pause, stopping = p->stop;
     pthread_mutex_unlock(&p->lock);
-    if (pausing || stopping || now() - p->last_publish >= p->interval)
+    /* A snapshot costs O(elements) (the vertex values: 0.5 s at 10^6
+     * elements, docs/viewer.md): with an interval, at most a tenth of the
+     * worker's time goes to them. */
+    double wait = p->interval > 0.0 ? fmax(p->interval, 9.0 * p->publish_cost) : 0.0;
+    if (pausing || stopping || now() - p->last_publish >= wait)
         publish(p, step);
     pthread_mutex_lock(&p->lock);
     p->status.step = *step;

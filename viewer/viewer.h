@@ -156,8 +156,9 @@ int rv_step_forward(void *slot, rad_solution *solution, const rad_solve_step *st
  * on_step_user = slot) on a worker thread with its own context
  * (`threads` worker threads).  A snapshot of the display values
  * (rad_solution_display_radiosity, `ambient` as given) is published after
- * a step when `interval` seconds have passed since the last (0: every
- * step), and when the solve ends.  `paused`: held at its first step
+ * a step when `interval` seconds have passed since the last, or 9 times
+ * the last snapshot's cost where that is longer (0: every step), and when
+ * the solve ends.  `paused`: held at its first step
  * until rv_progress_pause(p, false).  The caller must not touch the solution
  * until rv_progress_finish.  NULL on failure (out of memory, no thread). */
 rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int threads, bool ambient,
