@@ -52,6 +52,7 @@ typedef struct window_state {
     rv_progress *progress;        /* NULL once the solve has ended */
     rv_camera camera;
     bool fly, false_colour, wireframe, ambient, paused, stopped, solved;
+    bool auto_pending;            /* the automatic exposure waits for lit surfaces */
     rad_shading shading;
     double exposure;              /* 0 until the first automatic one */
     double false_min, false_max;  /* log10 luminance */
@@ -176,7 +177,12 @@ static void finish_solve(window_state *w)
     w->progress = NULL;
     w->solved = r == RAD_OK;
     if (r == RAD_OK || r == RAD_ERROR_INTERRUPTED) {
-        if (!rebuild(w))
+        bool rebuilt = rebuild(w);
+        if (rebuilt && w->auto_pending) {
+            auto_exposure(w); /* no snapshot came (hierarchical): on the result */
+            w->auto_pending = false;
+        }
+        if (!rebuilt)
             say(w, "cannot rebuild the buffers: %s", rad_context_error(w->ctx));
         else
             say(w, "%s", r == RAD_ERROR_INTERRUPTED ? "interrupted: the iterate is kept (E exports it)"
@@ -384,7 +390,8 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
         printf("radiosity view: %zu elements, OpenGL %s (%s); H prints the keys\n",
                rv_renderer_elements(w.renderer), (const char *)glGetString(GL_VERSION),
                (const char *)glGetString(GL_RENDERER));
-    bool quit = false, vsync = SDL_GL_GetSwapInterval() == 1, auto_pending = a->exposure == 0.0 && !saved;
+    bool quit = false, vsync = SDL_GL_GetSwapInterval() == 1;
+    w.auto_pending = a->exposure == 0.0 && !saved;
     const char *script = a->keys; /* --keys: pressed one a frame */
     GLsync in_flight = NULL;
     Uint64 last = SDL_GetPerformanceCounter(), last_title = 0;
@@ -415,9 +422,9 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
                  * lights lit), is fixed on the first shot's picture, as
                  * render --progress-images fixes it: from then on the
                  * picture visibly brightens as light is shot. */
-                if (auto_pending) {
+                if (w.auto_pending) {
                     auto_exposure(&w);
-                    auto_pending = false;
+                    w.auto_pending = false;
                 }
             }
             if (w.status.done)
