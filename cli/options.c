@@ -63,14 +63,12 @@ const char *cli_command_name(int command)
 
 /* ---- the flags ---- */
 
-/* The commands that solve (render, export, solve), and those that also
- * mesh and couple (viewfactors). */
-#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
-#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
+/* The commands that solve (render, export, solve, bake, view), and those
+ * that also mesh and couple (viewfactors); view writes no stats or
+ * history (its rows below take it out). */
+#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW)
+#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW)
 #define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE | CLI_VIEW)
-/* The same with the viewer, which solves (and meshes) as render does. */
-#define RSW (RS | CLI_VIEW)
-#define RVW (RV | CLI_VIEW)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
 #define RENDER(field_) .target = CLI_TO_RENDER, .field = #field_
 #define OFFICE(field_) .target = CLI_TO_OFFICE, .field = #field_
@@ -122,31 +120,31 @@ static const cli_flag FLAGS[] = {
     {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
     {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
     {"closed-doors", 0, NULL, CLI_GENERATE, OFFICE(closed_doors)},
-    {"mesh-size", 0, "L", RVW, SOLVE(mesh_size)},
-    {"elements", 0, "N", RVW, SOLVE(target_elements)},
-    {"form-factors", 0, "NAME", RVW, SOLVE(form_factors)},
-    {"solver", 0, "NAME", RSW, SOLVE(solver)},
-    {"visibility", 0, "NAME", RVW, SOLVE(visibility)},
-    {"shadow-rays", 0, "N", RVW, SOLVE(shadow_rays)},
-    {"hemicube-res", 0, "N", RVW, SOLVE(hemicube_resolution)},
-    {"ff-samples", 0, "N", RVW, SOLVE(samples)},
-    {"near-field", 0, "X", RVW, SOLVE(near_field)},
-    {"closure-correction", 0, NULL, RVW, SOLVE(closure_correction)},
-    {"raw-form-factors", 0, NULL, RVW, SOLVE(raw_form_factors)},
-    {"adaptive", 0, "LEVELS", RSW, SOLVE(adaptive_levels)},
-    {"adaptive-threshold", 0, "X", RSW, SOLVE(adaptive_threshold)},
-    {"adaptive-elements", 0, "N", RSW, SOLVE(adaptive_max_elements)},
+    {"mesh-size", 0, "L", RV, SOLVE(mesh_size)},
+    {"elements", 0, "N", RV, SOLVE(target_elements)},
+    {"form-factors", 0, "NAME", RV, SOLVE(form_factors)},
+    {"solver", 0, "NAME", RS, SOLVE(solver)},
+    {"visibility", 0, "NAME", RV, SOLVE(visibility)},
+    {"shadow-rays", 0, "N", RV, SOLVE(shadow_rays)},
+    {"hemicube-res", 0, "N", RV, SOLVE(hemicube_resolution)},
+    {"ff-samples", 0, "N", RV, SOLVE(samples)},
+    {"near-field", 0, "X", RV, SOLVE(near_field)},
+    {"closure-correction", 0, NULL, RV, SOLVE(closure_correction)},
+    {"raw-form-factors", 0, NULL, RV, SOLVE(raw_form_factors)},
+    {"adaptive", 0, "LEVELS", RS, SOLVE(adaptive_levels)},
+    {"adaptive-threshold", 0, "X", RS, SOLVE(adaptive_threshold)},
+    {"adaptive-elements", 0, "N", RS, SOLVE(adaptive_max_elements)},
     {"level", 0, "WHICH", CLI_VIEWFACTORS, OWN(element_level, RAD_OPTION_ENUM), .own.words = level_words,
      .own.default_text = "surface", .own.help = "view factors between surfaces or between elements"},
-    {"epsilon", 0, "X", RSW, SOLVE(epsilon)},
-    {"min-area", 0, "A", RSW, SOLVE(min_area)},
-    {"clustering", 0, "WHEN", RSW, SOLVE(clustering)},
-    {"oracle", 0, "WHICH", RSW, SOLVE(classic_oracle)},
-    {"tolerance", 0, "X", RSW, SOLVE(tolerance)},
-    {"max-iterations", 0, "N", RSW, SOLVE(max_iterations)},
-    {"unshot-tolerance", 0, "X", RSW, SOLVE(unshot_tolerance)},
-    {"relaxation", 0, "W", RSW, SOLVE(relaxation)},
-    {"history", 0, "FILE.csv", RS, OWN(history, RAD_OPTION_STRING),
+    {"epsilon", 0, "X", RS, SOLVE(epsilon)},
+    {"min-area", 0, "A", RS, SOLVE(min_area)},
+    {"clustering", 0, "WHEN", RS, SOLVE(clustering)},
+    {"oracle", 0, "WHICH", RS, SOLVE(classic_oracle)},
+    {"tolerance", 0, "X", RS, SOLVE(tolerance)},
+    {"max-iterations", 0, "N", RS, SOLVE(max_iterations)},
+    {"unshot-tolerance", 0, "X", RS, SOLVE(unshot_tolerance)},
+    {"relaxation", 0, "W", RS, SOLVE(relaxation)},
+    {"history", 0, "FILE.csv", RS & ~CLI_VIEW, OWN(history, RAD_OPTION_STRING),
      .own.help = "write the convergence history: iteration, seconds, residual, unshot power"},
     {"progress-images", 0, "DIR", CLI_RENDER, OWN(progress_dir, RAD_OPTION_STRING),
      .own.help = "write the image every --every iterations while solving (progressive display)"},
@@ -164,13 +162,13 @@ static const cli_flag FLAGS[] = {
      .help = "multiplier on radiance for the display colours (glTF COLOR_0, PLY red/green/blue)"},
     {"flat", 0, NULL, CLI_RENDER | CLI_VIEW, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
-    {"seed", 0, "S", RVW, SOLVE(seed)},
-    {"threads", 0, "N", RVW, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
+    {"seed", 0, "S", RV, SOLVE(seed)},
+    {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
      .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},
-    {"stats", 0, "FILE.json", RV, OWN(stats, RAD_OPTION_STRING),
+    {"stats", 0, "FILE.json", RV & ~CLI_VIEW, OWN(stats, RAD_OPTION_STRING),
      .own.help = "write run statistics as JSON (docs/stats.md)"},
-    {"max-memory", 0, "SIZE", RVW, SOLVE(max_memory_bytes)},
-    {"read-outside-scene-folder", 0, NULL, RVW, OWN(read_outside, RAD_OPTION_FLAG),
+    {"max-memory", 0, "SIZE", RV, SOLVE(max_memory_bytes)},
+    {"read-outside-scene-folder", 0, NULL, RV, OWN(read_outside, RAD_OPTION_FLAG),
      .own.help = "let the scene refer to files outside its folder (by default an mtllib, glTF "
                  "buffer or image that resolves outside the scene file's folder is refused)"},
     {"quiet", 'q', NULL, ALL, OWN(quiet, RAD_OPTION_FLAG), .own.help = "print nothing but errors"},
