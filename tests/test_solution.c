@@ -389,7 +389,32 @@ static void test_step_finish_keeps_the_iterate(void **state)
         char path[64];
         snprintf(path, sizeof path, "/tmp/test_solution_finish_%d.radsol", k);
         assert_int_equal(rad_solution_save(ctx, s, path), RAD_OK);
+        /* The file says so too: read back, it is not converged and gives the
+         * same warning. */
+        rad_scene *loaded_scene = NULL;
+        rad_solution *loaded = NULL;
+        assert_int_equal(rad_solution_load_file(ctx, path, &loaded_scene, &loaded), RAD_OK);
+        assert_false(rad_solution_converged(loaded));
+        assert_string_equal(rad_solution_warning(loaded), rad_solution_warning(s));
+        rad_solution_destroy(loaded);
+        rad_scene_destroy(loaded_scene);
         remove(path);
+        /* And the stats: not converged, the warning given. */
+        snprintf(path, sizeof path, "/tmp/test_solution_finish_%d.json", k);
+        assert_int_equal(rad_solution_write_stats(ctx, s, path, false), RAD_OK);
+        FILE *f = fopen(path, "rb");
+        assert_non_null(f);
+        static char text[1 << 20];
+        size_t size = fread(text, 1, sizeof text - 1, f);
+        fclose(f);
+        remove(path);
+        text[size] = '\0';
+        cJSON *json = cJSON_Parse(text);
+        const cJSON *solver = cJSON_GetObjectItem(json, "solver");
+        assert_true(cJSON_IsFalse(cJSON_GetObjectItem(solver, "converged")));
+        assert_string_equal(cJSON_GetStringValue(cJSON_GetObjectItem(solver, "warning")), rad_solution_warning(s));
+        cJSON_Delete(json);
+        snprintf(path, sizeof path, "/tmp/test_solution_finish_%d.radsol", k);
 
         size_t nv = rad_solution_vertex_count(s), ne = rad_solution_element_count(s);
         double *plain = malloc(3 * nv * sizeof *plain), *vertex = malloc(3 * nv * sizeof *vertex);

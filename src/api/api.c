@@ -19,8 +19,10 @@
 static void refresh_view(rad_solution *s)
 {
     s->strategy->view(s->state, &s->view);
+    /* on_step ended it: the iterate is the result, with its own warning */
+    s->view.ended_early = s->finished_early ? s->finish_warning : NULL;
     if (s->finished_early)
-        s->view.solved = true; /* on_step ended it: the iterate is the result */
+        s->view.solved = true;
     s->view.scene = s->scene;
     s->view.options = &s->options;
     s->view.threads = s->threads;
