@@ -20,6 +20,9 @@
 #ifdef RADIOSITY_MPI
 #include "mpi_ranks.h"
 #endif
+#ifdef RADIOSITY_HAVE_VIEWER
+#include "viewer.h"
+#endif
 
 #include <errno.h>
 #include <limits.h>
@@ -195,6 +198,30 @@ static int on_step(void *user, rad_solution *solution, const rad_solve_step *ste
 }
 
 /* ---- the commands ---- */
+
+/* `radiosity view`: the window or an off-screen frame (viewer/), when this
+ * program was built with the viewer (CMake RADIOSITY_VIEWER). */
+static int run_view(rad_context *ctx, const settings *s)
+{
+#ifdef RADIOSITY_HAVE_VIEWER
+    rad_camera camera;
+    if (s->camera && rad_camera_from_string(ctx, s->camera, &camera) != RAD_OK) {
+        fprintf(stderr, "radiosity: --%s (see radiosity view --help)\n", rad_context_error(ctx));
+        return EXIT_USAGE;
+    }
+    rv_args a = {.input = s->scene_path, .solve = s->solve, .width = s->render.width,
+                 .height = s->render.height, .camera = s->camera ? &camera : NULL,
+                 .shading = s->render.shading, .exposure = s->render.exposure, .output = s->output,
+                 .offscreen = s->offscreen != 0, .no_ambient = s->no_ambient != 0, .keys = s->keys,
+                 .quiet = s->quiet != 0};
+    return rv_main(ctx, &a);
+#else
+    (void)ctx, (void)s;
+    fprintf(stderr, "radiosity: view: this program was built without the viewer (it needs libsdl2-dev and "
+                    "libepoxy-dev: scripts/setup.sh installs them, then rebuild; docs/viewer.md)\n");
+    return 1;
+#endif
+}
 
 /* The library's message, with its field names written as our flags
  * ("rad_options.max_memory_bytes" -> "--max-memory"). */
@@ -512,6 +539,13 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
     }
     if (s.command == CLI_GENERATE) {
         status = cli_generate(&s, ctx);
+        cancel_context = NULL;
+        rad_context_destroy(ctx);
+        return cancel_signal ? interrupted_status() : status;
+    }
+
+    if (s.command == CLI_VIEW) {
+        status = run_view(ctx, &s);
         cancel_context = NULL;
         rad_context_destroy(ctx);
         return cancel_signal ? interrupted_status() : status;

@@ -50,6 +50,9 @@ static const command_def COMMANDS[] = {
     {CLI_THERMAL, "thermal", "thermal [SCENE] --bc BC.json [options]",
      "radiative heat exchange between grey diffuse surfaces with given temperatures or heat fluxes: "
      "radiosity, net flux, net power and the unknown temperatures per surface (docs/thermal.md)"},
+    {CLI_VIEW, "view", "view [SCENE|SOLUTION.radsol] [options]",
+     "open a window that shows the solution as the solver refines it (progressive), or with --offscreen "
+     "draw one frame with OpenGL without a window (docs/viewer.md; an optional build part)"},
 };
 #define COMMAND_COUNT (sizeof COMMANDS / sizeof COMMANDS[0])
 
@@ -63,11 +66,12 @@ const char *cli_command_name(int command)
 
 /* ---- the flags ---- */
 
-/* The commands that solve (render, export, solve), and those that also
- * mesh and couple (viewfactors). */
-#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE)
-#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_THERMAL)
-#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE | CLI_THERMAL)
+/* The commands that solve (render, export, solve, bake, view), and those
+ * that also mesh and couple (viewfactors, thermal); view writes no stats or
+ * history (its rows below take it out). */
+#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW)
+#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW | CLI_THERMAL)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE | CLI_VIEW | CLI_THERMAL)
 /* The solver's own flags, for the commands that solve B and for thermal's net-radiation solve. */
 #define RST (RS | CLI_THERMAL)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
@@ -110,6 +114,16 @@ static const cli_flag FLAGS[] = {
                  "and the environment temperature (docs/thermal.md); required"},
     {"gebhart", 0, "FILE", CLI_THERMAL, OWN(gebhart, RAD_OPTION_STRING),
      .own.help = "also write the Gebhart factors between surfaces: .csv or .json"},
+    {"output", 'o', "FILE", CLI_VIEW, OWN(output, RAD_OPTION_STRING),
+     .own.help = "with --offscreen: the frame, .png (exposed, sRGB), .hdr or .pfm (linear)",
+     .own.default_text = "view.png"},
+    {"offscreen", 0, NULL, CLI_VIEW, OWN(offscreen, RAD_OPTION_FLAG),
+     .own.help = "draw one frame with OpenGL (EGL, no window or display needed) to --output and exit"},
+    {"no-ambient", 0, NULL, CLI_VIEW, OWN(no_ambient, RAD_OPTION_FLAG),
+     .own.help = "show the radiosity without the ambient term of the unshot light (shooting)"},
+    {"keys", 0, "K1,K2,...", CLI_VIEW, OWN(keys, RAD_OPTION_STRING),
+     .own.help = "keys the window presses itself, one a frame (SDL key names; \"wait\" holds until the "
+                 "solve ends): \"wait,p,c,q\" saves a screenshot, prints the camera and quits"},
     {"texels-per-metre", 0, "N", CLI_BAKE, OWN(texels_per_metre, RAD_OPTION_DOUBLE), .own.min = 0.0,
      .own.max = 1e6, .own.min_open = true, .own.default_text = "10",
      .own.help = "lightmap texels per metre of surface"},
@@ -166,28 +180,28 @@ static const cli_flag FLAGS[] = {
     {"max-iterations", 0, "N", RST, SOLVE(max_iterations)},
     {"unshot-tolerance", 0, "X", RS, SOLVE(unshot_tolerance)},
     {"relaxation", 0, "W", RS, SOLVE(relaxation)},
-    {"history", 0, "FILE.csv", RS, OWN(history, RAD_OPTION_STRING),
+    {"history", 0, "FILE.csv", RS & ~CLI_VIEW, OWN(history, RAD_OPTION_STRING),
      .own.help = "write the convergence history: iteration, seconds, residual, unshot power"},
     {"progress-images", 0, "DIR", CLI_RENDER, OWN(progress_dir, RAD_OPTION_STRING),
      .own.help = "write the image every --every iterations while solving (progressive display)"},
     {"every", 0, "K", CLI_RENDER, OWN(every, RAD_OPTION_INT), .own.min = 1.0, .own.max = INT_MAX,
      .own.default_text = "1", .own.help = "with --progress-images: every K iterations"},
-    {"width", 0, "W", CLI_RENDER, RENDER(width)},
-    {"height", 0, "H", CLI_RENDER, RENDER(height)},
+    {"width", 0, "W", CLI_RENDER | CLI_VIEW, RENDER(width)},
+    {"height", 0, "H", CLI_RENDER | CLI_VIEW, RENDER(height)},
     {"samples", 0, "N", CLI_RENDER, RENDER(samples)},
-    {"camera", 0, "P,L[,U[,FOV]]", CLI_RENDER, OWN(camera, RAD_OPTION_STRING),
+    {"camera", 0, "P,L[,U[,FOV]]", CLI_RENDER | CLI_VIEW, OWN(camera, RAD_OPTION_STRING),
      .own.help = "camera: position px,py,pz, look-at point lx,ly,lz, up ux,uy,uz (0,1,0), "
                  "vertical field of view in degrees (40)",
      .own.default_text = "the scene's camera, else framed automatically"},
-    {"exposure", 0, "X", CLI_RENDER, RENDER(exposure)},
+    {"exposure", 0, "X", CLI_RENDER | CLI_VIEW, RENDER(exposure)},
     {"exposure", 0, "X", CLI_EXPORT | CLI_BAKE, RENDER(exposure),
      .help = "multiplier on radiance for the display colours (glTF COLOR_0, PLY red/green/blue)"},
-    {"flat", 0, NULL, CLI_RENDER, RENDER(shading), .word = "flat",
+    {"flat", 0, NULL, CLI_RENDER | CLI_VIEW, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
     {"seed", 0, "S", RV, SOLVE(seed)},
     {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
      .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},
-    {"stats", 0, "FILE.json", RV, OWN(stats, RAD_OPTION_STRING),
+    {"stats", 0, "FILE.json", RV & ~CLI_VIEW, OWN(stats, RAD_OPTION_STRING),
      .own.help = "write run statistics as JSON (docs/stats.md)"},
     {"max-memory", 0, "SIZE", RV, SOLVE(max_memory_bytes)},
     {"read-outside-scene-folder", 0, NULL, RV, OWN(read_outside, RAD_OPTION_FLAG),
@@ -434,7 +448,8 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         if (!f && !known)
             bad = usage_error(e, "unknown option '%s'", arg);
         else if (!f && !s->command)
-            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export, bake, thermal or generate", arg);
+            bad = usage_error(e, "%s needs a command: render, solve, viewfactors, export, bake, thermal, generate "
+                                 "or view", arg);
         else if (!f)
             bad = usage_error(e, "%s does not apply to %s", arg, cli_command_name(s->command));
         else if (f->metavar && !value && i + 1 >= argc)
@@ -464,7 +479,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render, solve, viewfactors, export, bake, thermal or generate");
+        usage_error(e, "no command given: use render, solve, viewfactors, export, bake, thermal, generate or view");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
@@ -494,6 +509,10 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
      * progress images (elements that stay put while solving), and the
      * uniform mesh's and the matrix's own options, which hierarchical would
      * ignore (adaptive subdivision among them). */
+    /* The window shows progressive refinement: shooting, unless another
+     * solver is asked for (an off-screen frame solves as render does). */
+    if (!s->solve.solver && s->command == CLI_VIEW && !s->offscreen && s->solve.adaptive_levels == 0)
+        s->solve.solver = "shooting";
     if (!s->solve.solver &&
         (s->command == CLI_VIEWFACTORS || s->progress_dir || s->solve.target_elements != 0 ||
          s->solve.mesh_size != 0.0 || s->solve.form_factors || s->solve.adaptive_levels != 0 ||

@@ -23,9 +23,8 @@
 #include <stdio.h>
 
 /* The commands, as bits: a flag lists those that take it. */
-enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32 };
-/* thermal: radiative heat exchange (docs/thermal.md) */
-enum { CLI_THERMAL = 128 };
+enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32,
+       CLI_VIEW = 64, CLI_THERMAL = 128 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -68,6 +67,9 @@ typedef struct cli_settings {
     const char *gebhart;      /* thermal: where the Gebhart factors go, or NULL */
     const char *thermal_solver; /* thermal --solver (also made the solution's); NULL = direct */
     double thermal_tolerance; /* thermal --tolerance; 0 = the library's default */
+    int offscreen;            /* view: one frame to --output, no window */
+    int no_ambient;           /* view: B without the ambient term while shooting */
+    const char *keys;         /* view: keys the window presses itself */
 } cli_settings;
 
 /* Where a flag's value goes. */

@@ -327,6 +327,11 @@ typedef struct rad_solve_step {
     double unshot;                /* unshot power / emitted power (shooting); NAN otherwise */
 } rad_solve_step;
 
+/* rad_options.on_step's return value that ends the solve with its iterate kept
+ * as the solution (an interactive "stop here"), where any other nonzero value
+ * interrupts it. */
+#define RAD_STEP_FINISH 2
+
 typedef struct rad_options {
     /* Meshing: elements no longer than mesh_size metres on a side; or, when
      * mesh_size is 0, about target_elements elements in all (default 2000). */
@@ -366,7 +371,10 @@ typedef struct rad_options {
                                      and gauss-seidel, overshooting for southwell; 0 = 1 */
     /* Called after every solver iteration (sweep or shot) with the solution in its
      * current state (rad_solution_render works on it: progressive display).  Return
-     * nonzero to stop the solve early (it then returns RAD_ERROR_INTERRUPTED). */
+     * nonzero to stop the solve early (it then returns RAD_ERROR_INTERRUPTED), or
+     * RAD_STEP_FINISH to end it here with the iterate as its result: the solve
+     * returns RAD_OK, the solution is solved but not converged (rad_solution_warning
+     * says where it stopped) and saves, renders and exports as any other. */
     int (*on_step)(void *user, rad_solution *solution, const struct rad_solve_step *step);
     void *on_step_user;
     int record_history;           /* nonzero: keep every step's residual in the history
@@ -1238,6 +1246,42 @@ typedef struct rad_view_factor_options {
 RAD_API rad_result rad_solution_write_view_factors_with(rad_context *ctx, const rad_solution *solution,
                                                         const char *path,
                                                         const rad_view_factor_options *options);
+
+/* ------------------------------------------------------------------------
+ * Display values and images from pixels (interactive viewers)
+ * ---------------------------------------------------------------------- */
+
+/* What rad_solution_render draws, for a program that draws the mesh itself
+ * (the `radiosity view` window): per element (3 per element, W/m^2 RGB)
+ * and per vertex (3 per vertex), either array may be NULL.  With `ambient`
+ * true they are the renderer's: each element's radiosity plus, for a
+ * partial shooting solution, its reflectance times the ambient term of the
+ * unshot light (Cohen, Chen, Wallace, Greenberg 1988), never below 0, and
+ * the vertex values interpolated from those as rad_solution_vertex_radiosity
+ * interpolates; with `ambient` false the radiosity itself (0 added).  Reads
+ * only: callable from rad_options.on_step on the solver's thread (the
+ * iterate of that step), or at any time on a solution not being solved;
+ * never at the same time as a solve on another thread.  Fails with
+ * RAD_ERROR_OUT_OF_MEMORY; NULL ctx or solution, or both arrays NULL:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_solution_display_radiosity(rad_context *ctx, const rad_solution *solution,
+                                                  bool ambient, double *element_rgb, double *vertex_rgb);
+
+/* The hierarchical solver's links after its last solve (the interactions
+ * it kept between nodes of its hierarchy: the status line's figure, as
+ * element_count is); 0 for the other solvers, before the first solve and
+ * for a NULL solution. */
+RAD_API size_t rad_solution_link_count(const rad_solution *solution);
+
+/* An image made from `width` x `height` RGB radiance triples (W/(m^2 sr),
+ * row 0 at the top), copied: a program's own pictures (an OpenGL frame
+ * read back) then go through rad_image_write_exposed like a rendered one,
+ * the same exposure, sRGB curve and atomic writing.  Destroy it with
+ * rad_image_destroy.  Fails with RAD_ERROR_OUT_OF_MEMORY; a size outside
+ * [1, 16384] or a NULL ctx, rgb or out: RAD_ERROR_INVALID_ARGUMENT (*out
+ * NULL). */
+RAD_API rad_result rad_image_from_pixels(rad_context *ctx, int width, int height, const float *rgb,
+                                         rad_image **out);
 
 #ifdef __cplusplus
 }

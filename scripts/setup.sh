@@ -16,7 +16,8 @@ cd "$(dirname "$0")/.."
 
 packages=(build-essential g++ cmake pkg-config libembree-dev libassimp-dev libstb-dev
           libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev
-          libopenmpi-dev openmpi-bin)
+          libopenmpi-dev openmpi-bin
+          libsdl2-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri)  # the last five: the viewer
 if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
   packages+=(clang-14 libclang-rt-14-dev libomp-14-dev)
 fi

@@ -288,6 +288,7 @@ static void test_null_solution(void **state)
     double xyz[3] = {7, 7, 7}, rgb3[3] = {7, 7, 7};
     size_t corners[4] = {7, 7, 7, 7};
     assert_int_equal(rad_solution_vertex_count(NULL), 0);
+    assert_int_equal(rad_solution_link_count(NULL), 0);
     assert_false(rad_solution_vertex_position(NULL, 0, xyz));
     assert_false(rad_solution_vertex_position(s, 0, NULL));
     assert_int_equal(rad_solution_element_vertices(NULL, 0, corners), 0);
@@ -303,6 +304,12 @@ static void test_null_solution(void **state)
     assert_invalid(rad_solution_vertex_radiosity(NULL, s, vertex_rgb), NULL, "rad_solution_vertex_radiosity");
     assert_invalid(rad_solution_vertex_radiosity(ctx, NULL, vertex_rgb), ctx, "rad_solution_vertex_radiosity");
     assert_invalid(rad_solution_vertex_radiosity(ctx, s, NULL), ctx, "rad_solution_vertex_radiosity");
+    assert_invalid(rad_solution_display_radiosity(NULL, s, true, NULL, vertex_rgb), NULL,
+                   "rad_solution_display_radiosity");
+    assert_invalid(rad_solution_display_radiosity(ctx, NULL, true, NULL, vertex_rgb), ctx,
+                   "rad_solution_display_radiosity");
+    assert_invalid(rad_solution_display_radiosity(ctx, s, true, NULL, NULL), ctx, "rad_solution_display_radiosity");
+    assert_int_equal(rad_solution_display_radiosity(ctx, s, true, NULL, vertex_rgb), RAD_OK);
     free(vertex_rgb);
 
     const char *partial = temp_path("partial.json");
@@ -337,6 +344,17 @@ static void test_null_image(void **state)
     assert_int_equal(rad_image_height(NULL), 0);
     assert_null(rad_image_pixels(NULL));
     assert_true(rad_image_auto_exposure(NULL) == 1.0);
+    float pixel[3] = {1.0f, 2.0f, 3.0f};
+    rad_image *made = (rad_image *)&made; /* not NULL: the call must set it */
+    assert_invalid(rad_image_from_pixels(NULL, 1, 1, pixel, &made), NULL, "rad_image_from_pixels");
+    assert_null(made);
+    made = (rad_image *)&made;
+    assert_invalid(rad_image_from_pixels(ctx, 1, 1, NULL, &made), ctx, "rad_image_from_pixels");
+    assert_null(made);
+    assert_invalid(rad_image_from_pixels(ctx, 1, 1, pixel, NULL), ctx, "rad_image_from_pixels");
+    assert_int_equal(rad_image_from_pixels(ctx, 1, 1, pixel, &made), RAD_OK);
+    assert_true(rad_image_pixels(made)[2] == 3.0f);
+    rad_image_destroy(made);
 
     const char *png = temp_path("image.png");
     assert_invalid(rad_image_write(NULL, f->image, png), NULL, "rad_image_write");

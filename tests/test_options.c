@@ -464,7 +464,8 @@ static void test_generate_takes_the_shared_parser(void **state)
     assert_int_equal(parse("viewfactors", NULL), CLI_RUN);
     assert_string_equal(settings.output, "viewfactors.json");
     assert_int_equal(parse("--rooms", "3", NULL), CLI_USAGE_ERROR);
-    assert_string_equal(err, "--rooms needs a command: render, solve, viewfactors, export, bake, thermal or generate");
+    assert_string_equal(err, "--rooms needs a command: render, solve, viewfactors, export, bake, thermal, generate "
+                             "or view");
 }
 
 /* ---- --help, the man page, the messages ---- */

@@ -13,6 +13,9 @@
  *                 replaces it
  *   cancellation  an atomic flag: a cancelled context interrupts, with
  *                 nothing returned, and runs again once cleared
+ *   early end     on_step's RAD_STEP_FINISH keeps the iterate as a
+ *                 solution that saves; display values with and without
+ *                 the ambient term
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -26,6 +29,8 @@
 #include <string.h>
 
 #include "radiosity.h"
+
+#include <cjson/cJSON.h>
 
 static rad_context *ctx;
 
@@ -210,6 +215,7 @@ static void test_hierarchical_elements_are_leaves(void **state)
     rad_solution *s = NULL;
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     size_t patches = rad_solution_element_count(s);
+    assert_int_equal(rad_solution_link_count(s), 0); /* not solved yet */
     /* One element per patch: the polygons (coplanar triangle pairs merged
      * into quads), the floor cut along the blocks' footprints. */
     assert_true(patches >= rad_scene_surface_count(scene) && patches <= 2 * rad_scene_polygon_count(scene));
@@ -222,6 +228,23 @@ static void test_hierarchical_elements_are_leaves(void **state)
     for (size_t j = 0; j < rad_scene_surface_count(scene); j++)
         want += rad_scene_surface_area(scene, j);
     assert_true(fabs(total - want) < 1e-6 * want);
+    /* Its links: the stats file's count. */
+    const char *stats = "/tmp/test_solution_links.json";
+    assert_int_equal(rad_solution_write_stats(ctx, s, stats, false), RAD_OK);
+    FILE *f = fopen(stats, "rb");
+    assert_non_null(f);
+    static char text[1 << 20];
+    size_t size = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    remove(stats);
+    text[size] = '\0';
+    cJSON *json = cJSON_Parse(text);
+    const cJSON *links = cJSON_GetObjectItem(cJSON_GetObjectItem(cJSON_GetObjectItem(json, "solver"), "hierarchical"),
+                                             "links");
+    assert_true(cJSON_IsNumber(links));
+    assert_true(rad_solution_link_count(s) > 0);
+    assert_true((double)rad_solution_link_count(s) == links->valuedouble);
+    cJSON_Delete(json);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);
 }
@@ -323,6 +346,112 @@ static void test_cancellation_flag(void **state)
     rad_scene_destroy(scene);
     rad_context_cancel(NULL, true); /* no-op */
     assert_false(rad_context_cancelled(NULL));
+}
+
+/* on_step's answers: RAD_STEP_FINISH at step `finish_at` ends the solve
+ * with its iterate as the solution; 1 at `interrupt_at` interrupts it. */
+typedef struct step_stopper {
+    int finish_at, interrupt_at, last;
+} step_stopper;
+
+static int stop_at(void *user, rad_solution *solution, const rad_solve_step *step)
+{
+    step_stopper *s = user;
+    (void)solution;
+    s->last = step->iteration;
+    if (step->iteration == s->finish_at)
+        return RAD_STEP_FINISH;
+    return step->iteration == s->interrupt_at ? 1 : 0;
+}
+
+/* An interactive stop (the viewer's Backspace): the iterate of the step
+ * that said RAD_STEP_FINISH is the result, solved and not converged, and
+ * saves; any other nonzero answer still interrupts, and an interrupted
+ * solve is not saved.  The display values: without the ambient term the
+ * vertex values are rad_solution_vertex_radiosity's to the bit; with it,
+ * a partial shooting solution is brighter (the unshot light), never
+ * darker, while a converged Gauss-Seidel one is unchanged. */
+static void test_step_finish_keeps_the_iterate(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    const char *solvers[] = {"shooting", "gauss-seidel"};
+    for (int k = 0; k < 2; k++) {
+        step_stopper stopper = {.finish_at = 4};
+        rad_options o = {.solver = solvers[k], .target_elements = 300, .on_step = stop_at, .on_step_user = &stopper};
+        rad_solution *s = NULL;
+        assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+        assert_int_equal(stopper.last, 4);
+        assert_false(rad_solution_converged(s));
+        assert_non_null(strstr(rad_solution_warning(s), "after 4 iterations"));
+        char path[64];
+        snprintf(path, sizeof path, "/tmp/test_solution_finish_%d.radsol", k);
+        assert_int_equal(rad_solution_save(ctx, s, path), RAD_OK);
+        /* The file says so too: read back, it is not converged and gives the
+         * same warning. */
+        rad_scene *loaded_scene = NULL;
+        rad_solution *loaded = NULL;
+        assert_int_equal(rad_solution_load_file(ctx, path, &loaded_scene, &loaded), RAD_OK);
+        assert_false(rad_solution_converged(loaded));
+        assert_string_equal(rad_solution_warning(loaded), rad_solution_warning(s));
+        rad_solution_destroy(loaded);
+        rad_scene_destroy(loaded_scene);
+        remove(path);
+        /* And the stats: not converged, the warning given. */
+        snprintf(path, sizeof path, "/tmp/test_solution_finish_%d.json", k);
+        assert_int_equal(rad_solution_write_stats(ctx, s, path, false), RAD_OK);
+        FILE *f = fopen(path, "rb");
+        assert_non_null(f);
+        static char text[1 << 20];
+        size_t size = fread(text, 1, sizeof text - 1, f);
+        fclose(f);
+        remove(path);
+        text[size] = '\0';
+        cJSON *json = cJSON_Parse(text);
+        const cJSON *solver = cJSON_GetObjectItem(json, "solver");
+        assert_true(cJSON_IsFalse(cJSON_GetObjectItem(solver, "converged")));
+        assert_string_equal(cJSON_GetStringValue(cJSON_GetObjectItem(solver, "warning")), rad_solution_warning(s));
+        cJSON_Delete(json);
+        snprintf(path, sizeof path, "/tmp/test_solution_finish_%d.radsol", k);
+
+        size_t nv = rad_solution_vertex_count(s), ne = rad_solution_element_count(s);
+        double *plain = malloc(3 * nv * sizeof *plain), *vertex = malloc(3 * nv * sizeof *vertex);
+        double *with = malloc(3 * ne * sizeof *with), *without = malloc(3 * ne * sizeof *without);
+        assert_int_equal(rad_solution_vertex_radiosity(ctx, s, plain), RAD_OK);
+        assert_int_equal(rad_solution_display_radiosity(ctx, s, false, without, vertex), RAD_OK);
+        assert_memory_equal(plain, vertex, 3 * nv * sizeof *plain);
+        assert_int_equal(rad_solution_display_radiosity(ctx, s, true, with, NULL), RAD_OK);
+        int brighter = 0;
+        for (size_t i = 0; i < 3 * ne; i++) {
+            assert_true(with[i] >= without[i]);
+            brighter += with[i] > without[i];
+        }
+        if (k == 0)
+            assert_true(brighter > 0); /* four shots leave light unshot */
+
+        /* Interrupted (1) instead: not a solution to save. */
+        stopper = (step_stopper){.interrupt_at = 2};
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_ERROR_INTERRUPTED);
+        assert_int_equal(rad_solution_save(ctx, s, path), RAD_ERROR_INVALID_ARGUMENT);
+        /* And with no stop it converges: the early end left nothing behind. */
+        stopper = (step_stopper){0};
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+        assert_true(rad_solution_converged(s));
+        assert_string_equal(rad_solution_warning(s), "");
+        if (k == 1) {
+            assert_int_equal(rad_solution_display_radiosity(ctx, s, true, with, NULL), RAD_OK);
+            assert_int_equal(rad_solution_display_radiosity(ctx, s, false, without, NULL), RAD_OK);
+            assert_memory_equal(with, without, 3 * ne * sizeof *with); /* no ambient term */
+        }
+        free(plain);
+        free(vertex);
+        free(with);
+        free(without);
+        rad_solution_destroy(s);
+    }
+    rad_scene_destroy(scene);
 }
 
 /* Factors that make up power.  Monte Carlo at 16 samples on polygons that
@@ -502,6 +631,7 @@ int main(void)
         cmocka_unit_test(test_first_error_kept_and_reported_once),
         cmocka_unit_test(test_unconverged_is_reported),
         cmocka_unit_test(test_cancellation_flag),
+        cmocka_unit_test(test_step_finish_keeps_the_iterate),
         cmocka_unit_test(test_diverged_solution_refused),
         cmocka_unit_test(test_point_radiosity),
     };

@@ -19,6 +19,10 @@
 static void refresh_view(rad_solution *s)
 {
     s->strategy->view(s->state, &s->view);
+    /* on_step ended it: the iterate is the result, with its own warning */
+    s->view.ended_early = s->finished_early ? s->finish_warning : NULL;
+    if (s->finished_early)
+        s->view.solved = true;
     s->view.scene = s->scene;
     s->view.options = &s->options;
     s->view.threads = s->threads;
@@ -88,7 +92,10 @@ static int on_strategy_step(void *user, const rad_solve_step *step, bool display
         refresh_view(s);
         rad_free(s->point_values);
         s->point_values = NULL;
-        return s->options.on_step(s->options.on_step_user, s, step);
+        int stop = s->options.on_step(s->options.on_step_user, s, step);
+        if (stop == RAD_STEP_FINISH)
+            s->finish_asked = true;
+        return stop;
     }
     return 0;
 }
@@ -149,7 +156,17 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     s->vertex_radiosity = NULL;
     rad_free(s->point_values);
     s->point_values = NULL;
+    s->finish_asked = s->finished_early = false;
     rad_result r = s->strategy->solve(ctx, s->state, &hook);
+    if (r == RAD_ERROR_INTERRUPTED && s->finish_asked && !rad_context_cancelled(ctx)) {
+        /* Ended by on_step with RAD_STEP_FINISH: a result, not an interruption. */
+        s->finished_early = true;
+        r = RAD_OK;
+        size_t last = s->history_count;
+        snprintf(s->finish_warning, sizeof s->finish_warning,
+                 "the solve was ended by on_step (RAD_STEP_FINISH) after %d iterations, before its tolerance",
+                 last ? s->history[last - 1].iteration : s->view.solve->iterations);
+    }
     refresh_view(s);
     if (r == RAD_OK)
         r = check_bounded(ctx, &s->view);
@@ -199,9 +216,14 @@ void rad_solution_destroy(rad_solution *s)
 size_t rad_solution_element_count(const rad_solution *s) { return s ? s->view.n : 0; }
 double rad_solution_residual(const rad_solution *s) { return s ? s->view.solve->residual : NAN; }
 int rad_solution_iterations(const rad_solution *s) { return s ? s->view.solve->iterations : 0; }
-bool rad_solution_converged(const rad_solution *s) { return s && s->view.solved && s->view.solve->converged; }
+bool rad_solution_converged(const rad_solution *s)
+{
+    return s && s->view.solved && !s->finished_early && s->view.solve->converged;
+}
 const char *rad_solution_warning(const rad_solution *s)
 {
+    if (s && s->finished_early)
+        return s->finish_warning;
     return s && s->view.solved && !s->view.solve->converged ? s->view.solve->warning : "";
 }
 
@@ -309,6 +331,20 @@ bool rad_solution_element_values(const rad_solution *s, size_t element, double r
     return true;
 }
 
+/* Each element's radiosity plus the ambient term of a partial shooting
+ * solution, in display (3n).  Never below 0: overshooting (Southwell with
+ * relaxation above 1) makes the unshot light, and so the ambient term,
+ * negative on purpose.  Cannot fail. */
+static void display_elements(const rad_solution *s, double *display)
+{
+    size_t n = s->view.mesh->element_count;
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++)
+            display[3 * i + c] = fmax(s->view.radiosity[3 * i + c] +
+                                          s->view.reflectance[3 * i + c] * s->view.solve->ambient[c],
+                                      0.0);
+}
+
 /* What is displayed: each element's radiosity (plus the ambient term of a
  * partial shooting solution) in *display (3n, rad_free it), and the vertex
  * values interpolated from it in s->vertex_radiosity. */
@@ -318,13 +354,7 @@ static rad_result display_values(rad_context *ctx, rad_solution *s, double **dis
     double *display = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *display, "render: element values");
     if (!display)
         return RAD_ERROR_OUT_OF_MEMORY;
-    /* Never below 0: overshooting (Southwell with relaxation above 1) makes
-     * the unshot light, and so the ambient term, negative on purpose. */
-    for (size_t i = 0; i < n; i++)
-        for (int c = 0; c < 3; c++)
-            display[3 * i + c] = fmax(s->view.radiosity[3 * i + c] +
-                                          s->view.reflectance[3 * i + c] * s->view.solve->ambient[c],
-                                      0.0);
+    display_elements(s, display);
     rad_free(s->vertex_radiosity);
     s->vertex_radiosity = rad_alloc(ctx, RAD_MEM_RENDER, 3 * s->view.mesh->vertex_count, sizeof *s->vertex_radiosity,
                                     "render: vertex values");
@@ -714,3 +744,31 @@ bool rad_method_info(rad_method_kind kind, size_t index, const char **name, cons
         *description = method_description;
     return true;
 }
+
+rad_result rad_solution_display_radiosity(rad_context *ctx, const rad_solution *s, bool ambient,
+                                          double *element_rgb, double *vertex_rgb)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !s || (!element_rgb && !vertex_rgb))
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+    size_t n = s->view.mesh->element_count;
+    if (!ambient) {
+        if (element_rgb)
+            memcpy(element_rgb, s->view.radiosity, 3 * n * sizeof *element_rgb);
+        return vertex_rgb ? rad_vertex_values(ctx, s->view.mesh, s->view.radiosity, vertex_rgb) : RAD_OK;
+    }
+    double *display = element_rgb;
+    if (!display) {
+        display = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *display, "display: element values");
+        if (!display)
+            return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    display_elements(s, display);
+    rad_result r = vertex_rgb ? rad_vertex_values(ctx, s->view.mesh, display, vertex_rgb) : RAD_OK;
+    if (display != element_rgb)
+        rad_free(display);
+    return r;
+}
+
+size_t rad_solution_link_count(const rad_solution *s) { return s && s->view.hier ? s->view.hier->links : 0; }

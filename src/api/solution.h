@@ -25,6 +25,9 @@ struct rad_solution {
     bool history_failed;           /* the history could not grow (out of memory) */
     double *vertex_radiosity;      /* 3 per vertex of view.mesh, computed on demand: what is
                                       displayed (a partial shooting solution's ambient added) */
+    bool finish_asked;             /* on_step returned RAD_STEP_FINISH in this solve */
+    bool finished_early;           /* ...and the solve ended there: the iterate is the solution */
+    char finish_warning[192];      /* rad_solution_warning then */
     double *point_values;          /* 3 per vertex: the radiosity itself, for point queries
                                       (computed on the first one after a solve) */
 };

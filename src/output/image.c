@@ -61,6 +61,24 @@ rad_image *rad_image_create(rad_context *ctx, int width, int height)
     return image;
 }
 
+rad_result rad_image_from_pixels(rad_context *ctx, int width, int height, const float *rgb, rad_image **out)
+{
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !rgb || !out)
+        return rad_null_argument(ctx, __func__);
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "image: size %d x %d outside [1, 16384]", width,
+                        height);
+    rad_image *image = rad_image_create(ctx, width, height);
+    if (!image)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    memcpy(image->pixels, rgb, (size_t)width * (size_t)height * 3 * sizeof *rgb);
+    *out = image;
+    return RAD_OK;
+}
+
 void rad_image_destroy(rad_image *image)
 {
     if (!image)

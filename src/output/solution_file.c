@@ -131,13 +131,13 @@ static cJSON *solution_json(rad_context *ctx, const rad_solution_view *v, rad_re
         cJSON_AddNumberToObject(json, "iteration_limit", v->solve->iteration_limit);
     if (isfinite(v->solve->residual))
         cJSON_AddNumberToObject(json, "residual", v->solve->residual);
-    cJSON_AddBoolToObject(json, "converged", v->solve->converged);
+    cJSON_AddBoolToObject(json, "converged", v->solve->converged && !v->ended_early);
     if (isfinite(v->solve->unshot))
         cJSON_AddNumberToObject(json, "unshot", v->solve->unshot);
     cJSON_AddItemToObject(json, "ambient", numbers(v->solve->ambient, 3));
     cJSON_AddNumberToObject(json, "emitted_W", emitted);
     cJSON_AddNumberToObject(json, "absorbed_W", absorbed);
-    cJSON_AddStringToObject(json, "warning", v->solve->warning);
+    cJSON_AddStringToObject(json, "warning", v->ended_early ? v->ended_early : v->solve->warning);
     return json;
 }
 

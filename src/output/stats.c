@@ -223,7 +223,7 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
     cJSON *so = cJSON_AddObjectToObject(root, "solver");
     cJSON_AddStringToObject(so, "method", s->options->solver);
     cJSON_AddBoolToObject(so, "solved", s->solved);
-    cJSON_AddBoolToObject(so, "converged", s->solve->converged);
+    cJSON_AddBoolToObject(so, "converged", s->solve->converged && !s->ended_early);
     cJSON_AddNumberToObject(so, "iterations", s->solve->iterations);
     cJSON_AddNumberToObject(so, "iteration_limit", s->solve->iteration_limit);
     cJSON_AddNumberToObject(so, "residual", s->solve->residual);
@@ -231,7 +231,9 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
     cJSON_AddNumberToObject(so, "relaxation", s->options->relaxation);
     if (!isnan(s->solve->unshot))
         cJSON_AddNumberToObject(so, "unshot", s->solve->unshot);
-    if (s->solved && !s->solve->converged && s->solve->warning[0])
+    if (s->ended_early)
+        cJSON_AddStringToObject(so, "warning", s->ended_early);
+    else if (s->solved && !s->solve->converged && s->solve->warning[0])
         cJSON_AddStringToObject(so, "warning", s->solve->warning);
     cJSON_AddNumberToObject(so, "components", (double)s->solve->components);
     cJSON_AddNumberToObject(so, "components_lit", (double)s->solve->components_lit);

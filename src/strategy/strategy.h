@@ -53,6 +53,8 @@ typedef struct rad_solution_view {
     const rad_hier_stats *hier;     /* hierarchical only, else NULL */
     const struct rad_adaptive_stats *adaptive; /* dense with adaptive subdivision, else NULL */
     bool solved;
+    const char *ended_early;        /* the solve was ended by on_step (RAD_STEP_FINISH): why, in
+                                       place of solve->warning, and not converged; else NULL */
     rad_phase_seconds seconds;
     uint64_t render_rays;
 } rad_solution_view;
