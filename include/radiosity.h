@@ -939,7 +939,13 @@ typedef enum rad_thermal_condition {
     RAD_THERMAL_UNSET = 0,         /* no condition given (refused by rad_thermal_solve) */
     RAD_THERMAL_TEMPERATURE = 1,   /* value: T, K, finite, >= 0 */
     RAD_THERMAL_HEAT_FLUX = 2,     /* value: net flux leaving the surface, W/m^2, finite */
-    RAD_THERMAL_ADIABATIC = 3      /* q = 0: a re-radiating surface (value unused) */
+    RAD_THERMAL_ADIABATIC = 3,     /* q = 0: a re-radiating surface (value unused) */
+    /* A View3D obstruction-only surface (or mask): it blocks radiation and
+     * takes no part in the exchange; what it intercepts reaches the
+     * environment (a black surface at the environment temperature, its power
+     * counted as the environment's).  Set for those surfaces when the
+     * conditions are made; cannot be set or given otherwise. */
+    RAD_THERMAL_OBSTRUCTION = 4
 } rad_thermal_condition;
 
 typedef struct rad_thermal_surface {

@@ -590,6 +590,58 @@ static void test_long_duct(void **state)
     rad_context_destroy(ctx);
 }
 
+/* ---- View3D obstruction-only surfaces: they block and take no part ---- */
+
+/* A plate under an obstruction-only square: whatever the plate sends
+ * reaches the obstruction or escapes, both the environment, so its net
+ * power is exactly eps sigma (T^4 - T_env^4) A however much the square
+ * intercepts.  Treated as a surface of the exchange (re-radiating, or at
+ * any other temperature) it would send some back and change Q. */
+static void test_obstruction_surfaces(void **state)
+{
+    (void)state;
+    static const char vs3[] = "T plate under an obstruction\nC encl=0\nF 3\n"
+                              "V 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 0 1 0\n"
+                              "V 5 -.5 -.5 .2\nV 6 -.5 1.5 .2\nV 7 1.5 1.5 .2\nV 8 1.5 -.5 .2\n"
+                              "S 1 1 2 3 4 0 0 0.7 plate\nO 2 5 6 7 8 0 0 0.5 lid\nE\n";
+    rad_context *ctx = context();
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "lid.vs3", vs3, strlen(vs3), NULL, 0, &scene), RAD_OK);
+    rad_thermal_conditions *c = NULL;
+    const char *named = "{\"surfaces\": {\"plate\": {\"temperature\": 900}, \"lid\": {\"adiabatic\": true}}}";
+    assert_int_equal(rad_thermal_conditions_load_memory(ctx, scene, "bc.json", named, strlen(named), &c),
+                     RAD_ERROR_PARSE);
+    assert_non_null(strstr(rad_context_error(ctx), "surfaces.lid: an obstruction-only surface takes no condition"));
+    const char *bc = "{\"environment_temperature\": 300, \"default\": {\"temperature\": 900}}";
+    assert_int_equal(rad_thermal_conditions_load_memory(ctx, scene, "bc.json", bc, strlen(bc), &c), RAD_OK);
+    rad_thermal_surface lid;
+    assert_true(rad_thermal_conditions_get(c, 1, &lid));
+    assert_int_equal(lid.condition, RAD_THERMAL_OBSTRUCTION);
+    assert_int_equal(rad_thermal_conditions_set(ctx, c, 1, &(rad_thermal_surface){RAD_THERMAL_ADIABATIC, 0, 0.5}),
+                     RAD_ERROR_INVALID_ARGUMENT);
+    rad_options o = {0};
+    o.solver = "gauss-seidel";
+    o.target_elements = 50;
+    rad_solution *sol = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &sol), RAD_OK);
+    rad_thermal *t = NULL;
+    assert_int_equal(rad_thermal_solve(ctx, sol, c, NULL, &t), RAD_OK);
+    rad_thermal_values plate;
+    assert_true(rad_thermal_surface_values(t, 0, &plate));
+    double exact = 0.7 * RAD_SIGMA * (pow(900.0, 4) - pow(300.0, 4)) * 1.0;
+    print_message("plate under an obstruction: Q = %.12g W, exact %.12g W\n", plate.heat, exact);
+    assert_true(rel(plate.heat, exact) < 1e-9);
+    rad_thermal_balance b;
+    rad_thermal_get_balance(t, &b);
+    assert_true(rel(b.net_power, plate.heat) < 1e-12);    /* the lid's power is not summed */
+    assert_true(fabs(b.relative_imbalance) < 1e-9);       /* all of it reaches the environment */
+    rad_thermal_destroy(t);
+    rad_thermal_conditions_destroy(c);
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* ---- bad boundary-condition files: one line naming the file and the key ---- */
 
 static void test_bad_conditions(void **state)
@@ -811,6 +863,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_box_through_library),
         cmocka_unit_test(test_agrees_with_the_radiosity_solve),
         cmocka_unit_test(test_long_duct),
+        cmocka_unit_test(test_obstruction_surfaces),
         cmocka_unit_test(test_bad_conditions),
         cmocka_unit_test(test_command),
     };

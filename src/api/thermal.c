@@ -31,6 +31,9 @@ rad_result rad_thermal_conditions_create(rad_context *ctx, const rad_scene *scen
     c->scene = scene;
     c->surface_count = scene->surface_count;
     c->surfaces = s;
+    for (size_t k = 0; k < scene->surface_count; k++)
+        if (scene->surfaces[k].obstruction || scene->surfaces[k].mask)
+            s[k].condition = RAD_THERMAL_OBSTRUCTION;
     *out = c;
     return RAD_OK;
 }
@@ -81,6 +84,9 @@ rad_result rad_thermal_conditions_set(rad_context *ctx, rad_thermal_conditions *
     if (surface >= c->surface_count)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: surface %zu of %zu", __func__, surface,
                         c->surface_count);
+    if (c->surfaces[surface].condition == RAD_THERMAL_OBSTRUCTION)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: surface '%s' is obstruction-only: it takes no "
+                        "condition", __func__, c->scene->surfaces[surface].name);
     char why[160];
     if (!rad_thermal_surface_valid(s, why, sizeof why))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: surface '%s': %s", __func__,
@@ -131,6 +137,7 @@ void rad_thermal_destroy(rad_thermal *t)
     rad_free(t->fields.temperature);
     rad_free(t->surfaces);
     rad_free(t->element_condition);
+    rad_free(t->environment);
     rad_free(t);
 }
 
@@ -213,9 +220,10 @@ rad_result rad_thermal_solve(rad_context *ctx, const rad_solution *solution, con
     t->fields.temperature = rad_alloc(ctx, RAD_MEM_SOLVER, m, sizeof(double), "thermal: temperature");
     t->surfaces = rad_alloc(ctx, RAD_MEM_SOLVER, S ? S : 1, sizeof *t->surfaces, "thermal: surfaces");
     t->element_condition = rad_alloc(ctx, RAD_MEM_SOLVER, m, sizeof *t->element_condition, "thermal: conditions");
+    t->environment = rad_alloc(ctx, RAD_MEM_SOLVER, m, 1, "thermal: conditions");
     if (!t->emissivity || !t->value || !t->known_temperature || !t->surface || !t->surface_names ||
         !t->fields.radiosity || !t->fields.irradiation || !t->fields.heat_flux || !t->fields.temperature ||
-        !t->surfaces || !t->element_condition) {
+        !t->surfaces || !t->element_condition || !t->environment) {
         rad_thermal_destroy(t);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -234,9 +242,16 @@ rad_result rad_thermal_solve(rad_context *ctx, const rad_solution *solution, con
         t->known_temperature[i] = s->condition == RAD_THERMAL_TEMPERATURE;
         t->value[i] = s->condition == RAD_THERMAL_ADIABATIC ? 0.0 : s->value;
         t->element_condition[i] = s->condition;
+        t->environment[i] = s->condition == RAD_THERMAL_OBSTRUCTION;
+        if (t->environment[i]) { /* black, at the environment's temperature */
+            t->emissivity[i] = 1.0;
+            t->known_temperature[i] = 1;
+            t->value[i] = c->environment_temperature;
+        }
     }
     t->sys = (rad_thermal_system){.n = n, .F = v->F, .area = v->area, .emissivity = t->emissivity,
                                   .known_temperature = t->known_temperature, .value = t->value,
+                                  .environment = t->environment,
                                   .environment_temperature = c->environment_temperature, .surface = t->surface,
                                   .surface_names = t->surface_names, .source = c->source, .threads = solution->threads,
                                   .max_memory = solution->options.max_memory_bytes};

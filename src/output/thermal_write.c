@@ -15,6 +15,7 @@ static const char *condition_name(rad_thermal_condition c)
     case RAD_THERMAL_TEMPERATURE: return "temperature";
     case RAD_THERMAL_HEAT_FLUX: return "heat_flux";
     case RAD_THERMAL_ADIABATIC: return "adiabatic";
+    case RAD_THERMAL_OBSTRUCTION: return "obstruction";
     case RAD_THERMAL_UNSET: break;
     }
     return "none";

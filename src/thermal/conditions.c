@@ -42,6 +42,7 @@ bool rad_thermal_surface_valid(const rad_thermal_surface *s, char *why, size_t s
         }
         return true;
     case RAD_THERMAL_ADIABATIC: return true;
+    case RAD_THERMAL_OBSTRUCTION: snprintf(why, size, "obstruction-only surfaces take no condition"); return false;
     case RAD_THERMAL_UNSET: break;
     }
     snprintf(why, size, "no condition: give temperature, heat_flux or \"adiabatic\": true");
@@ -149,6 +150,10 @@ static rad_result parse_tree(rad_context *ctx, const char *name, const cJSON *ro
         if (k == SIZE_MAX)
             return rad_fail(ctx, RAD_ERROR_PARSE, "%s: surfaces.%.200s: the scene %s has no surface of that name",
                             name, item->string, scene->source ? scene->source : "");
+        if (c->surfaces[k].condition == RAD_THERMAL_OBSTRUCTION)
+            return rad_fail(ctx, RAD_ERROR_PARSE, "%s: surfaces.%.200s: an obstruction-only surface takes no "
+                            "condition (it only blocks; what it intercepts reaches the environment)",
+                            name, item->string);
         if (c->surfaces[k].condition != RAD_THERMAL_UNSET)
             return rad_fail(ctx, RAD_ERROR_PARSE, "%s: surfaces.%.200s: given twice", name, item->string);
         char where[256];

@@ -157,9 +157,12 @@ rad_result rad_thermal_solve_system(rad_context *ctx, const rad_thermal_system *
         out->radiosity[i] = B[3 * i] - B[3 * i + 1];
     for (size_t i = 0; i < n && r == RAD_OK; i++) {
         const double *Fi = sys->F + i * n;
-        double g = 0.0;
-        for (size_t j = 0; j < n; j++)
+        double g = 0.0, to_environment = 1.0 - row_sum[i]; /* and to obstruction surfaces */
+        for (size_t j = 0; j < n; j++) {
             g += Fi[j] * out->radiosity[j];
+            if (sys->environment && sys->environment[j])
+                to_environment += Fi[j];
+        }
         g += (1.0 - row_sum[i]) * env;
         double J = out->radiosity[i], q = J - g;
         out->irradiation[i] = g;
@@ -184,10 +187,12 @@ rad_result rad_thermal_solve_system(rad_context *ctx, const rad_thermal_system *
             }
             out->temperature[i] = t4 > 0.0 ? pow(t4 / RAD_SIGMA, 0.25) : 0.0;
         }
+        if (sys->environment && sys->environment[i])
+            continue;
         double Q = sys->area[i] * q;
         b.net_power += Q;
         b.power_scale += fabs(Q);
-        b.environment_power += sys->area[i] * (1.0 - row_sum[i]) * (J - env);
+        b.environment_power += sys->area[i] * to_environment * (J - env);
     }
     b.imbalance = b.net_power - b.environment_power;
     b.relative_imbalance = b.power_scale > 0.0 ? b.imbalance / b.power_scale : 0.0;

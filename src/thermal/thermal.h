@@ -72,6 +72,11 @@ typedef struct rad_thermal_system {
     const unsigned char *known_temperature; /* n: 1 = value is T (K), 0 = value is q (W/m^2) */
     const double *value;            /* n: K or W/m^2 */
     double environment_temperature; /* K, >= 0 */
+    /* n, or NULL (none): 1 = part of the environment (an obstruction-only
+     * surface: black, at the environment temperature, given so in
+     * known_temperature, value and emissivity); its Q is not summed, and
+     * what others send it counts as reaching the environment. */
+    const unsigned char *environment;
     /* For messages: the surface of each element and the surfaces' names
      * (either may be NULL: elements are then named by number). */
     const uint32_t *surface;
@@ -147,6 +152,7 @@ struct rad_thermal {
     rad_thermal_fields fields;      /* n each */
     rad_thermal_values *surfaces;   /* S */
     rad_thermal_condition *element_condition; /* n */
+    unsigned char *environment;           /* n: obstruction-only elements (rad_thermal_system.environment) */
     rad_thermal_balance balance;
 };
 
