@@ -83,7 +83,7 @@ typedef struct galerkin_state {
     double *node_radiosity;    /* 3 dofs, W/m^2: the solution */
     vec3 *point;               /* collocation: dofs points (vertices moved into their surface) */
     vec3 *point_normal;        /* collocation: dofs */
-    double *point_lift;        /* collocation: dofs, m: shadow rays leave the point this far off it */
+    vec3 *ray_origin;          /* collocation: dofs, where its shadow rays start (collocation_points) */
 } galerkin_state;
 
 /* ---- the basis on one element, in its parameters (u, v) ----
@@ -331,12 +331,11 @@ static void inner_integral(const element_geometry *f, int nodes, vec3 x, vec3 nx
     inner_region(f, nodes, x, nx, &whole, 0, max_depth, I, evaluations);
 }
 
-/* Fraction of rays from the point x (normal nx, lifted by `lift` along
- * it: the bend of its element above rad_vis_epsilon, as rad_ff_end_element
- * lifts a bent quad's points off the flat pieces the ray backend builds)
- * to f's 2 x 2 Gauss points (lifted by f's own) that pass; 1 without a ray
+/* Fraction of rays from `from` (a point lifted off its surface, normal
+ * nx) to f's Gauss points (lifted by f's own lift, pulled toward its
+ * centroid as rad_ff_end_element's ends) that pass; 1 without a ray
  * structure or when none faces. */
-static double point_visibility(const galerkin_state *st, vec3 x, vec3 nx, double lift, const element_geometry *f,
+static double point_visibility(const galerkin_state *st, vec3 from, vec3 nx, const element_geometry *f,
                                uint64_t *rays)
 {
     const rad_vis *vis = st->base.vis;
@@ -349,7 +348,6 @@ static double point_visibility(const galerkin_state *st, vec3 x, vec3 nx, double
     rad_ray ray[MAX_POINTS];
     uint8_t occluded[MAX_POINTS];
     int cast = 0;
-    vec3 from = v3_add(x, v3_scale(nx, lift));
     for (int q = 0; q < count; q++) {
         vec3 y = point_at(f, uv[q][0], uv[q][1]);
         y = v3_add(v3_add(y, v3_scale(f->normal, eps)), v3_scale(v3_normalize(v3_sub(f->centroid, y)), eps));
@@ -626,9 +624,11 @@ static rad_result collocation_points(rad_context *ctx, galerkin_state *st)
     const rad_mesh *mesh = st->base.mesh;
     double *count = rad_alloc(ctx, RAD_MEM_SOLVER, st->dofs + 1, sizeof *count, "collocation: points");
     vec3 *centre = rad_alloc(ctx, RAD_MEM_SOLVER, st->dofs + 1, sizeof *centre, "collocation: points");
-    if (!count || !centre) {
+    double *lift = rad_alloc(ctx, RAD_MEM_SOLVER, st->dofs + 1, sizeof *lift, "collocation: points");
+    if (!count || !centre || !lift) {
         rad_free(count);
         rad_free(centre);
+        rad_free(lift);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     for (uint32_t e = 0; e < mesh->element_count; e++) {
@@ -638,7 +638,7 @@ static rad_result collocation_points(rad_context *ctx, galerkin_state *st)
             count[i] += 1.0;
             centre[i] = v3_add(centre[i], el->centroid);
             st->point_normal[i] = v3_add(st->point_normal[i], el->normal);
-            st->point_lift[i] = fmax(st->point_lift[i], rad_vis_epsilon(mesh) + rad_element_bend(mesh, el));
+            lift[i] = fmax(lift[i], rad_vis_epsilon(mesh) + rad_element_bend(mesh, el));
         }
     }
     for (size_t i = 0; i < st->dofs; i++) {
@@ -647,12 +647,23 @@ static rad_result collocation_points(rad_context *ctx, galerkin_state *st)
             vec3 toward = v3_sub(v3_scale(centre[i], 1.0 / count[i]), v);
             st->point[i] = v3_add(v, v3_scale(toward, 1e-6));
             st->point_normal[i] = v3_normalize(st->point_normal[i]);
+            /* Shadow rays start off the surface by the lift and twice that
+             * into it: lifted only, a point beside an edge where the
+             * surfaces meet at less than 90 degrees (a tetrahedron's 70.5)
+             * would start behind the other surface. */
+            /* Inside a surface the elements' centroids average to the
+             * vertex itself, and `toward` is rounding: no pull there. */
+            vec3 n = st->point_normal[i], along = v3_sub(toward, v3_scale(n, v3_dot(n, toward)));
+            double d = v3_length(along);
+            vec3 in = d > 1e-3 * lift[i] ? v3_scale(along, 2.0 * lift[i] / d) : (vec3){0, 0, 0};
+            st->ray_origin[i] = v3_add(v3_add(st->point[i], v3_scale(st->point_normal[i], lift[i])), in);
         } else {
-            st->point[i] = v;
+            st->point[i] = st->ray_origin[i] = v;
         }
     }
     rad_free(count);
     rad_free(centre);
+    rad_free(lift);
     return RAD_OK;
 }
 
@@ -692,7 +703,7 @@ static rad_result assemble_collocation(rad_context *ctx, galerkin_state *st)
             if (!(I[0] + I[1] + I[2] + I[3] > 0.0))
                 continue;
             pairs++;
-            double V = point_visibility(st, x, nx, st->point_lift[k], &gf, &rays);
+            double V = point_visibility(st, st->ray_origin[k], nx, &gf, &rays);
             for (uint32_t b = 0; b < fe->vertex_count; b++)
                 row[fe->vertex[b]] += V * I[b];
         }
@@ -742,7 +753,7 @@ static void galerkin_destroy(void *state)
     rad_free(st->node_radiosity);
     rad_free(st->point);
     rad_free(st->point_normal);
-    rad_free(st->point_lift);
+    rad_free(st->ray_origin);
     rad_free(st);
 }
 
@@ -796,10 +807,10 @@ static rad_result galerkin_create(rad_context *ctx, const rad_scene *scene, cons
     if (st->method == GALERKIN_COLLOCATION) {
         st->point = rad_alloc(ctx, RAD_MEM_SOLVER, d, sizeof *st->point, "collocation: points");
         st->point_normal = rad_alloc(ctx, RAD_MEM_SOLVER, d, sizeof *st->point_normal, "collocation: normals");
-        st->point_lift = rad_alloc(ctx, RAD_MEM_SOLVER, d, sizeof *st->point_lift, "collocation: lifts");
+        st->ray_origin = rad_alloc(ctx, RAD_MEM_SOLVER, d, sizeof *st->ray_origin, "collocation: ray origins");
     }
     if (!st->K || !st->mass || !st->node_mass || !st->node_reflectance || !st->load || !st->node_radiosity ||
-        (st->method == GALERKIN_COLLOCATION && (!st->point || !st->point_normal || !st->point_lift))) {
+        (st->method == GALERKIN_COLLOCATION && (!st->point || !st->point_normal || !st->ray_origin))) {
         galerkin_destroy(st);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
