@@ -466,9 +466,9 @@ rad_result rad_solution_save(rad_context *ctx, rad_solution *s, const char *path
      * unknowns would come back as another solution. */
     if (s->view.vertex_radiosity)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: solver '%s' solves for vertex values, which a solution file does not hold "
-                        "(it keeps element values): not saved",
-                        path, s->options.solver);
+                        "solution file: solver '%s' solves for vertex values, which a solution file "
+                        "does not hold (it keeps element values): not saved",
+                        s->options.solver);
     double *display = NULL;
     rad_result r = display_values(ctx, s, &display);
     if (r == RAD_OK)
