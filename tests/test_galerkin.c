@@ -361,6 +361,44 @@ static void test_cornell_constant_matches_dense(void **state)
     rad_scene_destroy(scene);
 }
 
+/* ---- the same answer on any thread count ---- */
+
+static void test_threads_identical(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    const char *solvers[2] = {"galerkin-linear", "collocation"};
+    for (int k = 0; k < 2; k++) {
+        double *values[2] = {NULL, NULL};
+        size_t count = 0;
+        for (int t = 0; t < 2; t++) {
+            rad_context_options co = {0};
+            co.threads = t == 0 ? 1 : 3;
+            rad_context *c = NULL;
+            assert_int_equal(rad_context_create(&co, &c), RAD_OK);
+            rad_options o = {0};
+            o.target_elements = 60;
+            o.solver = solvers[k];
+            rad_solution *s = NULL;
+            assert_int_equal(rad_solution_create(c, scene, &o, &s), RAD_OK);
+            assert_int_equal(rad_solution_solve(c, s), RAD_OK);
+            count = 3 * rad_solution_vertex_count(s);
+            values[t] = malloc(count * sizeof(double));
+            assert_non_null(values[t]);
+            assert_int_equal(rad_solution_vertex_radiosity(c, s, values[t]), RAD_OK);
+            rad_solution_destroy(s);
+            rad_context_destroy(c);
+        }
+        /* Colours of elements that share no vertex add to K's rows one
+         * after another; collocation's rows are independent. */
+        assert_memory_equal(values[0], values[1], count * sizeof(double));
+        free(values[0]);
+        free(values[1]);
+    }
+    rad_scene_destroy(scene);
+}
+
 /* ---- the vertex values, refusals ---- */
 
 static void test_vertex_values_are_the_solution(void **state)
@@ -472,6 +510,7 @@ int main(void)
         cmocka_unit_test(test_constant_kernel_is_AF),
         cmocka_unit_test(test_convergence_orders),
         cmocka_unit_test(test_cornell_constant_matches_dense),
+        cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_vertex_values_are_the_solution),
         cmocka_unit_test(test_refusals),
     };
