@@ -16,7 +16,8 @@
  *           |B_s - B_ref| / B_ref (surface means).
  *
  * Usage: bench_galerkin floor|triangle|cornell [threads]
- * Prints one line per (method, mesh): unknowns, error, seconds.
+ * Prints one line per (method, mesh): unknowns, error, seconds, and the
+ * element size used (m).
  */
 #include "strategy/strategy.h"
 #include "api/options.h"
@@ -148,7 +149,7 @@ int main(int argc, char **argv)
     const char *methods[3] = {"galerkin-constant", "galerkin-linear", "collocation"};
     const double sizes[] = {0.5, 0.25, 0.125, 0.0625, 0.03125};
     const size_t counts[] = {50, 100, 200, 400, 800};
-    printf("# %s: method unknowns error seconds\n", which);
+    printf("# %s: method unknowns error seconds h\n", which);
     for (int m = 0; m < 3; m++)
         for (int k = 0; k < 5; k++) {
             rad_options in = {0}, o;
@@ -176,7 +177,7 @@ int main(int argc, char **argv)
             rad_galerkin_matrices g;
             rad_galerkin_get_matrices(state, &g);
             double error = cornell ? cornell_error(&v) : floor_error(&v, v.vertex_radiosity);
-            printf("%s %zu %.6e %.3f\n", methods[m], g.unknowns, error, seconds);
+            printf("%s %zu %.6e %.3f %.6g\n", methods[m], g.unknowns, error, seconds, v.mesh->mesh_size);
             fflush(stdout);
             rad_strategy_galerkin.destroy(state);
         }

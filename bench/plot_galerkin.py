@@ -7,8 +7,10 @@ orders fitted over the finest three meshes (plain SVG: no matplotlib).
     ./build/bench/bench_galerkin cornell > cornell.txt
     /usr/bin/python3 bench/plot_galerkin.py floor.txt triangle.txt cornell.txt docs/galerkin_convergence.svg
 
-The order is the slope in h: error ~ h^p, unknowns ~ h^-2, so
-p = -2 x the slope of log(error) against log(unknowns).
+The order p (error ~ h^p) is the least-squares slope of log(error)
+against log(h) over the finest three meshes, h the element size the
+bench prints; without it, -2 x the slope against log(unknowns) (unknowns
+~ h^-2 only asymptotically: (n+1)^2 vertices for n^2 elements inflate it).
 """
 import math
 import sys
@@ -24,21 +26,23 @@ def read(path):
             title = line[1:].split(":")[0].strip()
             continue
         parts = line.split()
-        if len(parts) != 4:
+        if len(parts) not in (4, 5):
             continue
-        series.setdefault(parts[0], []).append((float(parts[1]), float(parts[2]), float(parts[3])))
+        h = float(parts[4]) if len(parts) == 5 else None
+        series.setdefault(parts[0], []).append((float(parts[1]), float(parts[2]), float(parts[3]), h))
     return title, series
 
 
 def order(points, last=3):
-    """Least-squares slope of log error against log unknowns, as an order in h."""
+    """Least-squares slope of log error against log h (or log unknowns), as an order in h."""
     pts = points[-last:]
-    xs = [math.log(p[0]) for p in pts]
+    by_h = all(p[3] for p in pts)
+    xs = [math.log(p[3]) if by_h else math.log(p[0]) for p in pts]
     ys = [math.log(p[1]) for p in pts]
     mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
     sxx = sum((x - mx) ** 2 for x in xs)
     sxy = sum((x - mx) * (y - my) for x, y in zip(xs, ys))
-    return -2.0 * sxy / sxx
+    return sxy / sxx if by_h else -2.0 * sxy / sxx
 
 
 def panel(out, x0, y0, w, h, title, series):

@@ -265,15 +265,15 @@ static void region_polygon(const element_geometry *g, const region *r, vec3 poly
  * means of the basis.  (Only the means: the factor itself is exact.) */
 #define INNER_RATIO 2.0
 /* Split depths: the inner integral from an outer Gauss point (at least
- * ~0.1 of its region from an edge) needs ~8; a collocation point, 1e-6 of
- * an element from an edge (collocation_points), needs ~20. */
+ * 0.06 of a quarter element from an edge) needs ~8; a collocation point,
+ * 1e-6 of an element from an edge (collocation_points), ~20. */
 enum { INNER_DEPTH = 10, COLLOCATION_DEPTH = 24 };
 
 /* Add int_f N_j(y) G(x, y) dy over region r of f into I[j] (unoccluded):
  * the exact factor of the region, times the G-weighted mean of each N_j
  * by the fine rule. */
 static void inner_region(const element_geometry *f, int nodes, vec3 x, vec3 nx, const region *r, int depth,
-                         int max_depth, double I[4], uint64_t *evaluations)
+                         int max_depth, double I[4])
 {
     vec3 poly[4], centre;
     double size;
@@ -283,10 +283,9 @@ static void inner_region(const element_geometry *f, int nodes, vec3 x, vec3 nx, 
         region child[4];
         split_region(f->corners, r, child);
         for (int k = 0; k < 4; k++)
-            inner_region(f, nodes, x, nx, &child[k], depth + 1, max_depth, I, evaluations);
+            inner_region(f, nodes, x, nx, &child[k], depth + 1, max_depth, I);
         return;
     }
-    (*evaluations)++;
     double F = rad_point_polygon_ff(x, nx, poly, f->corners);
     if (!(F > 0.0))
         return;
@@ -318,17 +317,15 @@ static void inner_region(const element_geometry *f, int nodes, vec3 x, vec3 nx, 
 }
 
 /* int_f N_j(y) G(x, y) dy for f's nodes, unoccluded. */
-static void inner_integral(const element_geometry *f, int nodes, vec3 x, vec3 nx, int max_depth, double I[4],
-                           uint64_t *evaluations)
+static void inner_integral(const element_geometry *f, int nodes, vec3 x, vec3 nx, int max_depth, double I[4])
 {
     I[0] = I[1] = I[2] = I[3] = 0.0;
     if (nodes == 1) { /* the constant basis: the factor itself */
-        (*evaluations)++;
         I[0] = rad_point_polygon_ff(x, nx, f->c, f->corners);
         return;
     }
     region whole = whole_element(f->corners);
-    inner_region(f, nodes, x, nx, &whole, 0, max_depth, I, evaluations);
+    inner_region(f, nodes, x, nx, &whole, 0, max_depth, I);
 }
 
 /* Fraction of rays from `from` (a point lifted off its surface, normal
@@ -420,11 +417,11 @@ static void outer_rule_of(const element_geometry *e, int nodes, outer_rule *rule
 /* Kef[i][j] = int_e N_i(x) int_f N_j G dy dx (unoccluded) by e's outer
  * rule. */
 static void outer_integral(const element_geometry *e, const outer_rule *rule, const element_geometry *f,
-                           int nodes_e, int nodes_f, double Kef[4][4], uint64_t *evaluations)
+                           int nodes_e, int nodes_f, double Kef[4][4])
 {
     double I[4];
     for (int q = 0; q < rule->count; q++) {
-        inner_integral(f, nodes_f, rule->x[q], e->normal, INNER_DEPTH, I, evaluations);
+        inner_integral(f, nodes_f, rule->x[q], e->normal, INNER_DEPTH, I);
         for (int i = 0; i < nodes_e; i++)
             for (int j = 0; j < nodes_f; j++)
                 Kef[i][j] += rule->w[q] * rule->N[q][i] * I[j];
@@ -564,12 +561,12 @@ static rad_result assemble_galerkin(rad_context *ctx, galerkin_state *st)
     if (r != RAD_OK)
         return r;
     double plane_tol = rad_ff_plane_tolerance(mesh), eps = rad_vis_epsilon(mesh);
-    uint64_t evaluations = 0, rays = 0, pairs = 0, done = 0;
+    uint64_t rays = 0, pairs = 0, done = 0;
     bool cancelled = false;
     for (int c = 0; c <= MAX_COLOURS && !cancelled; c++) {
         long count = (long)(start[c + 1] - start[c]);
         int threads = c < MAX_COLOURS ? st->base.threads : 1;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : evaluations, rays, pairs)
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) reduction(+ : rays, pairs)
         for (long k = 0; k < count; k++) {
             if (cancelled)
                 continue;
@@ -593,7 +590,7 @@ static rad_result assemble_galerkin(rad_context *ctx, galerkin_state *st)
                 geometry_of(mesh, f, eps, &gf);
                 double Kef[4][4] = {{0}};
                 int nodes_f = element_nodes(st, &mesh->elements[f]);
-                outer_integral(&ge, &rule, &gf, nodes, nodes_f, Kef, &evaluations);
+                outer_integral(&ge, &rule, &gf, nodes, nodes_f, Kef);
                 for (int a = 0; a < nodes; a++) {
                     double *row = st->K + (size_t)node_of(st, e, a) * dofs;
                     for (int b = 0; b < nodes_f; b++)
@@ -607,7 +604,6 @@ static rad_result assemble_galerkin(rad_context *ctx, galerkin_state *st)
     rad_free(order);
     st->base.ff_stats.rays = rays;
     st->base.ff_stats.pairs = pairs;
-    (void)evaluations;
     if (cancelled)
         return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "galerkin kernel: interrupted");
     return RAD_OK;
@@ -677,9 +673,9 @@ static rad_result assemble_collocation(rad_context *ctx, galerkin_state *st)
     if (r != RAD_OK)
         return r;
     double eps = rad_vis_epsilon(mesh);
-    uint64_t evaluations = 0, rays = 0, pairs = 0;
+    uint64_t rays = 0, pairs = 0;
     bool cancelled = false;
-#pragma omp parallel for schedule(dynamic, 16) num_threads(st->base.threads) reduction(+ : evaluations, rays, pairs)
+#pragma omp parallel for schedule(dynamic, 16) num_threads(st->base.threads) reduction(+ : rays, pairs)
     for (long k = 0; k < (long)dofs; k++) {
         if (cancelled)
             continue;
@@ -699,7 +695,7 @@ static rad_result assemble_collocation(rad_context *ctx, galerkin_state *st)
             if (!(v3_dot(v3_sub(x, gf.centroid), gf.normal) > 0.0))
                 continue;
             double I[4];
-            inner_integral(&gf, (int)fe->vertex_count, x, nx, COLLOCATION_DEPTH, I, &evaluations);
+            inner_integral(&gf, (int)fe->vertex_count, x, nx, COLLOCATION_DEPTH, I);
             if (!(I[0] + I[1] + I[2] + I[3] > 0.0))
                 continue;
             pairs++;
@@ -710,7 +706,6 @@ static rad_result assemble_collocation(rad_context *ctx, galerkin_state *st)
     }
     st->base.ff_stats.rays = rays;
     st->base.ff_stats.pairs = pairs;
-    (void)evaluations;
     if (cancelled)
         return rad_fail(ctx, RAD_ERROR_INTERRUPTED, "collocation kernel: interrupted");
     return RAD_OK;
