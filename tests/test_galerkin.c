@@ -486,6 +486,39 @@ static void test_refusals(void **state)
     rad_scene_destroy(scene);
 }
 
+/* A cancel flag raised while the kernel is assembled (from the progress
+ * callback) stops it, of either kind. */
+static void cancel_in_kernel(void *user, const char *phase, uint64_t done, uint64_t total)
+{
+    (void)done, (void)total;
+    if (strstr(phase, "kernel"))
+        rad_context_cancel(*(rad_context **)user, true);
+}
+
+static void test_cancel(void **state)
+{
+    (void)state;
+    rad_scene *scene = make_cube(0.5, 1.0);
+    const char *solvers[2] = {"galerkin-linear", "collocation"};
+    for (int k = 0; k < 2; k++) {
+        rad_context *c = NULL;
+        rad_context_options co = {0};
+        co.threads = 2;
+        co.progress = cancel_in_kernel;
+        co.progress_user = &c;
+        assert_int_equal(rad_context_create(&co, &c), RAD_OK);
+        rad_options o = {0};
+        o.mesh_size = 0.125;
+        o.solver = solvers[k];
+        rad_solution *s = NULL;
+        assert_int_equal(rad_solution_create(c, scene, &o, &s), RAD_ERROR_INTERRUPTED);
+        assert_null(s);
+        assert_non_null(strstr(rad_context_error(c), "kernel: interrupted"));
+        rad_context_destroy(c);
+    }
+    rad_scene_destroy(scene);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -513,6 +546,7 @@ int main(void)
         cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_vertex_values_are_the_solution),
         cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_cancel),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

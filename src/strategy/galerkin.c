@@ -59,6 +59,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 enum { GALERKIN_CONSTANT, GALERKIN_LINEAR, GALERKIN_COLLOCATION };
 
@@ -562,7 +565,7 @@ static rad_result assemble_galerkin(rad_context *ctx, galerkin_state *st)
         return r;
     double plane_tol = rad_ff_plane_tolerance(mesh), eps = rad_vis_epsilon(mesh);
     uint64_t rays = 0, pairs = 0, done = 0;
-    bool cancelled = false;
+    volatile int cancelled = 0; /* raised by any thread (formfactor.c's pattern) */
     for (int c = 0; c <= MAX_COLOURS && !cancelled; c++) {
         long count = (long)(start[c + 1] - start[c]);
         int threads = c < MAX_COLOURS ? st->base.threads : 1;
@@ -571,7 +574,7 @@ static rad_result assemble_galerkin(rad_context *ctx, galerkin_state *st)
             if (cancelled)
                 continue;
             if (rad_cancelled(ctx)) {
-                cancelled = true;
+                cancelled = 1;
                 continue;
             }
             uint32_t e = order[start[c] + (size_t)k];
@@ -674,15 +677,21 @@ static rad_result assemble_collocation(rad_context *ctx, galerkin_state *st)
         return r;
     double eps = rad_vis_epsilon(mesh);
     uint64_t rays = 0, pairs = 0;
-    bool cancelled = false;
+    volatile int cancelled = 0; /* raised by any thread (formfactor.c's pattern) */
 #pragma omp parallel for schedule(dynamic, 16) num_threads(st->base.threads) reduction(+ : rays, pairs)
     for (long k = 0; k < (long)dofs; k++) {
         if (cancelled)
             continue;
         if (rad_cancelled(ctx)) {
-            cancelled = true;
+            cancelled = 1;
             continue;
         }
+#ifdef _OPENMP
+        if (omp_get_thread_num() == 0 && (k & 63) == 0)
+#else
+        if ((k & 63) == 0)
+#endif
+            rad_progress(ctx, "collocation kernel", (uint64_t)k, dofs);
         vec3 x = st->point[k], nx = st->point_normal[k];
         if (v3_length(nx) == 0.0) /* a vertex of no element */
             continue;
