@@ -134,6 +134,8 @@ static const scenario scenarios[] = {
     {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2},
     {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0},
     {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0},
+    {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0},
+    {"collocation", "collocation", NULL, 0, 0, 0, false, 0},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from

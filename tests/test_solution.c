@@ -113,7 +113,7 @@ static void test_every_solver_name_resolves(void **state)
         assert_null(strstr(rad_context_error(ctx), "unknown solver"));
         rad_scene_destroy(scene);
     }
-    assert_int_equal(count, 7); /* five linear solvers, shooting, hierarchical */
+    assert_int_equal(count, 10); /* five linear solvers, shooting, hierarchical, two Galerkin, collocation */
     rad_options o = {0};
     o.solver = "no-such-solver";
     rad_solution *s = NULL;
@@ -128,7 +128,7 @@ static void test_every_solver_name_resolves(void **state)
 static void test_strategies_furnace_and_accessors(void **state)
 {
     (void)state;
-    const char *solvers[] = {"gauss-seidel", "direct", "shooting", "hierarchical"};
+    const char *solvers[] = {"gauss-seidel", "direct", "shooting", "hierarchical", "collocation"};
     rad_scene *scene = furnace();
     size_t S = rad_scene_surface_count(scene);
     for (size_t k = 0; k < sizeof solvers / sizeof solvers[0]; k++) {

@@ -69,7 +69,9 @@ static const rad_option_info solution_rows[] = {
     {SOLUTION(solver), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_SOLVER, .default_value = NAN,
      .default_text = "hierarchical",
      .help = "solver (without one: gauss-seidel where an element count, a mesh size, a form-factor "
-             "method or adaptive subdivision is given, and for view factors and progress images)"},
+             "method or adaptive subdivision is given, and for view factors and progress images); "
+             "galerkin-linear, galerkin-constant and collocation: basis functions per vertex or element "
+             "(docs/methods.md, \"Galerkin elements\")"},
     {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0, .max_open = true,
      .default_value = 1e-6, .default_text = "1e-6",
      .help = "stop when the residual (unaccounted power / emitted power) falls below this"},

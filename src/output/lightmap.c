@@ -402,7 +402,7 @@ rad_result rad_lightmap_bake(rad_context *ctx, const rad_solution_view *view, co
         r = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
     }
-    r = rad_vertex_values(ctx, mesh, view->radiosity, vertex_value);
+    r = rad_view_vertex_values(ctx, view, view->radiosity, vertex_value);
     for (size_t k = 0; k < n && r == RAD_OK; k++) {
         if ((k & 255) == 0 && rad_cancelled(ctx))
             r = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "lightmap: interrupted");

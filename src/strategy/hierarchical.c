@@ -151,6 +151,7 @@ static void hierarchical_view(const void *state, rad_solution_view *v)
     v->vis = st->vis;
     v->F = NULL;
     v->F_variance = NULL;
+    v->vertex_radiosity = NULL;
     v->ff = &st->ff_stats;
     v->solve = &st->solve_stats;
     v->hier = st->leaves ? &st->hier_stats : NULL;

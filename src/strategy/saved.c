@@ -291,6 +291,7 @@ static void saved_view(const void *state, rad_solution_view *v)
     v->vis = st->vis;
     v->F = NULL;
     v->F_variance = NULL;
+    v->vertex_radiosity = NULL; /* made again from the elements (the file's are the renderer's) */
     v->ff = &st->ff_stats;
     v->solve = &st->solve_stats;
     v->hier = NULL;

@@ -17,6 +17,7 @@ const rad_strategy *const rad_strategies[] = {
     &rad_strategy_dense,
     &rad_strategy_matrix_free,
     &rad_strategy_hierarchical,
+    &rad_strategy_galerkin,
     NULL,
 };
 
@@ -223,6 +224,7 @@ void rad_meshed_view(const rad_meshed *m, rad_solution_view *v)
     v->vis = m->vis;
     v->F = NULL;
     v->F_variance = NULL;
+    v->vertex_radiosity = NULL;
     v->ff = &m->ff_stats;
     v->solve = &m->solve_stats;
     v->hier = NULL;

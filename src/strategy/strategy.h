@@ -10,6 +10,9 @@
  *     dense          the n x n form-factor matrix   a linear solver (solve.h table)
  *     matrix-free    nothing stored: rays per shot  progressive refinement (shooting)
  *     hierarchical   links between quadtree nodes   Jacobi sweeps + BF refinement
+ *     galerkin       the kernel K per pair of basis  the Neumann series of M^-1 rho K
+ *                    functions (constant, linear);   (Galerkin) or Jacobi (collocation)
+ *                    the mass matrix M
  *
  * Each strategy answers to one or more solver names (rad_options.solver):
  * dense to every linear solver in the solver table, the others to their
@@ -46,6 +49,11 @@ typedef struct rad_solution_view {
     const double *reflectance;      /* 3n, RGB */
     const double *emission;         /* 3n, W/m^2 */
     const double *radiosity;        /* 3n, W/m^2: E before solving, the iterate during */
+    /* 3 per mesh vertex, W/m^2: the strategy's own vertex values where they
+     * are its unknowns (galerkin-linear, collocation), to be interpolated
+     * with the basis as they are; NULL: derived from `radiosity` (interp/,
+     * through rad_view_vertex_values in output.h). */
+    const double *vertex_radiosity;
     const double *F;                 /* n x n; NULL where the strategy stores none */
     const double *F_variance;        /* n x n for sampling methods that estimate it, else NULL */
     const rad_ff_stats *ff;
@@ -217,5 +225,24 @@ void rad_view_surface_radiosity(const rad_solution_view *view, size_t surface, d
 /* Surface-to-surface factors F[a * S + b] (S surfaces), zero without F.
  * Fails only for memory (S doubles; F is then NAN). */
 rad_result rad_view_surface_view_factors(rad_context *ctx, const rad_solution_view *view, double *F);
+
+/* ---- Galerkin elements and point collocation (galerkin.c) ---- */
+
+/* The matrices of a galerkin strategy's state (rad_strategy_galerkin's
+ * create), for tests and benches: read-only, valid until it is destroyed. */
+typedef struct rad_galerkin_matrices {
+    size_t unknowns;                /* elements (galerkin-constant) or mesh vertices */
+    const double *K;                /* unknowns x unknowns, row-major: Galerkin int N_i int N_j G V (m^2),
+                                       collocation int N_j G(x_i, .) V (1); no reflectance */
+    const double *element_mass;     /* 16 per element: its mass matrix int N_a N_b (m^2), 4 x 4 row-major,
+                                       over its nodes (1 for the constant basis, else its vertices) */
+    const double *node_mass;        /* unknowns: int N_i (m^2) */
+    const double *node_radiosity;   /* 3 x unknowns, W/m^2: the solution */
+} rad_galerkin_matrices;
+
+extern const rad_strategy rad_strategy_galerkin;
+
+/* Cannot fail. */
+void rad_galerkin_get_matrices(const void *state, rad_galerkin_matrices *out);
 
 #endif /* RAD_STRATEGY_H */
