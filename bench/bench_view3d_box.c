@@ -3,10 +3,10 @@
  * without writing them: the View3D comparison of issue #17 (the box of
  * bench/view3d_box.py, driven by bench/view3d_box.sh).
  *
- *   build/bench/bench_view3d_box SCENE [--method NAME] [--threads N]
+ *   build/bench/bench_view3d_box SCENE [--method NAME] [--threads N] [--elements N]
  *
  * Meshes with one element per polygon (a mesh size of 10 m: the box's
- * facets are 1/N m), builds the Embree BVH, runs the form-factor method
+ * facets are 1/N m; with --elements, about that many in all), builds the Embree BVH, runs the form-factor method
  * (default analytic) and prints: elements, wall and CPU seconds of the
  * form-factor phase, rays, pairs, max |row sum - 1|, the worst reciprocity
  * error.  Seed 0; no closure correction or other smoothing: on a closed
@@ -29,21 +29,24 @@ int main(int argc, char **argv)
 {
     const char *path = NULL, *method_name = "analytic";
     int threads = 1;
+    size_t elements = 0;
     for (int a = 1; a < argc; a++) {
         if (strcmp(argv[a], "--threads") == 0 && a + 1 < argc)
             threads = atoi(argv[++a]);
+        else if (strcmp(argv[a], "--elements") == 0 && a + 1 < argc)
+            elements = (size_t)atol(argv[++a]);
         else if (strcmp(argv[a], "--method") == 0 && a + 1 < argc)
             method_name = argv[++a];
         else if (argv[a][0] != '-' && !path)
             path = argv[a];
         else {
-            fprintf(stderr, "usage: bench_view3d_box SCENE [--method NAME] [--threads N]\n");
+            fprintf(stderr, "usage: bench_view3d_box SCENE [--method NAME] [--threads N] [--elements N]\n");
             return 2;
         }
     }
     const rad_ff_method *method = rad_ff_find(method_name);
     if (!path || threads < 1 || !method) {
-        fprintf(stderr, "usage: bench_view3d_box SCENE [--method NAME] [--threads N]\n");
+        fprintf(stderr, "usage: bench_view3d_box SCENE [--method NAME] [--threads N] [--elements N]\n");
         return 2;
     }
     rad_context_options co = {0};
@@ -55,7 +58,7 @@ int main(int argc, char **argv)
     rad_scene *scene = NULL;
     rad_mesh *mesh = NULL;
     rad_vis *vis = NULL;
-    rad_mesh_options mo = {10.0, 0, 0};
+    rad_mesh_options mo = {elements ? 0.0 : 10.0, elements, 0};
     if (rad_scene_load_file(ctx, path, &scene) != RAD_OK || rad_mesh_build(ctx, scene, &mo, &mesh) != RAD_OK ||
         rad_vis_create(ctx, "embree", mesh, &vis) != RAD_OK) {
         fprintf(stderr, "%s\n", rad_context_error(ctx));

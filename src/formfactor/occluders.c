@@ -36,9 +36,12 @@
  * single primitive covers is blocked; the rest are partial (rays).  The
  * test is conservative: S may meet a primitive only near its corner, or
  * several primitives may cover S together, and the pair is then partial,
- * which costs rays, never accuracy.  Scenes with more than
- * RAD_FF_OCCLUDER_PLANES distinct planes, or primitives not flat to the
- * plane tolerance, are not classified (every pair partial, as before).
+ * which costs rays, never accuracy.  A primitive not flat to the plane
+ * tolerance (the Cornell box's blocks are bent by up to 2 mm) gets a plane
+ * of its own with a slab as thick as its bend: pairs that straddle or touch
+ * the slab and whose box meets the primitive's go to rays.  Scenes with
+ * more than RAD_FF_OCCLUDER_PLANES distinct planes are not classified
+ * (every pair partial, as before).
  */
 #include "formfactor/formfactor.h"
 
@@ -61,6 +64,8 @@ typedef struct occ_plane {
     double offset;        /* normal . x on the plane, m */
     vec3 lo, hi;          /* box of its primitives, m */
     uint32_t first, count;/* its primitives in prim[] */
+    double slab;          /* m: its primitives lie within this of the plane (the
+                             plane tolerance, or a bent primitive's spread) */
 } occ_plane;
 
 struct rad_ff_occluders {
@@ -123,12 +128,17 @@ rad_result rad_ff_occluders_build(rad_context *ctx, const rad_mesh *mesh, size_t
     for (size_t k = 0; k < count && classify; k++) {
         const rad_vis_prim *p = &prims[k];
         vec3 nrm = poly_normal(p->corner, p->corner_count);
-        double off = v3_dot(nrm, p->corner[0]);
-        for (uint32_t c = 1; c < p->corner_count; c++)
-            if (fabs(v3_dot(nrm, p->corner[c]) - off) > tol)
-                classify = false; /* bent: no one plane holds it */
-        size_t m = 0;
+        double off = 0.0;
+        for (uint32_t c = 0; c < p->corner_count; c++)
+            off += v3_dot(nrm, p->corner[c]) / p->corner_count;
+        double slab = 0.0; /* a bent primitive: its corners' spread about the mean plane */
+        for (uint32_t c = 0; c < p->corner_count; c++)
+            slab = fmax(slab, fabs(v3_dot(nrm, p->corner[c]) - off));
+        bool bent = slab > tol;
+        size_t m = bent ? nplanes : 0; /* a bent primitive has a plane of its own */
         for (; m < nplanes; m++) {
+            if (planes[m].slab > tol)
+                continue;
             /* Same plane, either orientation: all corners within tol. */
             bool on = true;
             for (uint32_t c = 0; c < p->corner_count && on; c++)
@@ -141,7 +151,7 @@ rad_result rad_ff_occluders_build(rad_context *ctx, const rad_mesh *mesh, size_t
                 classify = false;
                 break;
             }
-            planes[m] = (occ_plane){nrm, off, p->corner[0], p->corner[0], 0, 0};
+            planes[m] = (occ_plane){nrm, off, p->corner[0], p->corner[0], 0, 0, bent ? slab + tol : tol};
             nplanes++;
         }
         plane_of[k] = (uint32_t)m;
@@ -219,11 +229,15 @@ rad_result rad_ff_occluders_build(rad_context *ctx, const rad_mesh *mesh, size_t
             occ->box[2 * e + 1] = vmax(occ->box[2 * e + 1], mesh->vertices[el->vertex[c]]);
         }
         for (size_t m = 0; m < nplanes; m++) {
+            /* Beside a bent primitive's plane (within its slab, beyond the
+             * plane tolerance) an element counts as on both sides: such
+             * pairs go to rays. */
+            double slab = occ->plane[m].slab;
             bool front = false, back = false;
             for (uint32_t c = 0; c < el->vertex_count; c++) {
                 double s = v3_dot(occ->plane[m].normal, mesh->vertices[el->vertex[c]]) - occ->plane[m].offset;
-                front |= s > tol;
-                back |= s < -tol;
+                front |= s > slab || (slab > tol && fabs(s) <= slab);
+                back |= s < -slab || (slab > tol && fabs(s) <= slab);
             }
             if (front)
                 occ->front[e * words + m / 64] |= 1ull << (m % 64);
@@ -293,8 +307,15 @@ rad_ff_verdict rad_ff_occluders_classify(const rad_ff_occluders *occ, uint32_t i
             int bit = __builtin_ctzll(cand);
             cand &= cand - 1;
             const occ_plane *pl = &occ->plane[w * 64 + (size_t)bit];
-            if (!boxes_meet(plo, phi, pl->lo, pl->hi, tol))
+            if (!boxes_meet(plo, phi, pl->lo, pl->hi, pl->slab))
                 continue;
+            if (pl->slab > tol) {
+                /* A bent primitive: the plane test is not exact, rays decide. */
+                partial = true;
+                if (blockers)
+                    blockers->complete = false;
+                continue;
+            }
             /* S: corners on the plane and crossings of corner pairs. */
             double d[8];
             bool i_front = true, i_back = true, j_front = true, j_back = true;
