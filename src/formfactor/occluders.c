@@ -491,6 +491,20 @@ static bool split_piece(piece *in, vec3 o, vec3 m, piece *out_piece)
     return true;
 }
 
+/* The area of a flat polygon, m^2. */
+static double piece_area(const vec3 *c, int n)
+{
+    vec3 sum = v3(0, 0, 0);
+    for (int k = 1; k + 1 < n; k++)
+        sum = v3_add(sum, v3_cross(v3_sub(c[k], c[0]), v3_sub(c[k + 1], c[0])));
+    return 0.5 * v3_length(sum);
+}
+
+/* Visible pieces smaller than this fraction of the source are dropped: far
+ * above the rounding of shadows cut edge to edge (1e-16 of their size),
+ * far below anything a factor needs (1e-9 of one pair's factor). */
+#define VISIBLE_SLIVER 1e-6
+
 double rad_point_polygon_ff_visible(vec3 x, vec3 normal, const vec3 *src, size_t n, vec3 src_normal,
                                     const rad_ff_blockers *blockers)
 {
@@ -554,8 +568,14 @@ double rad_point_polygon_ff_visible(vec3 x, vec3 normal, const vec3 *src, size_t
         count = next;
         cur = 1 - cur;
     }
+    /* Pieces below VISIBLE_SLIVER of the source's area are the rounding of
+     * shadows that meet edge to edge (a wall of several polygons, a closed
+     * door in it): left in, they let sealed rooms see each other
+     * (test_hostile's ten closed offices became one lit group). */
+    double src_area = piece_area(src, (int)n);
     double f = 0.0;
     for (int p = 0; p < count; p++)
-        f += rad_point_polygon_ff_front(x, normal, pieces[cur][p].c, (size_t)pieces[cur][p].n);
+        if (piece_area(pieces[cur][p].c, pieces[cur][p].n) > VISIBLE_SLIVER * src_area)
+            f += rad_point_polygon_ff_front(x, normal, pieces[cur][p].c, (size_t)pieces[cur][p].n);
     return f;
 }
