@@ -204,6 +204,10 @@ rad_result rad_ff_refuse_open(rad_context *ctx, const char *source, double escap
  * polygon's own orientation is honoured: a polygon seen from its back gives
  * 0.  n <= 8 vertices. */
 double rad_point_polygon_ff(vec3 point, vec3 normal, const vec3 *poly, size_t n);
+/* The same for a point known to lie in front of the polygon (no test of
+ * the polygon's own orientation, so collinear leading corners are fine).
+ * Cannot fail. */
+double rad_point_polygon_ff_front(vec3 point, vec3 normal, const vec3 *poly, size_t n);
 
 /* How far a point sampled on element e (bilinear, rad_element_sample) can
  * lie from the flat pieces a ray backend builds over it, m: 0 for triangles
@@ -274,6 +278,68 @@ int rad_ff_rays(const rad_vis *vis, const rad_ff_end *a, const rad_ff_end *b, in
  * no ray faces.  Cannot fail. */
 double rad_ff_visibility(const rad_ff_request *req, uint32_t i, uint32_t j, double eps,
                          int base_rays, uint64_t *rays_cast);
+
+/* ---- which pairs need shadow rays (occluders.c) ---- */
+
+/* Distinct planes of the ray primitives that the classification handles:
+ * a scene with more (a tessellated curved surface) is not classified. */
+#define RAD_FF_OCCLUDER_PLANES 1024
+
+typedef enum rad_ff_verdict {
+    RAD_FF_CLEAR,   /* no primitive can meet a segment between the pair: V = 1 */
+    RAD_FF_BLOCKED, /* one primitive meets every segment: V = 0 */
+    RAD_FF_PARTIAL  /* neither shown: shadow rays */
+} rad_ff_verdict;
+
+typedef struct rad_ff_occluders rad_ff_occluders;
+
+enum { RAD_FF_MAX_BLOCKERS = 8 };
+
+/* The primitives that may block part of a partial pair, as flat convex
+ * polygons (counter-clockwise about their normals). */
+typedef struct rad_ff_blockers {
+    vec3 corner[RAD_FF_MAX_BLOCKERS][8]; /* m (4 as listed; up to 6 once trimmed) */
+    uint32_t corners[RAD_FF_MAX_BLOCKERS];
+    double top[RAD_FF_MAX_BLOCKERS]; /* trimmed: highest corner above the source's plane, m */
+    int count;
+    bool complete;        /* false: more may block than are listed (use rays) */
+    bool trimmed;         /* rad_ff_blockers_trim ran */
+} rad_ff_blockers;
+
+/* Cut each blocker to its part strictly in front of the source's plane
+ * (through src0, unit src_normal) and in front of the receiver's plane
+ * (through recv0, unit recv_normal), once per pair, so that
+ * rad_point_polygon_ff_visible, for points of that receiver, need not.
+ * Cannot fail. */
+void rad_ff_blockers_trim(rad_ff_blockers *b, vec3 src0, vec3 src_normal, vec3 recv0, vec3 recv_normal);
+
+/* Allocate one block (rad_alloc, the caller frees it with rad_free) of
+ * `header` bytes for the caller, zeroed, followed by the occluder tables of
+ * the mesh's ray primitives (rad_vis_primitives): *occ points into it, or
+ * is NULL when the scene is not classified (over RAD_FF_OCCLUDER_PLANES
+ * planes, or a primitive not flat to the plane tolerance; the block is
+ * then just the header).  Fails only for memory (*block NULL). */
+rad_result rad_ff_occluders_build(rad_context *ctx, const rad_mesh *mesh, size_t header, void **block,
+                                  const rad_ff_occluders **occ);
+
+/* Elements i and j: clear, blocked or partial (occluders.c's header says
+ * how).  Exact where it answers clear or blocked, up to sets of segments of
+ * measure zero.  With `blockers` (may be NULL), a partial pair's list of
+ * the primitives that may block it.  Thread-safe; cannot fail. */
+rad_ff_verdict rad_ff_occluders_classify(const rad_ff_occluders *occ, uint32_t i, uint32_t j,
+                                         rad_ff_blockers *blockers);
+
+/* The unoccluded factor of rad_point_polygon_ff from the point to the part
+ * of the source polygon (n <= 4 corners, unit normal src_normal) that no
+ * listed blocker hides from it: the blockers' parts between the point and
+ * the source's plane projected from the point onto that plane and cut out
+ * of the source (convex pieces, then Lambert's formula on each; trimmed
+ * blockers must have been trimmed for this point's receiver).  Exact
+ * for any number of flat convex blockers.  Returns -1 when the pieces
+ * outgrow the fixed room (more than 32 pieces or 8 corners): the caller
+ * falls back to rays.  Cannot fail otherwise. */
+double rad_point_polygon_ff_visible(vec3 point, vec3 normal, const vec3 *src, size_t n, vec3 src_normal,
+                                    const rad_ff_blockers *blockers);
 
 /* ---- the contour kernel (ff_contour.c): contour, hybrid ---- */
 

@@ -44,7 +44,6 @@ static size_t clip_to_hemisphere(vec3 x, vec3 normal, const vec3 *poly, size_t n
 
 double rad_point_polygon_ff(vec3 x, vec3 normal, const vec3 *poly, size_t n)
 {
-    vec3 clipped[9];
     if (n > 8)
         n = 8;
     /* Back side of the polygon (one-sided surfaces): nothing arrives. */
@@ -53,6 +52,14 @@ double rad_point_polygon_ff(vec3 x, vec3 normal, const vec3 *poly, size_t n)
         pn = v3_add(pn, v3_cross(v3_sub(poly[2], poly[0]), v3_sub(poly[3], poly[0])));
     if (v3_dot(pn, v3_sub(x, poly[0])) <= 0.0)
         return 0.0;
+    return rad_point_polygon_ff_front(x, normal, poly, n);
+}
+
+double rad_point_polygon_ff_front(vec3 x, vec3 normal, const vec3 *poly, size_t n)
+{
+    vec3 clipped[9];
+    if (n > 8)
+        n = 8;
     size_t m = clip_to_hemisphere(x, normal, poly, n, clipped);
     if (m < 3)
         return 0.0;
