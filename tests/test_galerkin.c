@@ -336,10 +336,13 @@ static void test_cornell_constant_matches_dense(void **state)
     o.solver = "galerkin-constant";
     assert_int_equal(rad_solution_create(ctx, scene, &o, &galerkin), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, galerkin), RAD_OK);
-    /* The same exact unoccluded factors (to the outer rule's 1e-5) and
-     * the same keyed shadow rays; but the analytic method also splits
-     * partly visible pairs (ff_analytic.c), so the shadowed surfaces
-     * differ by the visibility estimates: measured 3.5e-3 (the floor). */
+    /* The same exact unoccluded factors (to the outer rule's 1e-5); they
+     * differ in visibility: the analytic method integrates the exact
+     * visible part of a source behind flat blockers (occluders.c), the
+     * Galerkin kernel multiplies by keyed shadow-ray fractions.  Measured
+     * 2.3e-2 (the back wall; each against tests/data/cornell_converged.json
+     * at 150 elements: dense 2.4e-2, Galerkin 4.7e-2).  With the analytic
+     * method's shadow rays they agreed to 4.1e-3. */
     double worst = 0.0;
     for (size_t s = 0; s < scene->surface_count; s++) {
         double a[3], b[3];
@@ -349,7 +352,7 @@ static void test_cornell_constant_matches_dense(void **state)
             worst = fmax(worst, fabs(a[c] - b[c]) / a[c]);
     }
     print_message("Cornell box, 150 elements: surface means within %.2e of the dense strategy's\n", worst);
-    assert_true(worst < 1e-2);
+    assert_true(worst < 3e-2);
     /* Both balance the same power: emitted equal, absorbed within 1e-2. */
     double e1, a1, e2, a2;
     rad_solution_power(dense, &e1, &a1);
