@@ -532,6 +532,13 @@ typedef struct rad_render_options {
     const rad_camera *camera;     /* NULL = the scene's, else framed automatically */
     rad_shading shading;
     double exposure;              /* multiplier on radiance; 0 = automatic */
+    /* Per-pixel instant radiosity (Keller 1997, docs/methods.md): light
+     * paths from the emitters; each camera ray's point gathers their
+     * virtual point lights and the emitters with shadow rays, instead of
+     * reading the solved elements (which then give only reflectance and
+     * emission).  View-dependent, no mesh error; rad_options.seed keys it.
+     * 0 = off (the solved radiosity). */
+    int vpl_paths;
 } rad_render_options;
 
 /* A linear-radiance RGB image, W/(m^2 sr). */

@@ -134,6 +134,7 @@ static const scenario scenarios[] = {
     {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2},
     {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0},
     {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0},
+    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from
@@ -205,7 +206,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     }
     if (r == RAD_OK) {
         rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
-        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0};
         r = rad_solution_render(ctx, s, &ro, &image);
     }
     if (r == RAD_OK) {
@@ -604,7 +605,7 @@ static void test_stats_by_category(void **state)
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
     rad_image *image = NULL;
-    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0};
+    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0, 0};
     assert_int_equal(rad_solution_render(ctx, s, &ro, &image), RAD_OK);
     char path[512];
     output_path("stats.json", path, sizeof path);

@@ -24,6 +24,12 @@ typedef struct rad_render_input {
     const double *element_radiosity; /* 3 per element, W/m^2 */
     const double *vertex_radiosity;  /* 3 per mesh vertex, W/m^2 */
     rad_camera camera;               /* resolved: never "none" */
+    /* Per-pixel instant radiosity (rad_render_options.vpl_paths): the VPLs,
+     * and the elements' reflectance and emission (3 per element); vpls
+     * NULL: off. */
+    const struct rad_vpl_set *vpls;
+    const double *reflectance, *emission;
+    uint64_t seed;
 } rad_render_input;
 
 /* Ray-cast the mesh from the camera; each sample takes the radiance B/pi of

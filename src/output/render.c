@@ -23,8 +23,15 @@
  * instead of 16 at the default 4 x 4, with the edges as before.  Rows are
  * shared out to OpenMP threads; each thread sends its row's rays to the
  * visibility backend in batches.
+ *
+ * Per-pixel instant radiosity (input->vpls, rad_render_options.vpl_paths):
+ * each camera ray's point gathers the emitters and the virtual point
+ * lights itself (solve/vpl.h) instead of reading the solution, B = E + rho
+ * H at that very point: no mesh error, the VPLs' noise and clamp instead.
+ * The shadow rays of the direct light are keyed on (pixel, stratum).
  */
 #include "output/output.h"
+#include "solve/vpl.h"
 
 #include <stdlib.h>
 
@@ -105,8 +112,35 @@ static rad_result make_view(rad_context *ctx, const rad_camera *camera, int widt
 /* Radiosity (W/m^2) seen along `ray` given its hit; 0 for a miss or the
  * back of a patch.  Returns what was seen: the patch (smooth shading,
  * continuous across it) or the element (flat), RENDER_MISS or RENDER_BACK. */
+/* Per-pixel instant radiosity at the point p of element e seen by a
+ * camera ray: B = E + rho (direct + VPLs), the VPLs clamped as the
+ * strategy's (solve/vpl.h); the direct light's shadow rays from the
+ * stream keyed on `key` (pixel and stratum). */
+static void shade_vpl(const rad_render_input *input, uint32_t e, const rad_patch *patch, vec3 p, uint64_t key,
+                      double rgb[3])
+{
+    enum { BLOCK = 64, DIRECT_RAYS = 4 };
+    const rad_mesh *mesh = input->mesh;
+    const rad_vpl_set *set = input->vpls;
+    vec3 n = patch->normal;
+    vec3 x = v3_mad(p, n, rad_vis_epsilon(mesh) + rad_element_bend(mesh, &mesh->elements[e]));
+    rad_rng rng = rad_rng_keyed(input->seed, 0x52454e44u, key); /* "REND" */
+    double H[3], h[3], h_raw[3];
+    rad_vpl_direct(set, mesh, input->vis, input->emission, x, n, DIRECT_RAYS, &rng, H);
+    rad_ray rays[BLOCK];
+    uint8_t blocked[BLOCK];
+    for (size_t first = 0; first < set->count; first += BLOCK) {
+        size_t count = set->count - first < BLOCK ? set->count - first : BLOCK;
+        rad_vpl_gather(set, input->vis, x, n, first, count, rays, blocked, h, h_raw);
+        for (int c = 0; c < 3; c++)
+            H[c] += h[c];
+    }
+    for (int c = 0; c < 3; c++)
+        rgb[c] = input->emission[3 * (size_t)e + c] + input->reflectance[3 * (size_t)e + c] * fmax(H[c], 0.0);
+}
+
 static uint32_t shade(const rad_render_input *input, rad_shading shading, const rad_ray *ray,
-                      const rad_hit *hit, double rgb[3])
+                      const rad_hit *hit, uint64_t key, double rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     if (!isfinite(hit->t))
@@ -119,6 +153,10 @@ static uint32_t shade(const rad_render_input *input, rad_shading shading, const 
     double s, t, local_s, local_t;
     rad_patch_parameters(patch, p, &s, &t);
     uint32_t e = rad_mesh_locate(mesh, hit->patch, s, t, &local_s, &local_t);
+    if (input->vpls) {
+        shade_vpl(input, e, patch, p, key, rgb);
+        return hit->patch;
+    }
     bool smooth = shading == RAD_SHADING_SMOOTH && input->vertex_radiosity;
     if (smooth) {
         rad_element_interpolate(mesh, &mesh->elements[e], input->vertex_radiosity, local_s,
@@ -166,7 +204,8 @@ static void trace_pixels(const rad_render_input *input, rad_shading shading, con
         for (size_t k = 0; k < n; k++) {
             uint64_t r = first + k, x = pixel[r / per_pixel];
             double rgb[3];
-            uint32_t what = shade(input, shading, &rays[k], &hits[k], rgb);
+            uint64_t key = ((uint64_t)y * (uint64_t)view->width + x) * per_pixel * 2 + (r % per_pixel) * 2 + stream;
+            uint32_t what = shade(input, shading, &rays[k], &hits[k], key, rgb);
             if (r % per_pixel == 0) {
                 sum[3 * x] = sum[3 * x + 1] = sum[3 * x + 2] = 0.0;
                 seen[x] = what;

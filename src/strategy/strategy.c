@@ -12,11 +12,13 @@
 extern const rad_strategy rad_strategy_dense;
 extern const rad_strategy rad_strategy_matrix_free;
 extern const rad_strategy rad_strategy_hierarchical;
+extern const rad_strategy rad_strategy_instant;
 
 const rad_strategy *const rad_strategies[] = {
     &rad_strategy_dense,
     &rad_strategy_matrix_free,
     &rad_strategy_hierarchical,
+    &rad_strategy_instant,
     NULL,
 };
 
