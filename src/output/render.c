@@ -27,7 +27,9 @@
  * Per-pixel instant radiosity (input->vpls, rad_render_options.vpl_paths):
  * each camera ray's point gathers the emitters and the virtual point
  * lights itself (solve/vpl.h) instead of reading the solution, B = E + rho
- * H at that very point: no mesh error, the VPLs' noise and clamp instead.
+ * H at that very point: no mesh error, the VPLs' noise and clamp instead;
+ * what the clamp removes comes back from rays into the near field, which
+ * read the solution underneath (so it, too, should be a converged one).
  * The shadow rays of the direct light are keyed on (pixel, stratum).
  */
 #include "output/output.h"
@@ -113,9 +115,9 @@ static rad_result make_view(rad_context *ctx, const rad_camera *camera, int widt
  * back of a patch.  Returns what was seen: the patch (smooth shading,
  * continuous across it) or the element (flat), RENDER_MISS or RENDER_BACK. */
 /* Per-pixel instant radiosity at the point p of element e seen by a
- * camera ray: B = E + rho (direct + VPLs), the VPLs clamped as the
- * strategy's (solve/vpl.h); the direct light's shadow rays from the
- * stream keyed on `key` (pixel and stratum). */
+ * camera ray: B = E + rho (direct + VPLs + near field), the VPLs clamped
+ * as the strategy's (solve/vpl.h); the direct light's shadow rays and the
+ * near-field rays from the stream keyed on `key` (pixel and stratum). */
 static void shade_vpl(const rad_render_input *input, uint32_t e, const rad_patch *patch, vec3 p, uint64_t key,
                       double rgb[3])
 {
@@ -134,6 +136,40 @@ static void shade_vpl(const rad_render_input *input, uint32_t e, const rad_patch
         rad_vpl_gather(set, input->vis, x, n, first, count, rays, blocked, h, h_raw);
         for (int c = 0; c < 3; c++)
             H[c] += h[c];
+    }
+    /* The clamp's loss, recovered from the near field (as the strategy's
+     * compensation, strategy/instant.c): rays of length r_c; a ray that
+     * meets element j at distance t adds (1 - t^2 / r_c^2) of j's
+     * reflected radiosity B_j - E_j, B from the solution underneath. */
+    double rc = set->clamp_radius;
+    if (rc > 0.0) {
+        enum { NEAR_RAYS = 16, SIDE = 4 };
+        vec3 tu = v3_normalize(fabs(n.x) > 0.9 ? v3_cross(n, v3(0, 1, 0)) : v3_cross(n, v3(1, 0, 0)));
+        vec3 tv = v3_cross(n, tu);
+        rad_hit hits[NEAR_RAYS];
+        for (int k = 0; k < NEAR_RAYS; k++) {
+            double u = ((k % SIDE) + rad_rng_uniform(&rng)) / SIDE, v = ((k / SIDE) + rad_rng_uniform(&rng)) / SIDE;
+            double r = sqrt(u), phi = 2.0 * M_PI * v;
+            vec3 d = v3_add(v3_add(v3_scale(tu, r * cos(phi)), v3_scale(tv, r * sin(phi))),
+                            v3_scale(n, sqrt(fmax(0.0, 1.0 - u))));
+            rays[k] = (rad_ray){x, d, 0.0, rc};
+        }
+        input->vis->backend->intersect(input->vis->state, rays, NEAR_RAYS, hits);
+        for (int k = 0; k < NEAR_RAYS; k++) {
+            if (!isfinite(hits[k].t))
+                continue;
+            const rad_patch *q = &mesh->patches[hits[k].patch];
+            if (v3_dot(rays[k].direction, q->normal) >= 0.0)
+                continue;
+            double s0, t0, ls, lt;
+            rad_patch_parameters(q, v3_mad(x, rays[k].direction, hits[k].t), &s0, &t0);
+            uint32_t j = rad_mesh_locate(mesh, hits[k].patch, s0, t0, &ls, &lt);
+            double missing = 1.0 - hits[k].t * hits[k].t / (rc * rc);
+            for (int c = 0; c < 3 && missing > 0.0; c++)
+                H[c] += missing *
+                        fmax(input->element_radiosity[3 * (size_t)j + c] - input->emission[3 * (size_t)j + c], 0.0) /
+                        NEAR_RAYS;
+        }
     }
     for (int c = 0; c < 3; c++)
         rgb[c] = input->emission[3 * (size_t)e + c] + input->reflectance[3 * (size_t)e + c] * fmax(H[c], 0.0);
