@@ -156,6 +156,11 @@ typedef struct rad_context_options {
     rad_warning_fn on_warning;   /* optional: told of input read differently from the file,
                                     and of geometry finer than the rays resolve */
     void *warning_user;          /* passed to `on_warning` */
+    /* A reflectance texture (MTL map_Kd, glTF baseColorTexture) that cannot
+     * be read fails the load, naming the material, the MTL file and line
+     * and the image; true makes it a warning and the material keeps its
+     * flat Kd / base colour instead. */
+    bool missing_textures_flat;
 } rad_context_options;
 
 /* Create a context.  `options` may be NULL (all defaults); it is copied, but

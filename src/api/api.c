@@ -383,6 +383,7 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     in.reflectance = s->view.reflectance;
     in.emission = s->view.emission;
     in.seed = s->options.seed;
+    in.scene = s->scene;
     if (o.vpl_paths < 0 || o.vpl_paths > 10000000) {
         rad_free(display);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,

@@ -36,6 +36,7 @@
 #include "solve/vpl.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -171,8 +172,13 @@ static void shade_vpl(const rad_render_input *input, uint32_t e, const rad_patch
                         NEAR_RAYS;
         }
     }
+    double rho[3];
+    if (input->scene && rad_scene_textured(input->scene, patch->polygon))
+        rad_scene_reflectance_at(input->scene, patch->polygon, p, rho);
+    else
+        memcpy(rho, input->reflectance + 3 * (size_t)e, sizeof rho);
     for (int c = 0; c < 3; c++)
-        rgb[c] = input->emission[3 * (size_t)e + c] + input->reflectance[3 * (size_t)e + c] * fmax(H[c], 0.0);
+        rgb[c] = input->emission[3 * (size_t)e + c] + rho[c] * fmax(H[c], 0.0);
 }
 
 static uint32_t shade(const rad_render_input *input, rad_shading shading, const rad_ray *ray,
@@ -200,6 +206,19 @@ static uint32_t shade(const rad_render_input *input, rad_shading shading, const 
     } else {
         for (int c = 0; c < 3; c++)
             rgb[c] = input->element_radiosity[3 * (size_t)e + (size_t)c];
+    }
+    /* A texture modulates the reflected part by the texel's reflectance
+     * over the element's mean (which the solution used): a texture of one
+     * colour changes nothing. */
+    if (input->scene && input->reflectance && input->emission &&
+        rad_scene_textured(input->scene, patch->polygon)) {
+        double rho[3];
+        rad_scene_reflectance_at(input->scene, patch->polygon, p, rho);
+        for (int c = 0; c < 3; c++) {
+            double mean = input->reflectance[3 * (size_t)e + (size_t)c], E = input->emission[3 * (size_t)e + (size_t)c];
+            if (mean > 0.0)
+                rgb[c] = E + (rgb[c] - E) * (rho[c] / mean);
+        }
     }
     return smooth ? hit->patch : e;
 }
