@@ -18,6 +18,7 @@
  *               cell differ by the texels' ratio (flat shading)
  *   missing     a missing image fails the load naming the MTL file, line and
  *               image; with missing_textures_flat it loads with Kd
+ *   glTF        baseColorTexture with TEXCOORD_0, (0, 0) at the image's top left
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -289,6 +290,64 @@ static void test_missing_file(void **state)
     assert_non_null(strstr(rad_context_error(ctx), "nowhere.png"));
 }
 
+/* glTF: baseColorTexture beside the file, TEXCOORD_0 on the floor's two
+ * triangles (the same floor and lamp; glTF puts (u, v) = (0, 0) at the
+ * image's top left, OBJ at its bottom left): elements of a 2 x 2 checker
+ * cell each get its value, the corner at (0, 0, 0) the image's top-left. */
+static void test_gltf_base_color_texture(void **state)
+{
+    (void)state;
+    write_checker("checker.png", 8, 8, 8, 40, 200); /* cell (0, 0), top left: 40 */
+    static const char gltf[] =
+        "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],\"nodes\":[{\"name\":\"floor\",\""
+        "mesh\":0},{\"name\":\"lamp\",\"mesh\":1}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"T"
+        "EXCOORD_0\":1},\"indices\":2,\"material\":0}]},{\"primitives\":[{\"attributes\":{\"POSITION\":3},\"ind"
+        "ices\":4,\"material\":1}]}],\"materials\":[{\"name\":\"floor\",\"pbrMetallicRoughness\":{\"baseColorFa"
+        "ctor\":[0.9,0.9,0.9,1],\"baseColorTexture\":{\"index\":0},\"metallicFactor\":0}},{\"name\":\"lamp\",\""
+        "pbrMetallicRoughness\":{\"baseColorFactor\":[0,0,0,1],\"metallicFactor\":0},\"emissiveFactor\":[1"
+        ",1,1]}],\"textures\":[{\"source\":0}],\"images\":[{\"uri\":\"checker.png\"}],\"buffers\":[{\"byteLength"
+        "\":152,\"uri\":\"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAA"
+        "AAAAAIA/AAAAAAAAAAAAAIA/mpmZPgAAgD+amZk+MzMzPwAAgD+amZk+MzMzPwAAgD8zMzM/mpmZPgAAgD8zMzM/AA"
+        "AAAAAAAAAAAIA/AAAAAAAAgD8AAIA/AAAAAAAAgD8AAAMAAgAAAAIAAQAAAAEAAgAAAAIAAwA=\"}],\"bufferViews"
+        "\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":32"
+        "},{\"buffer\":0,\"byteOffset\":128,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":4"
+        "8},{\"buffer\":0,\"byteOffset\":140,\"byteLength\":12}],\"accessors\":[{\"bufferView\":0,\"componentT"
+        "ype\":5126,\"count\":4,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,0,1]},{\"bufferView\":1,\"componentT"
+        "ype\":5126,\"count\":4,\"type\":\"VEC2\"},{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\""
+        "SCALAR\"},{\"bufferView\":3,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\",\"min\":[0.3,1,0.3],\"m"
+        "ax\":[0.7,1,0.7]},{\"bufferView\":4,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}";
+    char path[512];
+    snprintf(path, sizeof path, "%s/t.gltf", folder);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(gltf, f);
+    fclose(f);
+    rad_scene *scene = NULL;
+    if (rad_scene_load_file(ctx, path, &scene) != RAD_OK)
+        fail_msg("%s", rad_context_error(ctx));
+    rad_solution *s = solve(scene, 0.125);
+    int count[2] = {0, 0};
+    bool corner_seen = false;
+    for (size_t e = 0; e < rad_solution_element_count(s); e++) {
+        if (rad_solution_element_surface(s, e) != 0)
+            continue;
+        double rho[3], centre[3];
+        rad_solution_element_values(s, e, rho, NULL, NULL);
+        rad_solution_element_geometry(s, e, NULL, centre);
+        bool is_bright = fabs(rho[0] - KD * linear(200)) < 1e-6;
+        assert_true(is_bright || fabs(rho[0] - KD * linear(40)) < 1e-6);
+        count[is_bright]++;
+        if (centre[0] < 0.125 && centre[2] < 0.125) {
+            assert_false(is_bright); /* (u, v) = (0, 0): the top-left texel */
+            corner_seen = true;
+        }
+    }
+    assert_true(corner_seen);
+    assert_int_equal(count[0], count[1]);
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -316,6 +375,7 @@ int main(void)
         cmocka_unit_test(test_flat_texture_renders_as_its_colour),
         cmocka_unit_test(test_modulation),
         cmocka_unit_test(test_missing_file),
+        cmocka_unit_test(test_gltf_base_color_texture),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
