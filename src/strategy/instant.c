@@ -68,10 +68,10 @@ static bool instant_solver_info(size_t index, const char **name, const char **de
 {
     static const char *const names[2] = {"instant-radiosity", "instant-radiosity-clamped"};
     static const char *const descriptions[2] = {
-        "instant radiosity (Keller 1997): virtual point lights on quasi-random light paths "
-        "(rad_options.samples paths, default 1024) gathered per element with shadow rays; the "
-        "1/r^2 clamp's loss compensated from the near field",
-        "instant radiosity with the clamp's loss measured but not compensated"};
+        "matrix-free instant radiosity (Keller 1997): virtual point lights on quasi-random light "
+        "paths (rad_options.samples paths, default 1024) gathered per element with shadow rays; "
+        "the 1/r^2 clamp's loss compensated from the near field",
+        "matrix-free instant radiosity with the clamp's loss measured but not compensated"};
     if (index >= 2)
         return false;
     *name = names[index];
