@@ -15,7 +15,8 @@
  * where r_c, the clamping radius, bounds the 1/r^2 singularity.  The
  * clamp removes the fraction 1 - r^2 / r_c^2 of what a VPL nearer than r_c
  * gives: a bias (energy lost) that the gathers measure and that the
- * per-element strategy can compensate (vpl.c, rad_vpl_compensate).
+ * strategy (strategy/instant.c) and the renderer recover from rays into
+ * the near field.
  */
 #ifndef RAD_VPL_H
 #define RAD_VPL_H

@@ -9,7 +9,7 @@
  * with no linear system and no stored coupling: memory is O(n + VPLs),
  * time O(n x VPLs) shadow rays.  View-independent, so the result is a
  * per-element solution like the other strategies'; the renderer's
- * per-pixel gather (rad_render_options.vpl) is the view-dependent form.
+ * per-pixel gather (rad_render_options.vpl_paths) is the view-dependent form.
  *
  *   element i:  4 stratified points      -> H_direct (exact factors x visible fraction)
  *               VPL k at its own point x_k, uniform over i -> H_vpl (unbiased for the
