@@ -520,6 +520,7 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
     /* --max-memory limits everything the engine allocates, loading included. */
     co.max_memory_bytes = s.solve.max_memory_bytes;
     co.read_outside_scene_folder = s.read_outside != 0;
+    co.missing_textures_flat = s.missing_textures != 0;
     co.on_warning = print_warning;
     if (!s.quiet && isatty(STDERR_FILENO) && s.command != CLI_GENERATE) {
         co.progress = progress_bar;

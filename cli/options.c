@@ -88,6 +88,8 @@ static const rad_option_word lightmap_words[] = {{"radiosity", RAD_LIGHTMAP_RADI
                                                  {"irradiance", RAD_LIGHTMAP_IRRADIANCE},
                                                  {NULL, 0}};
 
+static const rad_option_word missing_texture_words[] = {{"error", 0}, {"flat", 1}, {NULL, 0}};
+
 static const cli_flag FLAGS[] = {
     {"output", 'o', "FILE", CLI_RENDER, OWN(output, RAD_OPTION_STRING),
      .own.help = "output image: .png (exposed, sRGB), .hdr or .pfm (linear)",
@@ -198,12 +200,17 @@ static const cli_flag FLAGS[] = {
      .help = "multiplier on radiance for the display colours (glTF COLOR_0, PLY red/green/blue)"},
     {"flat", 0, NULL, CLI_RENDER | CLI_VIEW, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
+    {"vpl", 0, "N", CLI_RENDER, RENDER(vpl_paths)},
     {"seed", 0, "S", RV, SOLVE(seed)},
     {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
      .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},
     {"stats", 0, "FILE.json", RV & ~CLI_VIEW, OWN(stats, RAD_OPTION_STRING),
      .own.help = "write run statistics as JSON (docs/stats.md)"},
     {"max-memory", 0, "SIZE", RV, SOLVE(max_memory_bytes)},
+    {"missing-textures", 0, "WHAT", RV, OWN(missing_textures, RAD_OPTION_ENUM), .own.words = missing_texture_words,
+     .own.default_text = "error",
+     .own.help = "a texture (map_Kd, baseColorTexture) that cannot be read: error (fail, naming the "
+                 "material, file and line) or flat (warn and use the material's flat colour)"},
     {"read-outside-scene-folder", 0, NULL, RV, OWN(read_outside, RAD_OPTION_FLAG),
      .own.help = "let the scene refer to files outside its folder (by default an mtllib, glTF "
                  "buffer or image that resolves outside the scene file's folder is refused)"},
@@ -551,6 +558,7 @@ char *cli_rewrite_message(const char *message, char *out, size_t size)
     } context_fields[] = {
         {"rad_context_options.max_memory_bytes", "max-memory"},
         {"rad_context_options.read_outside_scene_folder", "read-outside-scene-folder"},
+        {"rad_context_options.missing_textures_flat", "missing-textures"},
         {"rad_context_options.threads", "threads"},
     };
     size_t n = 0;

@@ -60,6 +60,7 @@ typedef struct cli_settings {
     int threads;
     int quiet;
     int read_outside;         /* --read-outside-scene-folder */
+    int missing_textures;     /* --missing-textures: 0 error, 1 flat */
     double texels_per_metre;  /* bake: 0 = the library's default */
     int atlas_size;           /* bake: 0 = the library's default */
     int lightmap_quantity;    /* bake: rad_lightmap_quantity */

@@ -156,6 +156,11 @@ typedef struct rad_context_options {
     rad_warning_fn on_warning;   /* optional: told of input read differently from the file,
                                     and of geometry finer than the rays resolve */
     void *warning_user;          /* passed to `on_warning` */
+    /* A reflectance texture (MTL map_Kd, glTF baseColorTexture) that cannot
+     * be read fails the load, naming the material, the MTL file and line
+     * and the image; true makes it a warning and the material keeps its
+     * flat Kd / base colour instead. */
+    bool missing_textures_flat;
 } rad_context_options;
 
 /* Create a context.  `options` may be NULL (all defaults); it is copied, but
@@ -540,6 +545,13 @@ typedef struct rad_render_options {
     const rad_camera *camera;     /* NULL = the scene's, else framed automatically */
     rad_shading shading;
     double exposure;              /* multiplier on radiance; 0 = automatic */
+    /* Per-pixel instant radiosity (Keller 1997, docs/methods.md): light
+     * paths from the emitters; each camera ray's point gathers their
+     * virtual point lights and the emitters with shadow rays, instead of
+     * reading the solved elements (which then give only reflectance and
+     * emission).  View-dependent, no mesh error; rad_options.seed keys it.
+     * 0 = off (the solved radiosity). */
+    int vpl_paths;
 } rad_render_options;
 
 /* A linear-radiance RGB image, W/(m^2 sr). */

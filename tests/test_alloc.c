@@ -18,12 +18,12 @@
 
 #include <cjson/cJSON.h>
 #include <dirent.h>
+#include <fcntl.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#include <fcntl.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -50,6 +50,23 @@ static const char box_obj[] = "mtllib box.mtl\n"
 
 static const char box_mtl[] = "newmtl white\nKd 0.5 0.5 0.5\n"
                               "newmtl lamp\nKd 0.3 0.3 0.3\nKe 1 1 1\n";
+
+/* A textured floor (map_Kd, an 8 x 8 checker PNG) under a lamp: the
+ * texture's reading, its texels and the coordinates' maps. */
+static const char textured_obj[] = "mtllib textured.mtl\n"
+                                   "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                   "v 0.3 1 0.3\nv 0.7 1 0.3\nv 0.7 1 0.7\nv 0.3 1 0.7\n"
+                                   "o floor\nusemtl floor\nf 1/1 4/4 3/3 2/2\no lamp\nusemtl lamp\nf 5 6 7 8\n";
+static const char textured_mtl[] = "newmtl floor\nKd 0.9 0.9 0.9\nmap_Kd checker.png\n"
+                                   "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+static const unsigned char checker_png[] = {
+    0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48,
+    0x44, 0x52, 0x00, 0x00, 0x00, 0x08, 0x00, 0x00, 0x00, 0x08, 0x08, 0x02, 0x00, 0x00,
+    0x00, 0x4b, 0x6d, 0x29, 0xdc, 0x00, 0x00, 0x00, 0x19, 0x49, 0x44, 0x41, 0x54, 0x78,
+    0x9c, 0x63, 0xb0, 0xb1, 0xb1, 0x79, 0xf6, 0xec, 0x19, 0x26, 0xc9, 0x80, 0x55, 0x14,
+    0x48, 0x32, 0x0c, 0x4a, 0x1d, 0x00, 0x7e, 0x3e, 0x6c, 0xc1, 0x4e, 0x2c, 0xd7, 0xe5,
+    0x00, 0x00, 0x00, 0x00, 0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82,
+};
 
 /* One emissive triangle, positions only (no indices), in a data URI. */
 static const char triangle_gltf[] =
@@ -136,6 +153,7 @@ static const scenario scenarios[] = {
     {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0},
     {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0},
     {"collocation", "collocation", NULL, 0, 0, 0, false, 0},
+    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from
@@ -147,6 +165,11 @@ static rad_result run_loading(rad_context *ctx, outputs *out)
     snprintf(path, sizeof path, "%s/box.obj", input_dir);
     rad_result r = rad_scene_load_file(ctx, path, &scene);
     rad_scene_destroy(scene);
+    if (r == RAD_OK) {
+        snprintf(path, sizeof path, "%s/textured.obj", input_dir);
+        r = rad_scene_load_file(ctx, path, &scene);
+        rad_scene_destroy(scene);
+    }
     if (r == RAD_OK) {
         r = rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), box_mtl, strlen(box_mtl), &scene);
         rad_scene_destroy(scene);
@@ -240,7 +263,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     }
     if (r == RAD_OK) {
         rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
-        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0};
         r = rad_solution_render(ctx, s, &ro, &image);
     }
     if (r == RAD_OK) {
@@ -656,7 +679,7 @@ static void test_stats_by_category(void **state)
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
     rad_image *image = NULL;
-    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0};
+    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0, 0};
     assert_int_equal(rad_solution_render(ctx, s, &ro, &image), RAD_OK);
     char path[512];
     output_path("stats.json", path, sizeof path);
@@ -703,7 +726,17 @@ static int setup(void **state)
         return -1;
     write_text(input_dir, "box.obj", box_obj);
     write_text(input_dir, "box.mtl", box_mtl);
-    return 0;
+    write_text(input_dir, "textured.obj", textured_obj);
+    write_text(input_dir, "textured.mtl", textured_mtl);
+    char png[600];
+    snprintf(png, sizeof png, "%s/checker.png", input_dir);
+    /* open/write, not stdio: no buffer allocated here (test_default_limit's
+     * child under ASan has no address space to spare for new size classes). */
+    int fd = open(png, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    bool written = fd >= 0 && write(fd, checker_png, sizeof checker_png) == (ssize_t)sizeof checker_png;
+    if (fd >= 0)
+        close(fd);
+    return written ? 0 : -1;
 }
 
 static int teardown(void **state)
@@ -716,6 +749,11 @@ static int teardown(void **state)
     remove(path);
     snprintf(path, sizeof path, "%s/box.mtl", input_dir);
     remove(path);
+    static const char *const textured[] = {"textured.obj", "textured.mtl", "checker.png"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/%s", input_dir, textured[k]);
+        remove(path);
+    }
     rmdir(input_dir);
     return 0;
 }

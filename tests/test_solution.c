@@ -113,7 +113,8 @@ static void test_every_solver_name_resolves(void **state)
         assert_null(strstr(rad_context_error(ctx), "unknown solver"));
         rad_scene_destroy(scene);
     }
-    assert_int_equal(count, 10); /* five linear solvers, shooting, hierarchical, two Galerkin, collocation */
+    assert_int_equal(count, 12); /* five linear solvers, shooting, hierarchical, two Galerkin, collocation,
+                                    two instant radiosity */
     rad_options o = {0};
     o.solver = "no-such-solver";
     rad_solution *s = NULL;

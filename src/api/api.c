@@ -8,6 +8,7 @@
  */
 #include "api/solution.h"
 #include "strategy/saved.h"
+#include "solve/vpl.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -412,7 +413,29 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
         in.camera = *o.camera;
     else if (!rad_scene_camera(s->scene, &in.camera))
         in.camera = rad_camera_frame(s->scene->bounds_min, s->scene->bounds_max, (double)w / h);
+    /* Per-pixel instant radiosity: its VPLs, for this image only. */
+    rad_vpl_set vpls = {0};
+    in.vpls = NULL;
+    in.reflectance = s->view.reflectance;
+    in.emission = s->view.emission;
+    in.seed = s->options.seed;
+    in.scene = s->scene;
+    if (o.vpl_paths < 0 || o.vpl_paths > 10000000) {
+        rad_free(display);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "rad_render_options.vpl_paths must be in [1, 10000000], got %d (0: off)", o.vpl_paths);
+    }
+    if (o.vpl_paths > 0) {
+        r = rad_vpl_create(ctx, s->view.mesh, s->view.vis, s->view.reflectance, s->view.emission,
+                           (size_t)o.vpl_paths, s->options.seed, &vpls);
+        if (r != RAD_OK) {
+            rad_free(display);
+            return r;
+        }
+        in.vpls = &vpls;
+    }
     r = rad_render_image(ctx, &in, &o, out);
+    rad_vpl_free(&vpls);
     s->view.seconds.render = rad_seconds() - t;
     int spp = o.samples > 0 ? o.samples : 4;
     s->view.render_rays = (uint64_t)w * (uint64_t)h * (uint64_t)spp * (uint64_t)spp;

@@ -56,7 +56,7 @@ static const rad_option_info solution_rows[] = {
     {SOLUTION(samples), .type = RAD_OPTION_INT, .min = 1.0, .max = INT_MAX, .default_value = NAN,
      .default_text = "the method's",
      .help = "hemisphere: rays per element; montecarlo: point pairs per element pair; "
-             "shooting: rays per shot"},
+             "shooting: rays per shot; instant-radiosity: light paths (default 1024)"},
     {SOLUTION(near_field), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = 3.0, .default_text = "3",
      .help = "hybrid: pairs closer than this many element sizes use the exact method"},
@@ -135,6 +135,11 @@ static const rad_option_info render_rows[] = {
      .default_text = "smooth", .help = "smooth (vertex values interpolated) or flat (one colour per element)"},
     {RENDER(exposure), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = NAN, .default_text = "automatic", .help = "multiplier on radiance before sRGB"},
+    {RENDER(vpl_paths), .type = RAD_OPTION_INT, .min = 1.0, .max = 1e7, .default_value = NAN,
+     .default_text = "off (the solved radiosity)",
+     .help = "per-pixel instant radiosity: this many light paths' virtual point lights and the emitters "
+             "gathered at each camera ray's point (view-dependent; the 1/r^2 clamp as the "
+             "instant-radiosity solver's)"},
 };
 
 static const rad_option_info office_rows[] = {

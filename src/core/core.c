@@ -73,6 +73,7 @@ rad_result rad_context_create(const rad_context_options *options, rad_context **
     ctx->progress_user = options->progress_user;
     ctx->on_error = options->on_error;
     ctx->read_outside_scene_folder = options->read_outside_scene_folder;
+    ctx->missing_textures_flat = options->missing_textures_flat;
     ctx->error_user = options->error_user;
     ctx->on_warning = options->on_warning;
     ctx->warning_user = options->warning_user;

@@ -90,6 +90,7 @@ struct rad_context {
     rad_warning_fn on_warning;
     void *warning_user;
     bool read_outside_scene_folder; /* see rad_context_options */
+    bool missing_textures_flat;     /* see rad_context_options */
     atomic_int cancel;          /* raised by rad_context_cancel, even from a signal handler */
     rad_result last_result;
     bool error_latched;         /* this call already recorded its first failure */

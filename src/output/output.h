@@ -31,6 +31,16 @@ typedef struct rad_render_input {
     const double *element_radiosity; /* 3 per element, W/m^2 */
     const double *vertex_radiosity;  /* 3 per mesh vertex, W/m^2 */
     rad_camera camera;               /* resolved: never "none" */
+    /* Per-pixel instant radiosity (rad_render_options.vpl_paths): the VPLs,
+     * and the elements' reflectance and emission (3 per element); vpls
+     * NULL: off. */
+    const struct rad_vpl_set *vpls;
+    const double *reflectance, *emission; /* 3 per element; also for textures */
+    uint64_t seed;
+    /* Textures: the reflectance at the point seen modulates the element's
+     * reflected light, B = E + (B_element - E) rho(point) / rho_element
+     * (NULL: no textures drawn). */
+    const rad_scene *scene;
 } rad_render_input;
 
 /* Ray-cast the mesh from the camera; each sample takes the radiance B/pi of

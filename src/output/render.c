@@ -23,10 +23,20 @@
  * instead of 16 at the default 4 x 4, with the edges as before.  Rows are
  * shared out to OpenMP threads; each thread sends its row's rays to the
  * visibility backend in batches.
+ *
+ * Per-pixel instant radiosity (input->vpls, rad_render_options.vpl_paths):
+ * each camera ray's point gathers the emitters and the virtual point
+ * lights itself (solve/vpl.h) instead of reading the solution, B = E + rho
+ * H at that very point: no mesh error, the VPLs' noise and clamp instead;
+ * what the clamp removes comes back from rays into the near field, which
+ * read the solution underneath (so it, too, should be a converged one).
+ * The shadow rays of the direct light are keyed on (pixel, stratum).
  */
 #include "output/output.h"
+#include "solve/vpl.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -105,8 +115,74 @@ static rad_result make_view(rad_context *ctx, const rad_camera *camera, int widt
 /* Radiosity (W/m^2) seen along `ray` given its hit; 0 for a miss or the
  * back of a patch.  Returns what was seen: the patch (smooth shading,
  * continuous across it) or the element (flat), RENDER_MISS or RENDER_BACK. */
+/* Per-pixel instant radiosity at the point p of element e seen by a
+ * camera ray: B = E + rho (direct + VPLs + near field), the VPLs clamped
+ * as the strategy's (solve/vpl.h); the direct light's shadow rays and the
+ * near-field rays from the stream keyed on `key` (pixel and stratum). */
+static void shade_vpl(const rad_render_input *input, uint32_t e, const rad_patch *patch, vec3 p, uint64_t key,
+                      double rgb[3])
+{
+    enum { BLOCK = 64, DIRECT_RAYS = 4 };
+    const rad_mesh *mesh = input->mesh;
+    const rad_vpl_set *set = input->vpls;
+    vec3 n = patch->normal;
+    vec3 x = v3_mad(p, n, rad_vis_epsilon(mesh) + rad_element_bend(mesh, &mesh->elements[e]));
+    rad_rng rng = rad_rng_keyed(input->seed, 0x52454e44u, key); /* "REND" */
+    double H[3], h[3], h_raw[3];
+    rad_vpl_direct(set, mesh, input->vis, input->emission, x, n, DIRECT_RAYS, &rng, H);
+    rad_ray rays[BLOCK];
+    uint8_t blocked[BLOCK];
+    for (size_t first = 0; first < set->count; first += BLOCK) {
+        size_t count = set->count - first < BLOCK ? set->count - first : BLOCK;
+        rad_vpl_gather(set, input->vis, x, n, first, count, rays, blocked, h, h_raw);
+        for (int c = 0; c < 3; c++)
+            H[c] += h[c];
+    }
+    /* The clamp's loss, recovered from the near field (as the strategy's
+     * compensation, strategy/instant.c): rays of length r_c; a ray that
+     * meets element j at distance t adds (1 - t^2 / r_c^2) of j's
+     * reflected radiosity B_j - E_j, B from the solution underneath. */
+    double rc = set->clamp_radius;
+    if (rc > 0.0) {
+        enum { NEAR_RAYS = 16, SIDE = 4 };
+        vec3 tu = v3_normalize(fabs(n.x) > 0.9 ? v3_cross(n, v3(0, 1, 0)) : v3_cross(n, v3(1, 0, 0)));
+        vec3 tv = v3_cross(n, tu);
+        rad_hit hits[NEAR_RAYS];
+        for (int k = 0; k < NEAR_RAYS; k++) {
+            double u = ((k % SIDE) + rad_rng_uniform(&rng)) / SIDE, v = ((k / SIDE) + rad_rng_uniform(&rng)) / SIDE;
+            double r = sqrt(u), phi = 2.0 * M_PI * v;
+            vec3 d = v3_add(v3_add(v3_scale(tu, r * cos(phi)), v3_scale(tv, r * sin(phi))),
+                            v3_scale(n, sqrt(fmax(0.0, 1.0 - u))));
+            rays[k] = (rad_ray){x, d, 0.0, rc};
+        }
+        input->vis->backend->intersect(input->vis->state, rays, NEAR_RAYS, hits);
+        for (int k = 0; k < NEAR_RAYS; k++) {
+            if (!isfinite(hits[k].t))
+                continue;
+            const rad_patch *q = &mesh->patches[hits[k].patch];
+            if (v3_dot(rays[k].direction, q->normal) >= 0.0)
+                continue;
+            double s0, t0, ls, lt;
+            rad_patch_parameters(q, v3_mad(x, rays[k].direction, hits[k].t), &s0, &t0);
+            uint32_t j = rad_mesh_locate(mesh, hits[k].patch, s0, t0, &ls, &lt);
+            double missing = 1.0 - hits[k].t * hits[k].t / (rc * rc);
+            for (int c = 0; c < 3 && missing > 0.0; c++)
+                H[c] += missing *
+                        fmax(input->element_radiosity[3 * (size_t)j + c] - input->emission[3 * (size_t)j + c], 0.0) /
+                        NEAR_RAYS;
+        }
+    }
+    double rho[3];
+    if (input->scene && rad_scene_textured(input->scene, patch->polygon))
+        rad_scene_reflectance_at(input->scene, patch->polygon, p, rho);
+    else
+        memcpy(rho, input->reflectance + 3 * (size_t)e, sizeof rho);
+    for (int c = 0; c < 3; c++)
+        rgb[c] = input->emission[3 * (size_t)e + c] + rho[c] * fmax(H[c], 0.0);
+}
+
 static uint32_t shade(const rad_render_input *input, rad_shading shading, const rad_ray *ray,
-                      const rad_hit *hit, double rgb[3])
+                      const rad_hit *hit, uint64_t key, double rgb[3])
 {
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     if (!isfinite(hit->t))
@@ -119,6 +195,10 @@ static uint32_t shade(const rad_render_input *input, rad_shading shading, const 
     double s, t, local_s, local_t;
     rad_patch_parameters(patch, p, &s, &t);
     uint32_t e = rad_mesh_locate(mesh, hit->patch, s, t, &local_s, &local_t);
+    if (input->vpls) {
+        shade_vpl(input, e, patch, p, key, rgb);
+        return hit->patch;
+    }
     bool smooth = shading == RAD_SHADING_SMOOTH && input->vertex_radiosity;
     if (smooth) {
         rad_element_interpolate(mesh, &mesh->elements[e], input->vertex_radiosity, local_s,
@@ -126,6 +206,19 @@ static uint32_t shade(const rad_render_input *input, rad_shading shading, const 
     } else {
         for (int c = 0; c < 3; c++)
             rgb[c] = input->element_radiosity[3 * (size_t)e + (size_t)c];
+    }
+    /* A texture modulates the reflected part by the texel's reflectance
+     * over the element's mean (which the solution used): a texture of one
+     * colour changes nothing. */
+    if (input->scene && input->reflectance && input->emission &&
+        rad_scene_textured(input->scene, patch->polygon)) {
+        double rho[3];
+        rad_scene_reflectance_at(input->scene, patch->polygon, p, rho);
+        for (int c = 0; c < 3; c++) {
+            double mean = input->reflectance[3 * (size_t)e + (size_t)c], E = input->emission[3 * (size_t)e + (size_t)c];
+            if (mean > 0.0)
+                rgb[c] = E + (rgb[c] - E) * (rho[c] / mean);
+        }
     }
     return smooth ? hit->patch : e;
 }
@@ -166,7 +259,8 @@ static void trace_pixels(const rad_render_input *input, rad_shading shading, con
         for (size_t k = 0; k < n; k++) {
             uint64_t r = first + k, x = pixel[r / per_pixel];
             double rgb[3];
-            uint32_t what = shade(input, shading, &rays[k], &hits[k], rgb);
+            uint64_t key = ((uint64_t)y * (uint64_t)view->width + x) * per_pixel * 2 + (r % per_pixel) * 2 + stream;
+            uint32_t what = shade(input, shading, &rays[k], &hits[k], key, rgb);
             if (r % per_pixel == 0) {
                 sum[3 * x] = sum[3 * x + 1] = sum[3 * x + 2] = 0.0;
                 seen[x] = what;

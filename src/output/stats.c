@@ -239,6 +239,15 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
     cJSON_AddNumberToObject(so, "components_lit", (double)s->solve->components_lit);
     cJSON_AddItemToObject(so, "ambient", rgb_array(s->solve->ambient));
     cJSON_AddNumberToObject(so, "seconds", s->solve->seconds);
+    if (s->solve->vpl_lights > 0) { /* instant radiosity: the VPLs and the clamp's bias */
+        cJSON *ir = cJSON_AddObjectToObject(so, "instant_radiosity");
+        cJSON_AddNumberToObject(ir, "paths", (double)s->solve->vpl_paths);
+        cJSON_AddNumberToObject(ir, "lights", (double)s->solve->vpl_lights);
+        cJSON_AddNumberToObject(ir, "clamp_radius_m", s->solve->vpl_clamp_radius);
+        cJSON_AddNumberToObject(ir, "clamp_loss", s->solve->vpl_clamp_loss);
+        cJSON_AddNumberToObject(ir, "clamp_loss_unclamped", s->solve->vpl_clamp_loss_unclamped);
+        cJSON_AddBoolToObject(ir, "compensated", s->solve->vpl_compensated);
+    }
     if (s->hier) {
         const rad_hier_stats *h = s->hier;
         cJSON *hi = cJSON_AddObjectToObject(so, "hierarchical");

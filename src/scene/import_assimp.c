@@ -145,6 +145,8 @@ typedef struct converter {
     size_t use_count, use_capacity;
     const import_obj_positions *positions;       /* OBJ: the exact positions; else NULL */
     const import_material_names *materials_exact; /* OBJ: exact Kd and Ke; else NULL */
+    import_file_log *log;        /* a file load's confinement; NULL from memory (no textures read) */
+    bool *textured;              /* aiMaterial index -> it got a texture */
 } converter;
 
 /* A surface that uses a material with a note. */
@@ -152,6 +154,105 @@ typedef struct note_use {
     size_t note;
     int surface; /* the builder's index: the order of first use */
 } note_use;
+
+/* The reflectance texture of assimp material `index` (already the
+ * builder's material_of[index]): MTL map_Kd / glTF baseColorTexture, an
+ * external image beside the scene (confined like every file it names).
+ * One that cannot be read fails the load naming the MTL file and line
+ * (OBJ) or the material (glTF), unless the context says
+ * missing_textures_flat: then a warning, and the flat colour stays.
+ * Images embedded in a GLB, and any texture of a scene loaded from memory,
+ * are not read (a warning: the flat colour). */
+static rad_result convert_texture(converter *cv, unsigned index, const char *material_name,
+                                  const import_material_name *exact)
+{
+    const struct aiMaterial *material = cv->ai->mMaterials[index];
+    struct aiString file;
+    file.length = 0;
+    file.data[0] = '\0';
+    if ((aiGetMaterialTexture(material, aiTextureType_DIFFUSE, 0, &file, NULL, NULL, NULL, NULL, NULL, NULL) !=
+             aiReturn_SUCCESS ||
+         file.length == 0) &&
+        (aiGetMaterialTexture(material, aiTextureType_BASE_COLOR, 0, &file, NULL, NULL, NULL, NULL, NULL, NULL) !=
+             aiReturn_SUCCESS ||
+         file.length == 0))
+        return RAD_OK;
+    const char *statement = cv->gltf_materials ? "baseColorTexture" : "map_Kd";
+    char where[600];
+    if (exact && exact->map_kd_line > 0 && cv->materials_exact && exact->library < cv->materials_exact->library_count)
+        snprintf(where, sizeof where, "%s:%d: material '%s'", cv->materials_exact->libraries[exact->library],
+                 exact->map_kd_line, material_name);
+    else
+        snprintf(where, sizeof where, "%s: material '%s'", cv->name, material_name);
+    if (!cv->log)
+        return RAD_OK; /* from memory: no files read; the load's notes say it is not used */
+    if (file.data[0] == '*') {
+        rad_warn(cv->ctx, "%s: %s '%s' is an image embedded in the file, which is not read: its flat colour "
+                 "is used", where, statement, file.data);
+        return RAD_OK;
+    }
+    /* Relative to the scene file's folder. */
+    char path[4096];
+    const char *slash = strrchr(cv->name, '/');
+    if (file.data[0] == '/' || !slash)
+        snprintf(path, sizeof path, "%s", file.data);
+    else
+        snprintf(path, sizeof path, "%.*s/%s", (int)(slash - cv->name), cv->name, file.data);
+    if (!import_file_allowed(cv->log, path))
+        return RAD_ERROR_IO; /* the refusal is the context's message */
+    float *rgb = NULL;
+    int width = 0, height = 0;
+    char why[256] = "";
+    rad_result r = import_texture_read(cv->ctx, path, &rgb, &width, &height, why, sizeof why);
+    if (r != RAD_OK) {
+        if (cv->ctx && cv->ctx->missing_textures_flat && r != RAD_ERROR_OUT_OF_MEMORY) {
+            rad_warn(cv->ctx, "%s: %s '%s': cannot read %s: %s; its flat colour is used", where, statement,
+                     file.data, path, why);
+            return RAD_OK;
+        }
+        return rad_fail(cv->ctx, r, "%s: %s '%s': cannot read %s: %s%s", where, statement, file.data, path, why,
+                        r == RAD_ERROR_OUT_OF_MEMORY ? "" : " (--missing-textures flat uses its flat colour)");
+    }
+    import_file_log_add(cv->log, path);
+    r = rad_scene_builder_texture(cv->builder, cv->material_of[index], file.data, rgb, width, height);
+    if (r == RAD_OK)
+        cv->textured[index] = true;
+    return r;
+}
+
+/* An affine (u, v) map of a face's plane fitted to the texture
+ * coordinates of its three vertices spanning the most area; false where
+ * they are degenerate or not finite. */
+static bool fit_uv_map(const vec3 *p, const struct aiVector3D *const uv[], unsigned n, rad_uv_map *map)
+{
+    unsigned a = 1, b = 2;
+    double best = 0.0;
+    for (unsigned i = 1; i + 1 < n; i++)
+        for (unsigned j = i + 1; j < n; j++) {
+            double area = v3_length(v3_cross(v3_sub(p[i], p[0]), v3_sub(p[j], p[0])));
+            if (area > best)
+                best = area, a = i, b = j;
+        }
+    vec3 e1 = v3_sub(p[a], p[0]), e2 = v3_sub(p[b], p[0]);
+    double g11 = v3_dot(e1, e1), g12 = v3_dot(e1, e2), g22 = v3_dot(e2, e2), det = g11 * g22 - g12 * g12;
+    if (!(best > 0.0) || !(det > 0.0))
+        return false;
+    for (int k = 0; k < 2; k++) {
+        double t0 = k ? uv[0]->y : uv[0]->x, t1 = k ? uv[a]->y : uv[a]->x, t2 = k ? uv[b]->y : uv[b]->x;
+        double d1 = t1 - t0, d2 = t2 - t0;
+        /* gradient g = alpha e1 + beta e2 with g.e1 = d1, g.e2 = d2 */
+        double alpha = (d1 * g22 - d2 * g12) / det, beta = (d2 * g11 - d1 * g12) / det;
+        vec3 g = v3_add(v3_scale(e1, alpha), v3_scale(e2, beta));
+        map->m[4 * k] = g.x;
+        map->m[4 * k + 1] = g.y;
+        map->m[4 * k + 2] = g.z;
+        map->m[4 * k + 3] = t0 - v3_dot(g, p[0]);
+    }
+    for (int k = 0; k < 8; k++)
+        if (!isfinite(map->m[k]))
+            return false;
+    return true;
+}
 
 /* The builder material for assimp material `index`, added on first use so
  * that materials no polygon uses are never validated. */
@@ -203,6 +304,8 @@ static int convert_material(converter *cv, unsigned index)
     }
     cv->material_of[index] = rad_scene_builder_material(cv->builder, name.data, reflectance,
                                                         emission);
+    if (cv->material_of[index] >= 0 && convert_texture(cv, index, name.data, exact) != RAD_OK)
+        return -1;
     return cv->material_of[index];
 }
 
@@ -400,8 +503,22 @@ static rad_result convert_mesh(converter *cv, const struct aiNode *node, unsigne
                                 mesh->mName.data, v, cv->positions->count);
             cv->face[mirrored ? face->mNumIndices - 1 - i : i] = affine_point(world, position);
         }
-        rad_result r = rad_scene_builder_polygon(cv->builder, surface, material, cv->face,
-                                                 face->mNumIndices, 0);
+        /* Texture coordinates where the material has a texture. */
+        rad_result r = RAD_OK;
+        if (mesh->mMaterialIndex < cv->ai->mNumMaterials && cv->textured[mesh->mMaterialIndex] &&
+            mesh->mTextureCoords[0]) {
+            const struct aiVector3D *uv[64];
+            rad_uv_map map;
+            bool fitted = face->mNumIndices <= 64;
+            for (unsigned i = 0; fitted && i < face->mNumIndices; i++)
+                uv[mirrored ? face->mNumIndices - 1 - i : i] = &mesh->mTextureCoords[0][face->mIndices[i]];
+            fitted = fitted && fit_uv_map(cv->face, uv, face->mNumIndices, &map);
+            r = rad_scene_builder_uv_map(cv->builder, fitted ? &map : NULL);
+        } else {
+            r = rad_scene_builder_uv_map(cv->builder, NULL);
+        }
+        if (r == RAD_OK)
+            r = rad_scene_builder_polygon(cv->builder, surface, material, cv->face, face->mNumIndices, 0);
         if (r != RAD_OK)
             return r;
     }
@@ -566,7 +683,8 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
         rad_result checked = import_gltf_parse_and_check(ctx, name, data, size, glb, io, &json,
                                                          &facts);
         if (checked == RAD_OK)
-            checked = import_gltf_note_unused(ctx, name, json, &in->notes);
+            checked = import_gltf_note_unused(ctx, name, json, &in->notes,
+                                              ((const import_files *)(const void *)io->UserData)->log != NULL);
         if (checked != RAD_OK) {
             cJSON_Delete(json);
             return checked;
@@ -607,7 +725,10 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
     cv.builder = rad_scene_builder_create(ctx, name);
     cv.material_of = cv.builder ? rad_alloc(ctx, RAD_MEM_SCENE, ai->mNumMaterials, sizeof *cv.material_of, name)
                                 : NULL;
-    if (!cv.material_of) {
+    cv.textured = cv.material_of ? rad_alloc(ctx, RAD_MEM_SCENE, ai->mNumMaterials + 1, sizeof *cv.textured, name)
+                                 : NULL;
+    cv.log = ((const import_files *)(const void *)io->UserData)->log;
+    if (!cv.textured) {
         r = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
     }
@@ -632,6 +753,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
 done:
     rad_scene_builder_destroy(cv.builder);
     rad_free(cv.material_of);
+    rad_free(cv.textured);
     rad_free(cv.note_of);
     rad_free(cv.uses);
     rad_free(cv.face);

@@ -330,6 +330,7 @@ static rad_result read_library(libraries *l, const char *name, size_t name_lengt
         import_file_log_add(l->log, path);
         l->read += (double)size;
         skip_byte_order_mark(&start, &size);
+        l->names.textures_read = true; /* a file load: its textures are read */
         r = import_mtl_prescan(l->ctx, path, start, size, &l->names, l->notes);
     }
     if (r == RAD_OK)

@@ -59,7 +59,7 @@ void import_join_items(char *text, size_t size, const char *const *items, size_t
  * vertex colours of its primitives; the extensions of extensionsUsed that
  * nothing else names.  RAD_ERROR_OUT_OF_MEMORY or RAD_OK. */
 rad_result import_gltf_note_unused(rad_context *ctx, const char *name, const struct cJSON *root,
-                                   import_notes *notes);
+                                   import_notes *notes, bool textures_read);
 /* Set `note`'s surfaces: `shown` names (at most 3) of `total` distinct
  * surfaces.  RAD_ERROR_OUT_OF_MEMORY or RAD_OK. */
 rad_result import_note_set_surfaces(rad_context *ctx, import_note *note,
@@ -127,6 +127,7 @@ typedef struct import_material_name {
     size_t order;   /* definition order */
     bool has_kd, has_ke; /* Kd / Ke given (the last of each counts, as in assimp) */
     double kd[3], ke[3]; /* as strtod reads them: assimp keeps only floats */
+    int map_kd_line;     /* the line of its (last) map_Kd; 0: none */
 } import_material_name;
 
 typedef struct import_material_names {
@@ -135,6 +136,7 @@ typedef struct import_material_names {
     char **libraries;              /* the libraries' names for messages (rad_alloc'd) */
     size_t library_count, library_capacity;
     bool sorted;                   /* by name (import_material_names_check) */
+    bool textures_read;            /* a file load: map_Kd is read (texture.c), so not noted unused */
 } import_material_names;
 
 /* Check the MTL text [text, text + size), as import_obj_prescan, and add
@@ -294,5 +296,15 @@ typedef struct import_files {
 /* Fill `io` so that assimp reads `files` (which must outlive the import).
  * Cannot fail. */
 void import_io(struct aiFileIO *io, import_files *files);
+
+/* Read the image at `path` (PNG, JPEG, BMP, TGA...: stb_image) as a
+ * reflectance texture: width x height x 3 linear floats (rad_alloc'd, row
+ * 0 the image's top) into *rgb.  On failure *rgb is NULL, `why` says why
+ * in a few words, and the result is RAD_ERROR_IO (cannot open),
+ * RAD_ERROR_PARSE (not an image) or RAD_ERROR_OUT_OF_MEMORY (above the
+ * memory limit, checked from the header before decoding); nothing is
+ * reported to the context: the caller names the material. */
+rad_result import_texture_read(rad_context *ctx, const char *path, float **rgb, int *width, int *height,
+                               char *why, size_t why_size);
 
 #endif /* RAD_SCENE_IMPORT_INTERNAL_H */

@@ -727,6 +727,11 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
             break;
         }
         bool is_kd = strcasecmp(token, "Kd") == 0, is_ke = strcasecmp(token, "Ke") == 0;
+        if (strcasecmp(token, "map_Kd") == 0) { /* its line for the importer's messages */
+            names->entries[names->count - 1].map_kd_line = lines.number;
+            if (names->textures_read)
+                continue; /* read (scene/texture.c), so not noted as unused */
+        }
         if (!is_kd && !is_ke) {
             int property = mtl_property_of(token);
             if (extras && property >= 0)

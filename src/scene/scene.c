@@ -22,6 +22,7 @@
 #include "scene/scene.h"
 
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -49,6 +50,11 @@ struct rad_scene_builder {
     size_t triangulate_scratch_capacity;
     bool has_camera;
     rad_camera camera;
+    rad_texture *textures;
+    size_t texture_count, texture_capacity;
+    rad_uv_map *uv_maps;
+    size_t uv_map_count, uv_map_capacity;
+    bool uv_current;       /* the polygons added next take uv_maps[uv_map_count - 1] */
 };
 
 /* Return `array` grown (by doubling) to hold at least `needed` elements of
@@ -106,7 +112,65 @@ void rad_scene_builder_destroy(rad_scene_builder *b)
     rad_free(b->polygon_scratch);
     rad_free(b->triangle_scratch);
     rad_free(b->triangulate_scratch);
+    for (size_t i = 0; i < b->texture_count; i++) {
+        rad_free(b->textures[i].path);
+        rad_free(b->textures[i].rgb);
+    }
+    rad_free(b->textures);
+    rad_free(b->uv_maps);
     rad_free(b);
+}
+
+rad_result rad_scene_builder_texture(rad_scene_builder *b, int material, const char *path, float *rgb,
+                                     int width, int height)
+{
+    if (!b || material < 0 || (size_t)material >= b->material_count || !rgb || width < 1 || height < 1) {
+        rad_free(rgb);
+        return b ? rad_fail(b->ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: texture for material %d of %zu", b->source,
+                            material, b->material_count)
+                 : RAD_ERROR_INVALID_ARGUMENT;
+    }
+    rad_texture *textures = reserve(b, b->textures, &b->texture_capacity, b->texture_count + 1,
+                                    sizeof *textures, "textures");
+    char *name = textures ? rad_strdup(b->ctx, RAD_MEM_SCENE, path, b->source) : NULL;
+    if (!name) {
+        if (textures)
+            b->textures = textures;
+        rad_free(rgb);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    b->textures = textures;
+    rad_texture *t = &textures[b->texture_count++];
+    *t = (rad_texture){name, width, height, rgb, {0, 0, 0}};
+    size_t texels = (size_t)width * (size_t)height;
+    for (size_t k = 0; k < texels; k++)
+        for (int c = 0; c < 3; c++)
+            t->mean[c] += rgb[3 * k + (size_t)c];
+    rad_material *m = &b->materials[material];
+    m->texture = (uint32_t)b->texture_count;
+    for (int c = 0; c < 3; c++) {
+        t->mean[c] /= (double)texels;
+        m->texture_scale[c] = m->reflectance[c];
+        m->reflectance[c] *= t->mean[c];
+    }
+    return RAD_OK;
+}
+
+rad_result rad_scene_builder_uv_map(rad_scene_builder *b, const rad_uv_map *map)
+{
+    if (!b)
+        return RAD_ERROR_INVALID_ARGUMENT;
+    b->uv_current = false;
+    if (!map)
+        return RAD_OK;
+    rad_uv_map *maps = reserve(b, b->uv_maps, &b->uv_map_capacity, b->uv_map_count + 1, sizeof *maps,
+                               "texture coordinates");
+    if (!maps)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    b->uv_maps = maps;
+    maps[b->uv_map_count++] = *map;
+    b->uv_current = true;
+    return RAD_OK;
 }
 
 int rad_scene_builder_material(rad_scene_builder *b, const char *name,
@@ -279,6 +343,7 @@ static rad_result append_polygon(rad_scene_builder *b, int surface, int material
     p->material = (uint32_t)material;
     p->normal = normal;
     p->area = area;
+    p->uv_map = b->uv_current ? (uint32_t)b->uv_map_count : 0;
     for (size_t i = 0; i < n; i++) {
         indices[b->index_count++] = (uint32_t)b->position_count;
         positions[b->position_count++] = vertices[i];
@@ -590,6 +655,10 @@ rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out)
     scene->material_count = b->material_count;
     scene->has_camera = b->has_camera;
     scene->camera = b->camera;
+    scene->textures = b->textures; /* kept whole: materials refer to them by index */
+    scene->texture_count = b->texture_count;
+    scene->uv_maps = b->uv_maps;
+    scene->uv_map_count = b->uv_map_count;
     rad_free(b->polygon_scratch);
     rad_free(b->triangle_scratch);
     rad_free(b->triangulate_scratch);
@@ -665,7 +734,53 @@ void rad_scene_destroy(rad_scene *scene)
     rad_free(scene->polygons);
     rad_free(scene->surfaces);
     rad_free(scene->materials);
+    for (size_t i = 0; i < scene->texture_count; i++) {
+        rad_free(scene->textures[i].path);
+        rad_free(scene->textures[i].rgb);
+    }
+    rad_free(scene->textures);
+    rad_free(scene->uv_maps);
     rad_free(scene);
+}
+
+/* ---- textures ---- */
+
+bool rad_scene_uv(const rad_scene *scene, uint32_t polygon, vec3 p, double *u, double *v)
+{
+    uint32_t k = scene->polygons[polygon].uv_map;
+    if (k == 0 || k > scene->uv_map_count)
+        return false;
+    const double *m = scene->uv_maps[k - 1].m;
+    *u = m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3];
+    *v = m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7];
+    return isfinite(*u) && isfinite(*v);
+}
+
+bool rad_scene_textured(const rad_scene *scene, uint32_t polygon)
+{
+    const rad_polygon *poly = &scene->polygons[polygon];
+    uint32_t t = scene->materials[poly->material].texture;
+    return t > 0 && t <= scene->texture_count && poly->uv_map > 0;
+}
+
+void rad_scene_reflectance_at(const rad_scene *scene, uint32_t polygon, vec3 p, double rgb[3])
+{
+    const rad_material *m = &scene->materials[scene->polygons[polygon].material];
+    double u, v;
+    if (!rad_scene_textured(scene, polygon) || !rad_scene_uv(scene, polygon, p, &u, &v)) {
+        memcpy(rgb, m->reflectance, 3 * sizeof *rgb);
+        return;
+    }
+    const rad_texture *t = &scene->textures[m->texture - 1];
+    /* Wrapped (repeat, the MTL and glTF default); the texel containing (u, v). */
+    u -= floor(u);
+    v -= floor(v);
+    long x = (long)(u * t->width), y = (long)((1.0 - v) * t->height);
+    x = x < 0 ? 0 : x >= t->width ? t->width - 1 : x;
+    y = y < 0 ? 0 : y >= t->height ? t->height - 1 : y;
+    const float *texel = t->rgb + 3 * ((size_t)y * (size_t)t->width + (size_t)x);
+    for (int c = 0; c < 3; c++)
+        rgb[c] = m->texture_scale[c] * texel[c]; /* Kd < 1, texels <= 1 */
 }
 
 void rad_scene_set_inputs(rad_scene *scene, char **paths, size_t count)

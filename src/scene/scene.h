@@ -14,9 +14,21 @@
 
 typedef struct rad_material {
     char *name;
-    double reflectance[3]; /* rho, RGB, in [0, 1) */
+    double reflectance[3]; /* rho, RGB, in [0, 1): with a texture, Kd x the texture's mean */
     double emission[3];    /* E, self-emitted exitance, W/m^2 (= pi * radiance) */
+    uint32_t texture;      /* 1 + index into rad_scene.textures (map_Kd, baseColorTexture); 0: none */
+    double texture_scale[3]; /* with a texture: Kd, by which its texels are multiplied */
 } rad_material;
+
+/* A reflectance texture (MTL map_Kd, glTF baseColorTexture): texels
+ * decoded from sRGB to linear, a piecewise-constant function of (u, v) in
+ * [0, 1)^2 repeated (wrapped) outside; row 0 is v = 1 (the image's top). */
+typedef struct rad_texture {
+    char *path;            /* the file, as the material names it */
+    int width, height;     /* texels */
+    float *rgb;            /* width x height x 3, linear, in [0, 1] */
+    double mean[3];        /* over all texels */
+} rad_texture;
 
 typedef struct rad_surface {
     char *name;            /* OBJ o/g name, glTF node name; unique in the scene */
@@ -43,7 +55,25 @@ typedef struct rad_polygon {
     uint32_t material;
     vec3 normal;           /* unit, right-hand rule over the vertex order */
     double area;           /* m^2 */
+    uint32_t uv_map;       /* 1 + index into rad_scene.uv_maps; 0: no texture coordinates */
 } rad_polygon;
+
+/* Texture coordinates of a planar polygon as an affine map of position:
+ * u = m[0] x + m[1] y + m[2] z + m[3], v = m[4] x + ... + m[7] (fitted to
+ * three of its vertices; exact for triangles and for the parallelogram
+ * maps modellers give quads). */
+typedef struct rad_uv_map {
+    double m[8];
+} rad_uv_map;
+
+/* (u, v) of point p of polygon `polygon`; false without coordinates. */
+bool rad_scene_uv(const rad_scene *scene, uint32_t polygon, vec3 p, double *u, double *v);
+/* The reflectance (RGB) at point p of polygon `polygon`: its material's
+ * Kd x the texel under p where the material has a texture and the polygon
+ * coordinates, else the material's reflectance.  Cannot fail. */
+void rad_scene_reflectance_at(const rad_scene *scene, uint32_t polygon, vec3 p, double rgb[3]);
+/* Whether polygon `polygon` is textured (a texture and coordinates). */
+bool rad_scene_textured(const rad_scene *scene, uint32_t polygon);
 
 struct rad_scene {
     char *source;             /* file name, or "cornell-box" */
@@ -57,6 +87,10 @@ struct rad_scene {
     size_t surface_count;
     rad_material *materials;
     size_t material_count;
+    rad_texture *textures;
+    size_t texture_count;
+    rad_uv_map *uv_maps;
+    size_t uv_map_count;
     vec3 bounds_min, bounds_max; /* m */
     double load_seconds;      /* time the importer took */
     bool has_camera;
@@ -81,6 +115,15 @@ void rad_scene_builder_destroy(rad_scene_builder *b);
  * `emission` is exitance in W/m^2. */
 int rad_scene_builder_material(rad_scene_builder *b, const char *name,
                                const double reflectance[3], const double emission[3]);
+/* Give material `material` the reflectance texture `rgb` (width x height x
+ * 3 linear floats, rad_alloc'd: taken over, freed on failure too) read
+ * from `path`: its reflectance becomes Kd x the texture's mean, Kd kept as
+ * the texels' scale.  Fails for memory or a bad material index. */
+rad_result rad_scene_builder_texture(rad_scene_builder *b, int material, const char *path, float *rgb,
+                                     int width, int height);
+/* Texture coordinates for the polygons added next (NULL: none), kept until
+ * changed.  Fails only for memory. */
+rad_result rad_scene_builder_uv_map(rad_scene_builder *b, const rad_uv_map *map);
 /* Returns the index of the surface with that name, creating it if new;
  * -1 on failure. */
 int rad_scene_builder_surface(rad_scene_builder *b, const char *name);

@@ -249,14 +249,14 @@ static void items_sentence(item_list *l, char *text, size_t size)
 /* Note material `index` of the glTF; `colours`: some primitive of it has
  * vertex colours. */
 static rad_result gltf_note_material(rad_context *ctx, const char *name, const cJSON *root,
-                                     const cJSON *material, size_t index, bool colours,
+                                     const cJSON *material, size_t index, bool colours, bool textures_read,
                                      import_notes *notes)
 {
     item_list l = {.count = 0};
     char *item;
     const cJSON *pbr = member(material, "pbrMetallicRoughness");
-    const cJSON *base = member(pbr, "baseColorTexture"), *emissive = member(material,
-                                                                             "emissiveTexture");
+    const cJSON *base = textures_read ? NULL : member(pbr, "baseColorTexture"),
+                *emissive = member(material, "emissiveTexture");
     if (base && (item = next_item(&l)))
         texture_item(root, "baseColorTexture", base, item, ITEM_SIZE);
     const cJSON *metallic = member(pbr, "metallicFactor");
@@ -278,8 +278,8 @@ static rad_result gltf_note_material(rad_context *ctx, const char *name, const c
     double alpha = cJSON_IsNumber(alpha_item) ? alpha_item->valuedouble : 1.0;
     double threshold = cJSON_IsNumber(cutoff) ? cutoff->valuedouble : 0.5;
     if (cJSON_IsString(mode) &&
-        ((strcmp(mode->valuestring, "BLEND") == 0 && (base || alpha < 1.0)) ||
-         (strcmp(mode->valuestring, "MASK") == 0 && (base || alpha < threshold))) &&
+        ((strcmp(mode->valuestring, "BLEND") == 0 && (member(pbr, "baseColorTexture") || alpha < 1.0)) ||
+         (strcmp(mode->valuestring, "MASK") == 0 && (member(pbr, "baseColorTexture") || alpha < threshold))) &&
         (item = next_item(&l)))
         snprintf(item, ITEM_SIZE, "alphaMode %s", mode->valuestring);
     const cJSON *extension;
@@ -332,7 +332,7 @@ static bool material_has_extension(const cJSON *materials, const char *extension
 }
 
 rad_result import_gltf_note_unused(rad_context *ctx, const char *name, const cJSON *root,
-                                   import_notes *notes)
+                                   import_notes *notes, bool textures_read)
 {
     /* The extensions the file uses that nothing reads and no material
      * lists: one line for the whole file (KHR_lights_punctual's lights do
@@ -381,7 +381,7 @@ rad_result import_gltf_note_unused(rad_context *ctx, const char *name, const cJS
     cJSON_ArrayForEach(material, array_or_null(materials))
     {
         if (r == RAD_OK)
-            r = gltf_note_material(ctx, name, root, material, index, colours[index], notes);
+            r = gltf_note_material(ctx, name, root, material, index, colours[index], textures_read, notes);
         index++;
     }
     rad_free(colours);

@@ -59,6 +59,14 @@ typedef struct rad_solve_stats {
     size_t components;        /* independent groups of elements solved separately (0 = not split) */
     size_t components_lit;    /* of those, the groups of two or more elements holding an emitter */
     double iteration_limit;   /* the most iterations it could take (rad_solve_bound) */
+    /* instant radiosity (strategy/instant.c; vpl_lights 0 for the others): */
+    size_t vpl_paths;         /* light paths traced */
+    size_t vpl_lights;        /* VPLs placed */
+    double vpl_clamp_radius;  /* m */
+    double vpl_clamp_loss;    /* the VPL irradiance the clamp removed, as a fraction of it (area-weighted;
+                                 the near-field estimate, instant.c) */
+    double vpl_clamp_loss_unclamped; /* the same from the unclamped gather (unbiased, heavy-tailed) */
+    bool vpl_compensated;     /* the loss was added back (solver instant-radiosity) */
     char warning[320];        /* why it stopped short of its tolerance, one line; "" when
                                  it converged or was interrupted */
 } rad_solve_stats;

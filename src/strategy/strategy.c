@@ -12,12 +12,14 @@
 extern const rad_strategy rad_strategy_dense;
 extern const rad_strategy rad_strategy_matrix_free;
 extern const rad_strategy rad_strategy_hierarchical;
+extern const rad_strategy rad_strategy_instant;
 
 const rad_strategy *const rad_strategies[] = {
     &rad_strategy_dense,
     &rad_strategy_matrix_free,
     &rad_strategy_hierarchical,
     &rad_strategy_galerkin,
+    &rad_strategy_instant,
     NULL,
 };
 
@@ -46,6 +48,41 @@ bool rad_strategy_solver_info(size_t index, const char **name, const char **desc
 
 /* ---- shared parts ---- */
 
+/* A textured element's reflectance: the texture (times Kd) averaged over
+ * the element, so that the power it reflects is the texels' (docs/
+ * methods.md, "Textures"): k x k stratum centres, k from the texels the
+ * element spans (two samples a texel, 4 to 64 a side).  Untextured
+ * elements keep their material's value. */
+static void element_texture_mean(const rad_scene *scene, const rad_mesh *mesh, const rad_element *el,
+                                 double rgb[3])
+{
+    uint32_t polygon = mesh->patches[el->patch].polygon;
+    if (!rad_scene_textured(scene, polygon))
+        return;
+    const rad_texture *t = &scene->textures[scene->materials[scene->polygons[polygon].material].texture - 1];
+    double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
+    for (uint32_t k = 0; k < el->vertex_count; k++) {
+        double u, v;
+        if (!rad_scene_uv(scene, polygon, mesh->vertices[el->vertex[k]], &u, &v))
+            return;
+        lo_u = fmin(lo_u, u), hi_u = fmax(hi_u, u), lo_v = fmin(lo_v, v), hi_v = fmax(hi_v, v);
+    }
+    double span = fmax((hi_u - lo_u) * t->width, (hi_v - lo_v) * t->height);
+    int side = (int)fmin(64.0, fmax(4.0, ceil(2.0 * span)));
+    double sum[3] = {0, 0, 0}, weights = 0.0;
+    for (int a = 0; a < side; a++)
+        for (int b = 0; b < side; b++) {
+            double u = (a + 0.5) / side, v = (b + 0.5) / side, w = rad_element_sample_weight(mesh, el, u, v);
+            double texel[3];
+            rad_scene_reflectance_at(scene, polygon, rad_element_sample(mesh, el, u, v), texel);
+            for (int c = 0; c < 3; c++)
+                sum[c] += w * texel[c];
+            weights += w;
+        }
+    for (int c = 0; c < 3; c++)
+        rgb[c] = weights > 0.0 ? sum[c] / weights : rgb[c];
+}
+
 rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
                                rad_elements *out)
 {
@@ -68,6 +105,8 @@ rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const r
             e.reflectance[3 * i + (size_t)c] = m->reflectance[c];
             e.emission[3 * i + (size_t)c] = m->emission[c];
         }
+        if (scene->texture_count > 0)
+            element_texture_mean(scene, mesh, el, e.reflectance + 3 * i);
     }
     memcpy(e.radiosity, e.emission, 3 * n * sizeof *e.radiosity);
     *out = e;
