@@ -179,6 +179,8 @@ static const cli_flag FLAGS[] = {
      .help = "multiplier on radiance for the display colours (glTF COLOR_0, PLY red/green/blue)"},
     {"flat", 0, NULL, CLI_RENDER, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
+    {"specular-depth", 0, "N", CLI_RENDER, RENDER(specular_depth)},
+    {"glossy-samples", 0, "N", CLI_RENDER, RENDER(glossy_samples)},
     {"seed", 0, "S", RV, SOLVE(seed)},
     {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
      .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},

@@ -238,7 +238,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     }
     if (r == RAD_OK) {
         rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
-        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0};
         r = rad_solution_render(ctx, s, &ro, &image);
     }
     if (r == RAD_OK) {
@@ -639,7 +639,7 @@ static void test_stats_by_category(void **state)
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
     rad_image *image = NULL;
-    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0};
+    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0, 0, 0};
     assert_int_equal(rad_solution_render(ctx, s, &ro, &image), RAD_OK);
     char path[512];
     output_path("stats.json", path, sizeof path);

@@ -133,6 +133,12 @@ static const rad_option_info render_rows[] = {
      .default_text = "smooth", .help = "smooth (vertex values interpolated) or flat (one colour per element)"},
     {RENDER(exposure), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = INFINITY,
      .default_value = NAN, .default_text = "automatic", .help = "multiplier on radiance before sRGB"},
+    {RENDER(specular_depth), .type = RAD_OPTION_INT, .min = -1.0, .max = 64.0, .default_value = 8.0,
+     .default_text = "8",
+     .help = "second pass: mirror, glass and glossy bounces followed from the eye where the scene has "
+             "specular materials; -1: the first pass alone"},
+    {RENDER(glossy_samples), .type = RAD_OPTION_INT, .min = 1.0, .max = 16384.0, .default_value = 16.0,
+     .default_text = "16", .help = "second pass: rays a glossy surface seen from the eye sends"},
 };
 
 static const rad_option_info office_rows[] = {

@@ -24,6 +24,8 @@ typedef struct rad_render_input {
     const double *element_radiosity; /* 3 per element, W/m^2 */
     const double *vertex_radiosity;  /* 3 per mesh vertex, W/m^2 */
     rad_camera camera;               /* resolved: never "none" */
+    const rad_material *materials;   /* per patch->material: the specular parts the second pass
+                                        follows; NULL: the first pass alone */
 } rad_render_input;
 
 /* Ray-cast the mesh from the camera; each sample takes the radiance B/pi of

@@ -127,6 +127,10 @@ typedef struct import_material_name {
     size_t order;   /* definition order */
     bool has_kd, has_ke; /* Kd / Ke given (the last of each counts, as in assimp) */
     double kd[3], ke[3]; /* as strtod reads them: assimp keeps only floats */
+    /* The specular statements (the last of each counts; NAN when absent or
+     * not numbers): Ks (one value is grey), Ns, Ni, d, Tr, illum. */
+    double ks[3], ns, ni, d, tr, illum;
+    int ks_line, ni_line; /* the line of the last Ks (Ni), or of newmtl */
 } import_material_name;
 
 typedef struct import_material_names {

@@ -13,7 +13,7 @@
  *    that succeeds says them, one line a material:
  *
  *    scene.mtl: material 'mirror' (surfaces 'panel', 'frame'): Ks, Ns and
- *    illum 3 are not used (the engine is diffuse: Kd and Ke only)
+ *    illum 3 are not used (the engine reads Kd and Ke, and the specular keys with illum 3 to 7)
  *
  * Values that change nothing are not said (Ks 0 0 0, d 1, an explicit
  * metallicFactor 0, alphaMode BLEND with nothing transparent), nor
