@@ -126,6 +126,105 @@ static void test_mtl_specular_energy(void **state)
     rad_context_destroy(ctx);
 }
 
+/* ---- the first pass: extended form factors ---- */
+
+/* The factor from a point to a rectangle in a parallel plane at height h,
+ * the rectangle [a1, a2] x [b1, b2] in coordinates centred under the point
+ * (Howell's catalogue, C-11, by superposition of corner rectangles). */
+static double corner_factor(double x, double y, double h)
+{
+    double X = sqrt(x * x + h * h), Y = sqrt(y * y + h * h);
+    return (x / X * atan(y / X) + y / Y * atan(x / Y)) / (2.0 * M_PI);
+}
+
+static double parallel_rectangle(double a1, double a2, double b1, double b2, double h)
+{
+    return corner_factor(a2, b2, h) - corner_factor(a1, b2, h) - corner_factor(a2, b1, h) +
+           corner_factor(a1, b1, h);
+}
+
+/* A floor (rho_d 0.5) under a small lamp (radiance 1, E = pi) beside a
+ * vertical mirror (rho_s 0.8, no diffuse part) at x = 0: each floor
+ * element receives, beyond what it receives with a black wall there,
+ * exactly rho_s x the factor from its centroid to the lamp's mirror image
+ * (the lamp reflected to x in [0.4, 0.6]), so its B grows by rho_d E
+ * rho_s F(image): against Howell's closed form to 1e-9 (the floor sees
+ * itself in the mirror edge-on: nothing more comes back).  The same with
+ * the mirror turned away (its back to the floor): nothing added. */
+static void test_mirror_image_irradiance(void **state)
+{
+    (void)state;
+    rad_context *ctx = make_context(2);
+    const char *obj = "mtllib two.mtl\n"
+                      "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
+                      "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 0 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
+                      "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
+                      "f 9 10 11 12\n";
+    const char *mtl_mirror = "newmtl floor\nKd 0.5 0.5 0.5\n"
+                             "newmtl mirror\nKd 0 0 0\nKs 0.8 0.8 0.8\nillum 3\n"
+                             "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+    const char *mtl_black = "newmtl floor\nKd 0.5 0.5 0.5\n"
+                            "newmtl mirror\nKd 0 0 0\n"
+                            "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+    rad_scene *with = load(ctx, obj, mtl_mirror), *without = load(ctx, obj, mtl_black);
+    rad_options o = {.target_elements = 300};
+    rad_solution *a = NULL, *b = NULL;
+    assert_int_equal(rad_solution_create(ctx, with, &o, &a), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, a), RAD_OK);
+    assert_int_equal(rad_solution_create(ctx, without, &o, &b), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, b), RAD_OK);
+    size_t n = rad_solution_element_count(a), floor_elements = 0;
+    assert_int_equal(n, rad_solution_element_count(b));
+    double worst = 0.0, largest = 0.0;
+    for (size_t e = 0; e < n; e++) {
+        if (rad_solution_element_surface(a, e) != 0)
+            continue;
+        double c[3], Ba[3], Bb[3];
+        assert_true(rad_solution_element_geometry(a, e, NULL, c));
+        assert_true(rad_solution_element_values(a, e, NULL, NULL, Ba));
+        assert_true(rad_solution_element_values(b, e, NULL, NULL, Bb));
+        double image = parallel_rectangle(0.4 - c[0], 0.6 - c[0], -0.1 - c[2], 0.1 - c[2], 1.0);
+        double expected = 0.5 * M_PI * 0.8 * image;
+        double error = fabs((Ba[0] - Bb[0]) - expected) / expected;
+        worst = fmax(worst, error);
+        largest = fmax(largest, expected);
+        floor_elements++;
+    }
+    print_message("mirror image: %zu floor elements, largest extra B %.6f W/m^2, worst relative error %.2e\n",
+                  floor_elements, largest, worst);
+    assert_true(floor_elements > 50);
+    assert_true(worst < 1e-9);
+    rad_solution_destroy(a);
+    rad_solution_destroy(b);
+    rad_scene_destroy(with);
+    rad_scene_destroy(without);
+
+    /* The mirror's back to the floor: what reaches the floor is the black
+     * wall's (nothing through a mirror seen from behind). */
+    const char *turned = "mtllib two.mtl\n"
+                         "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
+                         "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 2 -2\nv 0 2 2\nv 0 0 2\nf 5 6 7 8\n"
+                         "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
+                         "f 9 10 11 12\n";
+    with = load(ctx, turned, mtl_mirror);
+    without = load(ctx, turned, mtl_black);
+    assert_int_equal(rad_solution_create(ctx, with, &o, &a), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, a), RAD_OK);
+    assert_int_equal(rad_solution_create(ctx, without, &o, &b), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, b), RAD_OK);
+    for (size_t e = 0; e < rad_solution_element_count(a); e++) {
+        double Ba[3], Bb[3];
+        assert_true(rad_solution_element_values(a, e, NULL, NULL, Ba));
+        assert_true(rad_solution_element_values(b, e, NULL, NULL, Bb));
+        assert_true(Ba[0] == Bb[0]);
+    }
+    rad_solution_destroy(a);
+    rad_solution_destroy(b);
+    rad_scene_destroy(with);
+    rad_scene_destroy(without);
+    rad_context_destroy(ctx);
+}
+
 /* ---- the second pass ---- */
 
 /* Solve `scene` (dense, a few hundred elements) and render a w x w image
@@ -247,6 +346,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mtl_specular_read),
         cmocka_unit_test(test_mtl_specular_energy),
+        cmocka_unit_test(test_mirror_image_irradiance),
         cmocka_unit_test(test_render_mirror),
         cmocka_unit_test(test_render_glass_pane),
         cmocka_unit_test(test_render_glossy),

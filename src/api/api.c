@@ -48,6 +48,16 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->options.max_memory_bytes = rad_memory_limit(ctx);
     /* mesh -> visibility -> couplings, as the strategy does them */
     s->strategy = rad_strategy_for_solver(s->options.solver);
+    /* The first pass's light through mirrors is the dense strategy's
+     * (formfactor/ff_mirror.c); the others solve the diffuse part alone. */
+    bool mirrors = false;
+    for (size_t m = 0; m < scene->material_count; m++)
+        mirrors |= scene->materials[m].specular_kind == RAD_SPECULAR_MIRROR;
+    if (mirrors && strcmp(s->strategy->name, "dense") != 0)
+        rad_warn(ctx,
+                 "%s: solver '%s' does not carry light through mirrors (the first pass's mirror images "
+                 "are the dense solvers'); the render's second pass still shows them",
+                 scene->source, s->options.solver);
     r = s->strategy->create(ctx, scene, &s->options, &s->state);
     if (r != RAD_OK) {
         rad_free(s);
