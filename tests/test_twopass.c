@@ -28,6 +28,11 @@ static rad_context *make_context(int threads)
     return ctx;
 }
 
+static void keep_warning(void *user, const char *message)
+{
+    snprintf(user, 512, "%s", message);
+}
+
 static rad_scene *load(rad_context *ctx, const char *obj, const char *mtl)
 {
     rad_scene *scene = NULL;
@@ -225,6 +230,40 @@ static void test_mirror_image_irradiance(void **state)
     rad_context_destroy(ctx);
 }
 
+/* Southwell's shooting reads F_ji through reciprocity, which light
+ * through mirrors does not keep: refused, naming the way out; the
+ * hierarchical solver solves the diffuse part and says so. */
+static void test_mirror_solvers(void **state)
+{
+    (void)state;
+    char said[512] = "";
+    rad_context *ctx = NULL;
+    rad_context_options co = {.threads = 1, .on_warning = keep_warning, .warning_user = said};
+    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
+    const char *obj = "mtllib two.mtl\n"
+                      "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
+                      "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 0 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
+                      "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
+                      "f 9 10 11 12\n";
+    const char *mtl = "newmtl floor\nKd 0.5 0.5 0.5\n"
+                      "newmtl mirror\nKd 0 0 0\nKs 0.8 0.8 0.8\nillum 3\n"
+                      "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+    rad_scene *scene = load(ctx, obj, mtl);
+    rad_options o = {.target_elements = 50, .solver = "southwell"};
+    rad_solution *s = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_ERROR_INVALID_ARGUMENT);
+    assert_null(s);
+    assert_string_equal(rad_context_error(ctx),
+                        "two.obj: solver 'southwell' reads F_ji through reciprocity, which light through "
+                        "mirrors does not keep; use gauss-seidel, jacobi, direct or conjugate-gradient");
+    o.solver = "hierarchical";
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    assert_non_null(strstr(said, "solver 'hierarchical' does not carry light through mirrors"));
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* ---- the second pass ---- */
 
 /* Solve `scene` (dense, a few hundred elements) and render a w x w image
@@ -347,6 +386,7 @@ int main(void)
         cmocka_unit_test(test_mtl_specular_read),
         cmocka_unit_test(test_mtl_specular_energy),
         cmocka_unit_test(test_mirror_image_irradiance),
+        cmocka_unit_test(test_mirror_solvers),
         cmocka_unit_test(test_render_mirror),
         cmocka_unit_test(test_render_glass_pane),
         cmocka_unit_test(test_render_glossy),

@@ -53,6 +53,13 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     bool mirrors = false;
     for (size_t m = 0; m < scene->material_count; m++)
         mirrors |= scene->materials[m].specular_kind == RAD_SPECULAR_MIRROR;
+    if (mirrors && strcmp(s->options.solver, "southwell") == 0) {
+        rad_free(s);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: solver 'southwell' reads F_ji through reciprocity, which light through mirrors "
+                        "does not keep; use gauss-seidel, jacobi, direct or conjugate-gradient",
+                        scene->source);
+    }
     if (mirrors && strcmp(s->strategy->name, "dense") != 0)
         rad_warn(ctx,
                  "%s: solver '%s' does not carry light through mirrors (the first pass's mirror images "
