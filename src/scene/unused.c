@@ -2,18 +2,21 @@
  * unused.c -- what a scene file's materials say that the engine does not
  * use, said once per load as warnings.
  *
- * The engine is diffuse (Lambertian): a material is its reflectance rho
- * (MTL Kd, glTF baseColorFactor) and its emitted radiance (MTL Ke, glTF
- * emissiveFactor x KHR_materials_emissive_strength).  Highlights, mirrors,
- * glass, metals, textures and vertex colours would change the picture, and
- * were dropped without a word.  Now:
+ * A material is its reflectance rho (MTL Kd, glTF baseColorFactor), its
+ * emitted radiance (MTL Ke, glTF emissiveFactor x
+ * KHR_materials_emissive_strength) and, from MTL, its specular part
+ * (mirrors and glossy reflectors: illum 3 or 5 with Ks and Ns; glass:
+ * illum 4, 6 or 7 with Ni, d, Tr; import_assimp.c mtl_specular).
+ * Highlights (illum 2), glTF metals and transmission, textures and vertex
+ * colours would change the picture, and were dropped without a word.  Now:
  *
  *    pre-scan (MTL: obj_prescan.c; glTF JSON: here) --notes--> assimp, the
  *    builder --which surfaces use each material (import_assimp.c)--> a load
  *    that succeeds says them, one line a material:
  *
- *    scene.mtl: material 'mirror' (surfaces 'panel', 'frame'): Ks, Ns and
- *    illum 3 are not used (the engine reads Kd and Ke, and the specular keys with illum 3 to 7)
+ *    scene.mtl: material 'shiny' (surfaces 'desk', 'shelf'): Ks, Ns and
+ *    illum 2 are not used (the engine reads Kd and Ke, and the specular
+ *    keys with illum 3 to 7)
  *
  * Values that change nothing are not said (Ks 0 0 0, d 1, an explicit
  * metallicFactor 0, alphaMode BLEND with nothing transparent), nor
