@@ -131,6 +131,67 @@ static void test_mtl_specular_energy(void **state)
     rad_context_destroy(ctx);
 }
 
+/* glTF: a written metallicFactor with a smooth roughnessFactor is a
+ * mirror (r = 0) or a Phong lobe of Ns = 2 / r^4 - 2 (r = 0.3: 303.8),
+ * rho_s = m x base, rho_d = (1 - m) x base; KHR_materials_transmission is
+ * glass of KHR_materials_ior's index, rho_d = (1 - t) x base; a rough metal
+ * (roughness 1 by default) stays diffuse. */
+static void test_gltf_specular_read(void **state)
+{
+    (void)state;
+    rad_context *ctx = make_context(1);
+    const char *gltf =
+        "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0,\n"
+        " \"extensionsUsed\": [\"KHR_materials_transmission\", \"KHR_lights_punctual\", "
+        "\"KHR_materials_emissive_strength\"],\n"
+        " \"scenes\": [{\"nodes\": [0, 1, 2, 3, 4]}],\n"
+        " \"nodes\": [{\"name\": \"desk\", \"mesh\": 0}, {\"name\": \"shelf\", \"mesh\": 0, "
+        "\"translation\": [0, 0, 2]},\n"
+        "   {\"name\": \"window\", \"mesh\": 1, \"translation\": [0, 0, 4]}, {\"name\": \"floor\", "
+        "\"mesh\": 2, \"translation\": [0, 0, 6]},\n"
+        "   {\"name\": \"lamp\", \"mesh\": 3, \"translation\": [0, 1, 0]}],\n"
+        " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, "
+        "\"material\": 0}]},\n"
+        "   {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 1}]},\n"
+        "   {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 2}]},\n"
+        "   {\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 3}]}],\n"
+        " \"materials\": [{\"name\": \"wood\", \"pbrMetallicRoughness\": {\"baseColorFactor\": "
+        "[0.9, 0.9, 0.9, 1], \"metallicFactor\": 1, \"roughnessFactor\": 0}},\n"
+        "   {\"name\": \"glass\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, "
+        "1], \"metallicFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": "
+        "{\"transmissionFactor\": 0.8}, \"KHR_materials_ior\": {\"ior\": 1.4}}},\n"
+        "   {\"name\": \"plain\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, "
+        "1], \"metallicFactor\": 0.5, \"roughnessFactor\": 0.3}},\n"
+        "   {\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1], "
+        "\"metallicFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}],\n"
+        " \"textures\": [{\"source\": 0}], \"images\": [{\"uri\": \"wood.png\"}],\n"
+        " \"buffers\": [{\"byteLength\": 60, \"uri\": \"data:application/octet-stream;base64,"
+        "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA\"}],\n"
+        " \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": "
+        "48, \"byteLength\": 12}],\n"
+        " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": "
+        "\"VEC3\"},\n"
+        "   {\"bufferView\": 1, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}\n";
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "x.gltf", gltf, strlen(gltf), NULL, 0, &scene), RAD_OK);
+    const rad_material *m = material_named(scene, "wood");
+    assert_int_equal(m->specular_kind, RAD_SPECULAR_MIRROR);
+    assert_true(fabs(m->specular[0] - 0.9) < 1e-7 && m->reflectance[0] == 0.0);
+    m = material_named(scene, "glass");
+    assert_int_equal(m->specular_kind, RAD_SPECULAR_GLASS);
+    assert_true(fabs(m->ior - 1.4) < 1e-12 && fabs(m->specular[0] - 0.8) < 1e-12);
+    assert_true(fabs(m->reflectance[1] - 0.1) < 1e-7);
+    m = material_named(scene, "plain");
+    assert_int_equal(m->specular_kind, RAD_SPECULAR_GLOSSY);
+    assert_true(fabs(m->shininess - (2.0 / (0.09 * 0.09) - 2.0)) < 1e-9);
+    assert_true(fabs(m->specular[2] - 0.4) < 1e-7 && fabs(m->reflectance[2] - 0.4) < 1e-7);
+    m = material_named(scene, "lamp");
+    assert_int_equal(m->specular_kind, RAD_SPECULAR_NONE);
+    assert_true(fabs(m->reflectance[0] - 0.5) < 1e-7);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* ---- the first pass: extended form factors ---- */
 
 /* The factor from a point to a rectangle in a parallel plane at height h,
@@ -385,6 +446,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mtl_specular_read),
         cmocka_unit_test(test_mtl_specular_energy),
+        cmocka_unit_test(test_gltf_specular_read),
         cmocka_unit_test(test_mirror_image_irradiance),
         cmocka_unit_test(test_mirror_solvers),
         cmocka_unit_test(test_render_mirror),

@@ -239,10 +239,21 @@ static int convert_material(converter *cv, unsigned index)
         if (exact->has_ke)
             emission[c] = M_PI * exact->ke[c];
     }
+    /* glTF: metals and transmission (their diffuse part first). */
+    import_specular gltf;
+    bool gltf_specular = cv->gltf_materials &&
+                         import_gltf_specular(import_gltf_material(cv->gltf_materials, index, name.data),
+                                              reflectance, &gltf);
+    if (gltf_specular)
+        memcpy(reflectance, gltf.reflectance, sizeof gltf.reflectance);
     cv->material_of[index] = rad_scene_builder_material(cv->builder, name.data, reflectance,
                                                         emission);
     if (cv->material_of[index] >= 0 && exact &&
         mtl_specular(cv, exact, cv->material_of[index], reflectance) != RAD_OK)
+        cv->material_of[index] = -1;
+    if (cv->material_of[index] >= 0 && gltf_specular &&
+        rad_scene_builder_material_specular(cv->builder, cv->material_of[index], cv->name, gltf.kind,
+                                            gltf.specular, gltf.shininess, gltf.ior) != RAD_OK)
         cv->material_of[index] = -1;
     return cv->material_of[index];
 }

@@ -147,7 +147,8 @@ void import_notes_warn(rad_context *ctx, const char *name, const import_notes *n
 /* ---- glTF ---- */
 
 /* Extensions the loader reads (gltf_fixes.c). */
-static const char *const gltf_read_extensions[] = {"KHR_materials_emissive_strength"};
+static const char *const gltf_read_extensions[] = {"KHR_materials_emissive_strength",
+                                                   "KHR_materials_transmission", "KHR_materials_ior"};
 
 static bool extension_is_read(const char *extension)
 {
@@ -265,7 +266,11 @@ static rad_result gltf_note_material(rad_context *ctx, const char *name, const c
     const cJSON *metallic = member(pbr, "metallicFactor");
     /* Only a factor written: the spec's default is 1, but files that omit
      * it mean a plain colour nearly always, and the base colour is read so. */
-    if (cJSON_IsNumber(metallic) && metallic->valuedouble > 0.0 && (item = next_item(&l)))
+    /* A smooth metal is read (import_gltf_specular); a rough one is not. */
+    const cJSON *roughness = member(pbr, "roughnessFactor");
+    bool smooth = cJSON_IsNumber(roughness) && roughness->valuedouble >= 0.0 &&
+                  roughness->valuedouble <= IMPORT_GLTF_MAX_ROUGHNESS;
+    if (cJSON_IsNumber(metallic) && metallic->valuedouble > 0.0 && !smooth && (item = next_item(&l)))
         snprintf(item, ITEM_SIZE, "metallicFactor %g", metallic->valuedouble);
     static const char *const textures[] = {"metallicRoughnessTexture", "normalTexture",
                                            "occlusionTexture", "emissiveTexture"};
