@@ -50,6 +50,8 @@ static const char box_obj[] = "mtllib box.mtl\n"
 
 static const char box_mtl[] = "newmtl white\nKd 0.5 0.5 0.5\n"
                               "newmtl lamp\nKd 0.3 0.3 0.3\nKe 1 1 1\n";
+static const char mirror_mtl[] = "newmtl white\nKd 0.1 0.1 0.1\nKs 0.8 0.8 0.8\nillum 3\n"
+                                 "newmtl lamp\nKd 0.3 0.3 0.3\nKe 1 1 1\n";
 
 /* One emissive triangle, positions only (no indices), in a data URI. */
 static const char triangle_gltf[] =
@@ -123,17 +125,19 @@ typedef struct scenario {
     int hemicube_resolution, samples, closure_correction;
     bool view_factors;           /* the strategy keeps F */
     int adaptive_levels;
+    bool mirror;                 /* the white walls mirrors (illum 3): both passes of two-pass */
 } scenario;
 
 static const scenario scenarios[] = {
-    {"loading", NULL, NULL, 0, 0, 0, false, 0},
-    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0},
-    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0},
-    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0},
-    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0},
-    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2},
-    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0},
-    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0},
+    {"loading", NULL, NULL, 0, 0, 0, false, 0, false},
+    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false},
+    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0, false},
+    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0, false},
+    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0, false},
+    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2, false},
+    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0, false},
+    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0, false},
+    {"gauss-seidel (dense, mirror images, second pass)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, true},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from
@@ -214,7 +218,8 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     rad_image *image = NULL;
     double *vertex = NULL;
     char path[512];
-    rad_result r = rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), box_mtl, strlen(box_mtl), &scene);
+    const char *mtl = sc->mirror ? mirror_mtl : box_mtl;
+    rad_result r = rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), mtl, strlen(mtl), &scene);
     if (r == RAD_OK) {
         rad_options o = {0};
         o.target_elements = 48;
