@@ -265,29 +265,39 @@ static void test_mirror_image_irradiance(void **state)
     rad_scene_destroy(with);
     rad_scene_destroy(without);
 
-    /* The mirror's back to the floor: what reaches the floor is the black
-     * wall's (nothing through a mirror seen from behind). */
-    const char *turned = "mtllib two.mtl\n"
-                         "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
-                         "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 2 -2\nv 0 2 2\nv 0 0 2\nf 5 6 7 8\n"
-                         "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
-                         "f 9 10 11 12\n";
-    with = load(ctx, turned, mtl_mirror);
-    without = load(ctx, turned, mtl_black);
-    assert_int_equal(rad_solution_create(ctx, with, &o, &a), RAD_OK);
-    assert_int_equal(rad_solution_solve(ctx, a), RAD_OK);
-    assert_int_equal(rad_solution_create(ctx, without, &o, &b), RAD_OK);
-    assert_int_equal(rad_solution_solve(ctx, b), RAD_OK);
-    for (size_t e = 0; e < rad_solution_element_count(a); e++) {
-        double Ba[3], Bb[3];
-        assert_true(rad_solution_element_values(a, e, NULL, NULL, Ba));
-        assert_true(rad_solution_element_values(b, e, NULL, NULL, Bb));
-        assert_true(Ba[0] == Bb[0]);
+    /* Nothing added: the mirror's back to the floor (no light through a
+     * mirror seen from behind), and a mirror hung above the lamp's height,
+     * where every path from the floor to the lamp's image (which meets
+     * the wall below y = 1) misses it. */
+    const char *nothing[] = {
+        "mtllib two.mtl\n"
+        "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
+        "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 2 -2\nv 0 2 2\nv 0 0 2\nf 5 6 7 8\n"
+        "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
+        "f 9 10 11 12\n",
+        "mtllib two.mtl\n"
+        "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
+        "o mirror\nusemtl mirror\nv 0 1.01 -2\nv 0 1.01 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
+        "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
+        "f 9 10 11 12\n"};
+    for (int k = 0; k < 2; k++) {
+        with = load(ctx, nothing[k], mtl_mirror);
+        without = load(ctx, nothing[k], mtl_black);
+        assert_int_equal(rad_solution_create(ctx, with, &o, &a), RAD_OK);
+        assert_int_equal(rad_solution_solve(ctx, a), RAD_OK);
+        assert_int_equal(rad_solution_create(ctx, without, &o, &b), RAD_OK);
+        assert_int_equal(rad_solution_solve(ctx, b), RAD_OK);
+        for (size_t e = 0; e < rad_solution_element_count(a); e++) {
+            double Ba[3], Bb[3];
+            assert_true(rad_solution_element_values(a, e, NULL, NULL, Ba));
+            assert_true(rad_solution_element_values(b, e, NULL, NULL, Bb));
+            assert_true(Ba[0] == Bb[0]);
+        }
+        rad_solution_destroy(a);
+        rad_solution_destroy(b);
+        rad_scene_destroy(with);
+        rad_scene_destroy(without);
     }
-    rad_solution_destroy(a);
-    rad_solution_destroy(b);
-    rad_scene_destroy(with);
-    rad_scene_destroy(without);
     rad_context_destroy(ctx);
 }
 
