@@ -335,6 +335,42 @@ static void test_mirror_solvers(void **state)
     rad_context_destroy(ctx);
 }
 
+/* Energy: a closed box with a mirror floor (rho_d 0.1, rho_s 0.8) absorbs
+ * what it emits, the light through the mirror counted where it lands and
+ * the mirror absorbing 1 - rho_d - rho_s.  The mirror images' centroid
+ * rule leaves 1.6e-3 at 300 elements, 3.9e-4 at 1,200 (second order);
+ * counting the mirror's specular part as absorbed too reads 30 % more
+ * absorbed than emitted. */
+static void test_mirror_power_balance(void **state)
+{
+    (void)state;
+    rad_context *ctx = make_context(2);
+    const char *obj = "mtllib two.mtl\n"
+                      "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
+                      "o floor\nusemtl mirror\nf 1 5 6 2\n"
+                      "o top\nusemtl lamp\nf 4 3 7 8\n"
+                      "o left\nusemtl wall\nf 1 4 8 5\n"
+                      "o right\nusemtl wall\nf 2 6 7 3\n"
+                      "o back\nusemtl wall\nf 1 2 3 4\n"
+                      "o front\nusemtl wall\nf 5 8 7 6\n";
+    const char *mtl = "newmtl mirror\nKd 0.1 0.1 0.1\nKs 0.8 0.8 0.8\nillum 3\n"
+                      "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n"
+                      "newmtl wall\nKd 0.5 0.5 0.5\n";
+    rad_scene *scene = load(ctx, obj, mtl);
+    rad_options o = {.target_elements = 300, .solver = "gauss-seidel"};
+    rad_solution *s = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+    double emitted, absorbed;
+    rad_solution_power(s, &emitted, &absorbed);
+    print_message("closed box, mirror floor: emitted %.6f W, absorbed %.6f W (%.2e)\n", emitted, absorbed,
+                  (emitted - absorbed) / emitted);
+    assert_true(fabs(emitted - absorbed) < 2e-3 * emitted);
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* ---- the second pass ---- */
 
 /* Solve `scene` (dense, a few hundred elements) and render a w x w image
@@ -459,6 +495,7 @@ int main(void)
         cmocka_unit_test(test_gltf_specular_read),
         cmocka_unit_test(test_mirror_image_irradiance),
         cmocka_unit_test(test_mirror_solvers),
+        cmocka_unit_test(test_mirror_power_balance),
         cmocka_unit_test(test_render_mirror),
         cmocka_unit_test(test_render_glass_pane),
         cmocka_unit_test(test_render_glossy),

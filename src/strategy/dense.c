@@ -170,6 +170,7 @@ static void dense_view(const void *state, rad_solution_view *v)
     const dense_state *st = state;
     rad_meshed_view(&st->base, v);
     v->F = st->F;
+    v->F_coupling = st->F_ext;
     v->F_variance = st->F_variance;
     v->adaptive = rad_adaptive_get_stats(st->adaptive);
 }
