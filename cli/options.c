@@ -201,6 +201,8 @@ static const cli_flag FLAGS[] = {
     {"flat", 0, NULL, CLI_RENDER | CLI_VIEW, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
     {"vpl", 0, "N", CLI_RENDER, RENDER(vpl_paths)},
+    {"specular-depth", 0, "N", CLI_RENDER, RENDER(specular_depth)},
+    {"glossy-samples", 0, "N", CLI_RENDER, RENDER(glossy_samples)},
     {"seed", 0, "S", RV, SOLVE(seed)},
     {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
      .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},

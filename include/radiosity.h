@@ -552,6 +552,14 @@ typedef struct rad_render_options {
      * emission).  View-dependent, no mesh error; rad_options.seed keys it.
      * 0 = off (the solved radiosity). */
     int vpl_paths;
+    /* The second pass (on wherever the scene has specular materials: MTL
+     * illum 3 to 7): mirror, glass and glossy bounces followed from the
+     * eye, the first pass's B / pi read where a path lands on a diffuse
+     * surface (docs/methods.md "Two-pass rendering"). */
+    int specular_depth;           /* specular bounces a path follows; 0 = 8; -1 = none (B / pi at
+                                     the first hit, the first pass alone) */
+    int glossy_samples;           /* rays a glossy surface seen from the eye sends (stratified);
+                                     0 = 16; deeper glossy bounces send 1 */
 } rad_render_options;
 
 /* A linear-radiance RGB image, W/(m^2 sr). */

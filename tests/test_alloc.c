@@ -50,6 +50,8 @@ static const char box_obj[] = "mtllib box.mtl\n"
 
 static const char box_mtl[] = "newmtl white\nKd 0.5 0.5 0.5\n"
                               "newmtl lamp\nKd 0.3 0.3 0.3\nKe 1 1 1\n";
+static const char mirror_mtl[] = "newmtl white\nKd 0.1 0.1 0.1\nKs 0.8 0.8 0.8\nillum 3\n"
+                                 "newmtl lamp\nKd 0.3 0.3 0.3\nKe 1 1 1\n";
 
 /* A textured floor (map_Kd, an 8 x 8 checker PNG) under a lamp: the
  * texture's reading, its texels and the coordinates' maps. */
@@ -140,20 +142,22 @@ typedef struct scenario {
     int hemicube_resolution, samples, closure_correction;
     bool view_factors;           /* the strategy keeps F */
     int adaptive_levels;
+    bool mirror;                 /* the white walls mirrors (illum 3): both passes of two-pass */
 } scenario;
 
 static const scenario scenarios[] = {
-    {"loading", NULL, NULL, 0, 0, 0, false, 0},
-    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0},
-    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0},
-    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0},
-    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0},
-    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2},
-    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0},
-    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0},
-    {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0},
-    {"collocation", "collocation", NULL, 0, 0, 0, false, 0},
-    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0},
+    {"loading", NULL, NULL, 0, 0, 0, false, 0, false},
+    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false},
+    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0, false},
+    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0, false},
+    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0, false},
+    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2, false},
+    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0, false},
+    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0, false},
+    {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0, false},
+    {"collocation", "collocation", NULL, 0, 0, 0, false, 0, false},
+    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0, false},
+    {"gauss-seidel (dense, mirror images, second pass)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, true},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from
@@ -239,7 +243,8 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     rad_image *image = NULL;
     double *vertex = NULL;
     char path[512];
-    rad_result r = rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), box_mtl, strlen(box_mtl), &scene);
+    const char *mtl = sc->mirror ? mirror_mtl : box_mtl;
+    rad_result r = rad_scene_load_memory(ctx, "box.obj", box_obj, strlen(box_obj), mtl, strlen(mtl), &scene);
     if (r == RAD_OK) {
         rad_options o = {0};
         o.target_elements = 48;
@@ -263,7 +268,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     }
     if (r == RAD_OK) {
         rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
-        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0};
         r = rad_solution_render(ctx, s, &ro, &image);
     }
     if (r == RAD_OK) {
@@ -679,7 +684,7 @@ static void test_stats_by_category(void **state)
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
     rad_image *image = NULL;
-    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0, 0};
+    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0};
     assert_int_equal(rad_solution_render(ctx, s, &ro, &image), RAD_OK);
     char path[512];
     output_path("stats.json", path, sizeof path);

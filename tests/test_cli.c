@@ -363,7 +363,7 @@ static void test_unused_material_properties(void **state)
                             "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n");
     assert_int_equal(run("render shiny.obj -o shiny.png --elements 50 --width 32 --height 32"), 0);
     assert_one_line_error("radiosity: warning: shiny.mtl: material 'white' (surface 'floor'): Ks, "
-                          "Ns and illum 2 are not used (the engine is diffuse: Kd and Ke only)",
+                          "Ns and illum 2 are not used (the engine reads Kd and Ke, and the specular keys with illum 3 to 7)",
                           NULL);
     assert_true(exists("shiny.png"));
 }

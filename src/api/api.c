@@ -53,6 +53,23 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->options.max_memory_bytes = rad_memory_limit(ctx);
     /* mesh -> visibility -> couplings, as the strategy does them */
     s->strategy = rad_strategy_for_solver(s->options.solver);
+    /* The first pass's light through mirrors is the dense strategy's
+     * (formfactor/ff_mirror.c); the others solve the diffuse part alone. */
+    bool mirrors = false;
+    for (size_t m = 0; m < scene->material_count; m++)
+        mirrors |= scene->materials[m].specular_kind == RAD_SPECULAR_MIRROR;
+    if (mirrors && strcmp(s->options.solver, "southwell") == 0) {
+        rad_free(s);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: solver 'southwell' reads F_ji through reciprocity, which light through mirrors "
+                        "does not keep; use gauss-seidel, jacobi, direct or conjugate-gradient",
+                        scene->source);
+    }
+    if (mirrors && strcmp(s->strategy->name, "dense") != 0)
+        rad_warn(ctx,
+                 "%s: solver '%s' does not carry light through mirrors (the first pass's mirror images "
+                 "are the dense solvers'); the render's second pass still shows them",
+                 scene->source, s->options.solver);
     r = s->strategy->create(ctx, scene, &s->options, &s->state);
     if (r != RAD_OK) {
         rad_free(s);
@@ -398,6 +415,7 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     in.vis = s->view.vis;
     in.element_radiosity = display;
     in.vertex_radiosity = s->vertex_radiosity;
+    in.materials = rad_scene_has_specular(s->scene) ? s->scene->materials : NULL;
     int w = o.width > 0 ? o.width : 512, h = o.height > 0 ? o.height : 512;
     /* The image (3 floats a pixel) and its 8-bit copy for PNG. */
     double image_bytes = 15.0 * (double)w * (double)h;

@@ -140,6 +140,12 @@ static const rad_option_info render_rows[] = {
      .help = "per-pixel instant radiosity: this many light paths' virtual point lights and the emitters "
              "gathered at each camera ray's point (view-dependent; the 1/r^2 clamp as the "
              "instant-radiosity solver's)"},
+    {RENDER(specular_depth), .type = RAD_OPTION_INT, .min = -1.0, .max = 64.0, .default_value = 8.0,
+     .default_text = "8",
+     .help = "second pass: mirror, glass and glossy bounces followed from the eye where the scene has "
+             "specular materials; -1: the first pass alone"},
+    {RENDER(glossy_samples), .type = RAD_OPTION_INT, .min = 1.0, .max = 16384.0, .default_value = 16.0,
+     .default_text = "16", .help = "second pass: rays a glossy surface seen from the eye sends"},
 };
 
 static const rad_option_info office_rows[] = {

@@ -229,6 +229,29 @@ double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, dou
  * triangle's children use corners 0-2 of each sub[k].  Cannot fail. */
 void rad_ff_split4(const vec3 *region, uint32_t corners, vec3 sub[4][4]);
 
+/* ---- extended form factors through ideal mirrors (ff_mirror.c) ---- */
+
+typedef struct rad_ff_mirror_stats {
+    size_t mirror_patches;    /* patches of mirror materials */
+    uint64_t pairs;           /* (receiver, source) pairs tried per mirror patch, summed */
+    uint64_t rays;            /* visibility rays through the mirrors */
+    double seconds;
+} rad_ff_mirror_stats;
+
+/* True when some patch's material (materials[], the scene's) is an ideal
+ * mirror.  Cannot fail. */
+bool rad_mesh_has_mirror(const rad_mesh *mesh, const rad_material *materials);
+
+/* F_ext = F + for each mirror patch, rho_s (its channels' mean) x the
+ * factor from each element to each other's mirror image, visibility
+ * through the mirror included (the file's header): a new n x n matrix into
+ * *F_ext_out (the caller's, rad_free).  Deterministic, parallel on the
+ * context's threads; polls rad_cancelled (RAD_ERROR_INTERRUPTED); fails
+ * otherwise only for memory.  *F_ext_out is NULL on failure. */
+rad_result rad_ff_mirror_images(rad_context *ctx, const rad_mesh *mesh, const rad_vis *vis,
+                                const rad_material *materials, const double *F, double **F_ext_out,
+                                rad_ff_mirror_stats *stats);
+
 /* ---- the hemicube's delta form factors (ff_hemicube.c) ---- */
 
 /* Fill delta[] with the form factor of each pixel of a unit hemicube with

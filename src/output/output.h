@@ -41,6 +41,8 @@ typedef struct rad_render_input {
      * reflected light, B = E + (B_element - E) rho(point) / rho_element
      * (NULL: no textures drawn). */
     const rad_scene *scene;
+    const rad_material *materials;   /* per patch->material: the specular parts the second pass
+                                        follows; NULL: the first pass alone */
 } rad_render_input;
 
 /* Ray-cast the mesh from the camera; each sample takes the radiance B/pi of

@@ -31,15 +31,38 @@
  * what the clamp removes comes back from rays into the near field, which
  * read the solution underneath (so it, too, should be a converged one).
  * The shadow rays of the direct light are keyed on (pixel, stratum).
+ *
+ * Second pass (two-pass methods: Wallace, Cohen & Greenberg 1987; Sillion
+ * & Puech 1989): where a camera ray meets a specular material the path
+ * goes on from the eye, and where it lands on a diffuse surface it reads
+ * the first pass's radiosity, so the picture holds what radiosity cannot
+ * (the view-dependent mirror image, refraction, glossy reflection):
+ *
+ *   L(x, w) = B(x) / pi                                   the diffuse part
+ *           + rho_s L(x', r)                              mirror, r = reflected
+ *           + t [R L(x', r) + (1 - R) L(x'', refracted)]  glass, R Fresnel's
+ *           + rho_s mean over Phong-lobe samples of L      glossy
+ *
+ * Values are carried as pi L (radiosity units) and scaled with the rest.
+ * Glass is exact Fresnel for unpolarised light at each interface (Born &
+ * Wolf, ch. 1.5), total internal reflection included; both branches are
+ * followed, so the multiple reflections inside a pane sum to its
+ * (1 - R)^2 / (1 - R^2).  The glossy lobe is the modified Phong BRDF
+ * rho_s (n + 2) / (2 pi) cos^n(alpha) (Lafortune & Willems 1994),
+ * importance-sampled (pdf (n + 1) / (2 pi) cos^n alpha: each sample
+ * weighs rho_s (n + 2) / (n + 1) cos theta), stratified, keyed by (pixel,
+ * sample, bounce), so the image is the same on any number of threads.  A
+ * path ends after specular_depth bounces or when its weight falls below
+ * RENDER_MIN_WEIGHT.
  */
 #include "output/output.h"
 #include "solve/vpl.h"
 
 #include <stdlib.h>
-#include <string.h>
 
 #ifdef _OPENMP
 #include <omp.h>
+#include <string.h>
 #endif
 
 #define RAD_RENDER_MAX_SIZE 16384   /* pixels per side, samples per side */
@@ -109,12 +132,6 @@ static rad_result make_view(rad_context *ctx, const rad_camera *camera, int widt
     return RAD_OK;
 }
 
-#define RENDER_MISS UINT32_MAX        /* what a ray saw: nothing */
-#define RENDER_BACK (UINT32_MAX - 1u) /* what a ray saw: the back of a patch */
-
-/* Radiosity (W/m^2) seen along `ray` given its hit; 0 for a miss or the
- * back of a patch.  Returns what was seen: the patch (smooth shading,
- * continuous across it) or the element (flat), RENDER_MISS or RENDER_BACK. */
 /* Per-pixel instant radiosity at the point p of element e seen by a
  * camera ray: B = E + rho (direct + VPLs + near field), the VPLs clamped
  * as the strategy's (solve/vpl.h); the direct light's shadow rays and the
@@ -181,31 +198,175 @@ static void shade_vpl(const rad_render_input *input, uint32_t e, const rad_patch
         rgb[c] = input->emission[3 * (size_t)e + c] + rho[c] * fmax(H[c], 0.0);
 }
 
-static uint32_t shade(const rad_render_input *input, rad_shading shading, const rad_ray *ray,
-                      const rad_hit *hit, uint64_t key, double rgb[3])
+/* What a trace needs beyond the input: the second pass's settings. */
+typedef struct render_pass {
+    const rad_render_input *input;
+    rad_shading shading;
+    int specular_depth;  /* 0: the first pass alone */
+    int glossy_samples;
+    double epsilon;      /* m: secondary rays start this far off the surface */
+} render_pass;
+
+/* A path whose weight (the product of its bounces' weights) is below this
+ * contributes under 1e-6 of what it would alone: the inner reflections of
+ * a pane (R^2 = 1.6e-3 a round trip) are followed until their sum is exact
+ * to ~1e-9, and glass does not split into 2^depth paths. */
+#define RENDER_MIN_WEIGHT 1e-6
+
+#define RENDER_MISS UINT32_MAX        /* what a ray saw: nothing */
+#define RENDER_BACK (UINT32_MAX - 1u) /* what a ray saw: the back of a patch */
+#define RENDER_MIXED (UINT32_MAX - 2u) /* what a pixel's rays saw: not all the same (or specular) */
+
+/* Radiosity (W/m^2) seen along `ray` given its hit; 0 for a miss or the
+ * back of a patch.  Returns what was seen: the patch (smooth shading,
+ * continuous across it) or the element (flat), RENDER_MISS or RENDER_BACK. */
+static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit *hit, int depth,
+                      double carried, rad_rng *rng, double rgb[3]);
+
+/* rgb += weight x pi L along (origin, direction), when the path's weight
+ * (`carried` to here, times this bounce's) counts: one closest-hit query,
+ * then shade. */
+static void add_traced(const render_pass *pass, vec3 origin, vec3 direction, int depth, double carried,
+                       rad_rng *rng, const double weight[3], double rgb[3])
 {
+    double path = carried * fmax(fmax(weight[0], weight[1]), weight[2]);
+    if (path < RENDER_MIN_WEIGHT)
+        return;
+    rad_ray ray = {origin, direction, 0.0, INFINITY};
+    rad_hit hit;
+    pass->input->vis->backend->intersect(pass->input->vis->state, &ray, 1, &hit);
+    double seen[3];
+    shade(pass, &ray, &hit, depth, path, rng, seen);
+    for (int c = 0; c < 3; c++)
+        rgb[c] += weight[c] * seen[c];
+}
+
+/* Fresnel reflectance for unpolarised light from index n1 into n2 at
+ * cos_i (> 0); 1 beyond the critical angle, *cos_t the refracted cosine. */
+static double fresnel_dielectric(double n1, double n2, double cos_i, double *cos_t)
+{
+    double eta = n1 / n2, sin_t2 = eta * eta * fmax(0.0, 1.0 - cos_i * cos_i);
+    if (sin_t2 >= 1.0) {
+        *cos_t = 0.0;
+        return 1.0;
+    }
+    double ct = sqrt(1.0 - sin_t2);
+    double rs = (n1 * cos_i - n2 * ct) / (n1 * cos_i + n2 * ct);
+    double rp = (n2 * cos_i - n1 * ct) / (n2 * cos_i + n1 * ct);
+    *cos_t = ct;
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+/* A unit vector at cos_alpha from unit `axis`, at azimuth phi. */
+static vec3 about_axis(vec3 axis, double cos_alpha, double phi)
+{
+    vec3 helper = fabs(axis.x) < 0.9 ? v3(1.0, 0.0, 0.0) : v3(0.0, 1.0, 0.0);
+    vec3 u = v3_normalize(v3_cross(helper, axis)), w = v3_cross(axis, u);
+    double sin_alpha = sqrt(fmax(0.0, 1.0 - cos_alpha * cos_alpha));
+    return v3_add(v3_scale(axis, cos_alpha),
+                  v3_add(v3_scale(u, sin_alpha * cos(phi)), v3_scale(w, sin_alpha * sin(phi))));
+}
+
+/* The specular part at point p of a patch of material m, seen along unit
+ * `d`; `facing` is the patch's normal (front hits) or its negation (glass
+ * from inside).  Adds pi L to rgb. */
+static void specular_part(const render_pass *pass, const rad_material *m, vec3 p, vec3 d, vec3 normal,
+                          int depth, double carried, rad_rng *rng, double rgb[3])
+{
+    const double eps = pass->epsilon;
+    bool front = v3_dot(d, normal) < 0.0;
+    vec3 facing = front ? normal : v3_scale(normal, -1.0);
+    double cos_i = -v3_dot(d, facing);
+    vec3 reflected = v3_mad(d, facing, 2.0 * cos_i);
+    vec3 above = v3_mad(p, facing, eps), below = v3_mad(p, facing, -eps);
+    double weight[3];
+    switch (m->specular_kind) {
+    case RAD_SPECULAR_MIRROR:
+        add_traced(pass, above, reflected, depth + 1, carried, rng, m->specular, rgb);
+        break;
+    case RAD_SPECULAR_GLASS: {
+        double n1 = front ? 1.0 : m->ior, n2 = front ? m->ior : 1.0, cos_t;
+        double R = fresnel_dielectric(n1, n2, cos_i, &cos_t);
+        for (int c = 0; c < 3; c++)
+            weight[c] = m->specular[c] * R;
+        add_traced(pass, above, reflected, depth + 1, carried, rng, weight, rgb);
+        if (R < 1.0) {
+            double eta = n1 / n2;
+            vec3 refracted = v3_normalize(v3_mad(v3_scale(d, eta), facing, eta * cos_i - cos_t));
+            for (int c = 0; c < 3; c++)
+                weight[c] = m->specular[c] * (1.0 - R);
+            add_traced(pass, below, refracted, depth + 1, carried, rng, weight, rgb);
+        }
+        break;
+    }
+    case RAD_SPECULAR_GLOSSY: {
+        /* From the eye: glossy_samples stratified on a square grid; deeper: one. */
+        int grid = 1;
+        if (depth == 0)
+            while ((grid + 1) * (grid + 1) <= pass->glossy_samples)
+                grid++;
+        double n = m->shininess, sum[3] = {0.0, 0.0, 0.0};
+        for (int k = 0; k < grid * grid; k++) {
+            double u1 = ((double)(k % grid) + rad_rng_uniform(rng)) / grid;
+            double u2 = ((double)(k / grid) + rad_rng_uniform(rng)) / grid;
+            vec3 out = about_axis(reflected, pow(u1, 1.0 / (n + 1.0)), 2.0 * M_PI * u2);
+            double cos_out = v3_dot(out, facing);
+            if (cos_out <= 0.0) /* below the surface: the lobe's part that is absorbed */
+                continue;
+            for (int c = 0; c < 3; c++)
+                weight[c] = m->specular[c] * (n + 2.0) / (n + 1.0) * cos_out;
+            add_traced(pass, above, out, depth + 1, carried, rng, weight, sum);
+        }
+        for (int c = 0; c < 3; c++)
+            rgb[c] += sum[c] / (double)(grid * grid);
+        break;
+    }
+    case RAD_SPECULAR_NONE:
+        break;
+    }
+}
+
+static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit *hit, int depth,
+                      double carried, rad_rng *rng, double rgb[3])
+{
+    const rad_render_input *input = pass->input;
+    rad_shading shading = pass->shading;
     rgb[0] = rgb[1] = rgb[2] = 0.0;
     if (!isfinite(hit->t))
         return RENDER_MISS;
     const rad_mesh *mesh = input->mesh;
     const rad_patch *patch = &mesh->patches[hit->patch];
-    if (v3_dot(ray->direction, patch->normal) > 0.0)
-        return RENDER_BACK;
     vec3 p = v3_mad(ray->origin, ray->direction, hit->t);
+    const rad_material *m = input->materials && depth < pass->specular_depth
+                                ? &input->materials[patch->material] : NULL;
+    if (m && m->specular_kind == RAD_SPECULAR_NONE)
+        m = NULL;
+    bool back = v3_dot(ray->direction, patch->normal) > 0.0;
+    if (back && !(m && m->specular_kind == RAD_SPECULAR_GLASS))
+        return RENDER_BACK;
+    if (m) /* the specular part: the pixel is refined as an edge would be */
+        specular_part(pass, m, p, v3_normalize(ray->direction), patch->normal, depth, carried, rng, rgb);
+    if (back)
+        return RENDER_MIXED;
     double s, t, local_s, local_t;
     rad_patch_parameters(patch, p, &s, &t);
     uint32_t e = rad_mesh_locate(mesh, hit->patch, s, t, &local_s, &local_t);
-    if (input->vpls) {
-        shade_vpl(input, e, patch, p, key, rgb);
-        return hit->patch;
-    }
     bool smooth = shading == RAD_SHADING_SMOOTH && input->vertex_radiosity;
+    double diffuse[3];
+    if (input->vpls) {
+        /* The path's own stream keys the gather: (pixel, stratum, bounces). */
+        uint64_t key = (uint64_t)(rad_rng_uniform(rng) * 9007199254740992.0);
+        shade_vpl(input, e, patch, p, key, diffuse);
+        for (int c = 0; c < 3; c++)
+            rgb[c] += diffuse[c];
+        return m ? RENDER_MIXED : hit->patch;
+    }
     if (smooth) {
         rad_element_interpolate(mesh, &mesh->elements[e], input->vertex_radiosity, local_s,
-                                local_t, rgb);
+                                local_t, diffuse);
     } else {
         for (int c = 0; c < 3; c++)
-            rgb[c] = input->element_radiosity[3 * (size_t)e + (size_t)c];
+            diffuse[c] = input->element_radiosity[3 * (size_t)e + (size_t)c];
     }
     /* A texture modulates the reflected part by the texel's reflectance
      * over the element's mean (which the solution used): a texture of one
@@ -217,10 +378,12 @@ static uint32_t shade(const rad_render_input *input, rad_shading shading, const 
         for (int c = 0; c < 3; c++) {
             double mean = input->reflectance[3 * (size_t)e + (size_t)c], E = input->emission[3 * (size_t)e + (size_t)c];
             if (mean > 0.0)
-                rgb[c] = E + (rgb[c] - E) * (rho[c] / mean);
+                diffuse[c] = E + (diffuse[c] - E) * (rho[c] / mean);
         }
     }
-    return smooth ? hit->patch : e;
+    for (int c = 0; c < 3; c++)
+        rgb[c] += diffuse[c];
+    return m ? RENDER_MIXED : smooth ? hit->patch : e;
 }
 
 /* The camera ray through stratum `stratum` of `grid` x `grid` of pixel
@@ -239,12 +402,11 @@ static void camera_ray(const render_view *view, uint64_t stream, uint64_t x, int
     ray->tfar = INFINITY;
 }
 
-#define RENDER_MIXED (UINT32_MAX - 2u) /* what a pixel's rays saw: not all the same */
 
 /* Pixels `pixel[0 .. count)` of row y, `grid` x `grid` strata each, in
  * batches of `batch` rays: their sums into sum[3 x]; seen[x] what all of a
  * pixel's rays saw when they agree, RENDER_MIXED when they do not. */
-static void trace_pixels(const rad_render_input *input, rad_shading shading, const render_view *view, int y,
+static void trace_pixels(const render_pass *pass, const render_view *view, int y,
                          const uint32_t *pixel, size_t count, uint64_t grid, uint64_t stream, size_t batch,
                          rad_ray *rays, rad_hit *hits, double *sum, uint32_t *seen)
 {
@@ -255,12 +417,14 @@ static void trace_pixels(const rad_render_input *input, rad_shading shading, con
             uint64_t r = first + k;
             camera_ray(view, stream, pixel[r / per_pixel], y, r % per_pixel, grid, &rays[k]);
         }
-        input->vis->backend->intersect(input->vis->state, rays, n, hits);
+        pass->input->vis->backend->intersect(pass->input->vis->state, rays, n, hits);
         for (size_t k = 0; k < n; k++) {
             uint64_t r = first + k, x = pixel[r / per_pixel];
             double rgb[3];
-            uint64_t key = ((uint64_t)y * (uint64_t)view->width + x) * per_pixel * 2 + (r % per_pixel) * 2 + stream;
-            uint32_t what = shade(input, shading, &rays[k], &hits[k], key, rgb);
+            /* The second pass's stream: keyed like the camera ray's, apart. */
+            rad_rng rng = rad_rng_keyed(stream ^ 0x5bd1e9955bd1e995ULL,
+                                        (uint64_t)y * (uint64_t)view->width + x, r % per_pixel);
+            uint32_t what = shade(pass, &rays[k], &hits[k], 0, 1.0, &rng, rgb);
             if (r % per_pixel == 0) {
                 sum[3 * x] = sum[3 * x + 1] = sum[3 * x + 2] = 0.0;
                 seen[x] = what;
@@ -275,8 +439,7 @@ static void trace_pixels(const rad_render_input *input, rad_shading shading, con
 
 /* One row: every pixel's 2 x 2 pilot, then all strata where the pilot
  * saw more than one thing (file header); writes the row's pixels. */
-static void render_row(const rad_render_input *input, rad_shading shading,
-                       const render_view *view, int y, size_t batch, rad_ray *rays, rad_hit *hits,
+static void render_row(const render_pass *pass, const render_view *view, int y, size_t batch, rad_ray *rays, rad_hit *hits,
                        double *sum, uint32_t *seen, uint32_t *pixel, float *pixels)
 {
     const uint64_t grid = (uint64_t)view->samples, pilot = grid > 2 ? 2 : grid;
@@ -285,8 +448,7 @@ static void render_row(const rad_render_input *input, rad_shading shading,
         pixel[x] = (uint32_t)x;
     /* The pilot is the final sampling when the grid is no finer (stream 0,
      * as the full strata: the same rays then). */
-    trace_pixels(input, shading, view, y, pixel, width, pilot, pilot == grid ? 0 : 1, batch, rays, hits, sum,
-                 seen);
+    trace_pixels(pass, view, y, pixel, width, pilot, pilot == grid ? 0 : 1, batch, rays, hits, sum, seen);
     double scale[2] = {1.0 / (M_PI * (double)(pilot * pilot)), /* mean, and L = B / pi */
                        1.0 / (M_PI * (double)(grid * grid))};
     size_t again = 0;
@@ -301,7 +463,7 @@ static void render_row(const rad_render_input *input, rad_shading shading,
     /* Sums of the refined pixels are overwritten with their full strata. */
     uint32_t *unused = pixel + width; /* what the full strata saw: not needed */
     if (again)
-        trace_pixels(input, shading, view, y, pixel, again, grid, 0, batch, rays, hits, sum, unused);
+        trace_pixels(pass, view, y, pixel, again, grid, 0, batch, rays, hits, sum, unused);
     for (size_t x = 0; x < width; x++)
         for (int c = 0; c < 3; c++)
             pixels[3 * x + (size_t)c] = (float)(sum[3 * x + (size_t)c] * scale[seen[x]]);
@@ -324,6 +486,14 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
     if ((r = make_view(ctx, &input->camera, width, height, samples, &view)) != RAD_OK ||
         (r = check_camera_distance(ctx, input)) != RAD_OK)
         return r;
+
+    if (o.specular_depth < -1 || o.specular_depth > 64)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "rad_render_options.specular_depth must be in [-1, 64], got %d", o.specular_depth);
+    if (o.glossy_samples != 0 && (r = check_size(ctx, "glossy_samples", o.glossy_samples)) != RAD_OK)
+        return r;
+    render_pass pass = {input, o.shading, o.specular_depth < 0 ? 0 : option_or_default(o.specular_depth, 8),
+                        option_or_default(o.glossy_samples, 16), rad_vis_epsilon(input->mesh)};
 
     int threads = ctx && ctx->threads > 0 ? ctx->threads : 1;
     /* A row's rays, up to RAD_RENDER_BATCH at a time: small images need no more. */
@@ -368,7 +538,7 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
                 rows_skipped++;
                 continue;
             }
-            render_row(input, o.shading, &view, y, batch, my_rays, my_hits, my_sum, my_seen, my_pixel,
+            render_row(&pass, &view, y, batch, my_rays, my_hits, my_sum, my_seen, my_pixel,
                        &image->pixels[(size_t)y * (size_t)width * 3]);
             int done;
 #pragma omp atomic capture

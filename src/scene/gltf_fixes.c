@@ -88,7 +88,7 @@ rad_result import_glb_check_framing(rad_context *ctx, const char *name, const ch
 /* KHR_materials_emissive_strength of the glTF material assimp imported as
  * material `index` named `name`: assimp keeps the glTF order (and appends a
  * default material), so match by index, by name when the names differ. */
-double import_gltf_emissive_strength(const cJSON *materials, unsigned index, const char *name)
+const cJSON *import_gltf_material(const cJSON *materials, unsigned index, const char *name)
 {
     const cJSON *match = NULL, *item;
     unsigned i = 0;
@@ -102,9 +102,55 @@ double import_gltf_emissive_strength(const cJSON *materials, unsigned index, con
         if (!match && cJSON_IsString(item_name) && strcmp(item_name->valuestring, name) == 0)
             match = item;
     }
-    const cJSON *extensions = cJSON_GetObjectItemCaseSensitive(match, "extensions");
-    const cJSON *extension =
-        cJSON_GetObjectItemCaseSensitive(extensions, "KHR_materials_emissive_strength");
-    const cJSON *strength = cJSON_GetObjectItemCaseSensitive(extension, "emissiveStrength");
-    return cJSON_IsNumber(strength) ? strength->valuedouble : 1.0;
+    return match;
+}
+
+/* The number at object.key (objects only), or `fallback`. */
+static double number_at(const cJSON *object, const char *key, double fallback)
+{
+    const cJSON *value = cJSON_IsObject(object) ? cJSON_GetObjectItemCaseSensitive(object, key) : NULL;
+    return cJSON_IsNumber(value) ? value->valuedouble : fallback;
+}
+
+static const cJSON *object_at(const cJSON *object, const char *key)
+{
+    return cJSON_IsObject(object) ? cJSON_GetObjectItemCaseSensitive(object, key) : NULL;
+}
+
+double import_gltf_emissive_strength(const cJSON *materials, unsigned index, const char *name)
+{
+    const cJSON *extensions = object_at(import_gltf_material(materials, index, name), "extensions");
+    return number_at(object_at(extensions, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0);
+}
+
+bool import_gltf_specular(const cJSON *material, const double base[3], import_specular *out)
+{
+    const cJSON *pbr = object_at(material, "pbrMetallicRoughness");
+    const cJSON *extensions = object_at(material, "extensions");
+    double t = number_at(object_at(extensions, "KHR_materials_transmission"), "transmissionFactor", 0.0);
+    double metallic = number_at(pbr, "metallicFactor", 0.0); /* written only: unused.c says why */
+    double roughness = number_at(pbr, "roughnessFactor", 1.0);
+    if (t > 0.0 && t <= 1.0) {
+        out->kind = RAD_SPECULAR_GLASS;
+        out->ior = number_at(object_at(extensions, "KHR_materials_ior"), "ior", 1.5);
+        out->shininess = 0.0;
+        for (int c = 0; c < 3; c++) {
+            out->reflectance[c] = (1.0 - t) * base[c];
+            out->specular[c] = t;
+        }
+        return true;
+    }
+    if (!(metallic > 0.0 && metallic <= 1.0 && roughness >= 0.0 && roughness <= IMPORT_GLTF_MAX_ROUGHNESS))
+        return false;
+    /* Roughness r as a Phong exponent: alpha = r^2, Ns = 2 / alpha^2 - 2
+     * (Walter et al. 2007's match of the Beckmann and Blinn-Phong lobes). */
+    double alpha = roughness * roughness;
+    out->shininess = alpha > 0.0 ? 2.0 / (alpha * alpha) - 2.0 : RAD_MIRROR_SHININESS;
+    out->kind = out->shininess >= RAD_MIRROR_SHININESS ? RAD_SPECULAR_MIRROR : RAD_SPECULAR_GLOSSY;
+    out->ior = 1.0;
+    for (int c = 0; c < 3; c++) {
+        out->reflectance[c] = (1.0 - metallic) * base[c];
+        out->specular[c] = metallic * base[c];
+    }
+    return true;
 }

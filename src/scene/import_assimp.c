@@ -254,6 +254,44 @@ static bool fit_uv_map(const vec3 *p, const struct aiVector3D *const uv[], unsig
     return true;
 }
 
+/* The specular part an MTL material's statements give (docs/units.md
+ * "Specular materials"): illum 3 or 5 with Ks is a reflector, an ideal
+ * mirror from Ns RAD_MIRROR_SHININESS up (or without Ns), a Phong lobe of
+ * exponent Ns below; illum 4, 6 or 7 is glass of index Ni (1.5 without
+ * it), its transmitting part Tr, or 1 - d, or what Kd leaves (1 - the
+ * largest of Kd).  Other illum
+ * values (2: highlights) leave the material diffuse.  Errors name the
+ * library's line of Ks (glass: Ni), or of newmtl without it. */
+static rad_result mtl_specular(converter *cv, const import_material_name *exact, int material,
+                               const double reflectance[3])
+{
+    int illum = isfinite(exact->illum) ? (int)exact->illum : -1;
+    double specular[3] = {0.0, 0.0, 0.0};
+    rad_specular_kind kind = RAD_SPECULAR_NONE;
+    double shininess = isfinite(exact->ns) ? exact->ns : 0.0, ior = 1.0;
+    if ((illum == 3 || illum == 5) && isfinite(exact->ks[0])) {
+        memcpy(specular, exact->ks, sizeof specular);
+        if (specular[0] > 0.0 || specular[1] > 0.0 || specular[2] > 0.0)
+            kind = !isfinite(exact->ns) || exact->ns >= RAD_MIRROR_SHININESS ? RAD_SPECULAR_MIRROR
+                                                                             : RAD_SPECULAR_GLOSSY;
+    } else if (illum == 4 || illum == 6 || illum == 7) {
+        double t = isfinite(exact->tr) ? exact->tr : isfinite(exact->d) ? 1.0 - exact->d
+                                                                        : 1.0 - fmax(fmax(reflectance[0], reflectance[1]),
+                                                                                     reflectance[2]);
+        specular[0] = specular[1] = specular[2] = t;
+        ior = isfinite(exact->ni) ? exact->ni : 1.5;
+        if (t > 0.0)
+            kind = RAD_SPECULAR_GLASS;
+    }
+    if (kind == RAD_SPECULAR_NONE)
+        return RAD_OK;
+    char where[1024];
+    snprintf(where, sizeof where, "%s:%d", cv->materials_exact->libraries[exact->library],
+             kind == RAD_SPECULAR_GLASS ? exact->ni_line : exact->ks_line);
+    return rad_scene_builder_material_specular(cv->builder, material, where, kind, specular, shininess,
+                                               ior);
+}
+
 /* The builder material for assimp material `index`, added on first use so
  * that materials no polygon uses are never validated. */
 static int convert_material(converter *cv, unsigned index)
@@ -302,8 +340,22 @@ static int convert_material(converter *cv, unsigned index)
         if (exact->has_ke)
             emission[c] = M_PI * exact->ke[c];
     }
+    /* glTF: metals and transmission (their diffuse part first). */
+    import_specular gltf;
+    bool gltf_specular = cv->gltf_materials &&
+                         import_gltf_specular(import_gltf_material(cv->gltf_materials, index, name.data),
+                                              reflectance, &gltf);
+    if (gltf_specular)
+        memcpy(reflectance, gltf.reflectance, sizeof gltf.reflectance);
     cv->material_of[index] = rad_scene_builder_material(cv->builder, name.data, reflectance,
                                                         emission);
+    if (cv->material_of[index] >= 0 && exact &&
+        mtl_specular(cv, exact, cv->material_of[index], reflectance) != RAD_OK)
+        cv->material_of[index] = -1;
+    if (cv->material_of[index] >= 0 && gltf_specular &&
+        rad_scene_builder_material_specular(cv->builder, cv->material_of[index], cv->name, gltf.kind,
+                                            gltf.specular, gltf.shininess, gltf.ior) != RAD_OK)
+        cv->material_of[index] = -1;
     if (cv->material_of[index] >= 0 && convert_texture(cv, index, name.data, exact) != RAD_OK)
         return -1;
     return cv->material_of[index];

@@ -128,6 +128,10 @@ typedef struct import_material_name {
     bool has_kd, has_ke; /* Kd / Ke given (the last of each counts, as in assimp) */
     double kd[3], ke[3]; /* as strtod reads them: assimp keeps only floats */
     int map_kd_line;     /* the line of its (last) map_Kd; 0: none */
+    /* The specular statements (the last of each counts; NAN when absent or
+     * not numbers): Ks (one value is grey), Ns, Ni, d, Tr, illum. */
+    double ks[3], ns, ni, d, tr, illum;
+    int ks_line, ni_line; /* the line of the last Ks (Ni), or of newmtl */
 } import_material_name;
 
 typedef struct import_material_names {
@@ -223,6 +227,32 @@ struct cJSON *import_gltf_json(const char *data, size_t size, bool binary, size_
  * JSON chunk 4-byte aligned; RAD_ERROR_PARSE naming `name` if not. */
 rad_result import_glb_check_framing(rad_context *ctx, const char *name, const char *data,
                                     size_t size);
+
+/* The glTF material (from the "materials" array) that assimp imported as
+ * material `index` named `name`: assimp keeps the glTF order (and appends
+ * a default material), so matched by index, by name when the names
+ * differ; NULL if none.  Cannot fail. */
+const struct cJSON *import_gltf_material(const struct cJSON *materials, unsigned index, const char *name);
+
+/* glTF metals rougher than this stay diffuse (said unread): their lobe
+ * (Ns = 2 / r^4 - 2 < 30) is wider than the second pass shows well. */
+#define IMPORT_GLTF_MAX_ROUGHNESS 0.5
+
+/* A glTF material's specular part (docs/units.md "Specular materials"). */
+typedef struct import_specular {
+    rad_specular_kind kind;
+    double reflectance[3], specular[3]; /* rho_d and rho_s (glass: t) */
+    double shininess, ior;
+} import_specular;
+
+/* The specular part of glTF `material` with base colour `base`, into
+ * *out: KHR_materials_transmission's factor t > 0 is glass of
+ * KHR_materials_ior's index (1.5), rho_d = (1 - t) base; else a written
+ * metallicFactor m > 0 with roughnessFactor r (1) at most
+ * IMPORT_GLTF_MAX_ROUGHNESS is a mirror (r = 0) or a Phong lobe, rho_s =
+ * m base, rho_d = (1 - m) base.  False (out untouched) when the material
+ * is diffuse.  Cannot fail. */
+bool import_gltf_specular(const struct cJSON *material, const double base[3], import_specular *out);
 
 /* The emissive strength (1 when absent) of assimp material `index` named
  * `name`, from the glTF "materials" array. */

@@ -454,7 +454,9 @@ static rad_result add_material_name(rad_context *ctx, import_material_names *nam
         names->capacity = grown;
     }
     names->entries[names->count] = (import_material_name){
-        .name = name, .library = names->library_count - 1, .line = line, .order = names->count};
+        .name = name, .library = names->library_count - 1, .line = line, .order = names->count,
+        .ks = {NAN, NAN, NAN}, .ns = NAN, .ni = NAN, .d = NAN, .tr = NAN, .illum = NAN, .ks_line = line,
+        .ni_line = line};
     names->count++;
     names->sorted = false;
     return RAD_OK;
@@ -496,6 +498,43 @@ static int mtl_property_of(const char *statement)
         if (strcasecmp(statement, mtl_property_names[k]) == 0)
             return k;
     return -1;
+}
+
+/* Keep the values of the specular statements the engine reads (Ks, Ns,
+ * Ni, d, Tr, illum) on the material's entry, the rest of the line [p,
+ * end); a statement whose values are not all numbers is kept as absent
+ * (NAN), as is a Ks of other than one or three numbers. */
+static void note_specular(import_material_name *entry, int k, int line, const char *p, const char *end)
+{
+    char token[TOKEN_SIZE];
+    size_t length;
+    double values[3];
+    int count = 0;
+    while ((length = next_token(&p, end, token)) > 0) {
+        double value;
+        if (parse_number(token, length, &value) != NUMBER_FINITE || count == 3) {
+            count = -1;
+            break;
+        }
+        values[count++] = value;
+    }
+    double first = count > 0 ? values[0] : NAN;
+    switch (k) {
+    case MTL_KS:
+        for (int c = 0; c < 3; c++)
+            entry->ks[c] = count == 3 ? values[c] : count == 1 ? first : NAN;
+        entry->ks_line = line;
+        break;
+    case MTL_NS: entry->ns = count == 1 ? first : NAN; break;
+    case MTL_NI:
+        entry->ni = count == 1 ? first : NAN;
+        entry->ni_line = line;
+        break;
+    case MTL_D: entry->d = count == 1 ? first : NAN; break;
+    case MTL_TR: entry->tr = count == 1 ? first : NAN; break;
+    case MTL_ILLUM: entry->illum = count == 1 ? first : NAN; break;
+    default: break;
+    }
 }
 
 /* Texture statements: every map_*, and bump, disp, decal, refl, norm. */
@@ -589,6 +628,9 @@ static rad_result note_mtl_material(rad_context *ctx, const char *path, const ch
         x->high[MTL_ILLUM] == floor(x->high[MTL_ILLUM]))
         illum = (int)x->high[MTL_ILLUM];
     bool refractive = illum == 6 || illum == 7;
+    /* What the engine reads (import_assimp.c mtl_specular): a reflector's
+     * Ks, Ns and illum; glass's illum, Ni, d and Tr. */
+    bool reflector = (illum == 3 || illum == 5) && specular, glass = illum == 4 || refractive;
     bool listed[MTL_PROPERTIES] = {false};
     listed[MTL_KS] = specular;
     listed[MTL_NS] = x->seen[MTL_NS] && specular;
@@ -606,6 +648,10 @@ static rad_result note_mtl_material(rad_context *ctx, const char *path, const ch
     listed[MTL_PCR] = x->seen[MTL_PCR] && listed[MTL_PC];
     listed[MTL_ANISO] = above_zero(x, MTL_ANISO);
     listed[MTL_ANISOR] = x->seen[MTL_ANISOR] && listed[MTL_ANISO];
+    if (reflector)
+        listed[MTL_KS] = listed[MTL_NS] = listed[MTL_ILLUM] = false;
+    if (glass)
+        listed[MTL_ILLUM] = listed[MTL_NI] = listed[MTL_D] = listed[MTL_TR] = false;
 
     const char *items[MTL_PROPERTIES + MTL_MAPS + 1];
     size_t count = 0;
@@ -652,7 +698,7 @@ static rad_result note_mtl_material(rad_context *ctx, const char *path, const ch
                                  x->map_kd ? "," : ":", colour);
     }
     if (!x->map_kd && !x->map_ke && used < sizeof what)
-        snprintf(what + used, sizeof what - used, " (the engine is diffuse: Kd and Ke only)");
+        snprintf(what + used, sizeof what - used, " (the engine reads Kd and Ke, and the specular keys with illum 3 to 7)");
     char subject[512];
     snprintf(subject, sizeof subject, "%s: material '%s'", path, label);
     return import_notes_add(ctx, notes, subject, name, SIZE_MAX, what);
@@ -734,6 +780,8 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
         }
         if (!is_kd && !is_ke) {
             int property = mtl_property_of(token);
+            if (property >= 0)
+                note_specular(&names->entries[names->count - 1], property, lines.number, p, end);
             if (extras && property >= 0)
                 note_property(extras, property, p, end);
             else if (extras && is_mtl_map(token))

@@ -220,7 +220,53 @@ int rad_scene_builder_material(rad_scene_builder *b, const char *name,
         return -1;
     memcpy(m->reflectance, reflectance, sizeof m->reflectance);
     memcpy(m->emission, emission, sizeof m->emission);
+    m->specular_kind = RAD_SPECULAR_NONE;
+    m->specular[0] = m->specular[1] = m->specular[2] = 0.0;
+    m->shininess = 0.0;
+    m->ior = 1.0;
     return (int)b->material_count++;
+}
+
+rad_result rad_scene_builder_material_specular(rad_scene_builder *b, int material, const char *where,
+                                               rad_specular_kind kind, const double specular[3],
+                                               double shininess, double ior)
+{
+    rad_material *m = &b->materials[material];
+    const char *at = where ? where : b->source;
+    for (int c = 0; c < 3; c++) {
+        if (!(specular[c] >= 0.0 && specular[c] <= 1.0))
+            return rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                            "%s: material '%s': specular reflectance %g is outside [0, 1]", at, m->name,
+                            specular[c]);
+        /* Energy: what a surface reflects, diffusely and specularly, is at
+         * most what it receives (rounding of the decimal inputs allowed). */
+        if (m->reflectance[c] + specular[c] > 1.0 + 1e-12)
+            return rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                            "%s: material '%s': diffuse %g + specular %g reflectance is above 1 "
+                            "(the surface would reflect more than it receives)",
+                            at, m->name, m->reflectance[c], specular[c]);
+    }
+    if (!(shininess >= 0.0 && isfinite(shininess)))
+        return rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                        "%s: material '%s': shininess (Ns) %g is not a finite non-negative exponent", at,
+                        m->name, shininess);
+    if (kind == RAD_SPECULAR_GLASS && !(ior > 1.0 && ior <= 10.0))
+        return rad_fail(b->ctx, RAD_ERROR_INVALID_SCENE,
+                        "%s: material '%s': glass needs an index of refraction (Ni) in (1, 10], got %g", at,
+                        m->name, ior);
+    m->specular_kind = kind;
+    memcpy(m->specular, specular, sizeof m->specular);
+    m->shininess = shininess;
+    m->ior = kind == RAD_SPECULAR_GLASS ? ior : 1.0;
+    return RAD_OK;
+}
+
+bool rad_scene_has_specular(const rad_scene *scene)
+{
+    for (size_t i = 0; i < scene->material_count; i++)
+        if (scene->materials[i].specular_kind != RAD_SPECULAR_NONE)
+            return true;
+    return false;
 }
 
 /* FNV-1a. */

@@ -12,12 +12,32 @@
 
 #include "core/core.h"
 
+/* The specular part of a material (docs/units.md "Specular materials"):
+ * what the first pass folds into extended form factors (mirrors) and the
+ * renderer's second pass follows from the eye (all three). */
+typedef enum rad_specular_kind {
+    RAD_SPECULAR_NONE = 0, /* Lambertian only */
+    RAD_SPECULAR_MIRROR,   /* ideal mirror: rho_s of the light leaves along the reflected ray */
+    RAD_SPECULAR_GLOSSY,   /* Phong lobe of exponent `shininess` about the reflected ray */
+    RAD_SPECULAR_GLASS     /* clear dielectric of index `ior`: Fresnel reflection and refraction */
+} rad_specular_kind;
+
+/* Ns at or above which an MTL reflection (illum 3, 5) is an ideal mirror:
+ * a Phong lobe cos^1000 has half its energy within 2 degrees, finer than
+ * the elements the mirror shows. */
+#define RAD_MIRROR_SHININESS 1000.0
+
 typedef struct rad_material {
     char *name;
-    double reflectance[3]; /* rho, RGB, in [0, 1): with a texture, Kd x the texture's mean */
+    double reflectance[3]; /* rho (rho_d), RGB, in [0, 1): with a texture, Kd x the texture's mean */
     double emission[3];    /* E, self-emitted exitance, W/m^2 (= pi * radiance) */
     uint32_t texture;      /* 1 + index into rad_scene.textures (map_Kd, baseColorTexture); 0: none */
     double texture_scale[3]; /* with a texture: Kd, by which its texels are multiplied */
+    rad_specular_kind specular_kind;
+    double specular[3];    /* rho_s: mirror/glossy reflectance, glass transmittance factor;
+                              rho_d + rho_s <= 1 per channel */
+    double shininess;      /* Phong exponent (glossy), >= 0 */
+    double ior;            /* glass: index of refraction against the air, > 1 */
 } rad_material;
 
 /* A reflectance texture (MTL map_Kd, glTF baseColorTexture): texels
@@ -124,6 +144,16 @@ rad_result rad_scene_builder_texture(rad_scene_builder *b, int material, const c
 /* Texture coordinates for the polygons added next (NULL: none), kept until
  * changed.  Fails only for memory. */
 rad_result rad_scene_builder_uv_map(rad_scene_builder *b, const rad_uv_map *map);
+/* Give material `material` (an index rad_scene_builder_material gave) a
+ * specular part.  Refuses (RAD_ERROR_INVALID_SCENE, naming `where`, e.g.
+ * "scene.mtl:12", or the source when NULL) rho_s outside [0, 1], rho_d +
+ * rho_s > 1 in a channel (energy), a negative or non-finite shininess and
+ * glass with an index of refraction not in (1, 10]. */
+rad_result rad_scene_builder_material_specular(rad_scene_builder *b, int material, const char *where,
+                                               rad_specular_kind kind, const double specular[3],
+                                               double shininess, double ior);
+/* True if some material has a specular part. */
+bool rad_scene_has_specular(const rad_scene *scene);
 /* Returns the index of the surface with that name, creating it if new;
  * -1 on failure. */
 int rad_scene_builder_surface(rad_scene_builder *b, const char *name);

@@ -2,18 +2,21 @@
  * unused.c -- what a scene file's materials say that the engine does not
  * use, said once per load as warnings.
  *
- * The engine is diffuse (Lambertian): a material is its reflectance rho
- * (MTL Kd, glTF baseColorFactor) and its emitted radiance (MTL Ke, glTF
- * emissiveFactor x KHR_materials_emissive_strength).  Highlights, mirrors,
- * glass, metals, textures and vertex colours would change the picture, and
- * were dropped without a word.  Now:
+ * A material is its reflectance rho (MTL Kd, glTF baseColorFactor), its
+ * emitted radiance (MTL Ke, glTF emissiveFactor x
+ * KHR_materials_emissive_strength) and, from MTL, its specular part
+ * (mirrors and glossy reflectors: illum 3 or 5 with Ks and Ns; glass:
+ * illum 4, 6 or 7 with Ni, d, Tr; import_assimp.c mtl_specular).
+ * Highlights (illum 2), glTF metals and transmission, textures and vertex
+ * colours would change the picture, and were dropped without a word.  Now:
  *
  *    pre-scan (MTL: obj_prescan.c; glTF JSON: here) --notes--> assimp, the
  *    builder --which surfaces use each material (import_assimp.c)--> a load
  *    that succeeds says them, one line a material:
  *
- *    scene.mtl: material 'mirror' (surfaces 'panel', 'frame'): Ks, Ns and
- *    illum 3 are not used (the engine is diffuse: Kd and Ke only)
+ *    scene.mtl: material 'shiny' (surfaces 'desk', 'shelf'): Ks, Ns and
+ *    illum 2 are not used (the engine reads Kd and Ke, and the specular
+ *    keys with illum 3 to 7)
  *
  * Values that change nothing are not said (Ks 0 0 0, d 1, an explicit
  * metallicFactor 0, alphaMode BLEND with nothing transparent), nor
@@ -144,7 +147,8 @@ void import_notes_warn(rad_context *ctx, const char *name, const import_notes *n
 /* ---- glTF ---- */
 
 /* Extensions the loader reads (gltf_fixes.c). */
-static const char *const gltf_read_extensions[] = {"KHR_materials_emissive_strength"};
+static const char *const gltf_read_extensions[] = {"KHR_materials_emissive_strength",
+                                                   "KHR_materials_transmission", "KHR_materials_ior"};
 
 static bool extension_is_read(const char *extension)
 {
@@ -262,7 +266,11 @@ static rad_result gltf_note_material(rad_context *ctx, const char *name, const c
     const cJSON *metallic = member(pbr, "metallicFactor");
     /* Only a factor written: the spec's default is 1, but files that omit
      * it mean a plain colour nearly always, and the base colour is read so. */
-    if (cJSON_IsNumber(metallic) && metallic->valuedouble > 0.0 && (item = next_item(&l)))
+    /* A smooth metal is read (import_gltf_specular); a rough one is not. */
+    const cJSON *roughness = member(pbr, "roughnessFactor");
+    bool smooth = cJSON_IsNumber(roughness) && roughness->valuedouble >= 0.0 &&
+                  roughness->valuedouble <= IMPORT_GLTF_MAX_ROUGHNESS;
+    if (cJSON_IsNumber(metallic) && metallic->valuedouble > 0.0 && !smooth && (item = next_item(&l)))
         snprintf(item, ITEM_SIZE, "metallicFactor %g", metallic->valuedouble);
     static const char *const textures[] = {"metallicRoughnessTexture", "normalTexture",
                                            "occlusionTexture", "emissiveTexture"};

@@ -15,6 +15,8 @@ typedef struct dense_state {
     rad_meshed base;           /* mesh, visibility, elements, stats */
     double *F;                 /* n x n */
     double *F_variance;        /* n x n, or NULL */
+    double *F_ext;             /* n x n: F with the mirror images' factors added (scenes with
+                                  mirrors; the solve uses it), else NULL */
     rad_adaptive *adaptive;    /* rad_options.adaptive_levels > 0: the quadtrees, else NULL */
 } dense_state;
 
@@ -68,6 +70,7 @@ static void dense_destroy(void *state)
     rad_adaptive_destroy(st->adaptive);
     rad_free(st->F);
     rad_free(st->F_variance);
+    rad_free(st->F_ext);
     rad_free(st);
 }
 
@@ -81,7 +84,8 @@ static rad_result dense_couple(rad_context *ctx, void *state)
     const rad_scene *scene = m->scene;
     rad_free(st->F);
     rad_free(st->F_variance);
-    st->F = st->F_variance = NULL;
+    rad_free(st->F_ext);
+    st->F = st->F_variance = st->F_ext = NULL;
     /* An open scene is refused the closure correction before F where the
      * rays show it, after F (rad_form_factors) where only F can. */
     double *escape = NULL, escaped = 0.0;
@@ -94,6 +98,15 @@ static rad_result dense_couple(rad_context *ctx, void *state)
         r = rad_form_factors(ctx, rad_ff_find(o->form_factors), &req, o->max_memory_bytes,
                              o->closure_correction != 0, &st->F, &st->F_variance, &m->ff_stats);
         m->seconds.form_factors = m->ff_stats.seconds;
+    }
+    /* The first pass of two-pass rendering: light by way of ideal mirrors
+     * (formfactor/ff_mirror.c); F itself stays the geometric factors the
+     * view-factor outputs write. */
+    if (r == RAD_OK && rad_mesh_has_mirror(m->mesh, scene->materials)) {
+        rad_ff_mirror_stats ms;
+        r = rad_ff_mirror_images(ctx, m->mesh, m->vis, scene->materials, st->F, &st->F_ext, &ms);
+        m->seconds.form_factors += ms.seconds;
+        m->ff_stats.rays += ms.rays;
     }
     rad_free(escape);
     return r;
@@ -131,7 +144,7 @@ static rad_result dense_solve_mesh(rad_context *ctx, void *state, const rad_step
     rad_system sys;
     rad_solve_params p;
     rad_meshed_begin(m, solver->name, hook, &sys, &p);
-    sys.F = st->F;
+    sys.F = st->F_ext ? st->F_ext : st->F;
     double t0 = rad_seconds();
     /* Independent groups of elements (rooms that cannot see each other) are
      * solved separately; one group is solved as is. */
@@ -157,6 +170,7 @@ static void dense_view(const void *state, rad_solution_view *v)
     const dense_state *st = state;
     rad_meshed_view(&st->base, v);
     v->F = st->F;
+    v->F_coupling = st->F_ext;
     v->F_variance = st->F_variance;
     v->adaptive = rad_adaptive_get_stats(st->adaptive);
 }

@@ -261,7 +261,7 @@ void rad_meshed_view(const rad_meshed *m, rad_solution_view *v)
 {
     rad_view_elements(v, m->mesh, &m->elements);
     v->vis = m->vis;
-    v->F = NULL;
+    v->F = v->F_coupling = NULL;
     v->F_variance = NULL;
     v->vertex_radiosity = NULL;
     v->ff = &m->ff_stats;
@@ -336,13 +336,21 @@ rad_result rad_view_power(rad_context *ctx, const rad_solution_view *v, double *
         *emitted = *absorbed = NAN;
         return RAD_ERROR_OUT_OF_MEMORY;
     }
+    /* With mirrors: irradiance through the coupling the solve used (the
+     * mirror images' light included), and a mirror absorbs what it
+     * reflects neither diffusely nor specularly. */
+    const double *F = v->F_coupling ? v->F_coupling : v->F;
 #pragma omp parallel for schedule(static) num_threads(v->threads)
     for (size_t i = 0; i < n; i++) {
         double h[3];
-        rad_gather(v->F + i * n, v->radiosity, n, h);
+        rad_gather(F + i * n, v->radiosity, n, h);
+        const rad_material *m = &v->scene->materials[v->mesh->elements[i].material];
+        bool mirror = v->F_coupling && m->specular_kind == RAD_SPECULAR_MIRROR;
         double a = 0.0;
-        for (int c = 0; c < 3; c++)
-            a += v->area[i] * (1.0 - v->reflectance[3 * i + c]) * h[c];
+        for (int c = 0; c < 3; c++) {
+            double rho_s = mirror ? (m->specular[0] + m->specular[1] + m->specular[2]) / 3.0 : 0.0;
+            a += v->area[i] * (1.0 - v->reflectance[3 * i + c] - rho_s) * h[c];
+        }
         absorbed_by[i] = a;
     }
     for (size_t i = 0; i < n; i++) {

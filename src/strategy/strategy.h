@@ -55,6 +55,8 @@ typedef struct rad_solution_view {
      * through rad_view_vertex_values in output.h). */
     const double *vertex_radiosity;
     const double *F;                 /* n x n; NULL where the strategy stores none */
+    const double *F_coupling;        /* the F the solve used: F with the mirror images' factors
+                                        (ff_mirror.c) where the scene has mirrors, else NULL (= F) */
     const double *F_variance;        /* n x n for sampling methods that estimate it, else NULL */
     const rad_ff_stats *ff;
     const rad_solve_stats *solve;
