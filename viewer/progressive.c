@@ -368,8 +368,9 @@ void rv_progress_stop(rv_progress *p)
     bool steps = p->steps_seen;
     pthread_cond_broadcast(&p->wake);
     pthread_mutex_unlock(&p->lock);
-    /* A solver that reports no steps (hierarchical) or has not reached its
-     * first is cancelled instead: interrupted, its iterate kept for display
+    /* A solver that has not reached its first step (the hierarchical
+     * solver's first refinement round, the dense solvers' form factors) is
+     * cancelled instead: interrupted, its iterate kept for display
      * and export but not a solution to save.  Any thread may raise it. */
     if (!steps)
         rad_context_cancel(p->ctx, true);

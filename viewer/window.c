@@ -179,7 +179,7 @@ static void finish_solve(window_state *w)
     if (r == RAD_OK || r == RAD_ERROR_INTERRUPTED) {
         bool rebuilt = rebuild(w);
         if (rebuilt && w->auto_pending) {
-            auto_exposure(w); /* no snapshot came (hierarchical): on the result */
+            auto_exposure(w); /* no snapshot came (ended before its first step): on the result */
             w->auto_pending = false;
         }
         if (!rebuilt)
