@@ -379,7 +379,12 @@ typedef struct rad_options {
      * nonzero to stop the solve early (it then returns RAD_ERROR_INTERRUPTED), or
      * RAD_STEP_FINISH to end it here with the iterate as its result: the solve
      * returns RAD_OK, the solution is solved but not converged (rad_solution_warning
-     * says where it stopped) and saves, renders and exports as any other. */
+     * says where it stopped) and saves, renders and exports as any other.
+     * Hierarchical: after every Jacobi sweep, the solution's elements are then the
+     * current leaves (their count grows after each refinement round, never shrinks)
+     * with their current radiosity, and rad_solution_link_count the current links;
+     * keeping them so costs a leaf mesh per round and a copy of the leaves' values
+     * per sweep, paid only when on_step is set (docs/hierarchical.md). */
     int (*on_step)(void *user, rad_solution *solution, const struct rad_solve_step *step);
     void *on_step_user;
     int record_history;           /* nonzero: keep every step's residual in the history
@@ -388,7 +393,7 @@ typedef struct rad_options {
     /* Hierarchical radiosity (solver "hierarchical"): a link is refined while its
      * estimated error, as power reflected by the receiver, exceeds epsilon times
      * the power the scene emits; elements are not split below min_area.  Its
-     * progress reaches the history, not on_step (the mesh changes as it runs). */
+     * sweeps reach the history and on_step (with the leaves as the mesh, above). */
     double epsilon;               /* 0 = 1e-4 */
     double min_area;              /* m^2; 0 = 1e-4 x the scene's total area, divided by
                                      patches / 100 when there are more than 100 */
@@ -442,7 +447,7 @@ RAD_API rad_result rad_solution_solve(rad_context *ctx, rad_solution *solution);
 RAD_API void rad_solution_destroy(rad_solution *solution);
 
 /* Elements of the mesh (the hierarchical solver's leaves once it has
- * solved).  NULL solution: 0. */
+ * solved, or inside on_step).  NULL solution: 0. */
 RAD_API size_t rad_solution_element_count(const rad_solution *solution);
 /* Residual measure after solving: sum_i A_i |r_i| / sum_i A_i E_i summed over
  * the channels, with r = B - E - rho F B (the notes' residual); 0 before
@@ -1295,8 +1300,9 @@ RAD_API rad_result rad_solution_display_radiosity(rad_context *ctx, const rad_so
 
 /* The hierarchical solver's links after its last solve (the interactions
  * it kept between nodes of its hierarchy: the status line's figure, as
- * element_count is); 0 for the other solvers, before the first solve and
- * for a NULL solution. */
+ * element_count is), or, inside rad_options.on_step, the links of the
+ * current refinement round; 0 for the other solvers, before the first
+ * solve and for a NULL solution. */
 RAD_API size_t rad_solution_link_count(const rad_solution *solution);
 
 /* An image made from `width` x `height` RGB radiance triples (W/(m^2 sr),

@@ -143,21 +143,30 @@ typedef struct scenario {
     bool view_factors;           /* the strategy keeps F */
     int adaptive_levels;
     bool mirror;                 /* the white walls mirrors (illum 3): both passes of two-pass */
+    bool on_step;                /* an on_step that does nothing: the hierarchical leaves
+                                    made at every round for display */
 } scenario;
 
+static int no_op_step(void *user, rad_solution *s, const rad_solve_step *step)
+{
+    (void)user, (void)s, (void)step;
+    return 0;
+}
+
 static const scenario scenarios[] = {
-    {"loading", NULL, NULL, 0, 0, 0, false, 0, false},
-    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false},
-    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0, false},
-    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0, false},
-    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0, false},
-    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2, false},
-    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0, false},
-    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0, false},
-    {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0, false},
-    {"collocation", "collocation", NULL, 0, 0, 0, false, 0, false},
-    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0, false},
-    {"gauss-seidel (dense, mirror images, second pass)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, true},
+    {"loading", NULL, NULL, 0, 0, 0, false, 0, false, false},
+    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false, false},
+    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0, false, false},
+    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0, false, false},
+    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0, false, false},
+    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2, false, false},
+    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0, false, false},
+    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0, false, false},
+    {"hierarchical (progressive display)", "hierarchical", NULL, 0, 0, 0, false, 0, false, true},
+    {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0, false, false},
+    {"collocation", "collocation", NULL, 0, 0, 0, false, 0, false, false},
+    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0, false, false},
+    {"gauss-seidel (dense, mirror images, second pass)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, true, false},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from
@@ -255,6 +264,8 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
         o.closure_correction = sc->closure_correction;
         o.adaptive_levels = sc->adaptive_levels;
         o.record_history = 1;
+        if (sc->on_step)
+            o.on_step = no_op_step;
         o.epsilon = 1e-3;
         o.seed = 1;
         r = rad_solution_create(ctx, scene, &o, &s);

@@ -16,6 +16,9 @@
  *   early end     on_step's RAD_STEP_FINISH keeps the iterate as a
  *                 solution that saves; display values with and without
  *                 the ambient term
+ *   hier steps    the hierarchical solver's on_step shows its current
+ *                 leaves (counts never fall, areas tile the scene), the
+ *                 last step is the solution, RAD_STEP_FINISH keeps a step
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -455,6 +458,128 @@ static void test_step_finish_keeps_the_iterate(void **state)
     rad_scene_destroy(scene);
 }
 
+/* What a hierarchical step shows: its leaves and their radiosity. */
+typedef struct hier_watch {
+    int steps, finish_at, renders;
+    size_t first_elements, last_elements, last_links;
+    bool decreased, bad_area, no_links;
+    double area;                  /* the scene's, m^2 */
+    double *values;               /* 3 per element of the last step */
+    size_t values_count;
+} hier_watch;
+
+static int watch_hier(void *user, rad_solution *s, const rad_solve_step *step)
+{
+    hier_watch *w = user;
+    size_t n = rad_solution_element_count(s);
+    if (w->steps == 0)
+        w->first_elements = n;
+    w->decreased |= n < w->last_elements;
+    w->last_elements = n;
+    w->last_links = rad_solution_link_count(s);
+    w->no_links |= w->last_links == 0;
+    w->steps++;
+    /* The leaves tile the patches: their areas add up to the scene's. */
+    double area = 0.0;
+    for (size_t i = 0; i < n; i++)
+        area += rad_solution_element_area(s, i);
+    w->bad_area |= fabs(area - w->area) > 1e-5 * w->area; /* leaf quads of non-square patches: 5e-7 */
+    free(w->values);
+    w->values = malloc(3 * n * sizeof *w->values);
+    w->values_count = n;
+    for (size_t i = 0; w->values && i < n; i++)
+        rad_solution_element_values(s, i, NULL, NULL, w->values + 3 * i);
+    /* The iterate renders (the first step and every fifth). */
+    if (step->iteration == 1 || step->iteration % 5 == 0) {
+        rad_render_options ro = {.width = 24, .height = 24};
+        rad_image *image = NULL;
+        if (rad_solution_render(ctx, s, &ro, &image) == RAD_OK) {
+            const float *px = rad_image_pixels(image);
+            double sum = 0.0;
+            for (int i = 0; i < 3 * 24 * 24; i++)
+                sum += px[i];
+            w->renders += sum > 0.0;
+        }
+        rad_image_destroy(image);
+    }
+    return step->iteration == w->finish_at ? RAD_STEP_FINISH : 0;
+}
+
+/* The hierarchical solver's progressive display: on_step comes after every
+ * sweep with the current leaves as the elements (their areas adding up to
+ * the scene's), their count never falling and rising as rounds refine,
+ * links counted during the solve, and the iterate renders.  The last
+ * step's values are the solution's to the bit, which are those of a solve
+ * without on_step (the display changes nothing); RAD_STEP_FINISH keeps
+ * the step's leaves and values as the result. */
+static void test_hierarchical_steps_show_leaves(void **state)
+{
+    (void)state;
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_create_cornell_box(ctx, &scene), RAD_OK);
+    hier_watch w = {0};
+    rad_options o = {.solver = "hierarchical", .on_step = watch_hier, .on_step_user = &w};
+    rad_solution *s = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
+    for (size_t i = 0; i < rad_solution_element_count(s); i++)
+        w.area += rad_solution_element_area(s, i);
+    size_t patches = rad_solution_element_count(s);
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+    assert_true(rad_solution_converged(s));
+    size_t n = rad_solution_element_count(s);
+    assert_true(w.steps >= 5);
+    assert_false(w.decreased);
+    assert_false(w.bad_area);
+    assert_false(w.no_links);
+    assert_true(w.first_elements > patches);
+    assert_true(w.first_elements < w.last_elements); /* a later round split more */
+    assert_int_equal(w.last_elements, n);
+    assert_int_equal(w.last_links, rad_solution_link_count(s));
+    assert_true(w.renders >= 2);
+    double *final = malloc(3 * n * sizeof *final);
+    for (size_t i = 0; i < n; i++)
+        rad_solution_element_values(s, i, NULL, NULL, final + 3 * i);
+    assert_memory_equal(w.values, final, 3 * n * sizeof *final);
+    size_t count = 0;
+    const rad_solve_step *h = rad_solution_history(s, &count);
+    assert_int_equal(h[count - 1].iteration, w.steps);
+
+    /* Without on_step: the same leaves, the same values. */
+    rad_options plain = {.solver = "hierarchical"};
+    rad_solution *q = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &plain, &q), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, q), RAD_OK);
+    assert_int_equal(rad_solution_element_count(q), n);
+    for (size_t i = 0; i < n; i++) {
+        double b[3];
+        rad_solution_element_values(q, i, NULL, NULL, b);
+        assert_memory_equal(b, final + 3 * i, sizeof b);
+    }
+    rad_solution_destroy(q);
+
+    /* Finished at step 3: that step's leaves and values are the result. */
+    int steps = w.steps;
+    w = (hier_watch){.finish_at = 3, .area = w.area, .values = w.values};
+    assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+    assert_int_equal(w.steps, 3);
+    assert_true(steps > 3);
+    assert_false(rad_solution_converged(s));
+    assert_non_null(strstr(rad_solution_warning(s), "after 3 iterations"));
+    assert_int_equal(rad_solution_element_count(s), w.values_count);
+    for (size_t i = 0; i < w.values_count; i++) {
+        double b[3];
+        rad_solution_element_values(s, i, NULL, NULL, b);
+        assert_memory_equal(b, w.values + 3 * i, sizeof b);
+    }
+    char path[] = "/tmp/test_solution_hier_finish.radsol";
+    assert_int_equal(rad_solution_save(ctx, s, path), RAD_OK);
+    remove(path);
+    free(w.values);
+    free(final);
+    rad_solution_destroy(s);
+    rad_scene_destroy(scene);
+}
+
 /* Factors that make up power.  Monte Carlo at 16 samples on polygons that
  * touch at sharp angles (a fuzz_solve find) had rows summing to 3.4, and
  * Gauss-Seidel returned B = 1e5 (1e66 at other seeds) as a success; its
@@ -633,6 +758,7 @@ int main(void)
         cmocka_unit_test(test_unconverged_is_reported),
         cmocka_unit_test(test_cancellation_flag),
         cmocka_unit_test(test_step_finish_keeps_the_iterate),
+        cmocka_unit_test(test_hierarchical_steps_show_leaves),
         cmocka_unit_test(test_diverged_solution_refused),
         cmocka_unit_test(test_point_radiosity),
     };

@@ -17,11 +17,16 @@
  * rad_context (a context serves one thread at a time).  Stopping returns
  * RAD_STEP_FINISH from the next step: the iterate becomes the solution
  * (solved, not converged), which saves and exports; a solver that reports
- * no steps (hierarchical) is cancelled instead (interrupted).  Only the display values of the
- * mesh the solve began on are published: when the mesh changes during the
- * solve (adaptive subdivision, the hierarchical solver's leaves), the
- * window shows the last values of the old mesh and rebuilds its buffers
- * when the solve ends.
+ * no steps yet is cancelled instead (interrupted).
+ *
+ * The mesh may change during the solve (the hierarchical solver's leaves
+ * after each refinement round, adaptive subdivision): the worker notices
+ * it by the element and vertex counts (a refinement only adds elements),
+ * copies the new mesh (rv_mesh: positions and element corners, whence the
+ * triangles and the wireframe's edges) outside the lock and swaps it into
+ * the snapshot with the values, counting a mesh generation.  The frame
+ * loop then takes the mesh and rebuilds its buffers (rv_progress_take_mesh);
+ * otherwise it uploads only colours.
  */
 #include "viewer.h"
 
@@ -41,13 +46,16 @@ struct rv_progress {
     rv_step_slot *slot;
     bool ambient;                   /* under the lock */
     double interval;                /* s between snapshots */
-    size_t elements, vertices;      /* of the mesh the solve began on */
+    size_t elements, vertices;      /* the worker's: of the mesh last published */
     /* the worker's own arrays */
     double *work_element, *work_vertex;
     double last_publish;            /* s, monotonic */
     double publish_cost;            /* s the last snapshot took */
     /* under the lock */
     double *snap_element, *snap_vertex;
+    rv_mesh snap_mesh;              /* the mesh of generation status.mesh_generation > 0 */
+    size_t snap_elements, snap_vertices;
+    uint64_t taken_mesh;            /* the mesh generation the frame loop holds */
     rv_status status;
     bool pause, stop;
     bool steps_seen;                /* on_step has been called: it can end the solve */
@@ -67,26 +75,99 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* Copy the worker's arrays into the snapshot (the mesh unchanged). */
+/* A new mesh for the worker: its copy and arrays of its size, made
+ * outside the lock.  False when out of memory (nothing changed). */
+typedef struct new_mesh {
+    rv_mesh mesh;
+    double *work_element, *work_vertex, *snap_element, *snap_vertex;
+} new_mesh;
+
+static void new_mesh_free(new_mesh *m)
+{
+    rv_mesh_free(&m->mesh);
+    free(m->work_element);
+    free(m->work_vertex);
+    free(m->snap_element);
+    free(m->snap_vertex);
+}
+
+static bool new_mesh_make(const rad_solution *solution, new_mesh *m)
+{
+    *m = (new_mesh){0};
+    size_t ne = rad_solution_element_count(solution), nv = rad_solution_vertex_count(solution);
+    ne = ne ? ne : 1;
+    nv = nv ? nv : 1;
+    m->work_element = malloc(3 * ne * sizeof *m->work_element);
+    m->work_vertex = malloc(3 * nv * sizeof *m->work_vertex);
+    m->snap_element = malloc(3 * ne * sizeof *m->snap_element);
+    m->snap_vertex = malloc(3 * nv * sizeof *m->snap_vertex);
+    if (!m->work_element || !m->work_vertex || !m->snap_element || !m->snap_vertex ||
+        !rv_mesh_from_solution(solution, &m->mesh)) {
+        new_mesh_free(m);
+        return false;
+    }
+    return true;
+}
+
+/* Copy the worker's arrays into the snapshot, with the mesh when it
+ * changed. */
 static void publish(rv_progress *p, const rad_solve_step *step)
 {
     double start = now();
-    bool same_mesh = rad_solution_element_count(p->solution) == p->elements &&
-                     rad_solution_vertex_count(p->solution) == p->vertices;
+    size_t links = rad_solution_link_count(p->solution);
+    bool changed = rad_solution_element_count(p->solution) != p->elements ||
+                   rad_solution_vertex_count(p->solution) != p->vertices;
     pthread_mutex_lock(&p->lock);
     bool ambient = p->ambient;
     pthread_mutex_unlock(&p->lock);
-    bool computed = same_mesh && rad_solution_display_radiosity(p->ctx, p->solution, ambient, p->work_element,
-                                                                p->work_vertex) == RAD_OK;
+    new_mesh fresh = {0};
+    bool computed;
+    if (changed) {
+        /* the new mesh's values into its own arrays; the worker's swapped
+         * for them (they are its own: no lock) once they are complete */
+        computed = new_mesh_make(p->solution, &fresh) &&
+                   rad_solution_display_radiosity(p->ctx, p->solution, ambient, fresh.work_element,
+                                                  fresh.work_vertex) == RAD_OK;
+        if (computed) {
+            double *we = p->work_element, *wv = p->work_vertex;
+            p->work_element = fresh.work_element;
+            p->work_vertex = fresh.work_vertex;
+            fresh.work_element = we;
+            fresh.work_vertex = wv;
+            p->elements = fresh.mesh.elements;
+            p->vertices = fresh.mesh.vertices;
+        }
+    } else {
+        computed = rad_solution_display_radiosity(p->ctx, p->solution, ambient, p->work_element,
+                                                  p->work_vertex) == RAD_OK;
+    }
     pthread_mutex_lock(&p->lock);
+    if (changed && computed) {
+        /* the new mesh and arrays of its size into the snapshot; the old
+         * ones go back in `fresh`, freed after the lock */
+        rv_mesh old = p->snap_mesh;
+        double *se = p->snap_element, *sv = p->snap_vertex;
+        p->snap_mesh = fresh.mesh;
+        p->snap_element = fresh.snap_element;
+        p->snap_vertex = fresh.snap_vertex;
+        p->snap_elements = p->elements;
+        p->snap_vertices = p->vertices;
+        fresh.mesh = old;
+        fresh.snap_element = se;
+        fresh.snap_vertex = sv;
+        p->status.mesh_generation++;
+        p->status.elements = p->elements;
+    }
     if (computed) {
         memcpy(p->snap_element, p->work_element, 3 * p->elements * sizeof *p->snap_element);
         memcpy(p->snap_vertex, p->work_vertex, 3 * p->vertices * sizeof *p->snap_vertex);
         p->status.generation++;
     }
+    p->status.links = links;
     if (step)
         p->status.step = *step;
     pthread_mutex_unlock(&p->lock);
+    new_mesh_free(&fresh);
     p->last_publish = now();
     p->publish_cost = p->last_publish - start;
 }
@@ -134,7 +215,6 @@ static void *worker(void *user)
     pthread_mutex_lock(&p->lock);
     p->status.done = true;
     p->status.result = r;
-    p->status.elements = rad_solution_element_count(p->solution);
     pthread_mutex_unlock(&p->lock);
     return NULL;
 }
@@ -146,6 +226,7 @@ static void progress_free(rv_progress *p)
     free(p->work_vertex);
     free(p->snap_element);
     free(p->snap_vertex);
+    rv_mesh_free(&p->snap_mesh);
     free(p);
 }
 
@@ -162,6 +243,8 @@ rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int t
     p->pause = paused;
     p->elements = rad_solution_element_count(solution);
     p->vertices = rad_solution_vertex_count(solution);
+    p->snap_elements = p->elements;
+    p->snap_vertices = p->vertices;
     size_t ne = p->elements ? p->elements : 1, nv = p->vertices ? p->vertices : 1;
     p->work_element = malloc(3 * ne * sizeof *p->work_element);
     p->work_vertex = malloc(3 * nv * sizeof *p->work_vertex);
@@ -197,18 +280,70 @@ bool rv_progress_take(rv_progress *p, uint64_t *generation, double *element_rgb,
                       rv_status *status)
 {
     pthread_mutex_lock(&p->lock);
-    bool newer = p->status.generation > *generation;
+    bool newer = p->status.generation > *generation && p->status.mesh_generation == p->taken_mesh;
     if (newer) {
         if (element_rgb)
-            memcpy(element_rgb, p->snap_element, 3 * p->elements * sizeof *element_rgb);
+            memcpy(element_rgb, p->snap_element, 3 * p->snap_elements * sizeof *element_rgb);
         if (vertex_rgb)
-            memcpy(vertex_rgb, p->snap_vertex, 3 * p->vertices * sizeof *vertex_rgb);
+            memcpy(vertex_rgb, p->snap_vertex, 3 * p->snap_vertices * sizeof *vertex_rgb);
         *generation = p->status.generation;
     }
     if (status)
         *status = p->status;
     pthread_mutex_unlock(&p->lock);
     return newer;
+}
+
+/* A copy of `m`; false when out of memory. */
+static bool mesh_copy(const rv_mesh *m, rv_mesh *out)
+{
+    size_t nv = m->vertices ? m->vertices : 1, ne = m->elements ? m->elements : 1;
+    rv_mesh c = {m->vertices, m->elements, malloc(3 * nv * sizeof *c.position), malloc(4 * ne * sizeof *c.corner),
+                 malloc(ne)};
+    if (!c.position || !c.corner || !c.corners) {
+        rv_mesh_free(&c);
+        return false;
+    }
+    memcpy(c.position, m->position, 3 * nv * sizeof *c.position);
+    memcpy(c.corner, m->corner, 4 * ne * sizeof *c.corner);
+    memcpy(c.corners, m->corners, ne);
+    *out = c;
+    return true;
+}
+
+bool rv_progress_take_mesh(rv_progress *p, uint64_t *generation, rv_mesh *mesh, double **element_rgb,
+                           double **vertex_rgb)
+{
+    pthread_mutex_lock(&p->lock);
+    bool newer = p->status.mesh_generation != p->taken_mesh;
+    size_t ne = p->snap_elements ? p->snap_elements : 1, nv = p->snap_vertices ? p->snap_vertices : 1;
+    rv_mesh copy = {0};
+    double *e = NULL, *v = NULL;
+    /* Copied under the lock: it happens once per mesh (a refinement round). */
+    if (newer) {
+        e = malloc(3 * ne * sizeof *e);
+        v = malloc(3 * nv * sizeof *v);
+        newer = e && v && mesh_copy(&p->snap_mesh, &copy);
+    }
+    if (newer) {
+        memcpy(e, p->snap_element, 3 * ne * sizeof *e);
+        memcpy(v, p->snap_vertex, 3 * nv * sizeof *v);
+        *generation = p->status.generation;
+        p->taken_mesh = p->status.mesh_generation;
+    }
+    pthread_mutex_unlock(&p->lock);
+    if (!newer) {
+        free(e);
+        free(v);
+        return false;
+    }
+    rv_mesh_free(mesh);
+    *mesh = copy;
+    free(*element_rgb);
+    free(*vertex_rgb);
+    *element_rgb = e;
+    *vertex_rgb = v;
+    return true;
 }
 
 void rv_progress_pause(rv_progress *p, bool pause)
@@ -233,8 +368,9 @@ void rv_progress_stop(rv_progress *p)
     bool steps = p->steps_seen;
     pthread_cond_broadcast(&p->wake);
     pthread_mutex_unlock(&p->lock);
-    /* A solver that reports no steps (hierarchical) or has not reached its
-     * first is cancelled instead: interrupted, its iterate kept for display
+    /* A solver that has not reached its first step (the hierarchical
+     * solver's first refinement round, the dense solvers' form factors) is
+     * cancelled instead: interrupted, its iterate kept for display
      * and export but not a solution to save.  Any thread may raise it. */
     if (!steps)
         rad_context_cancel(p->ctx, true);

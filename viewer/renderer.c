@@ -148,15 +148,45 @@ static void to_radiance(const double *rgb, size_t count, float *out)
     }
 }
 
-/* Positions, triangles, edges and triangle -> element from the solution;
+void rv_mesh_free(rv_mesh *m)
+{
+    free(m->position);
+    free(m->corner);
+    free(m->corners);
+    *m = (rv_mesh){0};
+}
+
+bool rv_mesh_from_solution(const rad_solution *solution, rv_mesh *out)
+{
+    size_t nv = rad_solution_vertex_count(solution), ne = rad_solution_element_count(solution);
+    rv_mesh m = {nv, ne, malloc((nv ? nv : 1) * 3 * sizeof *m.position),
+                 malloc((ne ? ne : 1) * 4 * sizeof *m.corner), malloc(ne ? ne : 1)};
+    if (!m.position || !m.corner || !m.corners) {
+        rv_mesh_free(&m);
+        *out = m;
+        return false;
+    }
+    for (size_t v = 0; v < nv; v++)
+        rad_solution_vertex_position(solution, v, &m.position[3 * v]);
+    for (size_t i = 0; i < ne; i++) {
+        size_t corner[4] = {0, 0, 0, 0};
+        int count = rad_solution_element_vertices(solution, i, corner);
+        m.corners[i] = (uint8_t)count;
+        for (int k = 0; k < 4; k++)
+            m.corner[4 * i + (size_t)k] = (uint32_t)corner[k];
+    }
+    *out = m;
+    return true;
+}
+
+/* Positions, triangles, edges and triangle -> element from the mesh;
  * false when out of memory. */
-static bool upload_geometry(rv_renderer *r, const rad_solution *solution)
+static bool upload_geometry(rv_renderer *r, const rv_mesh *mesh)
 {
     size_t nv = r->vertices, ne = r->elements;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t v = 0; v < nv; v++) {
-        double p[3];
-        rad_solution_vertex_position(solution, v, p);
+        const double *p = &mesh->position[3 * v];
         for (int k = 0; k < 3; k++) {
             lo[k] = fmin(lo[k], p[k]);
             hi[k] = fmax(hi[k], p[k]);
@@ -177,16 +207,13 @@ static bool upload_geometry(rv_renderer *r, const rad_solution *solution)
     uint32_t *triangle_element = malloc((ne ? ne : 1) * 2 * sizeof *triangle_element);
     bool ok = positions && triangles && edges && triangle_element;
     if (ok) {
-        for (size_t v = 0; v < nv; v++) {
-            double p[3];
-            rad_solution_vertex_position(solution, v, p);
+        for (size_t v = 0; v < nv; v++)
             for (int k = 0; k < 3; k++)
-                positions[3 * v + (size_t)k] = (float)(p[k] - r->centre[k]);
-        }
+                positions[3 * v + (size_t)k] = (float)(mesh->position[3 * v + (size_t)k] - r->centre[k]);
         size_t t = 0, e = 0;
         for (size_t i = 0; i < ne; i++) {
-            size_t corner[4];
-            int count = rad_solution_element_vertices(solution, i, corner);
+            const uint32_t *corner = &mesh->corner[4 * i];
+            int count = mesh->corners[i];
             for (int k = 1; k + 1 < count; k++) {
                 triangles[3 * t + 0] = (uint32_t)corner[0];
                 triangles[3 * t + 1] = (uint32_t)corner[k];
@@ -235,11 +262,21 @@ static bool upload_geometry(rv_renderer *r, const rad_solution *solution)
 
 rv_renderer *rv_renderer_create(const rad_solution *solution, const double *element_rgb, const double *vertex_rgb)
 {
+    rv_mesh mesh;
+    if (!rv_mesh_from_solution(solution, &mesh))
+        return NULL;
+    rv_renderer *r = rv_renderer_create_mesh(&mesh, element_rgb, vertex_rgb);
+    rv_mesh_free(&mesh);
+    return r;
+}
+
+rv_renderer *rv_renderer_create_mesh(const rv_mesh *mesh, const double *element_rgb, const double *vertex_rgb)
+{
     rv_renderer *r = calloc(1, sizeof *r);
     if (!r)
         return NULL;
-    r->vertices = rad_solution_vertex_count(solution);
-    r->elements = rad_solution_element_count(solution);
+    r->vertices = mesh->vertices;
+    r->elements = mesh->elements;
     size_t most = r->vertices > r->elements ? r->vertices : r->elements;
     r->scratch = malloc((most ? most : 1) * 4 * sizeof *r->scratch);
     r->program = link_program();
@@ -270,7 +307,7 @@ rv_renderer *rv_renderer_create(const rad_solution *solution, const double *elem
     glUniform1i(glGetUniformLocation(r->program, "element_radiance"), 0);
     glUniform1i(glGetUniformLocation(r->program, "triangle_element"), 1);
     glUseProgram(0);
-    if (!upload_geometry(r, solution)) {
+    if (!upload_geometry(r, mesh)) {
         rv_renderer_destroy(r);
         return NULL;
     }

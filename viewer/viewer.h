@@ -94,12 +94,30 @@ typedef struct rv_draw {
     bool wireframe;               /* element edges over the surfaces */
 } rv_draw;
 
+/* A copy of a solution's mesh as the renderer draws it (no GL): what the
+ * progressive worker hands the window when the mesh changes during a
+ * solve (the hierarchical solver's leaves). */
+typedef struct rv_mesh {
+    size_t vertices, elements;
+    double *position;             /* 3 per vertex, m */
+    uint32_t *corner;             /* 4 per element: its vertices, counter-clockwise */
+    uint8_t *corners;             /* per element: 3 or 4 */
+} rv_mesh;
+
+/* Copy the solution's mesh (from rad_options.on_step on the solver's
+ * thread, or when no solve runs); false when out of memory (*out then
+ * empty).  rv_mesh_free frees the arrays and empties it. */
+bool rv_mesh_from_solution(const rad_solution *solution, rv_mesh *out);
+void rv_mesh_free(rv_mesh *mesh);
+
 /* Build the buffers for the solution's mesh (positions, vertex and element
  * colours, triangles, edges), colours from `element_rgb` / `vertex_rgb`
  * (W/m^2, 3 per element / vertex).  Reads the solution's mesh only: not
  * while it is being solved.  NULL when out of memory or when the driver
  * refuses the shaders (its log printed on stderr). */
 rv_renderer *rv_renderer_create(const rad_solution *solution, const double *element_rgb, const double *vertex_rgb);
+/* The same from a copied mesh. */
+rv_renderer *rv_renderer_create_mesh(const rv_mesh *mesh, const double *element_rgb, const double *vertex_rgb);
 void rv_renderer_destroy(rv_renderer *r);
 /* New colours for the same mesh (glBufferSubData of both colour buffers). */
 void rv_renderer_update(rv_renderer *r, const double *element_rgb, const double *vertex_rgb);
@@ -138,7 +156,9 @@ typedef struct rv_status {
     rad_solve_step step;          /* the last step seen */
     bool paused, done;
     rad_result result;            /* the solve's, once done */
-    size_t elements;              /* the solution's elements (changes when done, hierarchical) */
+    size_t elements;              /* the elements of the latest snapshot's mesh */
+    size_t links;                 /* hierarchical: the links at the last step, else 0 */
+    uint64_t mesh_generation;     /* meshes published: 0 while the solve's first mesh */
 } rv_status;
 
 /* The step hook a solution is made with (rad_options.on_step keeps its
@@ -165,10 +185,23 @@ rv_progress *rv_progress_start(rad_solution *solution, rv_step_slot *slot, int t
                                double interval, bool paused);
 /* Copy the latest snapshot out when it is newer than *generation (then
  * *generation is updated and true returned); never waits for a step.  The
- * arrays hold 3 per element / vertex of the mesh the solve started on;
- * either may be NULL.  *status, when not NULL, is filled in any case. */
+ * arrays hold 3 per element / vertex of the mesh last taken with
+ * rv_progress_take_mesh (at first the mesh the solve started on); either
+ * may be NULL.  While the snapshot is of a newer mesh nothing is copied
+ * (false): take the mesh first.  *status, when not NULL, is filled in any
+ * case. */
 bool rv_progress_take(rv_progress *p, uint64_t *generation, double *element_rgb, double *vertex_rgb,
                       rv_status *status);
+/* When the snapshot's mesh is newer than the last taken (the mesh changed
+ * during the solve: the hierarchical solver's leaves after a refinement
+ * round, adaptive subdivision), copy it and its values out: *mesh replaced
+ * (the old arrays freed), *element_rgb and *vertex_rgb reallocated to its
+ * counts and filled, *generation updated; true then (the caller rebuilds
+ * its buffers).  False with nothing changed when the mesh is the one taken,
+ * or when out of memory (tried again at the next call).  One caller (the
+ * frame loop) takes meshes. */
+bool rv_progress_take_mesh(rv_progress *p, uint64_t *generation, rv_mesh *mesh, double **element_rgb,
+                           double **vertex_rgb);
 void rv_progress_pause(rv_progress *p, bool pause);
 /* The ambient term on or off from the next snapshot on. */
 void rv_progress_ambient(rv_progress *p, bool ambient);

@@ -179,7 +179,7 @@ static void finish_solve(window_state *w)
     if (r == RAD_OK || r == RAD_ERROR_INTERRUPTED) {
         bool rebuilt = rebuild(w);
         if (rebuilt && w->auto_pending) {
-            auto_exposure(w); /* no snapshot came (hierarchical): on the result */
+            auto_exposure(w); /* no snapshot came (ended before its first step): on the result */
             w->auto_pending = false;
         }
         if (!rebuilt)
@@ -197,8 +197,9 @@ static void update_title(window_state *w)
 {
     char title[512], links[48] = "";
     const rad_solve_step *s = &w->status.step;
-    /* The solution is read only when no solve is running. */
-    size_t link_count = w->progress ? 0 : rad_solution_link_count(w->solution);
+    /* The solution is read only when no solve is running; while one runs,
+     * the links come with the snapshots. */
+    size_t link_count = w->progress ? w->status.links : rad_solution_link_count(w->solution);
     if (link_count)
         snprintf(links, sizeof links, " | %zu links", link_count);
     const char *state = w->progress ? (w->status.paused ? "paused" : "solving") : w->solved ? "solved" : "stopped";
@@ -416,7 +417,24 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
         last = t;
         held_keys(&w, fmin(seconds, 0.1));
         if (w.progress) {
-            if (rv_progress_take(w.progress, &w.generation, w.element_rgb, w.vertex_rgb, &w.status)) {
+            bool fresh = false;
+            /* A new mesh (the hierarchical solver refined its leaves): new
+             * buffers; else only the colours. */
+            rv_mesh mesh = {0};
+            if (rv_progress_take_mesh(w.progress, &w.generation, &mesh, &w.element_rgb, &w.vertex_rgb)) {
+                rv_renderer *renderer = rv_renderer_create_mesh(&mesh, w.element_rgb, w.vertex_rgb);
+                if (renderer) {
+                    rv_renderer_destroy(w.renderer);
+                    w.renderer = renderer;
+                    fresh = true;
+                } else {
+                    say(&w, "cannot build the buffers of the refined mesh; the old one stays");
+                }
+                rv_mesh_free(&mesh);
+            }
+            if (rv_progress_take(w.progress, &w.generation, w.element_rgb, w.vertex_rgb, &w.status))
+                fresh = true;
+            if (fresh) {
                 rv_renderer_update(w.renderer, w.element_rgb, w.vertex_rgb);
                 /* The automatic exposure, provisional on B = E (only the
                  * lights lit), is fixed on the first shot's picture, as

@@ -171,7 +171,7 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
                         "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
                         s->scene->source);
-    rad_step_hook hook = {NULL, s};
+    rad_step_hook hook = {NULL, s, s->options.on_step != NULL};
     if (s->options.record_history || s->options.on_step)
         hook.fn = on_strategy_step;
     s->history_count = 0;

@@ -58,6 +58,12 @@ typedef struct hr_state {
     double rho_max;       /* the largest reflectance of any channel of any patch */
     int sweeps;
     double start;
+    /* progressive display (p->display): the leaves' B in mesh order, and
+     * the node count when the last leaf mesh was handed over (the tree only
+     * grows, so an unchanged count is an unchanged hierarchy) */
+    double *display_B;
+    size_t display_leaves, display_nodes;
+    rad_hier_stats *hs;   /* links and leaves kept current for the display */
 } hr_state;
 
 static const double *node_emission(const hr_state *st, const hr_node *n)
@@ -305,6 +311,47 @@ static double push_pull(hr_state *st)
     return st->emitted > 0.0 ? change / st->emitted : 0.0;
 }
 
+static rad_result build_leaf_mesh(hr_state *st, rad_mesh **mesh, double **radiosity, size_t *leaves_out);
+
+/* The leaves' B below node k in the leaf mesh's order (encode's walk). */
+static void leaf_values(const hr_state *st, uint32_t k, double *out, size_t *i)
+{
+    const hr_node *n = &st->tree.nodes[k];
+    if (n->child[0] == 0) {
+        memcpy(out + 3 * (*i)++, st->B + 3 * (size_t)k, 3 * sizeof *out);
+        return;
+    }
+    for (uint32_t c = 0; c < 4; c++)
+        leaf_values(st, n->child[0] + c, out, i);
+}
+
+/* Hand the current leaves to the display: a new mesh when the hierarchy
+ * changed since the last call (once per refinement round), else only
+ * their values (a walk of the quadtrees, O(nodes)). */
+static rad_result display_leaves(hr_state *st)
+{
+    rad_mesh *mesh = NULL;
+    if (st->tree.count != st->display_nodes || !st->display_B) {
+        double *B = NULL;
+        size_t leaves = 0;
+        rad_result r = build_leaf_mesh(st, &mesh, &B, &leaves);
+        if (r != RAD_OK)
+            return r;
+        rad_free(st->display_B);
+        st->display_B = B;
+        st->display_leaves = leaves;
+        st->display_nodes = st->tree.count;
+    } else {
+        size_t i = 0;
+        for (size_t p = 0; p < st->tree.base->patch_count; p++)
+            leaf_values(st, st->tree.root_of_patch[p], st->display_B, &i);
+    }
+    st->hs->leaves = st->display_leaves;
+    st->hs->links = st->links.count;
+    st->hs->nodes = st->tree.count;
+    return st->p->display(st->p->display_user, mesh, st->display_B, st->display_leaves);
+}
+
 /* Sweeps until the residual is below `tol` (or `cap` sweeps). */
 static rad_result solve(hr_state *st, double tol, double cap, double *residual, bool *converged)
 {
@@ -316,6 +363,11 @@ static rad_result solve(hr_state *st, double tol, double cap, double *residual, 
         gather(st);
         *residual = push_pull(st);
         st->sweeps++;
+        if (st->p->display) {
+            rad_result r = display_leaves(st);
+            if (r != RAD_OK)
+                return r;
+        }
         if (st->p->monitor) {
             rad_solve_step step = {st->sweeps, rad_seconds() - st->start, *residual, NAN};
             if (st->p->monitor(st->p->monitor_user, &step, NULL, NULL))
@@ -729,6 +781,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     hr_state st = {0};
     st.ctx = ctx;
     st.p = p;
+    st.hs = hs;
     st.start = rad_seconds();
     const rad_mesh *base = p->base;
     const rad_scene *scene = p->scene;
@@ -930,5 +983,6 @@ done:
     rad_free(st.bins_in);
     rad_free(st.bins_total);
     rad_free(st.bins_exit);
+    rad_free(st.display_B);
     return r;
 }

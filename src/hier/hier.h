@@ -247,6 +247,16 @@ typedef struct rad_hier_params {
     double crease_angle_degrees;
     rad_solve_monitor_fn monitor; /* steps only (B is NULL) */
     void *monitor_user;
+    /* Progressive display (NULL: none, and no cost): called after every
+     * sweep, before the monitor, with the current leaves and their B (3 per
+     * leaf, in the leaf mesh's order, valid during the call).  `mesh` is a
+     * new leaf mesh, handed over (the callback frees it, also when it
+     * fails), when the hierarchy has changed since the last call (the first
+     * call and after each refinement round), else NULL: the leaves are those
+     * of the last mesh handed over.  `leaves` counts them.  A result other
+     * than RAD_OK ends the solve with it. */
+    rad_result (*display)(void *user, rad_mesh *mesh, const double *radiosity, size_t leaves);
+    void *display_user;
 } rad_hier_params;
 
 typedef struct rad_hier_stats {

@@ -24,6 +24,7 @@ typedef struct hierarchical_state {
     rad_phase_seconds seconds;
     bool solved;
     const rad_step_hook *hook; /* during a solve */
+    rad_context *ctx;          /* during a solve */
 } hierarchical_state;
 
 static bool hierarchical_solver_info(size_t index, const char **name, const char **description)
@@ -81,13 +82,34 @@ static rad_result hierarchical_create(rad_context *ctx, const rad_scene *scene, 
     return RAD_OK;
 }
 
-/* Steps reach the hook, marked not displayable: the leaves the view shows
- * are the last solve's while the hierarchy is refined. */
+/* Progressive display (the hook asks for it): the current leaves become
+ * the elements before each step reaches the hook, a new mesh once per
+ * refinement round and only the values between, so the view shows the
+ * iterate. */
+static rad_result hierarchical_display(void *user, rad_mesh *mesh, const double *B, size_t leaves)
+{
+    hierarchical_state *st = user;
+    if (mesh) {
+        rad_elements e;
+        if (rad_elements_create(st->ctx, st->scene, mesh, &e) != RAD_OK) {
+            rad_mesh_destroy(mesh);
+            return RAD_ERROR_OUT_OF_MEMORY;
+        }
+        rad_mesh_destroy(st->leaves);
+        rad_elements_free(&st->leaf_elements);
+        st->leaves = mesh;
+        st->leaf_elements = e;
+    }
+    memcpy(st->leaf_elements.radiosity, B, 3 * leaves * sizeof *B);
+    return RAD_OK;
+}
+
+/* Steps reach the hook, displayable when the leaves are shown as they go. */
 static int hierarchical_monitor(void *user, const rad_solve_step *step, const double *B, const double *ambient)
 {
     (void)B, (void)ambient;
     hierarchical_state *st = user;
-    return st->hook->fn ? st->hook->fn(st->hook->user, step, false) : 0;
+    return st->hook->fn ? st->hook->fn(st->hook->user, step, st->hook->display) : 0;
 }
 
 static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_step_hook *hook)
@@ -110,7 +132,13 @@ static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_st
                           .crease_angle_degrees = o->crease_angle_degrees,
                           .monitor = hierarchical_monitor,
                           .monitor_user = st};
+    if (hook->fn && hook->display) {
+        hp.display = hierarchical_display;
+        hp.display_user = st;
+    }
     st->hook = hook;
+    st->ctx = ctx;
+    st->solved = false;
     memset(&st->solve_stats, 0, sizeof st->solve_stats);
     st->solve_stats.method = "hierarchical";
     st->solve_stats.unshot = NAN;
@@ -122,6 +150,7 @@ static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_st
     st->solve_stats.seconds = rad_seconds() - t;
     st->seconds.solve = st->solve_stats.seconds;
     st->hook = NULL;
+    st->ctx = NULL;
     if (leaves) {
         /* The leaves, also of an interrupted solve, become the elements. */
         rad_elements e;

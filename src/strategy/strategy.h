@@ -77,6 +77,9 @@ typedef int (*rad_step_fn)(void *user, const rad_solve_step *step, bool displaya
 typedef struct rad_step_hook {
     rad_step_fn fn;                 /* NULL: no steps wanted */
     void *user;
+    bool display;                   /* the steps are displayed (rad_options.on_step): a
+                                       strategy whose mesh changes as it solves (hierarchical)
+                                       then keeps its view on the iterate, at a cost */
 } rad_step_hook;
 
 typedef struct rad_strategy {
