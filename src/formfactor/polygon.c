@@ -25,7 +25,10 @@
 
 #include <string.h>
 
-/* Clip to n.(y - x) >= 0.  `out` holds up to n + 1 vertices. */
+/* Clip to n.(y - x) >= 0.  A convex polygon gains at most one vertex, but
+ * corners within rounding of the plane can alternate sides (a piece of a
+ * source clipped by several blockers, occluders.c), each edge then giving
+ * two: `out` holds up to 2 n vertices. */
 static size_t clip_to_hemisphere(vec3 x, vec3 normal, const vec3 *poly, size_t n, vec3 *out)
 {
     size_t m = 0;
@@ -57,7 +60,7 @@ double rad_point_polygon_ff(vec3 x, vec3 normal, const vec3 *poly, size_t n)
 
 double rad_point_polygon_ff_front(vec3 x, vec3 normal, const vec3 *poly, size_t n)
 {
-    vec3 clipped[9];
+    vec3 clipped[16];
     if (n > 8)
         n = 8;
     size_t m = clip_to_hemisphere(x, normal, poly, n, clipped);

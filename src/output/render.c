@@ -221,13 +221,13 @@ typedef struct render_pass {
  * back of a patch.  Returns what was seen: the patch (smooth shading,
  * continuous across it) or the element (flat), RENDER_MISS or RENDER_BACK. */
 static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit *hit, int depth,
-                      double carried, rad_rng *rng, double rgb[3]);
+                      double carried, uint64_t key, rad_rng *rng, double rgb[3]);
 
 /* rgb += weight x pi L along (origin, direction), when the path's weight
  * (`carried` to here, times this bounce's) counts: one closest-hit query,
  * then shade. */
 static void add_traced(const render_pass *pass, vec3 origin, vec3 direction, int depth, double carried,
-                       rad_rng *rng, const double weight[3], double rgb[3])
+                       uint64_t key, rad_rng *rng, const double weight[3], double rgb[3])
 {
     double path = carried * fmax(fmax(weight[0], weight[1]), weight[2]);
     if (path < RENDER_MIN_WEIGHT)
@@ -236,7 +236,7 @@ static void add_traced(const render_pass *pass, vec3 origin, vec3 direction, int
     rad_hit hit;
     pass->input->vis->backend->intersect(pass->input->vis->state, &ray, 1, &hit);
     double seen[3];
-    shade(pass, &ray, &hit, depth, path, rng, seen);
+    shade(pass, &ray, &hit, depth, path, key, rng, seen);
     for (int c = 0; c < 3; c++)
         rgb[c] += weight[c] * seen[c];
 }
@@ -271,7 +271,7 @@ static vec3 about_axis(vec3 axis, double cos_alpha, double phi)
  * `d`; `facing` is the patch's normal (front hits) or its negation (glass
  * from inside).  Adds pi L to rgb. */
 static void specular_part(const render_pass *pass, const rad_material *m, vec3 p, vec3 d, vec3 normal,
-                          int depth, double carried, rad_rng *rng, double rgb[3])
+                          int depth, double carried, uint64_t key, rad_rng *rng, double rgb[3])
 {
     const double eps = pass->epsilon;
     bool front = v3_dot(d, normal) < 0.0;
@@ -282,20 +282,20 @@ static void specular_part(const render_pass *pass, const rad_material *m, vec3 p
     double weight[3];
     switch (m->specular_kind) {
     case RAD_SPECULAR_MIRROR:
-        add_traced(pass, above, reflected, depth + 1, carried, rng, m->specular, rgb);
+        add_traced(pass, above, reflected, depth + 1, carried, key, rng, m->specular, rgb);
         break;
     case RAD_SPECULAR_GLASS: {
         double n1 = front ? 1.0 : m->ior, n2 = front ? m->ior : 1.0, cos_t;
         double R = fresnel_dielectric(n1, n2, cos_i, &cos_t);
         for (int c = 0; c < 3; c++)
             weight[c] = m->specular[c] * R;
-        add_traced(pass, above, reflected, depth + 1, carried, rng, weight, rgb);
+        add_traced(pass, above, reflected, depth + 1, carried, key, rng, weight, rgb);
         if (R < 1.0) {
             double eta = n1 / n2;
             vec3 refracted = v3_normalize(v3_mad(v3_scale(d, eta), facing, eta * cos_i - cos_t));
             for (int c = 0; c < 3; c++)
                 weight[c] = m->specular[c] * (1.0 - R);
-            add_traced(pass, below, refracted, depth + 1, carried, rng, weight, rgb);
+            add_traced(pass, below, refracted, depth + 1, carried, key, rng, weight, rgb);
         }
         break;
     }
@@ -315,7 +315,7 @@ static void specular_part(const render_pass *pass, const rad_material *m, vec3 p
                 continue;
             for (int c = 0; c < 3; c++)
                 weight[c] = m->specular[c] * (n + 2.0) / (n + 1.0) * cos_out;
-            add_traced(pass, above, out, depth + 1, carried, rng, weight, sum);
+            add_traced(pass, above, out, depth + 1, carried, key, rng, weight, sum);
         }
         for (int c = 0; c < 3; c++)
             rgb[c] += sum[c] / (double)(grid * grid);
@@ -327,7 +327,7 @@ static void specular_part(const render_pass *pass, const rad_material *m, vec3 p
 }
 
 static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit *hit, int depth,
-                      double carried, rad_rng *rng, double rgb[3])
+                      double carried, uint64_t key, rad_rng *rng, double rgb[3])
 {
     const rad_render_input *input = pass->input;
     rad_shading shading = pass->shading;
@@ -345,7 +345,7 @@ static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit
     if (back && !(m && m->specular_kind == RAD_SPECULAR_GLASS))
         return RENDER_BACK;
     if (m) /* the specular part: the pixel is refined as an edge would be */
-        specular_part(pass, m, p, v3_normalize(ray->direction), patch->normal, depth, carried, rng, rgb);
+        specular_part(pass, m, p, v3_normalize(ray->direction), patch->normal, depth, carried, key, rng, rgb);
     if (back)
         return RENDER_MIXED;
     double s, t, local_s, local_t;
@@ -354,9 +354,10 @@ static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit
     bool smooth = shading == RAD_SHADING_SMOOTH && input->vertex_radiosity;
     double diffuse[3];
     if (input->vpls) {
-        /* The path's own stream keys the gather: (pixel, stratum, bounces). */
-        uint64_t key = (uint64_t)(rad_rng_uniform(rng) * 9007199254740992.0);
-        shade_vpl(input, e, patch, p, key, diffuse);
+        /* Keyed on (pixel, stratum, stream) from the eye; a path's later
+         * diffuse ends on a draw of its own stream. */
+        uint64_t k = depth == 0 ? key : (uint64_t)(rad_rng_uniform(rng) * 9007199254740992.0);
+        shade_vpl(input, e, patch, p, k, diffuse);
         for (int c = 0; c < 3; c++)
             rgb[c] += diffuse[c];
         return m ? RENDER_MIXED : hit->patch;
@@ -424,7 +425,8 @@ static void trace_pixels(const render_pass *pass, const render_view *view, int y
             /* The second pass's stream: keyed like the camera ray's, apart. */
             rad_rng rng = rad_rng_keyed(stream ^ 0x5bd1e9955bd1e995ULL,
                                         (uint64_t)y * (uint64_t)view->width + x, r % per_pixel);
-            uint32_t what = shade(pass, &rays[k], &hits[k], 0, 1.0, &rng, rgb);
+            uint64_t key = ((uint64_t)y * (uint64_t)view->width + x) * per_pixel * 2 + (r % per_pixel) * 2 + stream;
+            uint32_t what = shade(pass, &rays[k], &hits[k], 0, 1.0, key, &rng, rgb);
             if (r % per_pixel == 0) {
                 sum[3 * x] = sum[3 * x + 1] = sum[3 * x + 2] = 0.0;
                 seen[x] = what;
