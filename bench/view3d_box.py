@@ -98,7 +98,10 @@ def write_vs3(path, box, obstr, n):
         surfs.append(([vid(p) for p in quads[0]], name, True))
     with open(path, "w") as f:
         f.write("T unit box, faces %d x %d, 0.3 m cube obstruction (bench/view3d_box.py)\n" % (n, n))
-        f.write("C encl=1 list=0 eps=1.0e-4 maxU=8 maxO=8 minO=0 row=0 col=0\n")
+        # encl=0: the cube is obstruction-only, so the box's rows sum to what
+        # the cube leaves them (about 0.82), not 1; encl=1 would make the .vf
+        # smooth them to 1.
+        f.write("C encl=0 list=0 eps=1.0e-4 maxU=8 maxO=8 minO=0 row=0 col=0\n")
         f.write("F 3\n")
         for k, p in enumerate(verts, 1):
             f.write("V %d %s %s %s\n" % (k, fmt(p[0]), fmt(p[1]), fmt(p[2])))
