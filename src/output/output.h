@@ -105,6 +105,11 @@ char *rad_utf8_clean(rad_context *ctx, const char *text);
  * that trim would lose).  Cannot fail. */
 void rad_csv_field(FILE *f, const char *text);
 
+/* A cJSON tree written atomically as `path` (printed, then one line
+ * break); a NULL root or one cJSON cannot print: RAD_ERROR_OUT_OF_MEMORY. */
+struct cJSON;
+rad_result rad_write_json(rad_context *ctx, struct cJSON *root, const char *path);
+
 /* The stats JSON of a solution (docs/stats.md); `partial` marks an
  * interrupted run. */
 rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *view, const char *path, bool partial);
@@ -112,7 +117,6 @@ rad_result rad_write_stats(rad_context *ctx, const rad_solution_view *view, cons
 /* The same with `extra` adding its own members to the root object (a
  * cJSON object) before it is written; a failure it returns (out of
  * memory) is the writer's. */
-struct cJSON;
 typedef rad_result (*rad_stats_extra_fn)(rad_context *ctx, struct cJSON *root, const void *user);
 rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *view, const char *path, bool partial,
                                  rad_stats_extra_fn extra, const void *user);

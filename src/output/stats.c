@@ -84,8 +84,7 @@ static cJSON *rgb_array(const double v[3])
     return cJSON_CreateDoubleArray(v, 3);
 }
 
-/* Write a cJSON tree atomically. */
-static rad_result write_json(rad_context *ctx, cJSON *root, const char *path)
+rad_result rad_write_json(rad_context *ctx, cJSON *root, const char *path)
 {
     char *text = root ? cJSON_Print(root) : NULL;
     if (!text)
@@ -149,7 +148,7 @@ rad_result rad_scene_write_interrupted_stats(rad_context *ctx, const rad_scene *
     cJSON *sec = cJSON_AddObjectToObject(root, "seconds");
     cJSON_AddNumberToObject(sec, "total", seconds);
     if (r == RAD_OK)
-        r = write_json(ctx, root, path);
+        r = rad_write_json(ctx, root, path);
     cJSON_Delete(root);
     return r;
 }
@@ -341,7 +340,7 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
     if (r == RAD_OK && extra)
         r = extra(ctx, root, user);
     if (r == RAD_OK)
-        r = write_json(ctx, root, path);
+        r = rad_write_json(ctx, root, path);
     cJSON_Delete(root);
     return r;
 }
@@ -671,7 +670,7 @@ static rad_result write_view_factors(rad_context *ctx, const rad_solution_view *
                 cJSON_AddItemToArray(E, cJSON_CreateDoubleArray(rows.err + a * N, (int)N));
         }
         if (r == RAD_OK)
-            r = write_json(ctx, root, path);
+            r = rad_write_json(ctx, root, path);
         cJSON_Delete(root);
     } else {
         rad_atomic_file f;

@@ -57,22 +57,6 @@ static void free_names(char **names, size_t S)
     rad_free(names);
 }
 
-static rad_result write_json_tree(rad_context *ctx, cJSON *root, const char *path)
-{
-    char *text = root ? cJSON_Print(root) : NULL;
-    if (!text)
-        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory building JSON", path);
-    rad_atomic_file f;
-    rad_result r = rad_atomic_open(ctx, path, &f);
-    if (r == RAD_OK) {
-        fputs(text, f.file);
-        fputc('\n', f.file);
-        r = rad_atomic_commit(ctx, &f);
-    }
-    cJSON_free(text);
-    return r;
-}
-
 static cJSON *values_object(const char *name, const rad_thermal_values *v)
 {
     cJSON *o = cJSON_CreateObject();
@@ -124,7 +108,7 @@ static rad_result write_thermal_json(rad_context *ctx, const rad_thermal *t, con
             cJSON_AddItemToArray(list, o);
         }
     }
-    rad_result r = write_json_tree(ctx, root, path);
+    rad_result r = rad_write_json(ctx, root, path);
     cJSON_Delete(root);
     return r;
 }
@@ -212,7 +196,7 @@ rad_result rad_write_gebhart(rad_context *ctx, const rad_thermal *t, const doubl
             cJSON_AddItemToArray(list, o);
             cJSON_AddItemToArray(rows, cJSON_CreateDoubleArray(G + k * S, (int)S));
         }
-        r = write_json_tree(ctx, root, path);
+        r = rad_write_json(ctx, root, path);
         cJSON_Delete(root);
     } else {
         rad_atomic_file f;
