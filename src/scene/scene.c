@@ -20,6 +20,7 @@
  * shared vertices is the mesher's job, which knows the crease angle.
  */
 #include "scene/scene.h"
+#include "scene/photometry.h"
 
 #include <limits.h>
 #include <math.h>
@@ -786,6 +787,12 @@ void rad_scene_destroy(rad_scene *scene)
     }
     rad_free(scene->textures);
     rad_free(scene->uv_maps);
+    for (size_t i = 0; i < scene->photometry_count; i++)
+        rad_photometry_free(scene->photometries[i]);
+    rad_free(scene->photometries);
+    for (size_t i = 0; i < scene->luminaire_count; i++)
+        rad_free(scene->luminaires[i].name);
+    rad_free(scene->luminaires);
     rad_free(scene);
 }
 

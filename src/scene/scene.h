@@ -95,6 +95,21 @@ void rad_scene_reflectance_at(const rad_scene *scene, uint32_t polygon, vec3 p, 
 /* Whether polygon `polygon` is textured (a texture and coordinates). */
 bool rad_scene_textured(const rad_scene *scene, uint32_t polygon);
 
+/* A luminaire placed in the scene (docs/lighting.md "Luminaires"): a
+ * photometric distribution at a position, turned by its frame.  It is a
+ * light source, not geometry: it has no elements and blocks no rays. */
+struct rad_photometry; /* scene/photometry.h */
+typedef struct rad_luminaire {
+    char *name;               /* unique: the layout's name (with its index in an array) or the glTF node's */
+    uint32_t photometry;      /* index into rad_scene.photometries */
+    vec3 position;            /* m: the photometric centre */
+    vec3 axis[3];             /* unit, world: the luminaire's x (C = 0), y (C = 90), z (up; nadir = -z) */
+    double multiplier;        /* on the file's candela: light loss factor x lumens override ratio x
+                                 the tilt factor for this orientation */
+} rad_luminaire;
+
+struct rad_daylight; /* scene/daylight.h: the sky, the sun, the openings */
+
 struct rad_scene {
     char *source;             /* file name, or "cornell-box" */
     vec3 *positions;          /* m */
@@ -118,6 +133,14 @@ struct rad_scene {
     char **inputs;            /* the files read to make it (rad_scene_input_path) */
     size_t input_count;
     rad_view3d_control view3d; /* a .vs3 file's control line */
+    /* Light that is not emitted by surfaces (docs/lighting.md): luminaires
+     * (photometric files placed by a layout or by glTF nodes) and daylight;
+     * none by default. */
+    struct rad_photometry **photometries; /* each file once */
+    size_t photometry_count;
+    rad_luminaire *luminaires;
+    size_t luminaire_count;
+    struct rad_daylight *daylight;        /* NULL: no daylight */
 };
 
 /* Take over a list of malloc'd paths as the scene's inputs (freeing any it

@@ -1,0 +1,50 @@
+/*
+ * light.h -- direct light from sources that are not elements: luminaires
+ * (goniometric point sources, area sources near their opening) and
+ * daylight (the CIE sky and the sun, through openings).
+ *
+ * The pipeline asks two questions of a scene's light (docs/lighting.md):
+ *
+ *   rad_light_irradiance          direct irradiance at a point with a normal
+ *                                 (calculation points; exact: candela,
+ *                                 inverse square, cosine, shadow rays)
+ *   rad_light_element_irradiance  its mean over an element, which the
+ *                                 strategies add to the element's emission
+ *                                 as its first reflection, E += rho H
+ *
+ * so the interreflection is the radiosity solution and calculation points
+ * get the direct part exactly.  Units: W/m^2 per channel, the engine's
+ * (docs/units.md "Photometry": lux = 179 x Y).
+ *
+ * Folder order: core -> scene -> mesh -> vis -> formfactor -> light -> solve.
+ */
+#ifndef RAD_LIGHT_H
+#define RAD_LIGHT_H
+
+#include "scene/scene.h"
+#include "mesh/mesh.h"
+#include "vis/vis.h"
+
+/* Whether the scene has light besides its emitting surfaces. */
+bool rad_light_present(const rad_scene *scene);
+
+/* Direct irradiance (W/m^2 RGB) at point p, on a surface of unit normal n
+ * (light from behind it counts zero), from every luminaire and from the
+ * daylight of `scene`; shadow rays through vis (built over mesh; vis NULL:
+ * no shadows).  p lies on a surface or in free space; rays start
+ * rad_vis_epsilon(mesh) off it along n.  Thread-safe, deterministic. */
+void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                          vec3 n, double out[3]);
+
+/* The mean of rad_light_irradiance over element `element` of mesh
+ * (adaptive cubature over its polygon).  Thread-safe, deterministic. */
+void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                                  size_t element, double out[3]);
+
+/* The parts, one file each. */
+void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                               vec3 n, double out[3]);           /* light/luminaire.c */
+void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                             vec3 n, double out[3]);             /* light/daylight.c */
+
+#endif
