@@ -88,7 +88,7 @@ rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const r
 {
     memset(out, 0, sizeof *out);
     size_t n = mesh->element_count;
-    rad_elements e;
+    rad_elements e = {0};
     e.area = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *e.area, "solution: areas");
     e.reflectance = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *e.reflectance, "solution: reflectance");
     e.emission = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n, sizeof *e.emission, "solution: emission");
@@ -119,6 +119,7 @@ void rad_elements_free(rad_elements *e)
     rad_free(e->reflectance);
     rad_free(e->emission);
     rad_free(e->radiosity);
+    rad_free(e->direct);
     memset(e, 0, sizeof *e);
 }
 
@@ -129,6 +130,7 @@ void rad_view_elements(rad_solution_view *view, const rad_mesh *mesh, const rad_
     view->area = e->area;
     view->reflectance = e->reflectance;
     view->emission = e->emission;
+    view->direct = e->direct;
     view->radiosity = e->radiosity;
 }
 

@@ -47,7 +47,10 @@ typedef struct rad_solution_view {
     size_t n;                       /* elements */
     const double *area;             /* n, m^2 */
     const double *reflectance;      /* 3n, RGB */
-    const double *emission;         /* 3n, W/m^2 */
+    const double *emission;         /* 3n, W/m^2: self-emitted, plus rho x direct (below) */
+    const double *direct;           /* 3n, W/m^2: the mean direct irradiance from luminaires and
+                                       daylight (light/light.h), whose first reflection is part
+                                       of `emission`; NULL where the scene has none */
     const double *radiosity;        /* 3n, W/m^2: E before solving, the iterate during */
     /* 3 per mesh vertex, W/m^2: the strategy's own vertex values where they
      * are its unknowns (galerkin-linear, collocation), to be interpolated
@@ -120,6 +123,8 @@ typedef struct rad_elements {
     double *reflectance;            /* 3n */
     double *emission;               /* 3n */
     double *radiosity;              /* 3n */
+    double *direct;                 /* 3n: direct irradiance from luminaires and daylight; NULL
+                                       until rad_elements_add_light finds the scene has some */
 } rad_elements;
 
 /* Fill *out for `mesh`; nothing is allocated on failure (out of memory). */
