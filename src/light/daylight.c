@@ -10,3 +10,9 @@ void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const
     (void)scene, (void)mesh, (void)vis, (void)p, (void)n;
     out[0] = out[1] = out[2] = 0.0;
 }
+
+void rad_daylight_sky_horizontal(const rad_scene *scene, double out[3])
+{
+    (void)scene;
+    out[0] = out[1] = out[2] = 0.0;
+}

@@ -47,4 +47,9 @@ void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, con
 void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                              vec3 n, double out[3]);             /* light/daylight.c */
 
+/* The horizontal irradiance (W/m^2 RGB) outdoors under the unobstructed sky
+ * of the scene's daylight, the sun excluded: the daylight factor's
+ * denominator.  Zero without daylight.  (light/daylight.c) */
+void rad_daylight_sky_horizontal(const rad_scene *scene, double out[3]);
+
 #endif
