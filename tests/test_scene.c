@@ -1554,6 +1554,31 @@ static void test_material_libraries(void **state)
                      RAD_OK);
     check_lamp(scene);
 
+    /* A library named after the faces that use it, its materials in another
+     * order than their use: each face keeps its own material, from a file
+     * and from memory (assimp made the unknown names materials first and
+     * numbered the library's after them: the lamp got the panel's grey). */
+    char glow_first[256];
+    snprintf(glow_first, sizeof glow_first, "newmtl unused\nKd 0.7 0.7 0.7\n%snewmtl spare\nKd 0.2 0.2 0.2\n%s",
+             glow_mtl, grey_mtl);
+    write_temp("late.mtl", glow_first);
+    static const char *const tails[] = {"mtllib late.mtl\n", "mtllib late.mtl", "mtllib late.mtl\r\n"};
+    for (size_t i = 0; i < sizeof tails / sizeof tails[0]; i++) {
+        snprintf(obj, sizeof obj, "%s%s", lamp_body, tails[i]);
+        scene = NULL;
+        rad_result r = rad_scene_load_file(ctx, write_temp("libs.obj", obj), &scene);
+        if (r != RAD_OK)
+            print_error("'%s': %s\n", tails[i], rad_context_error(ctx));
+        assert_int_equal(r, RAD_OK);
+        check_lamp(scene);
+        scene = NULL;
+        assert_int_equal(rad_scene_load_memory(ctx, "libs.obj", obj, strlen(obj), glow_first,
+                                               strlen(glow_first), &scene),
+                         RAD_OK);
+        check_lamp(scene);
+    }
+    remove_temp("late.mtl");
+
     /* A missing library is the same error whichever it is. */
     write_temp("bad.mtl", "newmtl glow\nKd 1.5 0 0\n");
     write_temp("grey2.mtl", "newmtl glow\nKd 0.1 0.1 0.1\nKe 1 1 1\nnewmtl grey\nKd 0.3 0.3 0.3\n");

@@ -981,12 +981,27 @@ rad_result import_obj_exact_positions(rad_context *ctx, const char *path, const 
     memset(out, 0, sizeof *out);
     char token[TOKEN_SIZE];
     const char *p, *end;
-    /* First pass: how many positions, and the rewritten text's size. */
+    /* First pass: how many positions, and the rewritten text's size.  A
+     * `mtllib` after the first `usemtl` is moved to the top: assimp makes a
+     * material of every name it does not know yet and then numbers the
+     * library's own ones after them, so a face could get another
+     * material's values. */
     size_t count = 0, bytes = 0;
+    bool used = false;
+    const char *lib = NULL, *lib_end = NULL;
     text_lines lines = text_lines_of(text, size);
     const char *start = lines.next;
     while (next_line(&lines, &p, &end)) {
         next_token(&p, end, token);
+        if (strcmp(token, "usemtl") == 0)
+            used = true;
+        else if (strcmp(token, "mtllib") == 0 && !lib && used) {
+            lib = start;
+            lib_end = lines.next;
+            bytes += (size_t)(lib_end - lib) + 1;
+        }
+        if (strcmp(token, "mtllib") == 0)
+            used = true; /* only the first library statement counts */
         if (strcmp(token, "v") == 0) {
             bytes += (size_t)snprintf(NULL, 0, "v %zu %zu 0\n", count & ((1u << IMPORT_OBJ_INDEX_BITS) - 1),
                                       count >> IMPORT_OBJ_INDEX_BITS);
@@ -1006,8 +1021,21 @@ rad_result import_obj_exact_positions(rad_context *ctx, const char *path, const 
     lines = text_lines_of(text, size);
     start = lines.next;
     char *at = out->text;
+    if (lib) {
+        memcpy(at, lib, (size_t)(lib_end - lib));
+        at += lib_end - lib;
+        if (at[-1] != '\n')
+            *at++ = '\n';
+    }
     while (next_line(&lines, &p, &end)) {
         const char *line = p;
+        if (start == lib) { /* moved to the top: a comment here */
+            memcpy(at, start, (size_t)(lines.next - start));
+            at[p - start] = '#';
+            at += lines.next - start;
+            start = lines.next;
+            continue;
+        }
         next_token(&p, end, token);
         if (token[0] == '#' && !out->has_camera)
             read_camera_comment(line, end, out);
