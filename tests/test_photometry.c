@@ -788,6 +788,85 @@ static void test_data_file_and_memory(void **state)
     rad_context_destroy(ctx);
 }
 
+/* Every allocation of a load failing in turn: RAD_ERROR_OUT_OF_MEMORY,
+ * no distribution, nothing left in use (ASan checks the frees). */
+static void test_allocation_failures(void **state)
+{
+    (void)state;
+    rad_context *ctx = context();
+    double v[19], h[25], c1[1] = {0};
+    for (int i = 0; i < 19; i++)
+        v[i] = 10.0 * i;
+    for (int i = 0; i < 25; i++)
+        h[i] = 15.0 * i;
+    text t = {0};
+    put(&t, "1\n2\n0 90\n1 0.5\n");
+    save("alloc.tlt", &t);
+    ies_spec s = ies_default(19, v, 7, h, quad);
+    s.tilt = "alloc.tlt";
+    const char *files[4];
+    char names[4][512];
+    snprintf(names[0], sizeof names[0], "%s", write_ies("alloc_c.ies", &s));
+    s.tilt = NULL, s.type = 2, s.nh = 10, s.h = v, s.v = v, s.nv = 10; /* B: 0..90 both */
+    snprintf(names[1], sizeof names[1], "%s", write_ies("alloc_b.ies", &s));
+    snprintf(names[2], sizeof names[2], "%s", write_ldt("alloc3.ldt", 3, 24, h, 19, v, quad, 1000.0, 100.0, 1));
+    snprintf(names[3], sizeof names[3], "%s", write_ldt("alloc1.ldt", 1, 1, c1, 19, v, rot, 1000.0, 100.0, 1));
+    for (int f = 0; f < 4; f++) {
+        files[f] = names[f];
+        for (uint64_t k = 1;; k++) {
+            rad_api_enter(ctx);
+            rad_context_fail_allocation(ctx, k);
+            rad_photometry *p = (rad_photometry *)1;
+            rad_result r = rad_photometry_load(ctx, files[f], &p);
+            rad_context_fail_allocation(ctx, 0);
+            if (r == RAD_OK) {
+                assert_true(k > 3); /* it did allocate */
+                rad_photometry_free(p);
+                break;
+            }
+            assert_int_equal(r, RAD_ERROR_OUT_OF_MEMORY);
+            assert_null(p);
+            assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), 0);
+        }
+    }
+    rad_context_destroy(ctx);
+}
+
+/* `radiosity photometry FILE...`: the summary's lines, and a bad file
+ * named on stderr with status 1 while the good one is still printed. */
+static const char *g_binary;
+
+static void test_command(void **state)
+{
+    (void)state;
+    if (!g_binary)
+        skip();
+    char command[1400], output[8192];
+    snprintf(command, sizeof command, "'%s' photometry '%s' '%s/bad/negative.ldt' 2>&1; echo status $?", g_binary,
+             DATA "/downlight_2002.ies", DATA);
+    FILE *f = popen(command, "r");
+    assert_non_null(f);
+    size_t n = fread(output, 1, sizeof output - 1, f);
+    output[n] = '\0';
+    pclose(f);
+    /* 100 cd at 0, 80 at 45, 0 at 90 over the lower hemisphere, bilinear:
+     * the closed form per cell (photometry.c) gives 327.73 lm */
+    assert_non_null(strstr(output, "downlight_2002.ies: IES LM-63-2002, type C, \"test downlight\""));
+    assert_non_null(strstr(output, "  symmetry      rotational (C 0)"));
+    assert_non_null(strstr(output, "  maximum       100 cd at C 0, gamma 0"));
+    assert_non_null(strstr(output, "  flux          327.73 lm"));
+    assert_non_null(strstr(output, "  rated lumens  1000 lm, light output ratio 0.3277"));
+    assert_non_null(strstr(output, "radiosity: " DATA "/bad/negative.ldt:48: intensities (cd/klm): -1 is negative"));
+    assert_non_null(strstr(output, "status 1"));
+    snprintf(command, sizeof command, "'%s' photometry 2>&1; echo status $?", g_binary);
+    f = popen(command, "r");
+    n = fread(output, 1, sizeof output - 1, f);
+    output[n] = '\0';
+    pclose(f);
+    assert_non_null(strstr(output, "no photometric file given"));
+    assert_non_null(strstr(output, "status 2"));
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -803,8 +882,9 @@ static int teardown(void **state)
     return system(command) == 0 ? 0 : -1;
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
+    g_binary = argc > 1 ? argv[1] : NULL;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flux_closed_forms),
         cmocka_unit_test(test_flux_against_quadrature),
@@ -818,6 +898,8 @@ int main(void)
         cmocka_unit_test(test_lumens),
         cmocka_unit_test(test_malformed),
         cmocka_unit_test(test_data_file_and_memory),
+        cmocka_unit_test(test_allocation_failures),
+        cmocka_unit_test(test_command),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
