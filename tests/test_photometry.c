@@ -232,6 +232,24 @@ static void test_flux_closed_forms(void **state)
     assert_true(fabs(p->flux - 4.0 * M_PI * 250.0) < 1e-12 * p->flux);
     rad_photometry_free(p);
 
+    /* a table that stops short of the poles holds its end values: 0..90
+     * at 250 cd is isotropic */
+    double g90[2] = {0, 90};
+    p = rad_photometry_from_table(ctx, "half", 1, c1, 2, g90, iso, NULL);
+    assert_non_null(p);
+    assert_true(fabs(p->flux - 4.0 * M_PI * 250.0) < 1e-12 * p->flux);
+    assert_true(rad_photometry_intensity(p, v3(0, 0, 1)) == 250.0);
+    rad_photometry_free(p);
+    /* not a table: gamma beyond 180, decreasing, three equal; C not closing at 360 */
+    double bad_g[3] = {0, 90, 190}, dec_g[3] = {0, 90, 45}, three[4] = {0, 90, 90, 90}, cd4[8] = {0};
+    double open_c[2] = {0, 180};
+    rad_result err = RAD_OK;
+    assert_null(rad_photometry_from_table(ctx, "bad", 1, c1, 3, bad_g, cd4, &err));
+    assert_int_equal(err, RAD_ERROR_INVALID_ARGUMENT);
+    assert_null(rad_photometry_from_table(ctx, "bad", 1, c1, 3, dec_g, cd4, NULL));
+    assert_null(rad_photometry_from_table(ctx, "bad", 1, c1, 4, three, cd4, NULL));
+    assert_null(rad_photometry_from_table(ctx, "bad", 2, open_c, 2, g2, cd4, NULL));
+
     /* I0 cos(gamma), lower hemisphere: pi I0.  Linear interpolation of
      * cos on a step h errs by at most h^2/8 I0 (|cos''| <= 1), so the flux
      * by at most 2 pi (h^2/8) I0 int sin = pi I0 h^2/4: relative h^2/4,
@@ -780,6 +798,16 @@ static void test_data_file_and_memory(void **state)
     const char plain[] = "IESNA:LM-63-2002\nTILT=NONE\n1,-1,1,2,1,1,2,0,0,0,1,1,0,0,180,0,50,50";
     assert_int_equal(rad_photometry_parse(ctx, "mem.ies", NULL, plain, sizeof plain - 1, &p), RAD_OK);
     assert_true(fabs(p->flux - 4.0 * M_PI * 50.0) < 1e-12 * p->flux);
+    rad_photometry_free(p);
+    /* CRLF line ends, keyword lines, a 1991 first line, TILT=INCLUDE over
+     * several lines */
+    const char crlf[] = "IESNA91\r\n[LUMINAIRE] crlf lamp\r\n[MORE] second line\r\nTILT=INCLUDE\r\n1\r\n2\r\n0 90\r\n"
+                        "1 0.5\r\n1 -1 1 2 1 1 2 0 0 0\r\n1 1 0\r\n0 180\r\n0\r\n40 40\r\n";
+    assert_int_equal(rad_photometry_parse(ctx, "crlf.ies", NULL, crlf, sizeof crlf - 1, &p), RAD_OK);
+    assert_string_equal(p->label, "crlf lamp");
+    assert_string_equal(p->version, "LM-63-1991");
+    assert_true(fabs(p->flux - 4.0 * M_PI * 40.0) < 1e-12 * p->flux);
+    assert_true(fabs(rad_photometry_tilt_factor(p, 45) - 0.75) < 1e-15);
     rad_photometry_free(p);
     rad_api_enter(ctx);
     const char tilted[] = "IESNA:LM-63-2002\nTILT=x.tlt\n1,-1,1,2,1,1,2,0,0,0,1,1,0,0,180,0,50,50";

@@ -159,6 +159,13 @@ double ph_flux(const rad_photometry *p)
             double v0 = 0.5 * (a[ig] + b[ig]), v1 = 0.5 * (a[ig + 1] + b[ig + 1]);
             sum += v0 * (whole - ramp) + v1 * ramp;
         }
+        /* a table that stops short of a pole holds its end values there */
+        size_t last = p->gamma_count - 1;
+        double first_gamma = p->gamma_angles[0] * DEG, last_gamma = p->gamma_angles[last] * DEG;
+        if (first_gamma > 0.0)
+            sum += 0.5 * (a[0] + b[0]) * (1.0 - cos(first_gamma));
+        if (last_gamma < M_PI)
+            sum += 0.5 * (a[last] + b[last]) * (1.0 + cos(last_gamma));
         total += width * sum;
     }
     return total;
@@ -208,7 +215,8 @@ rad_result ph_set_tilt(rad_context *ctx, rad_photometry *p, int geometry, size_t
 /* Whether the table's angles are as the struct says. */
 static bool table_valid(size_t c_count, const double *c_angles, size_t gamma_count, const double *gamma_angles)
 {
-    if (c_count < 1 || gamma_count < 2 || gamma_angles[0] != 0.0 || gamma_angles[gamma_count - 1] != 180.0)
+    if (c_count < 1 || gamma_count < 2 || !(gamma_angles[0] >= 0.0) || !(gamma_angles[gamma_count - 1] <= 180.0) ||
+        !(gamma_angles[gamma_count - 1] > gamma_angles[0]))
         return false;
     for (size_t i = 1; i < gamma_count; i++)
         if (!(gamma_angles[i] >= gamma_angles[i - 1]) ||

@@ -68,9 +68,12 @@ typedef struct rad_photometry {
     /* The table over the whole sphere after symmetry expansion and type
      * conversion: C in [0, 360] degrees (c_count >= 1; one plane =
      * rotationally symmetric), C strictly increasing from 0 to 360; gamma
-     * from 0 to 180 degrees from nadir, non-decreasing: two equal gamma
+     * in [0, 180] degrees from nadir, non-decreasing: two equal gamma
      * angles in a row are a step (the edge of a hemisphere a file leaves
-     * out, whose candela are 0), never three; candela[ic * gamma_count + ig]. */
+     * out, whose candela are 0), never three.  The readers' tables run
+     * from 0 to 180; a table that stops short of a pole holds its end
+     * values beyond (evaluation and flux alike).
+     * candela[ic * gamma_count + ig]. */
     size_t c_count, gamma_count;
     double *c_angles, *gamma_angles;
     double *candela;           /* cd, multipliers applied, tilt not applied */
