@@ -408,6 +408,7 @@ static void test_every_symmetry_same_distribution(void **state)
 /* An asymmetric distribution in the four IES/LDT full layouts, and the
  * direction convention: C = 90 is +y. */
 static double skew(double c, double gamma) { return 100.0 + 50.0 * sin(c * DEG) * sin(gamma * DEG); }
+static double lean(double c, double gamma) { return 100.0 + 50.0 * cos(c * DEG) * sin(gamma * DEG); }
 
 static void test_c_frame(void **state)
 {
@@ -428,8 +429,30 @@ static void test_c_frame(void **state)
     assert_true(fabs(rad_photometry_intensity(p, v3(0, 1, 0)) - 150.0) < 1e-12);  /* +y: C 90 */
     assert_true(fabs(rad_photometry_intensity(p, v3(0, -1, 0)) - 50.0) < 1e-12);  /* -y: C 270 */
     assert_true(fabs(rad_photometry_intensity(p, v3(0, 0, -1)) - 100.0) < 1e-12); /* nadir */
-    rad_photometry_free(p);
+    /* skew is symmetric in the C90-C270 plane only: IES 90-270 and
+     * EULUMDAT Isym 3 (C 270..360/0..90 stored) give the full file's
+     * candela; lean is symmetric in the C0-C180 plane only: IES 0-180 and
+     * Isym 2 */
     rad_photometry_free(q);
+    s = ies_default(19, v, 13, h + 6, skew);
+    q = load(ctx, write_ies("skew90.ies", &s));
+    assert_same(p, q, 1e-12);
+    rad_photometry_free(q);
+    q = load(ctx, write_ldt("skew3.ldt", 3, 24, h, 19, v, skew, 1000.0, 100.0, 1));
+    assert_same(p, q, 1e-12);
+    rad_photometry_free(q);
+    s = ies_default(19, v, 25, h, lean);
+    rad_photometry *full = load(ctx, write_ies("lean.ies", &s));
+    s = ies_default(19, v, 13, h, lean);
+    q = load(ctx, write_ies("lean0.ies", &s));
+    assert_same(full, q, 1e-12);
+    rad_photometry_free(q);
+    q = load(ctx, write_ldt("lean2.ldt", 2, 24, h, 19, v, lean, 1000.0, 100.0, 1));
+    assert_same(full, q, 1e-12);
+    assert_true(fabs(rad_photometry_intensity(q, v3(1, 0, 0)) - 150.0) < 1e-12); /* +x: C 0 */
+    rad_photometry_free(q);
+    rad_photometry_free(full);
+    rad_photometry_free(p);
     rad_context_destroy(ctx);
 }
 
