@@ -818,7 +818,7 @@ static void test_data_file_and_memory(void **state)
     assert_string_equal(p->label, "test downlight");
     assert_true(fabs(rad_photometry_intensity(p, direction(0, 22.5)) - 90.0) < 1e-12);
     rad_photometry_free(p);
-    const char plain[] = "IESNA:LM-63-2002\nTILT=NONE\n1,-1,1,2,1,1,2,0,0,0,1,1,0,0,180,0,50,50";
+    const char plain[] = "IESNA:LM-63-2002\nTILT=none\n1,-1,1,2,1,1,2,0,0,0,1,1,0,0,180,0,50,50";
     assert_int_equal(rad_photometry_parse(ctx, "mem.ies", NULL, plain, sizeof plain - 1, &p), RAD_OK);
     assert_true(fabs(p->flux - 4.0 * M_PI * 50.0) < 1e-12 * p->flux);
     rad_photometry_free(p);

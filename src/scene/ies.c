@@ -28,6 +28,7 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 static const double DEG = M_PI / 180.0;
 static const double FOOT = 0.3048; /* m, exactly (the international foot) */
@@ -298,9 +299,9 @@ rad_result ph_parse_ies(rad_context *ctx, const char *name, const char *folder, 
     p->format = RAD_PHOTOMETRY_IES;
     snprintf(p->version, sizeof p->version, "%s", version->name);
     rad_result r = RAD_OK;
-    if (tilt_length == 4 && strncmp(tilt, "NONE", 4) == 0) {
+    if (tilt_length == 4 && strncasecmp(tilt, "NONE", 4) == 0) {
         strcpy(p->tilt_source, "none");
-    } else if (tilt_length == 7 && strncmp(tilt, "INCLUDE", 7) == 0) {
+    } else if (tilt_length == 7 && strncasecmp(tilt, "INCLUDE", 7) == 0) {
         strcpy(p->tilt_source, "include");
         r = read_tilt(&t, p);
     } else if (tilt_length == 0) {
