@@ -668,7 +668,8 @@ void cli_print_help(FILE *out, int command)
             c = &COMMANDS[k];
     if (c) {
         fprintf(out, "usage: radiosity %s\n%s.\n\n%s%soptions:\n", c->synopsis, c->summary,
-                command == CLI_GENERATE ? "" : DESCRIPTION, command == CLI_GENERATE ? "" : "\n");
+                command == CLI_GENERATE || command == CLI_PHOTOMETRY ? "" : DESCRIPTION,
+                command == CLI_GENERATE || command == CLI_PHOTOMETRY ? "" : "\n");
     } else {
         fprintf(out, "radiosity %s -- diffuse global illumination by the radiosity method\n\nusage:\n",
                 RAD_VERSION_STRING);
@@ -688,7 +689,7 @@ void cli_print_help(FILE *out, int command)
             continue;
         if (c && f->target == CLI_TO_ACTION && f->action != CLI_HELP)
             continue;
-        char usage[64], description[1200], commands[64] = "";
+        char usage[64], description[1200], commands[128] = "";
         flag_usage(f, usage, sizeof usage);
         flag_description(f, description, sizeof description);
         if (!c)
