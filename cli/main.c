@@ -484,6 +484,49 @@ static int stream_rank(rad_context *ctx, const settings *s, const rad_stream_ran
     return r == RAD_OK ? 0 : fail(ctx, r);
 }
 
+/* photometry FILE...: each file's summary (radiosity.h, "Photometric
+ * files"); a file that cannot be read is named on stderr and the rest are
+ * still read; the status is 1 if any failed. */
+static int run_photometry(rad_context *ctx, const settings *s)
+{
+    int status = 0;
+    for (size_t k = 0; k < s->photometry_file_count; k++) {
+        const char *path = s->photometry_files[k];
+        rad_photometry_info in;
+        rad_result r = rad_photometry_info_read(ctx, path, &in);
+        if (r != RAD_OK) {
+            status = fail(ctx, r);
+            continue;
+        }
+        static const char *const types[] = {"?", "C", "B", "A"};
+        printf("%s: %s%s%s, type %s%s%s%s\n", path, in.format, strcmp(in.format, in.version) ? " " : "",
+               strcmp(in.format, in.version) ? in.version : "", types[in.type >= 1 && in.type <= 3 ? in.type : 0],
+               in.label[0] ? ", \"" : "", in.label, in.label[0] ? "\"" : "");
+        printf("  symmetry      %s\n", in.symmetry);
+        printf("  angles        %zu %s from %g to %g, %zu %s from %g to %g (degrees)\n", in.vertical_count,
+               in.format[0] == 'E' ? "gamma" : "vertical", in.vertical_min, in.vertical_max, in.horizontal_count,
+               in.format[0] == 'E' ? "C" : "horizontal", in.horizontal_min, in.horizontal_max);
+        printf("  maximum       %.6g cd at C %g, gamma %g\n", in.max_candela, in.max_c, in.max_gamma);
+        printf("  flux          %.6g lm\n", in.flux);
+        if (in.rated_lumens > 0.0)
+            printf("  rated lumens  %.6g lm, light output ratio %.4f\n", in.rated_lumens, in.lor);
+        else
+            printf("  rated lumens  none (absolute photometry)\n");
+        if (in.stated_lor >= 0.0)
+            printf("  stated LOR    %.4f\n", in.stated_lor);
+        printf("  opening       %s, %g x %g x %g m (length x width x height)\n", in.shape, in.length, in.width,
+               in.height);
+        if (in.tilt_count)
+            printf("  tilt          %s, %zu angles\n", in.tilt, in.tilt_count);
+        else
+            printf("  tilt          none\n");
+        if (in.input_watts > 0.0)
+            printf("  input         %.6g W\n", in.input_watts);
+    }
+    return status;
+}
+
+
 static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 {
     /* Every command's flags come from the one table in options.c;
@@ -540,6 +583,13 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
     }
     if (s.command == CLI_GENERATE) {
         status = cli_generate(&s, ctx);
+        cancel_context = NULL;
+        rad_context_destroy(ctx);
+        return cancel_signal ? interrupted_status() : status;
+    }
+
+    if (s.command == CLI_PHOTOMETRY) {
+        status = run_photometry(ctx, &s);
         cancel_context = NULL;
         rad_context_destroy(ctx);
         return cancel_signal ? interrupted_status() : status;

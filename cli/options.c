@@ -50,6 +50,10 @@ static const command_def COMMANDS[] = {
     {CLI_THERMAL, "thermal", "thermal [SCENE] --bc BC.json [options]",
      "radiative heat exchange between grey diffuse surfaces with given temperatures or heat fluxes: "
      "radiosity, net flux, net power and the unknown temperatures per surface (docs/thermal.md)"},
+    {CLI_PHOTOMETRY, "photometry", "photometry FILE...",
+     "read luminaire photometric files (IES LM-63 1986-2019, EULUMDAT .ldt) and print each one's summary: "
+     "format, type, symmetry, angles, maximum candela and its direction, flux, rated lumens, light output "
+     "ratio, luminous opening, tilt (docs/lighting.md)"},
     {CLI_VIEW, "view", "view [SCENE|SOLUTION.radsol] [options]",
      "open a window that shows the solution as the solver refines it (progressive), or with --offscreen "
      "draw one frame with OpenGL without a window (docs/viewer.md; an optional build part)"},
@@ -213,7 +217,7 @@ static const cli_flag FLAGS[] = {
      .own.default_text = "error",
      .own.help = "a texture (map_Kd, baseColorTexture) that cannot be read: error (fail, naming the "
                  "material, file and line) or flat (warn and use the material's flat colour)"},
-    {"read-outside-scene-folder", 0, NULL, RV, OWN(read_outside, RAD_OPTION_FLAG),
+    {"read-outside-scene-folder", 0, NULL, RV | CLI_PHOTOMETRY, OWN(read_outside, RAD_OPTION_FLAG),
      .own.help = "let the scene refer to files outside its folder (by default an mtllib, glTF "
                  "buffer or image that resolves outside the scene file's folder is refused)"},
     {"quiet", 'q', NULL, ALL, OWN(quiet, RAD_OPTION_FLAG), .own.help = "print nothing but errors"},
@@ -438,6 +442,17 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
                 usage_error(e, "unknown command '%s'", arg);
                 return CLI_USAGE_ERROR;
             }
+            if (s->command == CLI_PHOTOMETRY) {
+                /* photometry FILE...: the files, given together */
+                if (s->photometry_file_count == 0)
+                    s->photometry_files = argv + i;
+                else if (argv + i != s->photometry_files + s->photometry_file_count) {
+                    usage_error(e, "give the photometric files together ('%s' after an option)", arg);
+                    return CLI_USAGE_ERROR;
+                }
+                s->photometry_file_count++;
+                continue;
+            }
             const char **scene = s->command == CLI_GENERATE ? &s->scene_kind : &s->scene_path;
             if (*scene) {
                 usage_error(e, "more than one scene given ('%s' and '%s')", *scene, arg);
@@ -489,6 +504,10 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
     }
     if (!s->command) {
         usage_error(e, "no command given: use render, solve, viewfactors, export, bake, thermal, generate or view");
+        return CLI_USAGE_ERROR;
+    }
+    if (s->command == CLI_PHOTOMETRY && s->photometry_file_count == 0) {
+        usage_error(e, "no photometric file given");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {
@@ -649,7 +668,8 @@ void cli_print_help(FILE *out, int command)
             c = &COMMANDS[k];
     if (c) {
         fprintf(out, "usage: radiosity %s\n%s.\n\n%s%soptions:\n", c->synopsis, c->summary,
-                command == CLI_GENERATE ? "" : DESCRIPTION, command == CLI_GENERATE ? "" : "\n");
+                command == CLI_GENERATE || command == CLI_PHOTOMETRY ? "" : DESCRIPTION,
+                command == CLI_GENERATE || command == CLI_PHOTOMETRY ? "" : "\n");
     } else {
         fprintf(out, "radiosity %s -- diffuse global illumination by the radiosity method\n\nusage:\n",
                 RAD_VERSION_STRING);
@@ -669,7 +689,7 @@ void cli_print_help(FILE *out, int command)
             continue;
         if (c && f->target == CLI_TO_ACTION && f->action != CLI_HELP)
             continue;
-        char usage[64], description[1200], commands[64] = "";
+        char usage[64], description[1200], commands[128] = "";
         flag_usage(f, usage, sizeof usage);
         flag_description(f, description, sizeof description);
         if (!c)

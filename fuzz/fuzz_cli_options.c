@@ -68,7 +68,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     case CLI_USAGE_ERROR: FUZZ_CHECK(err[0] != '\0'); break;
     case CLI_RUN:
         FUZZ_CHECK(cli_command_name(s.command)[0] != '\0'); /* one of the commands, whichever */
-        FUZZ_CHECK(s.output != NULL);
+        FUZZ_CHECK(s.output != NULL || s.command == CLI_PHOTOMETRY); /* photometry only prints */
+        FUZZ_CHECK(s.command != CLI_PHOTOMETRY ||
+                   (s.photometry_file_count > 0 && s.photometry_files >= argv + 2 &&
+                    s.photometry_files + s.photometry_file_count <= argv + argc));
         FUZZ_CHECK(s.command != CLI_GENERATE || (s.scene_kind && strcmp(s.scene_kind, "office") == 0));
         /* Every number set is 0 (the default) or within its field's range
          * in the library's option table. */
