@@ -34,6 +34,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cli_support.h"
 #include "radiosity.h"
 #include "light/light.h"
 #include "light/sky.h"
@@ -51,13 +52,13 @@ static double rel(double a, double b) { return fabs(a - b) / (b != 0.0 ? fabs(b)
 
 enum { ROOF = 1, FACADE = 2, PLATE = 4, OPENING_MATERIAL = 8 };
 
-typedef struct text {
+typedef struct obj_text {
     char buf[16384];
     size_t len;
     int vertices;
-} text;
+} obj_text;
 
-static void put(text *t, const char *fmt, ...)
+static void put(obj_text *t, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -68,7 +69,7 @@ static void put(text *t, const char *fmt, ...)
 }
 
 /* A quad a, b, c, d as OBJ object `name` of material `mtl`. */
-static void quad(text *t, const char *name, const char *mtl, double q[4][3])
+static void quad(obj_text *t, const char *name, const char *mtl, double q[4][3])
 {
     put(t, "o %s\nusemtl %s\n", name, mtl);
     for (int k = 0; k < 4; k++)
@@ -78,7 +79,7 @@ static void quad(text *t, const char *name, const char *mtl, double q[4][3])
 }
 
 /* Horizontal rectangle at height y, facing down (ceiling) or up. */
-static void rect_y(text *t, const char *name, const char *mtl, double y, double x0, double x1, double z0,
+static void rect_y(obj_text *t, const char *name, const char *mtl, double y, double x0, double x1, double z0,
                    double z1, bool up)
 {
     double a[4][3] = {{x0, y, z0}, {x0, y, z1}, {x1, y, z1}, {x1, y, z0}};
@@ -87,7 +88,7 @@ static void rect_y(text *t, const char *name, const char *mtl, double y, double 
 }
 
 /* Vertical rectangle in the plane z = z, facing +z (into the room) or -z. */
-static void rect_z(text *t, const char *name, const char *mtl, double z, double x0, double x1, double y0,
+static void rect_z(obj_text *t, const char *name, const char *mtl, double z, double x0, double x1, double y0,
                    double y1, bool plus)
 {
     double a[4][3] = {{x0, y0, z}, {x1, y0, z}, {x1, y1, z}, {x0, y1, z}};
@@ -95,7 +96,7 @@ static void rect_z(text *t, const char *name, const char *mtl, double z, double 
     quad(t, name, mtl, plus ? a : b);
 }
 
-static void rect_x(text *t, const char *name, const char *mtl, double x, double z0, double z1, double y0,
+static void rect_x(obj_text *t, const char *name, const char *mtl, double x, double z0, double z1, double y0,
                    double y1, bool plus)
 {
     double a[4][3] = {{x, y0, z0}, {x, y0, z1}, {x, y1, z1}, {x, y1, z0}};
@@ -108,12 +109,12 @@ static const char room_mtl[] = "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl floor\nKd 0.
 
 /* The room, with a 1 x 1 m roof opening "skylight" over its centre
  * (x, z in [1.5, 2.5], y = 3) and/or a 1 x 1 m facade opening "window" in
- * its wall z = 0 (x in [1.5, 2.5], y in [1, 2]); PLATE: an opaque plate
+ * its north wall z = 0 (x in [1.5, 2.5], y in [1, 2]; north is -z); PLATE: an opaque plate
  * over x < 2 at y = 3.5, 100 m wide; OPENING_MATERIAL: the openings are of
  * the material "opening" instead of being named. */
 static rad_scene *room(rad_context *ctx, int flags)
 {
-    static text t;
+    static obj_text t;
     memset(&t, 0, sizeof t);
     const char *om = flags & OPENING_MATERIAL ? "opening" : "dark";
     put(&t, "mtllib room.mtl\n");
@@ -128,15 +129,15 @@ static rad_scene *room(rad_context *ctx, int flags)
         rect_y(&t, "ceiling", "wall", 3.0, 0, 4, 0, 4, false);
     }
     if (flags & FACADE) {
-        rect_z(&t, "south_wall", "wall", 0.0, 0, 4, 0, 1, true);
-        rect_z(&t, "south_wall", "wall", 0.0, 0, 4, 2, 3, true);
-        rect_z(&t, "south_wall", "wall", 0.0, 0, 1.5, 1, 2, true);
-        rect_z(&t, "south_wall", "wall", 0.0, 2.5, 4, 1, 2, true);
+        rect_z(&t, "north_wall", "wall", 0.0, 0, 4, 0, 1, true);
+        rect_z(&t, "north_wall", "wall", 0.0, 0, 4, 2, 3, true);
+        rect_z(&t, "north_wall", "wall", 0.0, 0, 1.5, 1, 2, true);
+        rect_z(&t, "north_wall", "wall", 0.0, 2.5, 4, 1, 2, true);
         rect_z(&t, "window", om, 0.0, 1.5, 2.5, 1, 2, true);
     } else {
-        rect_z(&t, "south_wall", "wall", 0.0, 0, 4, 0, 3, true);
+        rect_z(&t, "north_wall", "wall", 0.0, 0, 4, 0, 3, true);
     }
-    rect_z(&t, "north_wall", "wall", 4.0, 0, 4, 0, 3, false);
+    rect_z(&t, "south_wall", "wall", 4.0, 0, 4, 0, 3, false);
     rect_x(&t, "west_wall", "wall", 0.0, 0, 4, 0, 3, true);
     rect_x(&t, "east_wall", "wall", 4.0, 0, 4, 0, 3, false);
     if (flags & PLATE)
@@ -498,6 +499,35 @@ static void test_sun_patch(void **state)
     rad_context_destroy(ctx);
 }
 
+/* Points outdoors see the sky over the hemisphere (the concentric-map
+ * quadrature): on the roof, the overcast sky's 7 pi Lz / 9 and the sun's
+ * E_n sin(altitude); on the outer face of a wall, the vertical
+ * illuminance of the overcast sky, Lz (pi/6 + 4/9) (its uniform third
+ * gives pi/6, its 2 cos Z / 3 gives 4/9), plus half of the ground's
+ * pi L_g = rho_g E_h,global. */
+static void test_outdoors(void **state)
+{
+    (void)state;
+    rad_context *ctx = context();
+    const char *json = "{\"sky\": {\"type\": \"cie-overcast\", \"zenith_luminance\": 8000}, "
+                       "\"sun\": {\"altitude\": 70, \"azimuth\": 180, \"normal_illuminance\": 50000}, "
+                       "\"ground\": {\"reflectance\": 0.2}, \"openings\": {\"surfaces\": [\"skylight\"]}}";
+    world w = make_world(ctx, ROOF, json);
+    double lz = 8000.0 / 179.0, eh = 7 * M_PI * lz / 9, en = 50000.0 / 179.0, sun = en * sin(70 * M_PI / 180);
+    double roof = daylight_at(&w, v3(1, 3, 1), v3(0, 1, 0));
+    if (rel(roof, eh + sun) > 1e-4)
+        fprintf(stderr, "roof %.8g, expected %.8g\n", roof, eh + sun);
+    assert_true(rel(roof, eh + sun) < 1e-4);
+    /* The south wall's outer face (north is -z), facing the sun. */
+    double ground = 0.2 * (eh + sun), wall = daylight_at(&w, v3(2, 1.5, 4), v3(0, 0, 1));
+    double want = lz * (M_PI / 6 + 4.0 / 9) + 0.5 * ground + en * cos(70 * M_PI / 180);
+    if (rel(wall, want) > 1e-4)
+        fprintf(stderr, "wall %.8g, expected %.8g\n", wall, want);
+    assert_true(rel(wall, want) < 1e-4);
+    free_world(&w);
+    rad_context_destroy(ctx);
+}
+
 /* DF = E / E_h at a grid point under the overcast sky, against the
  * quadrature: 1.7 % here. */
 static void test_daylight_factor(void **state)
@@ -700,6 +730,41 @@ static void test_example_file(void **state)
     rad_context_destroy(ctx);
 }
 
+/* The command: --daylight on a scene command takes the openings out of
+ * the view factors (the floor's row no longer sums to 1: the holes take
+ * the rest); a bad file is named with its key, exit status 1. */
+static void test_command(void **state)
+{
+    (void)state;
+    char out[1024], errors[1024], bad[1024];
+    snprintf(out, sizeof out, "%s/vf.json", cli_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
+    snprintf(bad, sizeof bad, "%s/bad.json", cli_workdir());
+    assert_int_equal(cli_run("viewfactors %s/daylight/room.obj --daylight %s/daylight/room.json -o %s",
+                             RAD_TEST_DATA, RAD_TEST_DATA, out), 0);
+    cJSON *vf = cli_read_json(out);
+    double row = 0;
+    const char *names[] = {"floor", "ceiling", "north_wall", "south_wall", "west_wall", "east_wall"};
+    for (int k = 0; k < 6; k++)
+        row += cli_vf_get(vf, "floor", names[k]);
+    /* F(floor -> skylight) = 0.0306 (a 1 x 1 m square 3 m over the 4 x 4 m
+     * floor's centre), F(floor -> window) is smaller. */
+    assert_true(row < 1.0 - 0.03 && row > 0.9);
+    char *written = cli_read_text(out);
+    assert_null(strstr(written, "\"skylight\""));
+    free(written);
+    cJSON_Delete(vf);
+    FILE *f = fopen(bad, "w");
+    assert_non_null(f);
+    fputs("{\"sky\": {\"type\": 3}, \"ground\": {\"reflectance\": \"grey\"}}", f);
+    fclose(f);
+    assert_int_equal(cli_run_capture(errors, "solve %s/daylight/room.obj --daylight %s -o %s/x.radsol", RAD_TEST_DATA,
+                                     bad, cli_workdir()), 1);
+    char *text = cli_read_text(errors);
+    assert_non_null(strstr(text, "bad.json: ground.reflectance: must be a number"));
+    free(text);
+}
+
 /* ---- threads ---- */
 
 typedef struct job {
@@ -799,12 +864,14 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_facade_opening),
         cmocka_unit_test(test_obstruction_halves),
         cmocka_unit_test(test_sun_patch),
+        cmocka_unit_test(test_outdoors),
         cmocka_unit_test(test_daylight_factor),
         cmocka_unit_test(test_flux_through_roof),
         cmocka_unit_test(test_daylight_only_solve),
         cmocka_unit_test(test_openings_leave_the_scene),
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_example_file),
+        cmocka_unit_test(test_command),
         cmocka_unit_test(test_threads_agree),
         cmocka_unit_test(cie171_5_9_roof_type1),
         cmocka_unit_test(cie171_5_9_roof_type3),
@@ -815,7 +882,14 @@ int main(int argc, char **argv)
         cmocka_unit_test(cie171_5_10_facade_type12),
         cmocka_unit_test(cie171_5_10_facade_overcast),
     };
-    if (argc > 1)
-        cmocka_set_test_filter(argv[1]); /* "cie171_*": the CIE 171 cases alone */
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    if (argc < 2)
+        return 2;
+    cli_set_binary(argv[1]);
+    if (argc > 2)
+        cmocka_set_test_filter(argv[2]); /* "cie171_*": the CIE 171 cases alone */
+    if (cli_setup("daylight") != 0)
+        return 1;
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    cli_teardown();
+    return failed;
 }
