@@ -361,7 +361,7 @@ static rad_result parse_tree(const reader *rd, const cJSON *root, rad_daylight *
     if (s[5] && (r = read_openings(rd, s[5], d)) != RAD_OK)
         return r;
     d->tolerance = 1e-4;
-    if (s[6] && (r = number(rd, "tolerance", s[6], 1e-9, 0.1, &d->tolerance)) != RAD_OK)
+    if (s[6] && (r = number(rd, "tolerance", s[6], 1e-6, 0.1, &d->tolerance)) != RAD_OK)
         return r;
     /* The material convention: polygons of a material named "opening". */
     for (size_t p = 0; p < rd->scene->polygon_count; p++)
