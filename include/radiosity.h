@@ -1334,8 +1334,9 @@ RAD_API rad_result rad_image_from_pixels(rad_context *ctx, int width, int height
  * "opening", leave the scene: they are holes the daylight enters through,
  * not elements, and block no ray; a surface left without polygons is
  * removed and the surfaces after it are renumbered.  The file is added to
- * the scene's inputs.  A second call replaces the daylight (openings
- * already removed stay removed).  Call it before any solution is made from
+ * the scene's inputs.  A second call replaces the sky, sun and ground;
+ * the openings of the first stay openings (their surfaces are gone, so
+ * the second file cannot name them).  Call it before any solution is made from
  * the scene, from one thread: it changes the scene.  Fails with
  * RAD_ERROR_IO (unreadable), RAD_ERROR_PARSE (a one-line message naming the
  * file and the key: "sky.json: sun.altitude: must be a number"),

@@ -624,7 +624,22 @@ static void test_openings_leave_the_scene(void **state)
             assert_true(rel(rad_scene_surface_area(scene, s), ceiling) < 1e-12);
     }
     assert_int_equal(scene->daylight->opening_count, 2);
-    rad_scene_destroy(scene);
+    /* A second file replaces the sky; the openings stay openings, and the
+     * second file cannot name them (their surfaces are gone). */
+    const char *again = "{\"sky\": {\"type\": 5}, \"openings\": {\"surfaces\": [\"window\"]}}";
+    assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "two.json", again, strlen(again)), RAD_ERROR_PARSE);
+    assert_int_equal(scene->daylight->sky.model, RAD_SKY_CIE_OVERCAST);
+    again = "{\"sky\": {\"type\": 5}}";
+    assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "two.json", again, strlen(again)), RAD_OK);
+    assert_int_equal(scene->daylight->opening_count, 2);
+    assert_int_equal(rad_scene_daylight_opening_count(scene), 2);
+    world w = {scene, NULL, NULL};
+    rad_mesh_options mo = {.mesh_size = 0.5};
+    assert_int_equal(rad_mesh_build(ctx, scene, &mo, &w.mesh), RAD_OK);
+    assert_int_equal(rad_vis_create(ctx, "embree", w.mesh, &w.vis), RAD_OK);
+    vec3 p = {2, 0, 2}, up = {0, 1, 0};
+    assert_true(rel(daylight_at(&w, p, up), roof_reference(&w, p, up) + facade_reference(&w, p, up)) < 1e-3);
+    free_world(&w);
     /* By material: the convention's "opening". */
     scene = room(ctx, ROOF | FACADE | OPENING_MATERIAL);
     const char *json = "{\"sky\": {\"type\": 3}}";

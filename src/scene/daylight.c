@@ -440,9 +440,13 @@ static rad_result collect_openings(rad_context *ctx, const rad_scene *scene, rad
             if (scene->polygons[p].vertex_count > biggest)
                 biggest = scene->polygons[p].vertex_count;
         }
-    d->openings = rad_alloc(ctx, RAD_MEM_SCENE, pieces + 1, sizeof *d->openings, "daylight: openings");
-    d->opening_names = rad_alloc(ctx, RAD_MEM_SCENE, scene->surface_count + 1, sizeof *d->opening_names,
-                                 "daylight: openings' names");
+    /* A daylight the scene had already: its openings stay openings. */
+    const rad_daylight *before = scene->daylight;
+    size_t before_pieces = before ? before->opening_count : 0, before_names = before ? before->opening_name_count : 0;
+    d->openings = rad_alloc(ctx, RAD_MEM_SCENE, before_pieces + pieces + 1, sizeof *d->openings,
+                            "daylight: openings");
+    d->opening_names = rad_alloc(ctx, RAD_MEM_SCENE, before_names + scene->surface_count + 1,
+                                 sizeof *d->opening_names, "daylight: openings' names");
     uint32_t *name_of = rad_alloc(ctx, RAD_MEM_SCENE, scene->surface_count + 1, sizeof *name_of, "daylight");
     vec3 *v = rad_alloc(ctx, RAD_MEM_SCENE, biggest, sizeof *v, "daylight: polygon");
     uint32_t *tri = rad_alloc(ctx, RAD_MEM_SCENE, 3 * biggest, sizeof *tri, "daylight: triangles");
@@ -452,6 +456,17 @@ static rad_result collect_openings(rad_context *ctx, const rad_scene *scene, rad
         r = RAD_ERROR_OUT_OF_MEMORY;
     for (size_t s = 0; r == RAD_OK && s < scene->surface_count; s++)
         name_of[s] = UINT32_MAX;
+    for (size_t k = 0; r == RAD_OK && k < before_names; k++) {
+        d->opening_names[k] = rad_strdup(ctx, RAD_MEM_SCENE, before->opening_names[k], "daylight: opening name");
+        if (!d->opening_names[k])
+            r = RAD_ERROR_OUT_OF_MEMORY;
+        else
+            d->opening_name_count++;
+    }
+    if (r == RAD_OK && before_pieces > 0) {
+        memcpy(d->openings, before->openings, before_pieces * sizeof *d->openings);
+        d->opening_count = before_pieces;
+    }
     for (size_t p = 0; r == RAD_OK && p < scene->polygon_count; p++) {
         if (!d->marked[p])
             continue;

@@ -93,7 +93,8 @@ rad_result rad_daylight_parse(rad_context *ctx, const rad_scene *scene, const ch
                               size_t size, rad_daylight **out);
 
 /* Move the openings out of `scene` into `daylight` and attach it
- * (scene->daylight; a previous one is freed): the marked polygons leave
+ * (scene->daylight; a previous one is freed, its openings carried over
+ * into `daylight`): the marked polygons leave
  * the scene, surfaces left with none are removed (the others renumbered),
  * the bounds are recomputed, the file is added to the scene's inputs.
  * Fails with RAD_ERROR_INVALID_SCENE when nothing would be left,
