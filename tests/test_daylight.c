@@ -525,6 +525,17 @@ static void test_outdoors(void **state)
         fprintf(stderr, "wall %.8g, expected %.8g\n", wall, want);
     assert_true(rel(wall, want) < 1e-4);
     free_world(&w);
+    /* A plane tilted by beta under the uniform sky, no ground: pi L (1 +
+     * cos beta) / 2, the horizon crossing the hemisphere's cells
+     * obliquely. */
+    json = "{\"sky\": {\"type\": 5, \"zenith_luminance\": 1000}, \"openings\": {\"surfaces\": [\"skylight\"]}}";
+    w = make_world(ctx, ROOF, json);
+    double beta = 50 * M_PI / 180, tilted = daylight_at(&w, v3(1, 3, 1), v3(sin(beta) * 0.6, cos(beta), sin(beta) * 0.8));
+    want = M_PI * 1000.0 / 179.0 * (1 + cos(beta)) / 2;
+    if (rel(tilted, want) > 1e-3)
+        fprintf(stderr, "tilted %.8g, expected %.8g (%.2g)\n", tilted, want, rel(tilted, want));
+    assert_true(rel(tilted, want) < 1e-3);
+    free_world(&w);
     rad_context_destroy(ctx);
 }
 

@@ -69,98 +69,139 @@ static double crossing(const rad_opening *o, vec3 origin, vec3 dir)
     return t;
 }
 
-/* Whether the ray from the point along dir reaches the environment with
- * `through` the first opening piece it crosses (NO_OPENING: crossing
- * none).  `any`: openings do not matter (the sun). */
-static bool escapes(const query *q, vec3 dir, size_t through, bool any)
+/* Whether the ray from the point along dir crosses opening piece
+ * `through` first (NO_OPENING: crosses none); `any`: openings do not
+ * matter (the sun). */
+static bool opening_first(const query *q, vec3 dir, size_t through, bool any)
 {
-    if (!any) {
-        const rad_daylight *d = q->day;
-        double limit = through == NO_OPENING ? INFINITY : crossing(&d->openings[through], q->origin, dir);
-        if (through != NO_OPENING && limit == INFINITY)
-            limit = v3_dot(d->openings[through].normal, v3_sub(d->openings[through].corner[0], q->origin)) /
-                    v3_dot(d->openings[through].normal, dir); /* on the piece's edge: its plane */
-        for (size_t k = 0; k < d->opening_count; k++) {
-            if (k == through)
-                continue;
-            double t = crossing(&d->openings[k], q->origin, dir);
-            if (t < limit || (through == NO_OPENING && t < INFINITY))
-                return false;
-        }
-    }
-    if (!q->vis)
+    if (any)
         return true;
-    rad_ray ray = {q->origin, dir, 0.0, INFINITY};
-    uint8_t blocked = 0;
-    q->vis->backend->occluded(q->vis->state, &ray, 1, &blocked);
-    return !blocked;
-}
-
-/* ---- through an opening ---- */
-
-/* The part's factor from the point (the part turned to face it) and its
- * contribution F L(centre) V(centre). */
-static double part_value(const query *q, const vec3 *region, uint32_t corners, size_t piece, double *factor)
-{
-    vec3 poly[4] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-    vec3 pn = q->day->openings[piece].normal;
-    bool flip = v3_dot(pn, v3_sub(q->point, region[0])) < 0.0;
-    for (uint32_t k = 0; k < corners; k++)
-        poly[k] = region[flip ? corners - 1 - k : k];
-    double f = rad_point_polygon_ff_front(q->point, q->normal, poly, corners);
-    *factor = f;
-    if (!(f > 0.0))
-        return 0.0;
-    vec3 c = {0, 0, 0};
-    for (uint32_t k = 0; k < corners; k++)
-        c = v3_add(c, region[k]);
-    vec3 dir = v3_normalize(v3_sub(v3_scale(c, 1.0 / corners), q->point));
-    double radiance = rad_daylight_radiance(q->day, dir);
-    if (radiance == 0.0 || !escapes(q, dir, piece, false))
-        return 0.0;
-    return M_PI * f * radiance; /* E = pi L F: F is the projected solid angle over pi */
-}
-
-/* Whether the rays toward the part's corners (pulled 1e-3 of the way to
- * its centre, inside it) all agree with the one toward its centre. */
-static bool part_visibility_uniform(const query *q, const vec3 *region, uint32_t corners, size_t piece)
-{
-    vec3 c = {0, 0, 0};
-    for (uint32_t k = 0; k < corners; k++)
-        c = v3_add(c, region[k]);
-    c = v3_scale(c, 1.0 / corners);
-    bool first = escapes(q, v3_normalize(v3_sub(c, q->point)), piece, false);
-    for (uint32_t k = 0; k < corners; k++) {
-        vec3 x = v3_lerp(region[k], c, 1e-3);
-        vec3 dir = v3_normalize(v3_sub(x, q->point));
-        bool lit = escapes(q, dir, piece, false);
-        /* Sky above and nothing below: the horizon is an edge too. */
-        if (lit != first || (rad_daylight_radiance(q->day, dir) == 0.0) !=
-                                (rad_daylight_radiance(q->day, v3_normalize(v3_sub(c, q->point))) == 0.0))
+    const rad_daylight *d = q->day;
+    double limit = through == NO_OPENING ? INFINITY : crossing(&d->openings[through], q->origin, dir);
+    if (through != NO_OPENING && limit == INFINITY)
+        limit = v3_dot(d->openings[through].normal, v3_sub(d->openings[through].corner[0], q->origin)) /
+                v3_dot(d->openings[through].normal, dir); /* on the piece's edge: its plane */
+    for (size_t k = 0; k < d->opening_count; k++) {
+        if (k == through)
+            continue;
+        double t = crossing(&d->openings[k], q->origin, dir);
+        if (t < limit || (through == NO_OPENING && t < INFINITY))
             return false;
     }
     return true;
 }
 
+enum { BATCH = 16 }; /* the ray backends' packet width */
+
+/* out[k]: whether the ray from the point along dirs[k] reaches the
+ * environment, `through` the first opening piece it crosses (as
+ * opening_first); rays with ask[k] false are not traced (out false).
+ * n <= BATCH: one packet for the ray backend. */
+static void escapes(const query *q, const vec3 *dirs, const bool *ask, size_t n, size_t through, bool any,
+                    bool *out)
+{
+    rad_ray rays[BATCH];
+    size_t which[BATCH], m = 0;
+    for (size_t k = 0; k < n; k++) {
+        out[k] = (!ask || ask[k]) && opening_first(q, dirs[k], through, any);
+        if (out[k] && q->vis) {
+            rays[m] = (rad_ray){q->origin, dirs[k], 0.0, INFINITY};
+            which[m++] = k;
+        }
+    }
+    if (m == 0)
+        return;
+    uint8_t blocked[BATCH];
+    q->vis->backend->occluded(q->vis->state, rays, m, blocked);
+    for (size_t k = 0; k < m; k++)
+        out[which[k]] = !blocked[k];
+}
+
+/* ---- through an opening ---- */
+
+/* What a part's shadow rays found: not yet asked, or all of them (centre
+ * and corners) agreeing on lit or on dark; parts inside a part whose rays
+ * agree are taken to agree too (the subdivision's resolution). */
+typedef enum part_sight { SIGHT_UNKNOWN = 0, SIGHT_LIT, SIGHT_DARK } part_sight;
+
+static vec3 part_centre(const vec3 *region, uint32_t corners)
+{
+    vec3 c = {0, 0, 0};
+    for (uint32_t k = 0; k < corners; k++)
+        c = v3_add(c, region[k]);
+    return v3_scale(c, 1.0 / corners);
+}
+
+/* Parts `regions[0..n)` (n <= 4) of opening piece `piece`: each one's
+ * factor from the point (the part turned to face it) and contribution
+ * pi F L(centre) V(centre) (E = pi L F, F the projected solid angle over
+ * pi); V from `sight` where known, else from shadow rays, traced as one
+ * batch. */
+static void part_values(const query *q, vec3 (*regions)[4], size_t n, uint32_t corners, size_t piece,
+                        part_sight sight, double *value, double *factor)
+{
+    vec3 pn = q->day->openings[piece].normal, dirs[4];
+    bool ask[4], lit[4];
+    for (size_t j = 0; j < n; j++) {
+        const vec3 *region = regions[j];
+        vec3 poly[4] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+        bool flip = v3_dot(pn, v3_sub(q->point, region[0])) < 0.0;
+        for (uint32_t k = 0; k < corners; k++)
+            poly[k] = region[flip ? corners - 1 - k : k];
+        factor[j] = rad_point_polygon_ff_front(q->point, q->normal, poly, corners);
+        dirs[j] = v3_normalize(v3_sub(part_centre(region, corners), q->point));
+        value[j] = factor[j] > 0.0 && sight != SIGHT_DARK ? M_PI * factor[j] * rad_daylight_radiance(q->day, dirs[j])
+                                                          : 0.0;
+        ask[j] = value[j] > 0.0 && sight == SIGHT_UNKNOWN;
+    }
+    if (sight != SIGHT_UNKNOWN)
+        return;
+    escapes(q, dirs, ask, n, piece, false, lit);
+    for (size_t j = 0; j < n; j++)
+        if (!lit[j])
+            value[j] = 0.0;
+}
+
+/* Whether the rays toward the part's corners (pulled 1e-3 of the way to
+ * its centre, inside it) and its centre agree, on reaching the
+ * environment and on seeing something there (the horizon is an edge too
+ * where there is no ground). */
+static part_sight part_visibility(const query *q, const vec3 *region, uint32_t corners, size_t piece)
+{
+    vec3 c = part_centre(region, corners), dirs[5];
+    bool ask[5], lit[5];
+    dirs[0] = v3_normalize(v3_sub(c, q->point));
+    for (uint32_t k = 0; k < corners; k++)
+        dirs[k + 1] = v3_normalize(v3_sub(v3_lerp(region[k], c, 1e-3), q->point));
+    for (uint32_t k = 0; k <= corners; k++)
+        ask[k] = rad_daylight_radiance(q->day, dirs[k]) > 0.0;
+    escapes(q, dirs, ask, corners + 1, piece, false, lit);
+    for (uint32_t k = 1; k <= corners; k++)
+        if (lit[k] != lit[0])
+            return SIGHT_UNKNOWN;
+    return lit[0] ? SIGHT_LIT : SIGHT_DARK;
+}
+
 static double integrate_part(const query *q, const vec3 *region, uint32_t corners, size_t piece, int depth,
-                             double value, double factor)
+                             double value, double factor, part_sight sight)
 {
     if (!(factor > 0.0) || depth >= PIECE_MAX_DEPTH)
         return value;
+    if (sight == SIGHT_UNKNOWN && depth >= PIECE_MIN_DEPTH)
+        sight = part_visibility(q, region, corners, piece);
+    if (sight == SIGHT_DARK)
+        return 0.0;
     vec3 sub[4][4];
     rad_ff_split4(region, corners, sub);
     double child[4], child_factor[4], sum = 0.0;
-    for (int k = 0; k < 4; k++) {
-        child[k] = part_value(q, sub[k], corners, piece, &child_factor[k]);
+    part_values(q, sub, 4, corners, piece, sight, child, child_factor);
+    for (int k = 0; k < 4; k++)
         sum += child[k];
-    }
-    bool settled = depth >= PIECE_MIN_DEPTH && fabs(sum - value) <= q->scale * factor &&
-                   part_visibility_uniform(q, region, corners, piece);
-    if (settled)
+    if (sight != SIGHT_UNKNOWN && fabs(sum - value) <= q->scale * factor)
         return sum;
     double total = 0.0;
     for (int k = 0; k < 4; k++)
-        total += integrate_part(q, sub[k], corners, piece, depth + 1, child[k], child_factor[k]);
+        total += integrate_part(q, sub[k], corners, piece, depth + 1, child[k], child_factor[k], sight);
     return total;
 }
 
@@ -181,33 +222,51 @@ static vec3 concentric(const query *q, vec3 t, vec3 b, double u, double v)
     return v3_normalize(v3_add(v3_add(v3_scale(t, x), v3_scale(b, y)), v3_scale(q->normal, z)));
 }
 
-static double cell_radiance(const query *q, vec3 t, vec3 b, double u, double v, bool *lit)
+/* L V toward (u[k], v[k]) of the square, n <= BATCH directions; lit[k]:
+ * the ray escapes through no opening to a non-zero radiance.  `known`:
+ * all are lit as `known_lit` says (no rays), else one batch of rays. */
+static void cell_radiance(const query *q, vec3 t, vec3 b, const double *u, const double *v, size_t n, bool known,
+                          bool known_lit, double *value, bool *lit)
 {
-    vec3 dir = concentric(q, t, b, u, v);
-    double radiance = rad_daylight_radiance(q->day, dir);
-    *lit = radiance > 0.0 && escapes(q, dir, NO_OPENING, false);
-    return *lit ? radiance : 0.0;
+    vec3 dirs[BATCH];
+    bool ask[BATCH];
+    for (size_t k = 0; k < n; k++) {
+        dirs[k] = concentric(q, t, b, u[k], v[k]);
+        value[k] = rad_daylight_radiance(q->day, dirs[k]);
+        ask[k] = value[k] > 0.0;
+        lit[k] = known_lit && ask[k];
+    }
+    if (!known)
+        escapes(q, dirs, ask, n, NO_OPENING, false, lit);
+    for (size_t k = 0; k < n; k++)
+        if (!lit[k])
+            value[k] = 0.0;
 }
 
-/* pi x the integral of L V over the cell [u, u + h] x [v, v + h]. */
-static double integrate_cell(const query *q, vec3 t, vec3 b, double u, double v, double h, int depth, double value)
+/* pi x the integral of L V over the cell [u, u + h] x [v, v + h], whose
+ * centre gave `value` (pi h^2 L V) and `centre_lit`.  The four children's
+ * centres are traced until their rays and the centre's agree; below such
+ * a cell its parts are taken to agree too (`known`), and only the sky's
+ * variation splits them further. */
+static double integrate_cell(const query *q, vec3 t, vec3 b, double u, double v, double h, int depth, double value,
+                             bool centre_lit, bool known)
 {
-    double child[4], sum = 0.0;
-    bool lit[4], centre_lit, uniform = true;
-    for (int k = 0; k < 4; k++) {
-        double cu = u + h * (0.25 + 0.5 * (k & 1)), cv = v + h * (0.25 + 0.5 * (k >> 1));
-        child[k] = M_PI * 0.25 * h * h * cell_radiance(q, t, b, cu, cv, &lit[k]);
-        sum += child[k];
-    }
-    cell_radiance(q, t, b, u + 0.5 * h, v + 0.5 * h, &centre_lit);
+    double cu[4], cv[4], child[4], sum = 0.0;
+    bool lit[4], uniform = true;
     for (int k = 0; k < 4; k++)
+        cu[k] = u + h * (0.25 + 0.5 * (k & 1)), cv[k] = v + h * (0.25 + 0.5 * (k >> 1));
+    cell_radiance(q, t, b, cu, cv, 4, known, centre_lit, child, lit);
+    for (int k = 0; k < 4; k++) {
+        child[k] *= M_PI * 0.25 * h * h;
+        sum += child[k];
         uniform &= lit[k] == centre_lit;
+    }
     if (depth >= CELL_MAX_DEPTH || (uniform && fabs(sum - value) <= q->scale * h * h))
         return sum;
     double total = 0.0;
     for (int k = 0; k < 4; k++)
-        total += integrate_cell(q, t, b, u + 0.5 * h * (k & 1), v + 0.5 * h * (k >> 1), 0.5 * h, depth + 1,
-                                child[k]);
+        total += integrate_cell(q, t, b, u + 0.5 * h * (k & 1), v + 0.5 * h * (k >> 1), 0.5 * h, depth + 1, child[k],
+                                lit[k], uniform);
     return total;
 }
 
@@ -216,12 +275,15 @@ static double through_no_opening(const query *q)
     vec3 n = q->normal;
     vec3 t = v3_normalize(v3_cross(fabs(n.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0), n)), b = v3_cross(n, t);
     double h = 1.0 / CELL_START, total = 0.0;
-    for (int i = 0; i < CELL_START; i++)
-        for (int j = 0; j < CELL_START; j++) {
-            bool lit;
-            double value = M_PI * h * h * cell_radiance(q, t, b, (i + 0.5) * h, (j + 0.5) * h, &lit);
-            total += integrate_cell(q, t, b, i * h, j * h, h, 0, value);
-        }
+    for (int i = 0; i < CELL_START; i++) {
+        double u[CELL_START], v[CELL_START], value[CELL_START];
+        bool lit[CELL_START];
+        for (int j = 0; j < CELL_START; j++)
+            u[j] = (i + 0.5) * h, v[j] = (j + 0.5) * h;
+        cell_radiance(q, t, b, u, v, CELL_START, false, false, value, lit);
+        for (int j = 0; j < CELL_START; j++)
+            total += integrate_cell(q, t, b, i * h, j * h, h, 0, M_PI * h * h * value[j], lit[j], false);
+    }
     return total;
 }
 
@@ -238,13 +300,18 @@ void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const
     double e = 0.0;
     for (size_t k = 0; k < day->opening_count; k++) {
         const rad_opening *o = &day->openings[k];
-        double factor, value = part_value(&q, o->corner, o->corner_count, k, &factor);
-        e += integrate_part(&q, o->corner, o->corner_count, k, 0, value, factor);
+        vec3 whole[1][4] = {{o->corner[0], o->corner[1], o->corner[2], o->corner[3]}};
+        double factor, value;
+        part_values(&q, whole, 1, o->corner_count, k, SIGHT_UNKNOWN, &value, &factor);
+        e += integrate_part(&q, o->corner, o->corner_count, k, 0, value, factor, SIGHT_UNKNOWN);
     }
     e += through_no_opening(&q);
     const rad_sky *sky = &day->sky;
     double cos_sun = v3_dot(n, sky->sun);
-    if (day->sun_normal > 0.0 && cos_sun > 0.0 && escapes(&q, sky->sun, NO_OPENING, true))
+    bool sunlit = false;
+    if (day->sun_normal > 0.0 && cos_sun > 0.0)
+        escapes(&q, &sky->sun, NULL, 1, NO_OPENING, true, &sunlit);
+    if (sunlit)
         e += day->sun_normal * cos_sun;
     out[0] = out[1] = out[2] = e;
 }
