@@ -36,6 +36,7 @@
 
 #include "cli_support.h"
 #include "radiosity.h"
+#include "core/core.h"
 #include "light/light.h"
 #include "light/sky.h"
 #include "vis/vis.h"
@@ -741,6 +742,37 @@ static void test_bad_files(void **state)
     rad_context_destroy(ctx);
 }
 
+/* Every allocation of loading a daylight file failing in turn (SQLite's
+ * sweep, as test_alloc): out of memory reported, the scene unchanged,
+ * nothing leaked (the scene category back where it was). */
+static void test_allocation_failures(void **state)
+{
+    (void)state;
+    rad_context *ctx = context();
+    /* Two openings, a sky that needs the sun. */
+    const char *json = "{\"sky\": {\"type\": 12}, \"sun\": {\"altitude\": 30, \"azimuth\": 10}, "
+                       "\"openings\": {\"surfaces\": [\"skylight\", \"window\"]}}";
+    rad_scene *scene = room(ctx, ROOF | FACADE);
+    uint64_t before = rad_memory_allocations(ctx);
+    assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "sky.json", json, strlen(json)), RAD_OK);
+    uint64_t count = rad_memory_allocations(ctx) - before;
+    rad_scene_destroy(scene);
+    assert_true(count > 5);
+    for (uint64_t k = 1; k <= count; k++) {
+        scene = room(ctx, ROOF | FACADE);
+        size_t in_use = rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), polygons = rad_scene_polygon_count(scene);
+        rad_context_fail_allocation(ctx, k);
+        rad_result r = rad_scene_daylight_load_memory(ctx, scene, "sky.json", json, strlen(json));
+        rad_context_fail_allocation(ctx, 0);
+        assert_int_equal(r, RAD_ERROR_OUT_OF_MEMORY);
+        assert_null(scene->daylight);
+        assert_int_equal(rad_scene_polygon_count(scene), polygons);
+        assert_int_equal(rad_memory_in_use(ctx, RAD_MEM_CATEGORIES), in_use);
+        rad_scene_destroy(scene);
+    }
+    rad_context_destroy(ctx);
+}
+
 /* The example file of docs/lighting.md, from disk: it is an input. */
 static void test_example_file(void **state)
 {
@@ -896,6 +928,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_daylight_only_solve),
         cmocka_unit_test(test_openings_leave_the_scene),
         cmocka_unit_test(test_bad_files),
+        cmocka_unit_test(test_allocation_failures),
         cmocka_unit_test(test_example_file),
         cmocka_unit_test(test_command),
         cmocka_unit_test(test_threads_agree),
