@@ -662,6 +662,44 @@ static void test_openings_leave_the_scene(void **state)
     rad_context_destroy(ctx);
 }
 
+/* An L-shaped opening (six corners: triangulated) hanging in the open
+ * over a floor: its pieces cover its area, and the sky the floor sees is
+ * the whole sky, 7 pi Lz / 9, whether through the opening or past it (no
+ * direction counted twice or missed). */
+static void test_opening_in_the_open(void **state)
+{
+    (void)state;
+    rad_context *ctx = context();
+    static const char obj[] = "o floor\nv 0 0 0\nv 0 0 4\nv 4 0 4\nv 4 0 0\nf 1 2 3 4\n"
+                              "o skylight\nv 1.5 3 1.5\nv 2.5 3 1.5\nv 2.5 3 2\nv 2 3 2\nv 2 3 2.5\nv 1.5 3 2.5\n"
+                              "f 5 6 7 8 9 10\n";
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_memory(ctx, "l.obj", obj, strlen(obj), NULL, 0, &scene), RAD_OK);
+    const char *json = "{\"sky\": {\"type\": \"cie-overcast\", \"zenith_luminance\": 5000}, "
+                       "\"openings\": {\"surfaces\": [\"skylight\"]}}";
+    assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "l.json", json, strlen(json)), RAD_OK);
+    const rad_daylight *day = scene->daylight;
+    assert_int_equal(day->opening_count, 4);
+    double area = 0;
+    for (size_t k = 0; k < day->opening_count; k++)
+        area += day->openings[k].area;
+    assert_true(rel(area, 0.75) < 1e-12);
+    world w = {scene, NULL, NULL};
+    rad_mesh_options mo = {.mesh_size = 0.5};
+    assert_int_equal(rad_mesh_build(ctx, scene, &mo, &w.mesh), RAD_OK);
+    assert_int_equal(rad_vis_create(ctx, "embree", w.mesh, &w.vis), RAD_OK);
+    double eh = 7 * M_PI * 5000.0 / 179.0 / 9;
+    static const double pts[][2] = {{2, 2}, {1.7, 2.2}, {0.5, 3.5}};
+    for (int k = 0; k < 3; k++) {
+        double e = daylight_at(&w, v3(pts[k][0], 0, pts[k][1]), v3(0, 1, 0));
+        if (rel(e, eh) > 1e-3)
+            fprintf(stderr, "under the open opening %.8g, the sky %.8g\n", e, eh);
+        assert_true(rel(e, eh) < 1e-3);
+    }
+    free_world(&w);
+    rad_context_destroy(ctx);
+}
+
 static void test_bad_files(void **state)
 {
     (void)state;
@@ -927,6 +965,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_flux_through_roof),
         cmocka_unit_test(test_daylight_only_solve),
         cmocka_unit_test(test_openings_leave_the_scene),
+        cmocka_unit_test(test_opening_in_the_open),
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_allocation_failures),
         cmocka_unit_test(test_example_file),

@@ -245,21 +245,26 @@ static void cell_radiance(const query *q, vec3 t, vec3 b, const double *u, const
 
 /* pi x the integral of L V over the cell [u, u + h] x [v, v + h], whose
  * centre gave `value` (pi h^2 L V) and `centre_lit`.  The four children's
- * centres are traced until their rays and the centre's agree; below such
- * a cell its parts are taken to agree too (`known`), and only the sky's
- * variation splits them further. */
+ * centres and the cell's corners are traced until their rays and the
+ * centre's agree; below such a cell its parts are taken to agree too
+ * (`known`), and only the sky's variation splits them further. */
 static double integrate_cell(const query *q, vec3 t, vec3 b, double u, double v, double h, int depth, double value,
                              bool centre_lit, bool known)
 {
-    double cu[4], cv[4], child[4], sum = 0.0;
-    bool lit[4], uniform = true;
-    for (int k = 0; k < 4; k++)
+    /* The children's centres, then (while the sight is not known) the
+     * cell's corners, 1e-3 of the side inside it. */
+    double cu[8], cv[8], child[8], sum = 0.0;
+    bool lit[8], uniform = true;
+    for (int k = 0; k < 4; k++) {
         cu[k] = u + h * (0.25 + 0.5 * (k & 1)), cv[k] = v + h * (0.25 + 0.5 * (k >> 1));
-    cell_radiance(q, t, b, cu, cv, 4, known, centre_lit, child, lit);
+        cu[k + 4] = u + h * (k & 1 ? 0.999 : 0.001), cv[k + 4] = v + h * (k >> 1 ? 0.999 : 0.001);
+    }
+    cell_radiance(q, t, b, cu, cv, known ? 4 : 8, known, centre_lit, child, lit);
+    for (int k = 0; k < (known ? 4 : 8); k++)
+        uniform &= lit[k] == centre_lit;
     for (int k = 0; k < 4; k++) {
         child[k] *= M_PI * 0.25 * h * h;
         sum += child[k];
-        uniform &= lit[k] == centre_lit;
     }
     if (depth >= CELL_MAX_DEPTH || (uniform && fabs(sum - value) <= q->scale * h * h))
         return sum;
