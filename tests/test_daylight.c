@@ -36,7 +36,7 @@
 
 #include "cli_support.h"
 #include "radiosity.h"
-#include "core/core.h"
+#include "api/solution.h"
 #include "light/light.h"
 #include "light/sky.h"
 #include "vis/vis.h"
@@ -612,6 +612,75 @@ static void test_daylight_only_solve(void **state)
     rad_context_destroy(ctx);
 }
 
+/* The room lit by daylight alone, solved here on the engine's own mesh
+ * and form factors: each element's direct daylight H_i (its mean,
+ * rad_light_element_irradiance) emits rho_i H_i, and B = rho H + rho F B
+ * by Jacobi to 1e-12.  Energy: the power that came in through the roof
+ * opening, sum A_i H_i, (a) is A E_h (the elements' means, 1 % on this
+ * mesh) and (b) is all absorbed, sum A_i (1 - rho_i) (H_i + sum_j F_ij
+ * B_j), or leaves through the openings again, sum A_i B_i (1 - sum_j
+ * F_ij) (1e-9). */
+static void test_daylight_room_energy(void **state)
+{
+    (void)state;
+    rad_context *ctx = context();
+    rad_scene *scene = room(ctx, ROOF);
+    const char *json = "{\"sky\": {\"type\": \"cie-overcast\"}, \"openings\": {\"surfaces\": [\"skylight\"]}}";
+    assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "sky.json", json, strlen(json)), RAD_OK);
+    rad_solution *sol = NULL;
+    rad_options o = {.mesh_size = 0.25, .form_factors = "analytic", .solver = "gauss-seidel"};
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &sol), RAD_OK);
+    const rad_solution_view *v = &sol->view;
+    assert_non_null(v->F);
+    size_t n = v->n;
+    double *h = calloc(n, sizeof *h), *b = calloc(n, sizeof *b), *next = calloc(n, sizeof *next);
+    assert_true(h && b && next);
+    double in = 0;
+    for (size_t i = 0; i < n; i++) {
+        double e[3];
+        rad_light_element_irradiance(scene, v->mesh, v->vis, i, e);
+        h[i] = e[1];
+        in += v->area[i] * h[i];
+    }
+    double eh[3];
+    rad_daylight_sky_horizontal(scene, eh);
+    assert_true(rel(in, 1.0 * eh[1]) < 0.01); /* 1.4e-3 with centroid means */
+    for (int it = 0; it < 2000; it++) {
+        double change = 0, size = 0;
+        for (size_t i = 0; i < n; i++) {
+            double g = h[i];
+            for (size_t j = 0; j < n; j++)
+                g += v->F[i * n + j] * b[j];
+            next[i] = v->reflectance[3 * i + 1] * g;
+            change = fmax(change, fabs(next[i] - b[i]));
+            size = fmax(size, next[i]);
+        }
+        memcpy(b, next, n * sizeof *b);
+        if (change <= 1e-14 * size)
+            break;
+    }
+    double absorbed = 0, out = 0;
+    for (size_t i = 0; i < n; i++) {
+        double g = h[i], row = 0;
+        for (size_t j = 0; j < n; j++)
+            g += v->F[i * n + j] * b[j], row += v->F[i * n + j];
+        absorbed += v->area[i] * (1 - v->reflectance[3 * i + 1]) * g;
+        out += v->area[i] * b[i] * (1 - row);
+        assert_true(b[i] >= 0);
+    }
+    /* About 1 % goes back out through the skylight. */
+    assert_true(out > 0.005 * in && absorbed > 0.5 * in);
+    if (rel(absorbed + out, in) > 1e-9)
+        fprintf(stderr, "in %.12g W, absorbed %.12g W, out %.12g W\n", in, absorbed, out);
+    assert_true(rel(absorbed + out, in) < 1e-9);
+    free(h);
+    free(b);
+    free(next);
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* ---- the file ---- */
 
 static void test_openings_leave_the_scene(void **state)
@@ -964,6 +1033,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_daylight_factor),
         cmocka_unit_test(test_flux_through_roof),
         cmocka_unit_test(test_daylight_only_solve),
+        cmocka_unit_test(test_daylight_room_energy),
         cmocka_unit_test(test_openings_leave_the_scene),
         cmocka_unit_test(test_opening_in_the_open),
         cmocka_unit_test(test_bad_files),
