@@ -20,7 +20,7 @@ double rad_daylight_radiance(const rad_daylight *daylight, vec3 d);
  * Gauss-Legendre (`order` nodes towards the horizon, 4 x order azimuths,
  * trapezoidal, periodic) in polar coordinates about the sun, where the
  * indicatrix has its cusp: the integrand is smooth in them up to the
- * horizon.  order 0: 64, which agrees with 128 to 1e-12 for every type
+ * horizon.  order 0: 64, which agrees with 128 to 2.4e-11 for every type
  * (tests/test_daylight.c).  Cannot fail. */
 double rad_sky_relative_horizontal(const rad_sky *sky, int order);
 
