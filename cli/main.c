@@ -468,12 +468,24 @@ static int stream_view_factors(rad_context *ctx, const settings *s, const rad_sc
     return cancel_signal ? interrupted_status() : 0;
 }
 
+/* The scene file, or the built-in Cornell box, with what the flags add to
+ * it (--daylight).  On failure *scene is NULL, the message in ctx. */
+static rad_result load_scene(rad_context *ctx, const settings *s, rad_scene **scene)
+{
+    rad_result r = s->scene_path ? rad_scene_load_file(ctx, s->scene_path, scene)
+                                 : rad_scene_create_cornell_box(ctx, scene);
+    if (r == RAD_OK && s->daylight && (r = rad_scene_daylight_load_file(ctx, *scene, s->daylight)) != RAD_OK) {
+        rad_scene_destroy(*scene);
+        *scene = NULL;
+    }
+    return r;
+}
+
 /* Ranks above 0: load the scene, make their blocks, send them to rank 0. */
 static int stream_rank(rad_context *ctx, const settings *s, const rad_stream_ranks *ranks)
 {
     rad_scene *scene = NULL;
-    rad_result r = s->scene_path ? rad_scene_load_file(ctx, s->scene_path, &scene)
-                                 : rad_scene_create_cornell_box(ctx, &scene);
+    rad_result r = load_scene(ctx, s, &scene);
     rad_stream_options so = {s->block_rows, s->element_level, 0, ranks, NULL};
     rad_stream_stats st;
     if (r == RAD_OK)
@@ -651,11 +663,16 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
         status = EXIT_USAGE;
         goto done;
     }
+    if (saved && s.daylight) {
+        fprintf(stderr, "radiosity: --daylight: %s is a solution file, solved already with its own light\n",
+                s.scene_path);
+        status = EXIT_USAGE;
+        goto done;
+    }
     if (saved)
         r = rad_solution_load_file(ctx, s.scene_path, &scene, &sol);
     else
-        r = s.scene_path ? rad_scene_load_file(ctx, s.scene_path, &scene)
-                         : rad_scene_create_cornell_box(ctx, &scene);
+        r = load_scene(ctx, &s, &scene);
     if (r != RAD_OK) {
         status = fail(ctx, r);
         goto done;

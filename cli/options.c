@@ -118,6 +118,9 @@ static const cli_flag FLAGS[] = {
     {"bc", 0, "FILE.json", CLI_THERMAL, OWN(bc, RAD_OPTION_STRING),
      .own.help = "boundary conditions: each surface's emissivity and temperature, heat flux or adiabatic, "
                  "and the environment temperature (docs/thermal.md); required"},
+    {"daylight", 0, "FILE.json", RV, OWN(daylight, RAD_OPTION_STRING),
+     .own.help = "light the scene by daylight: a CIE sky, the sun, the ground, entering through the surfaces "
+                 "the file names as openings, which leave the scene (docs/lighting.md \"Daylight\")"},
     {"gebhart", 0, "FILE", CLI_THERMAL, OWN(gebhart, RAD_OPTION_STRING),
      .own.help = "also write the Gebhart factors between surfaces: .csv or .json"},
     {"output", 'o', "FILE", CLI_VIEW, OWN(output, RAD_OPTION_STRING),

@@ -73,6 +73,7 @@ typedef struct cli_settings {
     const char *keys;         /* view: keys the window presses itself */
     char *const *photometry_files; /* photometry: the files (into argv, consecutive) */
     size_t photometry_file_count;
+    const char *daylight;     /* --daylight: the daylight file (sky, sun, openings), or NULL */
 } cli_settings;
 
 /* Where a flag's value goes. */

@@ -1356,6 +1356,49 @@ typedef struct rad_photometry_info {
  * RAD_ERROR_INVALID_ARGUMENT. */
 RAD_API rad_result rad_photometry_info_read(rad_context *ctx, const char *path, rad_photometry_info *out);
 
+/* ------------------------------------------------------------------------
+ * Daylight: a CIE sky, the sun and the ground, entering through openings
+ * (docs/lighting.md "Daylight").
+ *
+ *     rad_scene_load_file(ctx, "room.obj", &scene);
+ *     rad_scene_daylight_load_file(ctx, scene, "sky.json");
+ *     rad_solution_create(ctx, scene, NULL, &sol);      lit by daylight only
+ *
+ * Luminance in cd/m^2 and illuminance in lux enter as L / 179 W/(m^2 sr)
+ * and E / 179 W/m^2 on each channel (docs/units.md "Photometry").
+ * ---------------------------------------------------------------------- */
+
+/* Give `scene` the daylight of a daylight file (JSON: the sky type 1-15 of
+ * CIE S 011 or "cie-overcast", its zenith luminance or diffuse horizontal
+ * illuminance, the sun, up and north, the ground, the openings).  The
+ * surfaces the file names as openings, and the polygons of a material named
+ * "opening", leave the scene: they are holes the daylight enters through,
+ * not elements, and block no ray; a surface left without polygons is
+ * removed and the surfaces after it are renumbered.  The file is added to
+ * the scene's inputs.  A second call replaces the sky, sun and ground;
+ * the openings of the first stay openings (their surfaces are gone, so
+ * the second file cannot name them).  Call it before any solution is made from
+ * the scene, from one thread: it changes the scene.  Fails with
+ * RAD_ERROR_IO (unreadable), RAD_ERROR_PARSE (a one-line message naming the
+ * file and the key: "sky.json: sun.altitude: must be a number"),
+ * RAD_ERROR_INVALID_SCENE (every polygon an opening),
+ * RAD_ERROR_OUT_OF_MEMORY; on failure the scene is unchanged.  NULL ctx,
+ * scene or path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_daylight_load_file(rad_context *ctx, rad_scene *scene, const char *path);
+/* The same from `size` bytes at `data` (read during the call only);
+ * `name` stands for the file in messages and is not added to the inputs.
+ * NULL ctx, scene or name, or NULL data with a non-zero size:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_daylight_load_memory(rad_context *ctx, rad_scene *scene, const char *name,
+                                                  const void *data, size_t size);
+/* The horizontal illuminance (lux) of the scene's sky unobstructed, the
+ * sun excluded: the daylight factor's denominator (DF = E / this).  0 for
+ * a NULL scene or one without daylight. */
+RAD_API double rad_scene_daylight_sky_illuminance(const rad_scene *scene);
+/* How many surfaces became openings.  0 for a NULL scene or one without
+ * daylight. */
+RAD_API size_t rad_scene_daylight_opening_count(const rad_scene *scene);
+
 #ifdef __cplusplus
 }
 #endif

@@ -21,6 +21,7 @@
  */
 #include "scene/scene.h"
 #include "scene/photometry.h"
+#include "scene/daylight.h"
 
 #include <limits.h>
 #include <math.h>
@@ -793,6 +794,7 @@ void rad_scene_destroy(rad_scene *scene)
     for (size_t i = 0; i < scene->luminaire_count; i++)
         rad_free(scene->luminaires[i].name);
     rad_free(scene->luminaires);
+    rad_daylight_free(scene->daylight);
     rad_free(scene);
 }
 
