@@ -9,6 +9,7 @@
 #include "api/solution.h"
 #include "strategy/saved.h"
 #include "solve/vpl.h"
+#include "light/light.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -167,9 +168,10 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     if (!ctx || !s)
         return rad_null_argument(ctx, __func__);
     rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
-    if (!rad_scene_has_emitter(s->scene))
+    if (!rad_scene_has_emitter(s->scene) && !rad_light_present(s->scene))
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
-                        "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
+                        "%s: the scene has no emitter (no material with Ke > 0, no luminaire, no daylight): "
+                        "nothing to light it",
                         s->scene->source);
     rad_step_hook hook = {NULL, s, s->options.on_step != NULL};
     if (s->options.record_history || s->options.on_step)

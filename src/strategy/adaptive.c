@@ -272,6 +272,11 @@ static rad_result remesh(rad_context *ctx, rad_adaptive *a, rad_meshed *m)
         r = rad_vis_create(ctx, m->options->visibility, mesh, &vis);
     if (r == RAD_OK)
         r = rad_elements_create(ctx, m->scene, mesh, &elements);
+    if (r == RAD_OK) {
+        r = rad_elements_add_light(ctx, m->scene, mesh, vis, &elements);
+        if (r != RAD_OK)
+            rad_elements_free(&elements);
+    }
     rad_free(en.leaves);
     rad_free(en.tree);
     rad_free(root);
