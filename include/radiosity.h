@@ -364,7 +364,9 @@ typedef struct rad_options {
 
     const char *solver;           /* NULL = "hierarchical", or "gauss-seidel" when mesh_size,
                                      target_elements, form_factors or an adaptive_* field is
-                                     set (options of the uniform mesh and the matrix) */
+                                     set (options of the uniform mesh and the matrix), or the
+                                     scene has luminaires or daylight (which hierarchical
+                                     refuses) */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */

@@ -739,6 +739,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
                                               ((const import_files *)(const void *)io->UserData)->log != NULL);
         if (checked != RAD_OK) {
             cJSON_Delete(json);
+            rad_free(facts.luminaires);
             return checked;
         }
     }
@@ -746,6 +747,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
     struct aiPropertyStore *properties = aiCreatePropertyStore();
     if (!properties) {
         cJSON_Delete(json);
+        rad_free(facts.luminaires);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
     /* A skeleton without meshes must not turn into stick-figure polygons. */
@@ -759,6 +761,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
     if (!ai) {
         const char *why = aiGetErrorString();
         cJSON_Delete(json);
+        rad_free(facts.luminaires);
         return rad_fail(ctx, RAD_ERROR_PARSE, "%s: %s", name,
                         why && *why ? why : "assimp could not read it");
     }
@@ -811,6 +814,7 @@ done:
     rad_free(cv.face);
     aiReleaseImport(ai);
     cJSON_Delete(json);
+    rad_free(facts.luminaires);
     return r;
 }
 
