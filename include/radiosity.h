@@ -1317,6 +1317,47 @@ RAD_API size_t rad_solution_link_count(const rad_solution *solution);
 RAD_API rad_result rad_image_from_pixels(rad_context *ctx, int width, int height, const float *rgb,
                                          rad_image **out);
 
+/* ------------------------------------------------------------------------
+ * Photometric files: a luminaire's summary (IES LM-63, EULUMDAT)
+ * ---------------------------------------------------------------------- */
+
+/* What a luminaire's photometric file holds, summarised (docs/lighting.md,
+ * "Photometric files"): a plain struct of values, nothing to free. */
+typedef struct rad_photometry_info {
+    char format[16];          /* "IES" or "EULUMDAT" */
+    char version[24];         /* "LM-63-1986" .. "LM-63-2019", "EULUMDAT" */
+    char label[128];          /* the luminaire's name in the file (cut to fit), may be "" */
+    int type;                 /* the file's photometric type: 1 C, 2 B, 3 A */
+    char symmetry[64];        /* "quadrant (C 0-90)", "C0-C180 plane (Isym 2)", ... */
+    size_t horizontal_count;  /* the file's horizontal angles (EULUMDAT: C planes listed) */
+    size_t vertical_count;    /* the file's vertical angles (EULUMDAT: gamma angles) */
+    double horizontal_min, horizontal_max; /* degrees, as the file gives them */
+    double vertical_min, vertical_max;     /* degrees, as the file gives them */
+    double max_candela;       /* cd, multipliers applied */
+    double max_c, max_gamma;  /* degrees: its direction in the luminaire's C-gamma frame */
+    double flux;              /* lm: the interpolated distribution integrated over the sphere */
+    double rated_lumens;      /* lm: the lamps' rated flux; 0 for absolute photometry */
+    double lor;               /* 1: flux / rated_lumens; 0 without rated lumens */
+    double stated_lor;        /* 1: the file's own light output ratio (EULUMDAT LORL); -1 none */
+    double width, length, height; /* m: the luminous opening's extents along y, x, z */
+    char shape[32];           /* "point", "rectangle", "ellipse", ... (docs/lighting.md) */
+    char tilt[64];            /* "none", "include" or the tilt file's name */
+    size_t tilt_count;        /* tilt angles given; 0 without tilt data */
+    double input_watts;       /* W: the file's input power; 0 if not given */
+} rad_photometry_info;
+
+/* Read the photometric file at `path`, an IES LM-63 (1986 to 2019) or
+ * EULUMDAT file told by its content, and summarise it in *out.  Fails with
+ * RAD_ERROR_IO (unreadable; a TILT file outside the file's folder unless
+ * the context allows reading outside it), RAD_ERROR_PARSE (malformed: the
+ * message names the file and line, "lamp.ies:12: expected 37 vertical
+ * angles, found 12 (the file ends)"), RAD_ERROR_OUT_OF_MEMORY; *out is
+ * zeroed on failure.  A file whose integrated flux disagrees with its
+ * stated light output ratio by more than 2 % is read, with a warning
+ * (rad_context_options.on_warning).  NULL ctx, path or out:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_photometry_info_read(rad_context *ctx, const char *path, rad_photometry_info *out);
+
 #ifdef __cplusplus
 }
 #endif
