@@ -97,11 +97,11 @@ static rad_result test_loader(rad_context *ctx, const char *path, void *user, ra
     } else if (strcmp(base, "lambert.ies") == 0) { /* 0.6 m long, 0.3 m wide */
         p = cos_power(ctx, path, 1200.0, 1.0);
         if (p)
-            p->length = 0.6, p->width = 0.3;
+            p->length = 0.6, p->width = 0.3, p->shape = RAD_OPENING_RECTANGLE;
     } else if (strcmp(base, "disk.ies") == 0) { /* round, 0.4 m across */
         p = cos_power(ctx, path, 1200.0, 1.0);
         if (p)
-            p->length = -0.4, p->width = -0.4;
+            p->length = 0.4, p->width = 0.4, p->shape = RAD_OPENING_ELLIPSE;
     } else if (strcmp(base, "lobe.ies") == 0) {
         p = lobe(ctx, path);
     } else if (strcmp(base, "dark.ies") == 0) {

@@ -28,9 +28,12 @@
  *        +------------------------> x (C = 0)      l (length, along x)
  *
  * The opening lies in the luminaire's x-y plane through the photometric
- * centre; the height only enters the luminous size that decides point or
- * area (the largest of width, length and height).  A zero-size opening
- * stays a point at every distance.
+ * centre (a rectangle l x w, or an ellipse for the round shapes of
+ * photometry.h; a box or cylinder by its horizontal section), except the
+ * vertical discs, which stand in the y-z or x-z plane; the height of the
+ * other shapes only enters the luminous size that decides point or area
+ * (the largest of width, length and height).  An opening without area (a
+ * point, a line) stays a point at every distance.
  */
 #include "light/light.h"
 
@@ -138,8 +141,8 @@ static void piece_geometry(bool round, double half_l, double half_w, const piece
  * r^2 and phi, in which the area is uniform), a quarter of its share
  * each.  The midpoint alone errs by O((size / d)^2), up to 2 % at grazing
  * incidence beside the opening; the Gauss points by O((size / d)^4). */
-static void leaf(pending *q, const rad_luminaire *L, const rad_photometry *ph, bool round, double half_l,
-                 double half_w, const piece *s, double share, vec3 p, vec3 n, double eps)
+static void leaf(pending *q, const rad_luminaire *L, const rad_photometry *ph, vec3 au, vec3 av, bool round,
+                 double half_l, double half_w, const piece *s, double share, vec3 p, vec3 n, double eps)
 {
     static const double at[2] = {0.21132486540518711775, 0.78867513459481288225}; /* (1 -+ 1/sqrt 3) / 2 */
     for (int i = 0; i < 2; i++)
@@ -153,32 +156,50 @@ static void leaf(pending *q, const rad_luminaire *L, const rad_photometry *ph, b
                 double phi = s->b0 + at[j] * (s->b1 - s->b0);
                 x = half_l * r * cos(phi), y = half_w * r * sin(phi);
             }
-            vec3 centre = v3_add(L->position, v3_add(v3_scale(L->axis[0], x), v3_scale(L->axis[1], y)));
+            vec3 centre = v3_add(L->position, v3_add(v3_scale(au, x), v3_scale(av, y)));
             point_source(q, L, ph, 0.25 * share, centre, p, n, eps);
         }
+}
+
+/* The plane of a luminaire's opening: two of its axes, the extents along
+ * them (m) and whether the opening is round (photometry.h's shapes): the
+ * horizontal opening, or the bounding box's bottom, for all but the
+ * vertical discs, which stand in the y-z or x-z plane. */
+typedef struct opening {
+    int u, v;             /* indices into rad_luminaire.axis */
+    double extent_u, extent_v;
+    bool round;
+} opening;
+
+static opening opening_of(const rad_photometry *ph)
+{
+    opening o = {0, 1, ph->length, ph->width, false};
+    switch (ph->shape) {
+    case RAD_OPENING_ELLIPSE:
+    case RAD_OPENING_VERTICAL_CYLINDER:
+    case RAD_OPENING_ELLIPSOID: o.round = true; break;
+    case RAD_OPENING_VERTICAL_ELLIPSE_X: o = (opening){1, 2, ph->width, ph->height, true}; break;
+    case RAD_OPENING_VERTICAL_ELLIPSE_Y: o = (opening){0, 2, ph->length, ph->height, true}; break;
+    default: break;
+    }
+    return o;
 }
 
 /* One luminaire's irradiance at p into q. */
 static void one_luminaire(pending *q, const rad_scene *scene, const rad_luminaire *L, vec3 p, vec3 n, double eps)
 {
     const rad_photometry *ph = scene->photometries[L->photometry];
-    /* IES LM-63: a negative width or length is a round opening of that
-     * diameter (both given: an ellipse; one zero: a disk of the other). */
-    bool round = ph->width < 0.0 || ph->length < 0.0;
-    double length = fabs(ph->length), width = fabs(ph->width), height = fabs(ph->height);
-    if (round) {
-        if (length == 0.0)
-            length = width;
-        if (width == 0.0)
-            width = length;
-    }
-    double size = fmax(fmax(length, width), height);
+    opening o = opening_of(ph);
+    double size = fmax(fmax(ph->length, ph->width), ph->height);
     double d = v3_length(v3_sub(L->position, p));
-    if (size == 0.0 || d > FAR_FACTOR * size || length == 0.0 || width == 0.0) {
+    if (!(size > 0.0) || d > FAR_FACTOR * size || !(o.extent_u > 0.0) || !(o.extent_v > 0.0)) {
         point_source(q, L, ph, 1.0, L->position, p, n, eps);
         return;
     }
-    double half_l = 0.5 * length, half_w = 0.5 * width, total = round ? M_PI * half_l * half_w : length * width;
+    bool round = o.round;
+    double half_l = 0.5 * o.extent_u, half_w = 0.5 * o.extent_v;
+    double total = round ? M_PI * half_l * half_w : o.extent_u * o.extent_v;
+    vec3 au = L->axis[o.u], av = L->axis[o.v];
     piece stack[4 * MAX_DEPTH + 8];
     size_t top = 0;
     stack[top++] = round ? (piece){0.0, 1.0, 0.0, 2.0 * M_PI, 0} : (piece){-half_l, half_l, -half_w, half_w, 0};
@@ -186,12 +207,12 @@ static void one_luminaire(pending *q, const rad_scene *scene, const rad_luminair
         piece s = stack[--top];
         double x, y, area, sub;
         piece_geometry(round, half_l, half_w, &s, &x, &y, &area, &sub);
-        vec3 centre = v3_add(L->position, v3_add(v3_scale(L->axis[0], x), v3_scale(L->axis[1], y)));
+        vec3 centre = v3_add(L->position, v3_add(v3_scale(au, x), v3_scale(av, y)));
         /* The root piece always splits once: the luminous size (with the
          * height) already said it is near. */
         bool near = s.depth == 0 || v3_length(v3_sub(centre, p)) <= FAR_FACTOR * sub;
         if (!near || s.depth >= MAX_DEPTH) {
-            leaf(q, L, ph, round, half_l, half_w, &s, area / total, p, n, eps);
+            leaf(q, L, ph, au, av, round, half_l, half_w, &s, area / total, p, n, eps);
             continue;
         }
         /* Split in two along the longer side (rectangles), or in r and phi

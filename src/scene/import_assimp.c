@@ -52,6 +52,7 @@
  * (a FIFO, /dev/zero) stops there (import_input.c).
  */
 #include "scene/import_internal.h"
+#include "scene/layout.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -804,6 +805,22 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
         rad_scene_builder_camera(cv.builder, &cv.positions->camera); /* an OBJ's camera comment */
     r = rad_scene_builder_finish(cv.builder, out);
     cv.builder = NULL;
+    if (r == RAD_OK && facts.luminaire_count > 0) {
+        /* Luminaires placed by nodes' extras (layout.c): their files are
+         * read beside the glTF, so only when it was read from a file. */
+        if (cv.log)
+            r = rad_layout_place_gltf(ctx, *out, name, facts.luminaires, facts.luminaire_count,
+                                      rad_layout_load_photometry, NULL);
+        else
+            rad_warn(ctx, "%s: %zu node%s place%s a luminaire (extras.luminaire), which only a glTF read "
+                     "from a file places (its photometric files lie beside it)",
+                     name, facts.luminaire_count, facts.luminaire_count == 1 ? "" : "s",
+                     facts.luminaire_count == 1 ? "s" : "");
+        if (r != RAD_OK) {
+            rad_scene_destroy(*out);
+            *out = NULL;
+        }
+    }
 
 done:
     rad_scene_builder_destroy(cv.builder);

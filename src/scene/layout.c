@@ -39,6 +39,12 @@ static const double DEG = 3.14159265358979323846 / 180.0;
  * many times over; an array's count beyond it is a typing error. */
 #define MAX_LUMINAIRES 1000000
 
+rad_result rad_layout_load_photometry(rad_context *ctx, const char *path, void *user, rad_photometry **out)
+{
+    (void)user;
+    return rad_photometry_load(ctx, path, out);
+}
+
 /* ---- frames ---- */
 
 static vec3 rotate(vec3 v, vec3 k, double c, double s)

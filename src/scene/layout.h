@@ -18,6 +18,11 @@ struct cJSON;
 typedef rad_result (*rad_photometry_loader)(rad_context *ctx, const char *path, void *user,
                                             struct rad_photometry **out);
 
+/* The loader of files: rad_photometry_load (IES LM-63, EULUMDAT; user
+ * unused). */
+rad_result rad_layout_load_photometry(rad_context *ctx, const char *path, void *user,
+                                      struct rad_photometry **out);
+
 /* The luminaire's frame (axis[0] = x, C = 0; axis[1] = y, C = 90;
  * axis[2] = z, the nadir being -z) for a nadir along `aim` (any length but
  * zero) in a world whose up is `up` (unit), turned by `spin_degrees` about
