@@ -615,6 +615,68 @@ static void layout_errors(void **state)
     rad_context_destroy(ctx);
 }
 
+/* The files of tests/data/luminaires through the public calls: an IES
+ * file read once, placed by a layout and by a glTF node. */
+static void layout_and_gltf_files(void **state)
+{
+    (void)state;
+    rad_context *ctx = new_context(2);
+    rad_scene *scene = NULL;
+    assert_int_equal(rad_scene_load_file(ctx, RAD_TEST_DATA "/luminaires/room.obj", &scene), RAD_OK);
+    assert_int_equal(rad_scene_load_luminaires(ctx, scene, RAD_TEST_DATA "/luminaires/layout.json"), RAD_OK);
+    assert_int_equal(rad_scene_luminaire_count(scene), 5);
+    assert_int_equal(scene->photometry_count, 1);
+    assert_string_equal(rad_scene_luminaire_name(scene, 3), "grid[1,1]");
+    assert_string_equal(rad_scene_luminaire_name(scene, 4), "wallwash");
+    assert_null(rad_scene_luminaire_name(scene, 5));
+    /* The file's 1000 lm (I = 1000 / pi cos gamma, tabulated every 10
+     * degrees: the bilinear table's flux is 0.25 % below). */
+    double flux = scene->photometries[0]->flux;
+    assert_close(flux, 1000.0, 3e-3, "the downlight's flux");
+    assert_close(rad_scene_luminaire_flux(scene, 0), 0.8 * flux, 1e-12, "the layout's llf");
+    assert_close(rad_scene_luminaire_flux(scene, 4), flux, 1e-12, "the entry's llf");
+    double position[3], axes[9];
+    assert_true(rad_scene_luminaire_placement(scene, 3, position, axes));
+    assert_true(position[0] == 3.0 && position[1] == 3.0 && position[2] == 2.99);
+    assert_true(rad_scene_luminaire_placement(scene, 4, NULL, axes));
+    /* aim_at [4, 2, 1] from [2, 2, 2.5]: the nadir -z along (0.8, 0, -0.6) */
+    assert_true(fabs(axes[6] + 0.8) < 1e-12 && fabs(axes[7]) < 1e-12 && fabs(axes[8] - 0.6) < 1e-12);
+    assert_false(rad_scene_luminaire_placement(scene, 5, position, axes));
+    /* The near-field pieces are made for each receiver: what lands in the
+     * closed room is the flux within their accuracy. */
+    rad_solution *sol = NULL;
+    rad_options o = {.solver = "jacobi", .target_elements = 800};
+    assert_int_equal(rad_solution_create(ctx, scene, &o, &sol), RAD_OK);
+    double total = 4 * 0.8 * flux + flux, landing = rad_solution_direct_lumens(sol);
+    print_message("room: %.6g lm of %.6g lm landed (%.3g)\n", landing, total, landing / total - 1);
+    assert_close(landing, total, 1e-3, "the room's direct light");
+    rad_solution_destroy(sol);
+    /* A file that is not there: the reader's message, the scene as it was. */
+    const char *missing = "{\"luminaires\": [{\"file\": \"none.ies\", \"position\": [1, 1, 1]}]}";
+    assert_int_equal(rad_scene_load_luminaires_memory(ctx, scene, RAD_TEST_DATA "/luminaires/x.json", missing,
+                                                      strlen(missing)),
+                     RAD_ERROR_IO);
+    assert_non_null(strstr(rad_context_error(ctx), "none.ies"));
+    assert_int_equal(rad_scene_luminaire_count(scene), 5);
+    rad_scene_destroy(scene);
+
+    /* The glTF node: 2.5 m above the floor's centre, turned to look down
+     * (y up), llf 0.9 from its extras, named after the node. */
+    assert_int_equal(rad_scene_load_file(ctx, RAD_TEST_DATA "/luminaires/lamp.gltf", &scene), RAD_OK);
+    assert_int_equal(rad_scene_luminaire_count(scene), 1);
+    assert_string_equal(rad_scene_luminaire_name(scene, 0), "lamp");
+    assert_true(rad_scene_luminaire_placement(scene, 0, position, axes));
+    assert_true(fabs(position[0] - 2) < 1e-12 && fabs(position[1] - 2.5) < 1e-12 && fabs(position[2] - 2) < 1e-12);
+    assert_true(fabs(axes[7] - 1.0) < 1e-12); /* its z is world +y: the nadir down */
+    assert_close(rad_scene_luminaire_flux(scene, 0), 0.9 * scene->photometries[0]->flux, 1e-12, "extras' llf");
+    /* The floor's centre, 2.5 m below the nadir: 1000 / pi cd x 0.9 / 2.5^2. */
+    double h[3];
+    rad_luminaires_irradiance(scene, NULL, NULL, v3(2, 0, 2), v3(0, 1, 0), h);
+    assert_close(K * h[0], 0.9 * 318.3099 / 6.25, 1e-6, "under the glTF lamp");
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* ---- CIE 171:2006 (docs/cie171.md) ---- */
 
 /* Test case 5.1 (point source): an isotropic point source in a black
@@ -700,6 +762,7 @@ int main(void)
         cmocka_unit_test(direct_thread_determinism),
         cmocka_unit_test(layout_placement),
         cmocka_unit_test(layout_errors),
+        cmocka_unit_test(layout_and_gltf_files),
         cmocka_unit_test(cie171_point_source),
         cmocka_unit_test(cie171_area_source),
     };
