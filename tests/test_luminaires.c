@@ -412,8 +412,23 @@ static void solve_energy_balance(void **state)
             assert_true(v->radiosity[3 * i] >= v->emission[3 * i] * (1 - 1e-12));
         rad_solution_destroy(sol);
     }
-    /* Hierarchical refuses, naming the alternatives. */
+    /* Adaptive subdivision follows the luminaire's light (its lit
+     * elements are not emitters), and every new mesh gets its direct light. */
     rad_solution *sol = NULL;
+    rad_options ad = {.solver = "gauss-seidel", .target_elements = 200, .adaptive_levels = 2,
+                      .adaptive_threshold = 0.02, .tolerance = 1e-10};
+    assert_int_equal(rad_solution_create(ctx, scene, &ad, &sol), RAD_OK);
+    size_t before = rad_solution_element_count(sol);
+    assert_int_equal(rad_solution_solve(ctx, sol), RAD_OK);
+    assert_true(rad_solution_element_count(sol) > before);
+    assert_non_null(sol->view.direct);
+    double em, ab;
+    rad_solution_power(sol, &em, &ab);
+    print_message("adaptive: %zu -> %zu elements, %.6g lm landed\n", before, rad_solution_element_count(sol),
+                  rad_solution_direct_lumens(sol));
+    assert_close(rad_solution_direct_lumens(sol), rad_luminaire_flux(scene, 0), 1e-3, "adaptive: flux landed");
+    rad_solution_destroy(sol);
+    /* Hierarchical refuses, naming the alternatives. */
     rad_options h = {.solver = "hierarchical"};
     assert_int_equal(rad_solution_create(ctx, scene, &h, &sol), RAD_ERROR_INVALID_ARGUMENT);
     assert_non_null(strstr(rad_context_error(ctx), "hierarchical solver does not take luminaires"));
