@@ -36,6 +36,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 static const double DEG = M_PI / 180.0;
 #define K 179.0 /* RAD_LUMINOUS_EFFICACY */
@@ -427,6 +428,15 @@ static void solve_energy_balance(void **state)
     print_message("adaptive: %zu -> %zu elements, %.6g lm landed\n", before, rad_solution_element_count(sol),
                   rad_solution_direct_lumens(sol));
     assert_close(rad_solution_direct_lumens(sol), rad_luminaire_flux(scene, 0), 1e-3, "adaptive: flux landed");
+    /* A solution file would not hold the light: refused, nothing written. */
+    char path[] = "/tmp/rad_test_luminaires_XXXXXX";
+    int fd = mkstemp(path);
+    assert_true(fd >= 0);
+    close(fd);
+    unlink(path);
+    assert_int_equal(rad_solution_save(ctx, sol, path), RAD_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rad_context_error(ctx), "lit by luminaires or daylight"));
+    assert_int_equal(access(path, F_OK), -1);
     rad_solution_destroy(sol);
     /* Hierarchical refuses, naming the alternatives. */
     rad_options h = {.solver = "hierarchical"};
