@@ -9,7 +9,8 @@
  *                  seen from near: pi L F with the exact point-to-rectangle
  *                  factor, within 1 %; continuity at the five-times switch
  *   flux           a closed black box: sum A H_d x 179 = the flux x multiplier
- *   solve          a grey box lit by a luminaire: absorbed = emitted
+ *   solve          a grey box lit by a luminaire: absorbed = emitted; adaptive
+ *                  subdivision; the command (--luminaires, stats, errors)
  *   layout         placement (aim, aim_at, spin, arrays) by the peak's
  *                  direction; every error with its message
  *   determinism    the element means whatever the thread count
@@ -24,6 +25,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cli_support.h"
 #include "api/solution.h"
 #include "formfactor/formfactor.h"
 #include "light/light.h"
@@ -774,8 +776,68 @@ static void cie171_area_source(void **state)
     rad_context_destroy(ctx);
 }
 
-int main(void)
+/* ---- the command ---- */
+
+static void command_luminaires(void **state)
 {
+    (void)state;
+    assert_int_equal(cli_setup("luminaires"), 0);
+    char png[600], stats[600], errors[600], bad[600];
+    snprintf(png, sizeof png, "%s/room.png", cli_workdir());
+    snprintf(stats, sizeof stats, "%s/room.json", cli_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
+    snprintf(bad, sizeof bad, "%s/bad.json", cli_workdir());
+    /* The room lit by its layout only: the stats count the luminaires and
+     * the light they land; emitted = absorbed in the closed room. */
+    assert_int_equal(cli_run("render %s/luminaires/room.obj --luminaires %s/luminaires/layout.json --elements 300 "
+                             "--tolerance 1e-9 -o %s --stats %s --threads 2",
+                             RAD_TEST_DATA, RAD_TEST_DATA, png, stats),
+                     0);
+    cJSON *json = cli_read_json(stats);
+    assert_non_null(json);
+    assert_true(cli_stats_number(json, "luminaires", "count") == 5.0);
+    double lumens = cli_stats_number(json, "luminaires", "lumens");
+    cli_assert_relative(cli_stats_number(json, "luminaires", "direct_lumens"), lumens, 1e-3, "direct lumens");
+    /* (1e-5: the analytic factors' rows sum to 1 within a few 1e-6 here;
+     * with closure correction the library test above reaches 1e-11) */
+    cli_assert_relative(cli_stats_number(json, "power_W", "absorbed"), cli_stats_number(json, "power_W", "emitted"),
+                        1e-5, "the room's balance");
+    cJSON_Delete(json);
+    /* A bad layout: one line naming it and the key, exit 1, no image. */
+    unlink(png);
+    FILE *f = fopen(bad, "w");
+    assert_non_null(f);
+    fputs("{\"luminaires\": [{\"file\": \"downlight.ies\", \"position\": [1, 1]}]}\n", f);
+    fclose(f);
+    assert_int_equal(cli_run_capture(errors, "render %s/luminaires/room.obj --luminaires %s -o %s", RAD_TEST_DATA,
+                                     bad, png),
+                     1);
+    char *text = cli_read_text(errors);
+    assert_non_null(text);
+    assert_non_null(strstr(text, "bad.json: luminaires[0].position: must be 3 finite numbers"));
+    free(text);
+    assert_int_equal(access(png, F_OK), -1);
+    /* solve refuses the glTF lamp (a solution file would not hold it);
+     * --luminaires is not a flag of solve. */
+    assert_int_equal(cli_run_capture(errors, "solve %s/luminaires/lamp.gltf -o %s/x.radsol", RAD_TEST_DATA,
+                                     cli_workdir()),
+                     1);
+    text = cli_read_text(errors);
+    assert_non_null(strstr(text, "places luminaires"));
+    free(text);
+    assert_int_equal(cli_run_capture(errors, "solve %s/luminaires/room.obj --luminaires %s/luminaires/layout.json",
+                                     RAD_TEST_DATA, RAD_TEST_DATA),
+                     2);
+    assert_int_equal(cli_teardown(), 0);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_luminaires PATH/TO/radiosity\n");
+        return 2;
+    }
+    cli_set_binary(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(point_isotropic_planes),
         cmocka_unit_test(point_cos_power_planes),
@@ -790,6 +852,7 @@ int main(void)
         cmocka_unit_test(layout_and_gltf_files),
         cmocka_unit_test(cie171_point_source),
         cmocka_unit_test(cie171_area_source),
+        cmocka_unit_test(command_luminaires),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
