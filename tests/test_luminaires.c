@@ -704,6 +704,33 @@ static void layout_and_gltf_files(void **state)
     rad_context_destroy(ctx);
 }
 
+/* The public calls' NULL behaviour (radiosity.h, "NULL"). */
+static void public_null_arguments(void **state)
+{
+    (void)state;
+    rad_context *ctx = new_context(1);
+    rad_scene *scene = box(ctx, 1.0, 0.5);
+    assert_int_equal(rad_scene_load_luminaires(ctx, NULL, "x.json"), RAD_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rad_context_error(ctx), "rad_scene_load_luminaires"));
+    assert_int_equal(rad_scene_load_luminaires(ctx, scene, NULL), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_scene_load_luminaires(NULL, scene, "x.json"), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_scene_load_luminaires_memory(ctx, scene, "x.json", NULL, 0), RAD_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(rad_context_error(ctx), "rad_scene_load_luminaires_memory"));
+    assert_int_equal(rad_scene_load_luminaires_memory(ctx, scene, NULL, "{}", 2), RAD_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(rad_scene_load_luminaires(ctx, scene, "/nonexistent/layout.json"), RAD_ERROR_IO);
+    assert_int_equal(rad_scene_luminaire_count(NULL), 0);
+    assert_null(rad_scene_luminaire_name(NULL, 0));
+    assert_true(rad_scene_luminaire_flux(NULL, 0) == 0.0);
+    assert_true(rad_scene_luminaire_flux(scene, 0) == 0.0);
+    double p[3] = {7, 7, 7};
+    assert_false(rad_scene_luminaire_placement(NULL, 0, p, NULL));
+    assert_true(p[0] == 7.0);
+    assert_true(rad_solution_direct_lumens(NULL) == 0.0);
+    assert_int_equal(rad_scene_luminaire_count(scene), 0);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* ---- CIE 171:2006 (docs/cie171.md) ---- */
 
 /* Test case 5.1 (point source): an isotropic point source in a black
@@ -850,6 +877,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(layout_placement),
         cmocka_unit_test(layout_errors),
         cmocka_unit_test(layout_and_gltf_files),
+        cmocka_unit_test(public_null_arguments),
         cmocka_unit_test(cie171_point_source),
         cmocka_unit_test(cie171_area_source),
         cmocka_unit_test(command_luminaires),
