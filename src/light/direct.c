@@ -54,7 +54,25 @@ typedef struct cubature {
     const rad_mesh *mesh;
     const rad_vis *vis;
     vec3 normal;
+    double lift;          /* m: rad_vis_epsilon(mesh), once (it walks the mesh) */
 } cubature;
+
+/* rad_light_irradiance at x, the luminaires' part with the lift known. */
+static void light_at(const cubature *c, vec3 x, double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    double part[3];
+    if (c->scene->luminaire_count > 0) {
+        rad_luminaires_irradiance_lifted(c->scene, c->vis, c->lift, x, c->normal, part);
+        for (int ch = 0; ch < 3; ch++)
+            out[ch] += part[ch];
+    }
+    if (c->scene->daylight) {
+        rad_daylight_irradiance(c->scene, c->mesh, c->vis, x, c->normal, part);
+        for (int ch = 0; ch < 3; ch++)
+            out[ch] += part[ch];
+    }
+}
 
 /* The integral (W per channel) of the irradiance over one region. */
 static void region_integral(const cubature *c, const vec3 *q, uint32_t corners, double out[3])
@@ -67,7 +85,7 @@ static void region_integral(const cubature *c, const vec3 *q, uint32_t corners, 
         for (int k = 0; k < 3; k++) {
             vec3 x = v3_add(q[0], v3_add(v3_scale(v3_sub(q[1], q[0]), bary[k][0]),
                                          v3_scale(v3_sub(q[2], q[0]), bary[k][1])));
-            rad_light_irradiance(c->scene, c->mesh, c->vis, x, c->normal, h);
+            light_at(c, x, h);
             for (int ch = 0; ch < 3; ch++)
                 out[ch] += area / 3.0 * h[ch];
         }
@@ -81,7 +99,7 @@ static void region_integral(const cubature *c, const vec3 *q, uint32_t corners, 
             vec3 du = v3_add(v3_scale(v3_sub(q[1], q[0]), 1.0 - v), v3_scale(v3_sub(q[2], q[3]), v));
             vec3 dv = v3_sub(v3_lerp(q[3], q[2], u), v3_lerp(q[0], q[1], u));
             double jacobian = v3_length(v3_cross(du, dv));
-            rad_light_irradiance(c->scene, c->mesh, c->vis, x, c->normal, h);
+            light_at(c, x, h);
             for (int ch = 0; ch < 3; ch++)
                 out[ch] += 0.25 * jacobian * h[ch];
         }
@@ -120,11 +138,17 @@ static void refine(const cubature *c, const vec3 *q, uint32_t corners, const dou
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   size_t element, double out[3])
 {
+    rad_light_element_irradiance_lifted(scene, mesh, vis, rad_vis_epsilon(mesh), element, out);
+}
+
+void rad_light_element_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                                         double lift, size_t element, double out[3])
+{
     const rad_element *e = &mesh->elements[element];
     out[0] = out[1] = out[2] = 0.0;
     if (!rad_light_present(scene) || !(e->area > 0.0))
         return;
-    cubature c = {scene, mesh, vis, e->normal};
+    cubature c = {scene, mesh, vis, e->normal, lift};
     vec3 q[4];
     for (uint32_t k = 0; k < e->vertex_count; k++)
         q[k] = mesh->vertices[e->vertex[k]];

@@ -236,16 +236,21 @@ static void one_luminaire(pending *q, const rad_scene *scene, const rad_luminair
     }
 }
 
-void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
-                               vec3 n, double out[3])
+void rad_luminaires_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift, vec3 p, vec3 n,
+                                      double out[3])
 {
     pending q;
     q.count = 0;
     q.vis = vis;
     q.sum = 0.0;
-    double eps = mesh ? rad_vis_epsilon(mesh) : 0.0;
     for (size_t k = 0; k < scene->luminaire_count; k++)
-        one_luminaire(&q, scene, &scene->luminaires[k], p, n, eps);
+        one_luminaire(&q, scene, &scene->luminaires[k], p, n, lift);
     flush(&q);
     out[0] = out[1] = out[2] = q.sum;
+}
+
+void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                               vec3 n, double out[3])
+{
+    rad_luminaires_irradiance_lifted(scene, vis, mesh ? rad_vis_epsilon(mesh) : 0.0, p, n, out);
 }
