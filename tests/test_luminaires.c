@@ -107,6 +107,17 @@ static rad_result test_loader(rad_context *ctx, const char *path, void *user, ra
             p->length = 0.4, p->width = 0.4, p->shape = RAD_OPENING_ELLIPSE;
     } else if (strcmp(base, "lobe.ies") == 0) {
         p = lobe(ctx, path);
+    } else if (strcmp(base, "tilt.ies") == 0) { /* isotropic, TILT: 1 at 0 degrees, 0.5 at 90 */
+        double c = 0.0, g[2] = {0.0, 180.0}, cd[2] = {1000.0, 1000.0};
+        p = rad_photometry_from_table(ctx, path, 1, &c, 2, g, cd, NULL);
+        if (p) {
+            p->tilt_angles = rad_alloc(ctx, RAD_MEM_SCENE, 2, sizeof(double), "test: tilt");
+            p->tilt_factors = rad_alloc(ctx, RAD_MEM_SCENE, 2, sizeof(double), "test: tilt");
+            assert_true(p->tilt_angles && p->tilt_factors);
+            p->tilt_angles[0] = 0.0, p->tilt_angles[1] = 90.0;
+            p->tilt_factors[0] = 1.0, p->tilt_factors[1] = 0.5;
+            p->tilt_count = 2;
+        }
     } else if (strcmp(base, "dark.ies") == 0) {
         double c = 0.0, g[2] = {0.0, 180.0}, cd[2] = {0.0, 0.0};
         p = rad_photometry_from_table(ctx, path, 1, &c, 2, g, cd, NULL);
@@ -542,6 +553,18 @@ static void layout_placement(void **state)
     assert_close(lobe_lux(other, 0, v3(s60, -c60, 0)), 0.5 * peak, 1e-9, "y-up peak with the layout's llf");
     assert_string_equal(other->luminaires[0].name, "luminaire 1");
     rad_scene_destroy(other);
+    /* The file's TILT factor at the angle between the aim and straight
+     * down (interpolated: 0.75 at 45 degrees, 0.5 at 90, 1 aimed down). */
+    rad_scene *tilted = box(ctx, 1.0, 0.5);
+    assert_int_equal(layout(ctx, tilted, "{\"luminaires\": [{\"file\": \"tilt.ies\", \"position\": [0, 0, 3]},"
+                                         "{\"file\": \"tilt.ies\", \"position\": [0, 0, 3], \"aim\": [1, 0, -1]},"
+                                         "{\"file\": \"tilt.ies\", \"position\": [0, 0, 3], \"aim_at\": [0, 5, 3]}]}"),
+                     RAD_OK);
+    double iso = 4 * M_PI * 1000.0;
+    assert_close(rad_luminaire_flux(tilted, 0), iso, 1e-9, "not tilted");
+    assert_close(rad_luminaire_flux(tilted, 1), 0.75 * iso, 1e-9, "tilted 45 degrees");
+    assert_close(rad_luminaire_flux(tilted, 2), 0.5 * iso, 1e-9, "tilted 90 degrees");
+    rad_scene_destroy(tilted);
     /* lumens: scaled to the flux asked for */
     rad_scene *third = box(ctx, 1.0, 0.5);
     assert_int_equal(layout(ctx, third, "{\"luminaires\": [{\"file\": \"iso.ies\", \"position\": [0, 0, 3], "

@@ -82,7 +82,7 @@ void rad_layout_frame(vec3 aim, vec3 up, double spin_degrees, vec3 axis[3])
 
 double rad_layout_tilt_degrees(const vec3 axis[3], vec3 up)
 {
-    double c = -v3_dot(axis[2], v3_normalize(up)); /* nadir . down */
+    double c = v3_dot(axis[2], v3_normalize(up)); /* nadir . down = (-z) . (-up) */
     return acos(fmax(-1.0, fmin(1.0, c))) / DEG;
 }
 
