@@ -36,9 +36,18 @@ void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const ra
     out[0] = out[1] = out[2] = 0.0;
     if (!rad_light_present(scene))
         return;
+    rad_light_irradiance_lifted(scene, mesh, vis, mesh ? rad_vis_epsilon(mesh) : 0.0, p, n, out);
+}
+
+void rad_light_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, double lift,
+                                 vec3 p, vec3 n, double out[3])
+{
+    out[0] = out[1] = out[2] = 0.0;
+    if (!rad_light_present(scene))
+        return;
     double part[3];
     if (scene->luminaire_count > 0) {
-        rad_luminaires_irradiance(scene, mesh, vis, p, n, part);
+        rad_luminaires_irradiance_lifted(scene, vis, lift, p, n, part);
         for (int c = 0; c < 3; c++)
             out[c] += part[c];
     }
@@ -57,21 +66,9 @@ typedef struct cubature {
     double lift;          /* m: rad_vis_epsilon(mesh), once (it walks the mesh) */
 } cubature;
 
-/* rad_light_irradiance at x, the luminaires' part with the lift known. */
 static void light_at(const cubature *c, vec3 x, double out[3])
 {
-    out[0] = out[1] = out[2] = 0.0;
-    double part[3];
-    if (c->scene->luminaire_count > 0) {
-        rad_luminaires_irradiance_lifted(c->scene, c->vis, c->lift, x, c->normal, part);
-        for (int ch = 0; ch < 3; ch++)
-            out[ch] += part[ch];
-    }
-    if (c->scene->daylight) {
-        rad_daylight_irradiance(c->scene, c->mesh, c->vis, x, c->normal, part);
-        for (int ch = 0; ch < 3; ch++)
-            out[ch] += part[ch];
-    }
+    rad_light_irradiance_lifted(c->scene, c->mesh, c->vis, c->lift, x, c->normal, out);
 }
 
 /* The integral (W per channel) of the irradiance over one region. */

@@ -36,6 +36,13 @@ bool rad_light_present(const rad_scene *scene);
 void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                           vec3 n, double out[3]);
 
+/* rad_light_irradiance with the shadow rays' lift given, m
+ * (rad_vis_epsilon(mesh) walks the whole mesh: a caller asking at many
+ * points, calculation grids, computes it once).  Thread-safe,
+ * deterministic. */
+void rad_light_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, double lift,
+                                 vec3 p, vec3 n, double out[3]);
+
 /* The mean of rad_light_irradiance over element `element` of mesh
  * (adaptive cubature over its polygon).  Thread-safe, deterministic. */
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
