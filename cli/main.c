@@ -631,12 +631,6 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
             goto done;
         }
     }
-    if (s.command == CLI_SOLVE && rad_scene_luminaire_count(scene) > 0) {
-        fprintf(stderr, "radiosity: %s places luminaires (glTF nodes), which a solution file does not hold: "
-                        "render, export or bake it in one run\n", s.scene_path ? s.scene_path : "the scene");
-        status = 1;
-        goto done;
-    }
     status = check_scene_inputs(ctx, scene, &out);
     if (status >= 0)
         goto done;

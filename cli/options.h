@@ -71,7 +71,7 @@ typedef struct cli_settings {
     int offscreen;            /* view: one frame to --output, no window */
     int no_ambient;           /* view: B without the ambient term while shooting */
     const char *keys;         /* view: keys the window presses itself */
-    const char *luminaires;   /* render, export, bake, view: a layout file (docs/lighting.md) */
+    const char *luminaires;   /* render, export, solve, bake, view: a layout file (docs/lighting.md) */
 } cli_settings;
 
 /* Where a flag's value goes. */

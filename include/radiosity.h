@@ -633,8 +633,9 @@ RAD_API rad_result rad_solution_point_radiosity(rad_context *ctx, rad_solution *
  * solve's figures; atomically (a temporary, renamed).  The vertex values
  * are the renderer's, so they are computed here if no render did.  Fails
  * with RAD_ERROR_INVALID_ARGUMENT for a solution not solved, one whose
- * scene has luminaires (rad_scene_load_luminaires) or daylight, which the
- * file does not hold (or NULL ctx, solution or path), RAD_ERROR_IO,
+ * scene has daylight, which the file does not hold (luminaires it holds:
+ * their distributions, placements and each element's direct light), or
+ * NULL ctx, solution or path; RAD_ERROR_IO,
  * RAD_ERROR_OUT_OF_MEMORY.  Not at the same time as other calls on the
  * same solution. */
 RAD_API rad_result rad_solution_save(rad_context *ctx, rad_solution *solution, const char *path);
@@ -1372,7 +1373,7 @@ RAD_API rad_result rad_photometry_info_read(rad_context *ctx, const char *path, 
  * candela count as cd / 179 W/sr on each channel (docs/units.md
  * "Photometry").  A scene lit only by luminaires needs no emitting surface.
  * Hierarchical radiosity refuses luminaires (without a solver named, a lit
- * scene is solved by gauss-seidel); a solution file does not hold them.
+ * scene is solved by gauss-seidel); a solution file holds them.
  *
  *     rad_scene_load_file(ctx, "office.obj", &scene);
  *     rad_scene_load_luminaires(ctx, scene, "layout.json");

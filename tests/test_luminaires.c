@@ -451,15 +451,31 @@ static void solve_energy_balance(void **state)
     print_message("adaptive: %zu -> %zu elements, %.6g lm landed\n", before, rad_solution_element_count(sol),
                   rad_solution_direct_lumens(sol));
     assert_close(rad_solution_direct_lumens(sol), rad_luminaire_flux(scene, 0), 1e-3, "adaptive: flux landed");
-    /* A solution file would not hold the light: refused, nothing written. */
+    /* The solution file holds the light: read back, the luminaires, the
+     * direct light and the radiosity are the same bits. */
     char path[] = "/tmp/rad_test_luminaires_XXXXXX";
     int fd = mkstemp(path);
     assert_true(fd >= 0);
     close(fd);
+    assert_int_equal(rad_solution_save(ctx, sol, path), RAD_OK);
+    rad_scene *loaded_scene = NULL;
+    rad_solution *loaded = NULL;
+    assert_int_equal(rad_solution_load_file(ctx, path, &loaded_scene, &loaded), RAD_OK);
     unlink(path);
-    assert_int_equal(rad_solution_save(ctx, sol, path), RAD_ERROR_INVALID_ARGUMENT);
-    assert_non_null(strstr(rad_context_error(ctx), "lit by luminaires or daylight"));
-    assert_int_equal(access(path, F_OK), -1);
+    assert_int_equal(rad_scene_luminaire_count(loaded_scene), 1);
+    assert_string_equal(rad_scene_luminaire_name(loaded_scene, 0), rad_scene_luminaire_name(scene, 0));
+    assert_true(rad_scene_luminaire_flux(loaded_scene, 0) == rad_scene_luminaire_flux(scene, 0));
+    assert_int_equal(loaded->view.n, sol->view.n);
+    assert_non_null(loaded->view.direct);
+    assert_memory_equal(loaded->view.direct, sol->view.direct, 3 * sol->view.n * sizeof(double));
+    assert_memory_equal(loaded->view.emission, sol->view.emission, 3 * sol->view.n * sizeof(double));
+    assert_memory_equal(loaded->view.radiosity, sol->view.radiosity, 3 * sol->view.n * sizeof(double));
+    double h0[3], h1[3];
+    rad_luminaires_irradiance(scene, NULL, NULL, v3(1, 1, 0), v3(0, 0, 1), h0);
+    rad_luminaires_irradiance(loaded_scene, NULL, NULL, v3(1, 1, 0), v3(0, 0, 1), h1);
+    assert_memory_equal(h0, h1, sizeof h0);
+    rad_solution_destroy(loaded);
+    rad_scene_destroy(loaded_scene);
     rad_solution_destroy(sol);
     /* Hierarchical refuses, naming the alternatives. */
     rad_options h = {.solver = "hierarchical"};
@@ -877,17 +893,24 @@ static void command_luminaires(void **state)
     assert_non_null(strstr(text, "bad.json: luminaires[0].position: must be 3 finite numbers"));
     free(text);
     assert_int_equal(access(png, F_OK), -1);
-    /* solve refuses the glTF lamp (a solution file would not hold it);
-     * --luminaires is not a flag of solve. */
-    assert_int_equal(cli_run_capture(errors, "solve %s/luminaires/lamp.gltf -o %s/x.radsol", RAD_TEST_DATA,
-                                     cli_workdir()),
-                     1);
-    text = cli_read_text(errors);
-    assert_non_null(strstr(text, "places luminaires"));
-    free(text);
-    assert_int_equal(cli_run_capture(errors, "solve %s/luminaires/room.obj --luminaires %s/luminaires/layout.json",
-                                     RAD_TEST_DATA, RAD_TEST_DATA),
+    /* solve keeps the luminaires in the solution file; render draws it
+     * with them; --luminaires again with the file is a usage error. */
+    assert_int_equal(cli_run("solve %s/luminaires/room.obj --luminaires %s/luminaires/layout.json --elements 300 "
+                             "-o %s/room.radsol",
+                             RAD_TEST_DATA, RAD_TEST_DATA, cli_workdir()),
+                     0);
+    assert_int_equal(cli_run("render %s/room.radsol -o %s --stats %s", cli_workdir(), png, stats), 0);
+    json = cli_read_json(stats);
+    assert_non_null(json);
+    assert_true(cli_stats_number(json, "luminaires", "count") == 5.0);
+    cli_assert_relative(cli_stats_number(json, "luminaires", "direct_lumens"), lumens, 1e-3, "loaded direct lumens");
+    cJSON_Delete(json);
+    assert_int_equal(cli_run_capture(errors, "render %s/room.radsol --luminaires %s/luminaires/layout.json -o %s",
+                                     cli_workdir(), RAD_TEST_DATA, png),
                      2);
+    assert_int_equal(cli_run("solve %s/luminaires/lamp.gltf --elements 100 -o %s/lamp.radsol", RAD_TEST_DATA,
+                             cli_workdir()),
+                     0);
     assert_int_equal(cli_teardown(), 0);
 }
 
