@@ -74,6 +74,7 @@ typedef struct cli_settings {
     char *const *photometry_files; /* photometry: the files (into argv, consecutive) */
     size_t photometry_file_count;
     const char *daylight;     /* --daylight: the daylight file (sky, sun, openings), or NULL */
+    const char *luminaires;   /* render, export, solve, bake, view: a layout file (docs/lighting.md) */
 } cli_settings;
 
 /* Where a flag's value goes. */

@@ -145,6 +145,7 @@ typedef struct scenario {
     bool mirror;                 /* the white walls mirrors (illum 3): both passes of two-pass */
     bool on_step;                /* an on_step that does nothing: the hierarchical leaves
                                     made at every round for display */
+    bool luminaires;             /* a luminaire placed by a layout (tests/data/luminaires' IES) */
 } scenario;
 
 static int no_op_step(void *user, rad_solution *s, const rad_solve_step *step)
@@ -154,19 +155,20 @@ static int no_op_step(void *user, rad_solution *s, const rad_solve_step *step)
 }
 
 static const scenario scenarios[] = {
-    {"loading", NULL, NULL, 0, 0, 0, false, 0, false, false},
-    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false, false},
-    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0, false, false},
-    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0, false, false},
-    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0, false, false},
-    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2, false, false},
-    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0, false, false},
-    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0, false, false},
-    {"hierarchical (progressive display)", "hierarchical", NULL, 0, 0, 0, false, 0, false, true},
-    {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0, false, false},
-    {"collocation", "collocation", NULL, 0, 0, 0, false, 0, false, false},
-    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0, false, false},
-    {"gauss-seidel (dense, mirror images, second pass)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, true, false},
+    {"loading", NULL, NULL, 0, 0, 0, false, 0, false, false, false},
+    {"gauss-seidel (dense, analytic)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false, false, false},
+    {"direct (dense, hemicube, closure)", "direct", "hemicube", 16, 0, 1, true, 0, false, false, false},
+    {"conjugate-gradient (dense, montecarlo)", "conjugate-gradient", "montecarlo", 0, 4, 0, true, 0, false, false, false},
+    {"southwell (dense, hemisphere)", "southwell", "hemisphere", 0, 64, 0, true, 0, false, false, false},
+    {"jacobi (dense, adaptive)", "jacobi", "analytic", 0, 0, 0, true, 2, false, false, false},
+    {"shooting (matrix-free)", "shooting", NULL, 0, 32, 0, false, 0, false, false, false},
+    {"hierarchical", "hierarchical", NULL, 0, 0, 1, false, 0, false, false, false},
+    {"hierarchical (progressive display)", "hierarchical", NULL, 0, 0, 0, false, 0, false, true, false},
+    {"galerkin-linear", "galerkin-linear", NULL, 0, 0, 0, false, 0, false, false, false},
+    {"collocation", "collocation", NULL, 0, 0, 0, false, 0, false, false, false},
+    {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0, false, false, false},
+    {"gauss-seidel (dense, mirror images, second pass)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, true, false, false},
+    {"gauss-seidel (dense, a luminaire)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false, false, true},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from
@@ -268,7 +270,13 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
             o.on_step = no_op_step;
         o.epsilon = 1e-3;
         o.seed = 1;
-        r = rad_solution_create(ctx, scene, &o, &s);
+        if (sc->luminaires) {
+            static const char layout[] = "{\"up\": [0, 1, 0], \"luminaires\": [{\"file\": \"" RAD_TEST_DATA
+                                         "/luminaires/downlight.ies\", \"position\": [0.5, 0.9, 0.5]}]}";
+            r = rad_scene_load_luminaires_memory(ctx, scene, "layout.json", layout, strlen(layout));
+        }
+        if (r == RAD_OK)
+            r = rad_solution_create(ctx, scene, &o, &s);
     }
     if (r == RAD_OK)
         r = rad_solution_solve(ctx, s);

@@ -15,6 +15,7 @@
 #include "strategy/saved.h"
 
 #include "api/options.h"
+#include "scene/photometry.h"
 
 #include <cjson/cJSON.h>
 #include <inttypes.h>
@@ -206,6 +207,51 @@ void rad_saved_put_scene_and_mesh(rad_bytes *b, const rad_scene *scene, const ra
     cJSON_AddNumberToObject(counts, "vertices", (double)mesh->vertex_count);
     cJSON_AddNumberToObject(counts, "tvertices", (double)mesh->tvertex_count);
     cJSON_AddNumberToObject(counts, "tree_nodes", (double)mesh->tree_count);
+}
+
+cJSON *rad_saved_put_light(rad_bytes *b, const rad_scene *scene, const double *direct, size_t n)
+{
+    cJSON *light = cJSON_CreateObject(), *ph = cJSON_AddArrayToObject(light, "photometries");
+    cJSON *lu = cJSON_AddArrayToObject(light, "luminaires");
+    if (!light || !ph || !lu) {
+        cJSON_Delete(light);
+        return NULL;
+    }
+    bool ok = true;
+    for (size_t k = 0; k < scene->photometry_count; k++) {
+        const rad_photometry *p = scene->photometries[k];
+        cJSON *o = cJSON_CreateObject();
+        ok = ok && o && cJSON_AddItemToArray(ph, o) && cJSON_AddStringToObject(o, "source", p->source ? p->source : "") &&
+             cJSON_AddNumberToObject(o, "c_count", (double)p->c_count) &&
+             cJSON_AddNumberToObject(o, "gamma_count", (double)p->gamma_count) &&
+             cJSON_AddNumberToObject(o, "shape", (double)p->shape);
+        rad_bytes_f64(b, p->width);
+        rad_bytes_f64(b, p->length);
+        rad_bytes_f64(b, p->height);
+        for (size_t i = 0; i < p->c_count; i++)
+            rad_bytes_f64(b, p->c_angles[i]);
+        for (size_t i = 0; i < p->gamma_count; i++)
+            rad_bytes_f64(b, p->gamma_angles[i]);
+        for (size_t i = 0; i < p->c_count * p->gamma_count; i++)
+            rad_bytes_f64(b, p->candela[i]);
+    }
+    for (size_t k = 0; k < scene->luminaire_count; k++) {
+        const rad_luminaire *L = &scene->luminaires[k];
+        cJSON *o = cJSON_CreateObject();
+        ok = ok && o && cJSON_AddItemToArray(lu, o) && cJSON_AddStringToObject(o, "name", L->name) &&
+             cJSON_AddNumberToObject(o, "photometry", (double)L->photometry);
+        put_vec3(b, L->position);
+        for (int a = 0; a < 3; a++)
+            put_vec3(b, L->axis[a]);
+        rad_bytes_f64(b, L->multiplier);
+    }
+    for (size_t i = 0; i < 3 * n; i++)
+        rad_bytes_f64(b, direct ? direct[i] : 0.0);
+    if (!ok) {
+        cJSON_Delete(light);
+        return NULL;
+    }
+    return light;
 }
 
 /* ---- decoding ---- */
@@ -687,6 +733,98 @@ static rad_result read_mesh(rad_context *ctx, const char *name, const rad_scene 
     return RAD_OK;
 }
 
+static int compare_names(const void *x, const void *y)
+{
+    return strcmp(*(const char *const *)x, *(const char *const *)y);
+}
+
+/* The light part (saved.h): distributions rebuilt through
+ * rad_photometry_from_table (which validates the tables), luminaires with
+ * finite positions, orthonormal frames, multipliers >= 0 and unique names,
+ * attached to `scene`; *direct the elements' direct irradiance, finite and
+ * >= 0 (the caller's to free). */
+static rad_result read_light(rad_context *ctx, const char *name, rad_scene *scene, const cJSON *ph, const cJSON *lu,
+                             cursor *c, size_t elements, double **direct)
+{
+    size_t P = (size_t)cJSON_GetArraySize(ph), L = (size_t)cJSON_GetArraySize(lu);
+    scene->photometries = rad_alloc(ctx, RAD_MEM_SCENE, P + 1, sizeof *scene->photometries, "solution file: light");
+    scene->luminaires = rad_alloc(ctx, RAD_MEM_SCENE, L + 1, sizeof *scene->luminaires, "solution file: light");
+    if (!scene->photometries || !scene->luminaires)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    size_t k = 0;
+    for (const cJSON *o = ph->child; o; o = o->next, k++) {
+        size_t nc = (size_t)number_in(o, "c_count"), ng = (size_t)number_in(o, "gamma_count");
+        double dims[3], shape = number_in(o, "shape");
+        for (int d = 0; d < 3; d++)
+            dims[d] = get_f64(c);
+        double *values = rad_alloc(ctx, RAD_MEM_SCENE, nc + ng + nc * ng, sizeof *values, "solution file: light");
+        if (!values)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        for (size_t i = 0; i < nc + ng + nc * ng; i++)
+            values[i] = get_f64(c);
+        rad_result err = RAD_OK;
+        rad_photometry *p = rad_photometry_from_table(ctx, cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(o, "source")),
+                                                      nc, values, ng, values + nc, values + nc + ng, &err);
+        rad_free(values);
+        if (!p)
+            return err == RAD_ERROR_OUT_OF_MEMORY ? RAD_ERROR_OUT_OF_MEMORY
+                                                  : BAD("%s: light: distribution %zu is not a valid table", name, k);
+        scene->photometries[scene->photometry_count++] = p;
+        for (int d = 0; d < 3; d++)
+            if (!(isfinite(dims[d]) && dims[d] >= 0.0))
+                return BAD("%s: light: distribution %zu has an opening of %g m", name, k, dims[d]);
+        if (!(shape >= 0.0 && shape <= RAD_OPENING_VERTICAL_ELLIPSE_Y && shape == floor(shape)))
+            return BAD("%s: light: distribution %zu has no shape %g", name, k, shape);
+        p->width = dims[0], p->length = dims[1], p->height = dims[2];
+        p->shape = (rad_luminous_shape)shape;
+    }
+    k = 0;
+    for (const cJSON *o = lu->child; o; o = o->next, k++) {
+        rad_luminaire *l = &scene->luminaires[k];
+        memset(l, 0, sizeof *l);
+        l->name = rad_strdup(ctx, RAD_MEM_SCENE, cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(o, "name")),
+                             "solution file: light");
+        if (!l->name)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        scene->luminaire_count = k + 1;
+        l->photometry = (uint32_t)number_in(o, "photometry");
+        l->position = get_vec3(c);
+        for (int a = 0; a < 3; a++)
+            l->axis[a] = get_vec3(c);
+        l->multiplier = get_f64(c);
+        bool ok = v3_finite(l->position) && isfinite(l->multiplier) && l->multiplier >= 0.0;
+        for (int a = 0; a < 3 && ok; a++)
+            for (int b2 = 0; b2 < 3 && ok; b2++)
+                ok = fabs(v3_dot(l->axis[a], l->axis[b2]) - (a == b2 ? 1.0 : 0.0)) < 1e-9;
+        if (!ok)
+            return BAD("%s: light: luminaire %zu has a position, frame or multiplier out of range", name, k);
+    }
+    const char **names = rad_alloc(ctx, RAD_MEM_SCENE, L + 1, sizeof *names, "solution file: light");
+    if (!names)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < L; i++)
+        names[i] = scene->luminaires[i].name;
+    qsort(names, L, sizeof *names, compare_names);
+    bool unique = true;
+    for (size_t i = 1; i < L; i++)
+        unique = unique && strcmp(names[i - 1], names[i]) != 0;
+    rad_free(names);
+    if (!unique)
+        return BAD("%s: light: two luminaires have one name", name);
+    double *d = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * elements + 1, sizeof *d, "solution: direct light");
+    if (!d)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < 3 * elements; i++) {
+        d[i] = get_f64(c);
+        if (!(isfinite(d[i]) && d[i] >= 0.0)) {
+            rad_free(d);
+            return BAD("%s: light: element %zu has direct irradiance %g W/m^2", name, i / 3, d[i]);
+        }
+    }
+    *direct = d;
+    return RAD_OK;
+}
+
 rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned char *data, size_t size,
                           rad_scene **scene_out, rad_options *options, rad_method_names *names,
                           void **state)
@@ -736,6 +874,32 @@ rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned cha
     }
     size_t expected = 24 * corners + 16 * polygons + 48 * material_count + 88 + 160 * patches + 88 * elements + 24 * vertices +
                       24 * tvertices + 16 * tree_nodes + 24 * elements + 24 * vertices;
+    /* The light, when the header names it: its bytes follow the values. */
+    const cJSON *light = cJSON_GetObjectItemCaseSensitive(header, "light");
+    const cJSON *light_ph = cJSON_GetObjectItemCaseSensitive(light, "photometries");
+    const cJSON *light_lu = cJSON_GetObjectItemCaseSensitive(light, "luminaires");
+    size_t light_at = expected;
+    if (light) {
+        bool ok = cJSON_IsArray(light_ph) && cJSON_IsArray(light_lu) && cJSON_GetArraySize(light_lu) > 0;
+        for (const cJSON *o = ok ? light_ph->child : NULL; o && ok; o = o->next) {
+            size_t nc = 0, ng = 0;
+            ok = count_in(o, "c_count", most, &nc) && count_in(o, "gamma_count", most, &ng) && nc >= 1 && ng >= 2 &&
+                 (double)nc * (double)ng <= (double)most && cJSON_IsString(cJSON_GetObjectItemCaseSensitive(o, "source"));
+            expected += ok ? 24 + 8 * (nc + ng + nc * ng) : 0;
+        }
+        for (const cJSON *o = ok ? light_lu->child : NULL; o && ok; o = o->next) {
+            const char *lname = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(o, "name"));
+            size_t index = 0;
+            ok = lname && lname[0] && count_in(o, "photometry", (size_t)cJSON_GetArraySize(light_ph) - 1, &index) &&
+                 cJSON_GetArraySize(light_ph) > 0;
+            expected += 104;
+        }
+        expected += 24 * elements;
+        if (!ok || expected > size) {
+            r = BAD("%s: the header's light (photometries, luminaires) is malformed", name);
+            goto done;
+        }
+    }
     double payload_bytes = number_in(payload, "bytes");
     const char *checksum = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(payload, "fnv1a64"));
     if (payload_at > size || payload_bytes != (double)expected || expected != size - payload_at || !checksum) {
@@ -760,10 +924,24 @@ rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned cha
         r = read_mesh(ctx, name, scene, &c, patches, elements, vertices, tvertices, tree_nodes, &mesh);
     if (r != RAD_OK)
         goto done;
+    double *direct = NULL;
+    if (light) {
+        cursor lc = {data + payload_at + light_at, data + size};
+        r = read_light(ctx, name, scene, light_ph, light_lu, &lc, elements, &direct);
+        if (r != RAD_OK)
+            goto done;
+    }
     st = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *st, "solution file: state");
     if (!st || rad_elements_create(ctx, scene, mesh, &st->elements) != RAD_OK) {
+        rad_free(direct);
         r = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
+    }
+    if (direct) {
+        /* As rad_elements_add_light left them: E + rho H_d. */
+        for (size_t k = 0; k < 3 * elements; k++)
+            st->elements.emission[k] += st->elements.reflectance[k] * direct[k];
+        st->elements.direct = direct;
     }
     st->mesh = mesh;
     mesh = NULL;

@@ -19,6 +19,12 @@
  *                quadtree (4 x u32 per internal node)
  *     values     element radiosity 3 x f64 (W/m^2), vertex radiosity
  *                3 x f64 (W/m^2, as the renderer interpolates them)
+ *     light      only with luminaires (the header's "light": each
+ *                distribution's source, shape and angle counts, each
+ *                luminaire's name and distribution): per distribution width,
+ *                length, height, C angles, gamma angles, candela (f64); per
+ *                luminaire position, 3 axes, multiplier (13 f64); each
+ *                element's direct irradiance 3 x f64 (W/m^2)
  *
  * Loading trusts nothing: the scene is rebuilt through the scene builder
  * (which validates every polygon) and must hash to the stored checksum;
@@ -55,6 +61,12 @@ void rad_bytes_u32(rad_bytes *b, uint32_t v);
 void rad_bytes_f64(rad_bytes *b, double v);
 void rad_bytes_raw(rad_bytes *b, const void *data, size_t size);
 void rad_bytes_free(rad_bytes *b);
+
+struct cJSON;
+/* The light part of the payload (luminaires and the elements' direct
+ * irradiance `direct`, 3n, NULL: zeros) and its header object; NULL when
+ * out of memory. */
+struct cJSON *rad_saved_put_light(rad_bytes *b, const rad_scene *scene, const double *direct, size_t n);
 
 /* The scene and mesh part of the payload, and the counts that go with it
  * into the header (a cJSON object, `counts`). */
