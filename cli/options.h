@@ -24,7 +24,7 @@
 
 /* The commands, as bits: a flag lists those that take it. */
 enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32,
-       CLI_VIEW = 64, CLI_THERMAL = 128 };
+       CLI_VIEW = 64, CLI_THERMAL = 128, CLI_ILLUMINANCE = 256 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -71,6 +71,8 @@ typedef struct cli_settings {
     int offscreen;            /* view: one frame to --output, no window */
     int no_ambient;           /* view: B without the ambient term while shooting */
     const char *keys;         /* view: keys the window presses itself */
+    const char *grid;         /* illuminance: the grid file (--grid) */
+    const char *output2;      /* illuminance: a second -o (CSV and JSON both), or NULL */
 } cli_settings;
 
 /* Where a flag's value goes. */

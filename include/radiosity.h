@@ -1192,6 +1192,11 @@ RAD_API rad_result rad_illuminance_evaluate_file(rad_context *ctx, const rad_sol
 RAD_API rad_result rad_illuminance_evaluate_memory(rad_context *ctx, const rad_solution *solution,
                                                    const char *name, const void *data, size_t size,
                                                    rad_illuminance **out);
+/* Read and check the grid file at `path` against `scene` without solving
+ * (a command checks its input before the work); *points (may be NULL) the
+ * points it places.  Fails as rad_illuminance_evaluate_file. */
+RAD_API rad_result rad_illuminance_check_file(rad_context *ctx, const rad_scene *scene, const char *path,
+                                              size_t *points);
 /* NULL: no-op. */
 RAD_API void rad_illuminance_destroy(rad_illuminance *illuminance);
 

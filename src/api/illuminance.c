@@ -147,6 +147,26 @@ rad_result rad_illuminance_evaluate_file(rad_context *ctx, const rad_solution *s
     return r;
 }
 
+rad_result rad_illuminance_check_file(rad_context *ctx, const rad_scene *scene, const char *path, size_t *points)
+{
+    rad_api_enter(ctx);
+    if (points)
+        *points = 0;
+    if (!ctx || !scene || !path)
+        return rad_null_argument(ctx, __func__);
+    unsigned char *data = NULL;
+    size_t size = 0;
+    rad_grid_set *set = NULL;
+    rad_result r = rad_read_whole_file(ctx, path, &data, &size);
+    if (r == RAD_OK)
+        r = rad_grid_parse(ctx, scene, path, (const char *)data, size, &set);
+    if (r == RAD_OK && points)
+        *points = set->point_count;
+    rad_grid_set_destroy(set);
+    rad_free(data);
+    return r;
+}
+
 size_t rad_illuminance_grid_count(const rad_illuminance *il)
 {
     return il ? il->set->grid_count : 0;
