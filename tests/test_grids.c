@@ -18,6 +18,9 @@
  *   bad files      each with its message
  *   threads        1 and 2 threads give the same numbers, bit for bit
  *   outputs        CSV and JSON read back
+ *   command        radiosity illuminance: both files and the table; a bad
+ *                  grid file refused before the work, nothing written;
+ *                  usage errors
  *   cie171_*       CIE 171:2006's diffuse inter-reflection case
  */
 #include <stdarg.h>
@@ -34,6 +37,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 /* ---- scenes written as OBJ + MTL in memory ---- */
@@ -709,6 +713,100 @@ static void test_outputs(void **state)
     free(t);
 }
 
+/* ---- the command ---- */
+
+/* Run `radiosity ARGS` in `dir` with its output in dir/out.txt; the exit status. */
+static int run_program(const char *dir, const char *args)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s > out.txt 2>&1", dir, RAD_PROGRAM, args);
+    int status = system(cmd);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static void test_command(void **state)
+{
+    (void)state;
+    scene_text *t = malloc(sizeof *t);
+    room(t, 6.0, 4.0, 3.0);
+    char dir[] = "/tmp/test_grids_cmd_XXXXXX", path[512];
+    assert_non_null(mkdtemp(dir));
+    snprintf(path, sizeof path, "%s/scene.obj", dir);
+    FILE *f = fopen(path, "w");
+    fwrite(t->obj, 1, t->on, f);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/scene.mtl", dir);
+    f = fopen(path, "w");
+    fwrite(t->mtl, 1, t->mn, f);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/g.json", dir);
+    f = fopen(path, "w");
+    fputs("{\"grids\": [{\"name\": \"room\", \"surface\": \"floor\", \"height\": 0.8}]}\n", f);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/bad.json", dir);
+    f = fopen(path, "w");
+    fputs("{\"grids\": [{\"name\": \"room\", \"surface\": \"floor\", \"spacing\": 0}]}\n", f);
+    fclose(f);
+    /* A good run: both files, the table. */
+    assert_int_equal(run_program(dir, "illuminance scene.obj --grid g.json -o E.csv -o E.json --mesh-size 0.5 "
+                                      "--solver direct"), 0);
+    snprintf(path, sizeof path, "%s/out.txt", dir);
+    char *text = slurp(path);
+    assert_non_null(strstr(text, "Eavg lux"));
+    assert_non_null(strstr(text, "room                           45"));
+    free(text);
+    snprintf(path, sizeof path, "%s/E.json", dir);
+    text = slurp(path);
+    cJSON *root = cJSON_Parse(text);
+    free(text);
+    const cJSON *g0 = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "grids"), 0);
+    double eavg = cJSON_GetObjectItem(g0, "E_avg_lux")->valuedouble;
+    double emin = cJSON_GetObjectItem(g0, "E_min_lux")->valuedouble;
+    /* The statistics of the values written, and the table's figure. */
+    const cJSON *values = cJSON_GetObjectItem(g0, "values");
+    double sum = 0.0, lo = INFINITY;
+    for (int k = 0; k < cJSON_GetArraySize(values); k++) {
+        double E = cJSON_GetObjectItem(cJSON_GetArrayItem(values, k), "E_lux")->valuedouble;
+        sum += E;
+        lo = fmin(lo, E);
+    }
+    assert_int_equal(cJSON_GetArraySize(values), 45);
+    assert_true(fabs(sum / 45 - eavg) <= 1e-12 * eavg && lo == emin);
+    assert_true(fabs(cJSON_GetObjectItem(g0, "U0")->valuedouble - emin / eavg) < 1e-15);
+    char row[128];
+    snprintf(row, sizeof row, "room                           45 %12.1f", eavg);
+    snprintf(path, sizeof path, "%s/out.txt", dir);
+    text = slurp(path);
+    assert_non_null(strstr(text, row));
+    free(text);
+    cJSON_Delete(root);
+    snprintf(path, sizeof path, "%s/E.csv", dir);
+    assert_int_equal(access(path, F_OK), 0);
+    unlink(path);
+    snprintf(path, sizeof path, "%s/E.json", dir);
+    unlink(path);
+    /* A bad grid file: exit 1 before the work, the file and key named, no output. */
+    assert_int_equal(run_program(dir, "illuminance scene.obj --grid bad.json -o E.csv"), 1);
+    snprintf(path, sizeof path, "%s/out.txt", dir);
+    text = slurp(path);
+    assert_non_null(strstr(text, "bad.json: grids[0].spacing: must be a number of metres > 0"));
+    free(text);
+    snprintf(path, sizeof path, "%s/E.csv", dir);
+    assert_int_equal(access(path, F_OK), -1);
+    /* Usage errors: no --grid; a third -o; an unknown format. */
+    assert_int_equal(run_program(dir, "illuminance scene.obj -o E.csv"), 2);
+    assert_int_equal(run_program(dir, "illuminance scene.obj --grid g.json -o a.csv -o b.json -o c.csv"), 2);
+    assert_int_equal(run_program(dir, "illuminance scene.obj --grid g.json -o E.txt"), 2);
+    assert_int_equal(access(path, F_OK), -1);
+    static const char *const names[] = {"scene.obj", "scene.mtl", "g.json", "bad.json", "out.txt"};
+    for (size_t k = 0; k < 5; k++) {
+        snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+        unlink(path);
+    }
+    rmdir(dir);
+    free(t);
+}
+
 /* ---- CIE 171:2006 ---- */
 
 /* CIE 171:2006's diffuse inter-reflection case: a closed cubic room whose
@@ -722,7 +820,7 @@ static void test_outputs(void **state)
  * irradiance integrates to Phi rho / (1 - rho)).  The mean over grids of
  * equal cells on all six faces (points on the surfaces) must agree within
  * 1%, the report's bound for exact cases; the direct part's mean is Phi / A. */
-static void cie171_interreflection(double rho)
+static void interreflection_case(double rho)
 {
     scene_text *t = malloc(sizeof *t);
     begin(t);
@@ -770,20 +868,24 @@ static void cie171_interreflection(double rho)
     free(t);
 }
 
-static void test_cie171_interreflection_rho50(void **state)
+static void cie171_interreflection_rho50(void **state)
 {
     (void)state;
-    cie171_interreflection(0.5);
+    interreflection_case(0.5);
 }
 
-static void test_cie171_interreflection_rho80(void **state)
+static void cie171_interreflection_rho80(void **state)
 {
     (void)state;
-    cie171_interreflection(0.8);
+    interreflection_case(0.8);
 }
 
-int main(void)
+/* argv[1], if given, is a cmocka filter ("cie171_*": the CTest test
+ * cie171_grids runs the CIE 171 cases alone). */
+int main(int argc, char **argv)
 {
+    if (argc > 1)
+        cmocka_set_test_filter(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_spacing),
         cmocka_unit_test(test_placement),
@@ -795,8 +897,9 @@ int main(void)
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_threads),
         cmocka_unit_test(test_outputs),
-        cmocka_unit_test(test_cie171_interreflection_rho50),
-        cmocka_unit_test(test_cie171_interreflection_rho80),
+        cmocka_unit_test(test_command),
+        cmocka_unit_test(cie171_interreflection_rho50),
+        cmocka_unit_test(cie171_interreflection_rho80),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
