@@ -209,7 +209,12 @@ static int run_view(rad_context *ctx, const settings *s)
         fprintf(stderr, "radiosity: --%s (see radiosity view --help)\n", rad_context_error(ctx));
         return EXIT_USAGE;
     }
-    rv_args a = {.input = s->scene_path, .solve = s->solve, .width = s->render.width,
+    if (s->luminaires && s->scene_path && rad_file_is_solution(s->scene_path)) {
+        fprintf(stderr, "radiosity: --luminaires: %s is a solution file, solved already (give the layout with "
+                        "the scene)\n", s->scene_path);
+        return EXIT_USAGE;
+    }
+    rv_args a = {.input = s->scene_path, .luminaires = s->luminaires, .solve = s->solve, .width = s->render.width,
                  .height = s->render.height, .camera = s->camera ? &camera : NULL,
                  .shading = s->render.shading, .exposure = s->render.exposure, .output = s->output,
                  .offscreen = s->offscreen != 0, .no_ambient = s->no_ambient != 0, .keys = s->keys,
@@ -671,6 +676,28 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
         status = fail(ctx, r);
         goto done;
     }
+    if (s.luminaires && saved) {
+        fprintf(stderr, "radiosity: --luminaires: %s is a solution file, solved already (give the layout with "
+                        "the scene)\n", s.scene_path);
+        status = EXIT_USAGE;
+        goto done;
+    }
+    if (s.luminaires) {
+        /* Luminaires placed by the layout (docs/lighting.md), before any work. */
+        r = rad_scene_load_luminaires(ctx, scene, s.luminaires);
+        if (r == RAD_OK)
+            r = rad_output_set_add_input(ctx, out.set, s.luminaires);
+        if (r != RAD_OK) {
+            status = fail(ctx, r);
+            goto done;
+        }
+    }
+    if (s.command == CLI_SOLVE && rad_scene_luminaire_count(scene) > 0) {
+        fprintf(stderr, "radiosity: %s places luminaires (glTF nodes), which a solution file does not hold: "
+                        "render, export or bake it in one run\n", s.scene_path ? s.scene_path : "the scene");
+        status = 1;
+        goto done;
+    }
     status = check_scene_inputs(ctx, scene, &out);
     if (status >= 0)
         goto done;
@@ -881,6 +908,14 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
             printf("wrote %s (%dx%d, %zu elements, %s, %.1f s)%s\n", where(output, full),
                    rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
                    measure, now_seconds() - t0, partial ? " [partial]" : "");
+        size_t lights = rad_scene_luminaire_count(scene);
+        if (lights > 0) {
+            double lumens = 0.0;
+            for (size_t k = 0; k < lights; k++)
+                lumens += rad_scene_luminaire_flux(scene, k);
+            printf("luminaires: %zu, %.6g lm; %.6g lm of direct light lands on the surfaces\n", lights, lumens,
+                   rad_solution_direct_lumens(sol));
+        }
     }
     if (cancel_signal && !partial)
         fprintf(stderr, "radiosity: interrupted while writing the outputs; they were completed first\n");

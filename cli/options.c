@@ -146,6 +146,10 @@ static const cli_flag FLAGS[] = {
     {"lightmap", 0, "WHICH", CLI_BAKE, OWN(lightmap_quantity, RAD_OPTION_ENUM), .own.words = lightmap_words,
      .own.default_text = "radiosity",
      .own.help = "what the texels hold: radiosity B, or irradiance H = (B - E)/rho (as B/pi, H/pi, W/(m^2 sr))"},
+    {"luminaires", 0, "FILE.json", CLI_RENDER | CLI_EXPORT | CLI_BAKE | CLI_VIEW | CLI_ILLUMINANCE,
+     OWN(luminaires, RAD_OPTION_STRING),
+     .own.help = "place luminaires from a layout file (photometric files, positions, aims; docs/lighting.md): "
+                 "their direct light reaches every element exactly and its reflection enters the solve"},
     {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
     {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
     {"closed-doors", 0, NULL, CLI_GENERATE, OFFICE(closed_doors)},

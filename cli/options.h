@@ -73,6 +73,7 @@ typedef struct cli_settings {
     const char *keys;         /* view: keys the window presses itself */
     const char *grid;         /* illuminance: the grid file (--grid) */
     const char *output2;      /* illuminance: a second -o (CSV and JSON both), or NULL */
+    const char *luminaires;   /* render, export, bake, view, illuminance: a layout file (docs/lighting.md) */
 } cli_settings;
 
 /* Where a flag's value goes. */
