@@ -8,11 +8,14 @@
  * engine's visibility layer and a bare Embree loop on random segments of
  * the same mesh, in the same run.
  *
- *   build/bench/bench_office [--threads N] [--rooms N] [--points N] [--elements N]
+ *   build/bench/bench_office [--threads N] [--rooms N] [--points N] [--elements N] [--panels]
  *
- * The light: the generator's ceiling panels (1 or 2 per room, emitting
- * surfaces), not the 40 goniometric luminaires of a layout file (the
- * luminaires branch was not merged here; docs/performance.md says so).
+ * The light: four luminaires per room (40 in all), placed by a layout file
+ * (docs/lighting.md "Luminaires") written here in memory: the Lambertian
+ * downlight of tests/data/luminaires at 4,000 lm, 10 cm below the ceiling
+ * at the room's quarter points; the generator's ceiling panels stop
+ * emitting (a scene lit by luminaires has no emitting surface).  With
+ * --panels, the panels light the office instead and no layout is read.
  * Fixed seed (1): figures are comparable across commits on one machine.
  */
 #include "api/solution.h"
@@ -23,7 +26,7 @@
 
 static void usage(void)
 {
-    fprintf(stderr, "usage: bench_office [--threads N] [--rooms N] [--points N] [--elements N]\n");
+    fprintf(stderr, "usage: bench_office [--threads N] [--rooms N] [--points N] [--elements N] [--panels]\n");
     exit(2);
 }
 
@@ -96,7 +99,7 @@ static double bare_embree_rays_per_second(const rad_mesh *mesh, const rad_ray *r
 
 int main(int argc, char **argv)
 {
-    int threads = 0, rooms = 10;
+    int threads = 0, rooms = 10, panels = 0;
     size_t points = 2000, elements = 2000;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--threads") == 0 && i + 1 < argc)
@@ -107,6 +110,8 @@ int main(int argc, char **argv)
             points = (size_t)atol(argv[++i]);
         else if (strcmp(argv[i], "--elements") == 0 && i + 1 < argc)
             elements = (size_t)atol(argv[++i]);
+        else if (strcmp(argv[i], "--panels") == 0)
+            panels = 1;
         else
             usage();
     }
@@ -122,6 +127,49 @@ int main(int argc, char **argv)
     if (rad_scene_generate_office(ctx, &oo, &scene) != RAD_OK) {
         fprintf(stderr, "%s\n", rad_context_error(ctx));
         return 1;
+    }
+    /* The layout: 4 downlights per room at its quarter points, from each
+     * room's floor (x, z extent) and ceiling (height). */
+    size_t luminaires = 0;
+    if (!panels) {
+        for (size_t m = 0; m < scene->material_count; m++)
+            if (strcmp(scene->materials[m].name, "light_panel") == 0)
+                memset(scene->materials[m].emission, 0, sizeof scene->materials[m].emission);
+        size_t lcap = 512 + 4 * 200 * (size_t)rooms, llen = 0;
+        char *layout = malloc(lcap);
+        llen += (size_t)snprintf(layout + llen, lcap - llen, "{\"up\": [0, 1, 0], \"luminaires\": [");
+        for (int room = 0; room < rooms; room++) {
+            char fname[64], cname[64];
+            snprintf(fname, sizeof fname, "room%d/floor", room);
+            snprintf(cname, sizeof cname, "room%d/ceiling", room);
+            double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY, top = -INFINITY;
+            for (size_t q = 0; q < scene->polygon_count; q++) {
+                const rad_polygon *poly = &scene->polygons[q];
+                const char *sname = scene->surfaces[poly->surface].name;
+                bool fl = strcmp(sname, fname) == 0, ce = strcmp(sname, cname) == 0;
+                for (uint32_t c = 0; (fl || ce) && c < poly->vertex_count; c++) {
+                    vec3 x = scene->positions[scene->indices[poly->first_index + c]];
+                    if (fl)
+                        x0 = fmin(x0, x.x), x1 = fmax(x1, x.x), z0 = fmin(z0, x.z), z1 = fmax(z1, x.z);
+                    else
+                        top = fmax(top, x.y);
+                }
+            }
+            for (int k = 0; k < 4; k++) {
+                double px = x0 + (x1 - x0) * (k % 2 ? 0.75 : 0.25), pz = z0 + (z1 - z0) * (k / 2 ? 0.75 : 0.25);
+                llen += (size_t)snprintf(layout + llen, lcap - llen, "%s{\"file\": \"downlight.ies\", \"lumens\": "
+                                         "4000, \"position\": [%.4f, %.4f, %.4f], \"name\": \"room%d-%d\"}",
+                                         luminaires ? ", " : "", px, top - 0.1, pz, room, k);
+                luminaires++;
+            }
+        }
+        snprintf(layout + llen, lcap - llen, "]}");
+        if (rad_scene_load_luminaires_memory(ctx, scene, RAD_BENCH_DATA "/luminaires/office_layout.json", layout,
+                                             strlen(layout)) != RAD_OK) {
+            fprintf(stderr, "%s\n", rad_context_error(ctx));
+            return 1;
+        }
+        free(layout);
     }
     double load = rad_seconds() - t0;
     /* The grid file: each room's floor footprint at 0.8 m, border 0.5 m, one
@@ -154,7 +202,13 @@ int main(int argc, char **argv)
     o.solver = "gauss-seidel";
     o.seed = 1;
     rad_solution *sol;
-    if (rad_solution_create(ctx, scene, &o, &sol) != RAD_OK || rad_solution_solve(ctx, sol) != RAD_OK) {
+    double c0 = rad_seconds();
+    if (rad_solution_create(ctx, scene, &o, &sol) != RAD_OK) {
+        fprintf(stderr, "%s\n", rad_context_error(ctx));
+        return 1;
+    }
+    double create = rad_seconds() - c0;
+    if (rad_solution_solve(ctx, sol) != RAD_OK) {
         fprintf(stderr, "%s\n", rad_context_error(ctx));
         return 1;
     }
@@ -169,15 +223,19 @@ int main(int argc, char **argv)
     rad_illuminance_get_stats(il, &st);
     const rad_solution_view *v = &sol->view;
     size_t emitters = 0;
-    for (size_t s = 0; s < scene->surface_count; s++)
+    for (size_t s = 0; s < scene->surface_count && panels; s++)
         emitters += strstr(scene->surfaces[s].name, "/light") && !strstr(scene->surfaces[s].name, "housing");
-    printf("office: %d rooms (seed 1), %zu surfaces, %zu emitting panels, %zu elements, %zu patches, %d threads\n",
-           rooms, scene->surface_count, emitters, v->n, v->mesh->patch_count, rad_context_threads(ctx));
+    printf("office: %d rooms (seed 1), %zu surfaces, %zu luminaires, %zu emitting panels, %zu elements, %zu patches, "
+           "%d threads\n", rooms, scene->surface_count, luminaires, emitters, v->n, v->mesh->patch_count,
+           rad_context_threads(ctx));
     printf("grid: %zu floor footprints at 0.8 m, border 0.5 m, spacing %.3f m: %zu points\n", (size_t)floors,
            spacing, st.points);
-    printf("%8s %8s %8s %10s %8s %8s %8s\n", "load", "mesh", "bvh", "ff+direct", "solve", "grid", "total");
-    printf("%8.3f %8.3f %8.4f %10.3f %8.3f %8.3f %8.3f\n", load, v->seconds.mesh, v->seconds.visibility,
-           v->seconds.form_factors, v->seconds.solve, st.seconds, total);
+    /* What creating the solution spent beyond mesh, BVH and form factors:
+     * the element arrays and the direct light's element means. */
+    double direct = create - v->seconds.mesh - v->seconds.visibility - v->seconds.form_factors;
+    printf("%8s %8s %8s %8s %8s %8s %8s %8s\n", "load", "mesh", "bvh", "ff", "direct", "solve", "grid", "total");
+    printf("%8.3f %8.3f %8.4f %8.3f %8.3f %8.3f %8.3f %8.3f\n", load, v->seconds.mesh, v->seconds.visibility,
+           v->seconds.form_factors, direct, v->seconds.solve, st.seconds, total);
     double eavg = 0.0, u0 = 1.0;
     for (size_t g = 0; g < rad_illuminance_grid_count(il); g++) {
         const rad_grid_result *r = rad_illuminance_grid(il, g);
@@ -185,10 +243,15 @@ int main(int argc, char **argv)
         u0 = fmin(u0, r->uniformity);
     }
     printf("illuminance: Eavg %.1f lux over all points, lowest room U0 %.3f\n", eavg / (double)st.points, u0);
-    printf("gathering: %.0f points/s; %llu shadow rays (%.0f per point), %.2f M rays/s of gathering time; "
-           "%llu point-element pairs by rays, %llu exact\n",
-           st.points_per_second, st.shadow_rays, (double)st.shadow_rays / (double)st.points,
-           (double)st.shadow_rays / st.seconds / 1e6, st.ray_pairs, st.exact_pairs);
+    /* The gathering's own time: all the points' thread-seconds less the
+     * direct light's (luminaires, daylight). */
+    double gathering = st.thread_seconds - st.light_seconds;
+    printf("grid: %.0f points/s (wall); per point %.3f ms of direct light, %.3f ms of gathering (thread time)\n",
+           st.points_per_second, 1e3 * st.light_seconds / (double)st.points, 1e3 * gathering / (double)st.points);
+    printf("gathering: %llu shadow rays (%.0f per point), %.2f M rays per thread-second of gathering; %llu "
+           "point-element pairs by rays, %llu exact\n",
+           st.shadow_rays, (double)st.shadow_rays / (double)st.points, (double)st.shadow_rays / gathering / 1e6,
+           st.ray_pairs, st.exact_pairs);
     fflush(stdout);
 
     /* Ray throughput on the same mesh, one thread: the engine's layer and a
@@ -202,11 +265,12 @@ int main(int argc, char **argv)
         v->vis->backend->occluded(v->vis->state, rays + k, nrays - k < 64 ? nrays - k : 64, hit + k);
     double ours = (double)nrays / (rad_seconds() - r0);
     double bare = bare_embree_rays_per_second(v->mesh, rays, nrays);
-    double gather_per_thread = (double)st.shadow_rays / (st.seconds * rad_context_threads(ctx));
+    double gather_per_thread = (double)st.shadow_rays / gathering;
     printf("rays, 1 thread, random segments: engine layer %.2f M rays/s, bare Embree %.2f M rays/s\n", ours / 1e6,
            bare / 1e6);
-    printf("gathering per thread: %.2f M rays/s of its time = %.2f of the engine layer's rate (the rest is the "
-           "exact point-to-polygon factors)\n", gather_per_thread / 1e6, gather_per_thread / ours);
+    printf("gathering: %.2f M rays per thread-second = %.2f of the engine layer's rate on random segments (the "
+           "rest of its time is the exact point-to-polygon factors)\n", gather_per_thread / 1e6,
+           gather_per_thread / ours);
     free(rays);
     free(hit);
     free(json);

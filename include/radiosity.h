@@ -1180,6 +1180,9 @@ typedef struct rad_illuminance_stats {
     unsigned long long shadow_rays; /* cast by the gathering */
     unsigned long long exact_pairs; /* point-element pairs with exact visibility (no ray) */
     unsigned long long ray_pairs;   /* ... with visibility from shadow rays */
+    double light_seconds;          /* thread-seconds spent in the direct light of luminaires and
+                                      daylight at the points, summed over threads */
+    double thread_seconds;         /* thread-seconds of all the points' work, summed over threads */
 } rad_illuminance_stats;
 
 /* Evaluate the grid file at `grid_path` (or `size` bytes at `data`, named

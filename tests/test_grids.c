@@ -12,6 +12,8 @@
  *                  inclined point against Gauss-Legendre quadrature
  *   occluder       a square blocker halfway: the factor of the emitter less
  *                  the blocker's shadow, by the closed form (1e-6)
+ *   luminaire      a goniometric downlight (the luminaires' direct light,
+ *                  light.h) over points: I(theta) cos theta / d^2 (1e-6)
  *   cross-method   the mean of point values over an element against the
  *                  element's irradiance (B - E) / rho from the solve
  *   statistics     Eavg, Emin, Emax, U0 of free points by the closed form
@@ -113,12 +115,17 @@ typedef struct fixture {
     rad_solution *sol;
 } fixture;
 
-static void solve(fixture *fx, const scene_text *t, double mesh_size, int threads)
+/* Load the scene (and the luminaires of `layout`, a layout file's text,
+ * where not NULL), mesh it at mesh_size and solve with LU. */
+static void solve_lit(fixture *fx, const scene_text *t, double mesh_size, int threads, const char *layout)
 {
     rad_context_options co = {0};
     co.threads = threads;
     assert_int_equal(rad_context_create(&co, &fx->ctx), RAD_OK);
     rad_result r = rad_scene_load_memory(fx->ctx, "scene.obj", t->obj, t->on, t->mtl, t->mn, &fx->scene);
+    if (r == RAD_OK && layout)
+        r = rad_scene_load_luminaires_memory(fx->ctx, fx->scene, RAD_TEST_DATA "/luminaires/layout.json", layout,
+                                             strlen(layout));
     if (r != RAD_OK)
         fprintf(stderr, "%s\n", rad_context_error(fx->ctx));
     assert_int_equal(r, RAD_OK);
@@ -132,6 +139,11 @@ static void solve(fixture *fx, const scene_text *t, double mesh_size, int thread
     if (r != RAD_OK)
         fprintf(stderr, "%s\n", rad_context_error(fx->ctx));
     assert_int_equal(r, RAD_OK);
+}
+
+static void solve(fixture *fx, const scene_text *t, double mesh_size, int threads)
+{
+    solve_lit(fx, t, mesh_size, threads, NULL);
 }
 
 static void release(fixture *fx)
@@ -446,6 +458,44 @@ static void test_occluder(void **state)
     rad_illuminance_get_stats(il, &st);
     assert_int_equal(st.points, 3);
     assert_true(st.exact_pairs > 0);
+    rad_illuminance_destroy(il);
+    release(&fx);
+    free(t);
+}
+
+/* ---- a luminaire over points (the direct light's contract, light.h) ---- */
+
+static void test_luminaire(void **state)
+{
+    (void)state;
+    /* tests/data/luminaires/downlight.ies: Lambertian, 1000 lm, I(theta) =
+     * (1000 / pi) cos theta in 10 degree steps (318.3099 cd at 0, 275.6644 at
+     * 30); 2 m above a black floor, aimed down (y up), llf 1: a point below
+     * gets I(0) / 4 lux; one 2 tan 30 deg off, I(30) cos^3 30 / 4; a point on
+     * the floor as in the air (1.6 m below: beyond five luminous sizes, a
+     * point source).  No reflection: E_indirect = 0. */
+    scene_text *t = malloc(sizeof *t);
+    begin(t);
+    material(t, "black", 0.0, 0.0, 0.0, 0.0);
+    double of[3] = {-3, 0, -3}, fx_[3] = {6, 0, 0}, fz[3] = {0, 0, 6}, up[3] = {0, 1, 0};
+    rect(t, "floor", "black", of, fx_, fz, up);
+    fixture fx;
+    solve_lit(&fx, t, 1.0, 1,
+              "{\"up\": [0, 1, 0], \"luminaires\": [{\"file\": \"downlight.ies\", \"position\": [0, 2, 0]}]}");
+    double off = 2.0 * tan(M_PI / 6);
+    char json[512];
+    snprintf(json, sizeof json, "{\"points\": [{\"name\": \"below\", \"position\": [0, 0, 0]}, {\"name\": "
+             "\"air\", \"position\": [0, 0.4, 0]}, {\"name\": \"off\", \"position\": [%.17g, 0, 0]}]}", off);
+    rad_illuminance *il = evaluate(&fx, json);
+    const rad_grid_result *r = rad_illuminance_grid(il, 0);
+    double c30 = cos(M_PI / 6);
+    const double expect[3] = {318.3099 / 4.0, 318.3099 / (1.6 * 1.6), 275.6644 * c30 * c30 * c30 / 4.0};
+    for (int k = 0; k < 3; k++) {
+        printf("luminaire point %d: %.9g lux, expected %.9g\n", k, r->points[k].illuminance, expect[k]);
+        assert_true(fabs(r->points[k].illuminance / expect[k] - 1.0) < 1e-6);
+        assert_true(fabs(r->points[k].direct / expect[k] - 1.0) < 1e-6);
+        assert_true(r->points[k].indirect == 0.0);
+    }
     rad_illuminance_destroy(il);
     release(&fx);
     free(t);
@@ -892,6 +942,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_closed_box),
         cmocka_unit_test(test_square_emitter),
         cmocka_unit_test(test_occluder),
+        cmocka_unit_test(test_luminaire),
         cmocka_unit_test(test_cross_method),
         cmocka_unit_test(test_statistics),
         cmocka_unit_test(test_bad_files),

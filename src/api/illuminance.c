@@ -115,6 +115,8 @@ static rad_result evaluate(rad_context *ctx, const rad_solution *s, const char *
     il->stats.shadow_rays = gs.rays;
     il->stats.exact_pairs = gs.exact_pairs;
     il->stats.ray_pairs = gs.ray_pairs;
+    il->stats.light_seconds = gs.light_seconds;
+    il->stats.thread_seconds = gs.thread_seconds;
     *out = il;
     return RAD_OK;
 }

@@ -121,13 +121,15 @@ static int64_t receiver_of(const gather_shared *g, vec3 p, vec3 n)
 }
 
 static void gather_point(const gather_shared *g, size_t index, ray_batch *b, double direct[3],
-                         double indirect[3], uint64_t *exact_pairs, uint64_t *ray_pairs)
+                         double indirect[3], uint64_t *exact_pairs, uint64_t *ray_pairs, double *light_seconds)
 {
     const rad_solution_view *view = g->view;
     const rad_mesh *mesh = view->mesh;
     const double *B = view->radiosity;
     vec3 p = g->set->position[index], n = g->set->normal[index];
+    double t0 = rad_seconds();
     rad_light_irradiance(view->scene, mesh, view->vis, p, n, direct);
+    *light_seconds += rad_seconds() - t0;
     indirect[0] = indirect[1] = indirect[2] = 0.0;
     int64_t recv = receiver_of(g, p, n);
     const rad_element *re = recv >= 0 ? &mesh->elements[recv] : NULL;
@@ -255,28 +257,31 @@ rad_result rad_grid_gather(rad_context *ctx, const rad_solution_view *view, cons
                        view->options ? view->options->seed : 0};
     int done = 0, skipped = 0;
     uint64_t exact = 0, by_rays = 0;
+    double light = 0.0, busy = 0.0;
     rad_progress(ctx, "illuminance", 0, (uint64_t)points);
-#pragma omp parallel num_threads(threads) reduction(+ : exact, by_rays)
+#pragma omp parallel num_threads(threads) reduction(+ : exact, by_rays, light, busy)
     {
         int thread = 0;
 #ifdef _OPENMP
         thread = omp_get_thread_num();
 #endif
         ray_batch *b = &batches[thread];
-#pragma omp for schedule(dynamic, 4)
+        double start = rad_seconds();
+#pragma omp for schedule(dynamic, 4) nowait
         for (size_t k = 0; k < points; k++) {
             if (rad_cancelled(ctx)) {
 #pragma omp atomic update
                 skipped++;
                 continue;
             }
-            gather_point(&g, k, b, direct + 3 * k, indirect + 3 * k, &exact, &by_rays);
+            gather_point(&g, k, b, direct + 3 * k, indirect + 3 * k, &exact, &by_rays, &light);
             int now;
 #pragma omp atomic capture
             now = ++done;
             if (thread == 0)
                 rad_progress(ctx, "illuminance", (uint64_t)now, (uint64_t)points);
         }
+        busy += rad_seconds() - start;
     }
     rad_progress(ctx, "illuminance", (uint64_t)done, (uint64_t)points);
     for (int t = 0; t < threads; t++)
@@ -284,6 +289,8 @@ rad_result rad_grid_gather(rad_context *ctx, const rad_solution_view *view, cons
     stats->exact_pairs = exact;
     stats->ray_pairs = by_rays;
     stats->seconds = rad_seconds() - t0;
+    stats->light_seconds = light;
+    stats->thread_seconds = busy;
     rad_free(self);
     rad_free(diameter);
     rad_free(batches);

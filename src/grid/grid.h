@@ -70,6 +70,9 @@ typedef struct rad_grid_gather_stats {
     uint64_t exact_pairs;       /* point-element pairs whose visibility was exact (occluders.c) */
     uint64_t ray_pairs;         /* ... estimated by shadow rays */
     double seconds;             /* wall clock of the gathering */
+    double light_seconds;       /* thread-seconds in the direct light of luminaires and daylight
+                                   (rad_light_irradiance), summed over threads */
+    double thread_seconds;      /* thread-seconds of all the points' work, summed over threads */
 } rad_grid_gather_stats;
 
 /* Irradiance (W/m^2 RGB, 3 per point) at every point of `set` from a
