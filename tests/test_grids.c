@@ -4,7 +4,8 @@
  *
  *   spacing        EN 12464-1's p = 0.2 x 5^log10(d) and the point counts,
  *                  against values worked by hand
- *   placement      rectangles and footprints: counts, cell centres, border
+ *   placement      rectangles and footprints: counts, cell centres, border;
+ *                  an L-shaped floor of three quads, its outline's border
  *   closed box     uniform E and rho everywhere: every point (free, on the
  *                  floor, on a wall, inclined) sees E = 179 Y(E / (1 - rho))
  *   square         a square emitter over a point: the closed form of the
@@ -283,6 +284,44 @@ static void test_placement(void **state)
     assert_int_equal(d->point_count, 10);
     assert_true(fabs(d->points[0].normal[2] - 1.0) < 1e-15);
     assert_true(fabs(d->points[0].position[1] - 1.0) < 1e-12);
+    rad_illuminance_destroy(il);
+    release(&fx);
+    free(t);
+}
+
+/* An L-shaped floor of three quads (one surface): [0,2]x[0,2], [2,4]x[0,2]
+ * and [0,2]x[2,4] in (x, z); border 0.5, spacing 0.5 over its 4 x 4
+ * bounding square: 6 x 6 cell centres at 0.75 ... 3.25.  Kept, worked by
+ * hand: rows z = 0.75 and 1.25 all 6; z = 1.75 only x = 0.75, 1.25 (the
+ * others within 0.5 of the inner corner's edges, (2, 2) at 0.35 from
+ * (1.75, 1.75)); rows z = 2.25 ... 3.25 x = 0.75, 1.25 (x <= 1.5 in the
+ * arm): 6 + 6 + 2 + 3 x 2 = 20.  The inner edges the quads share are not
+ * the outline. */
+static void test_footprint_l(void **state)
+{
+    (void)state;
+    scene_text *t = malloc(sizeof *t);
+    begin(t);
+    material(t, "grey", 0.5, 0.5, 0.5, 0.0);
+    material(t, "lamp", 0.0, 0.0, 0.0, 10.0);
+    obj_printf(t, "o floor\nusemtl grey\n"
+                  "v 0 0 0\nv 2 0 0\nv 4 0 0\nv 0 0 2\nv 2 0 2\nv 4 0 2\nv 0 0 4\nv 2 0 4\n"
+                  "f 1 4 5 2\nf 2 5 6 3\nf 4 7 8 5\n");
+    t->vertices = 8;
+    double o[3] = {0.5, 2.5, 0.5}, u[3] = {1, 0, 0}, v[3] = {0, 0, 1}, down[3] = {0, -1, 0};
+    rect(t, "lamp", "lamp", o, u, v, down);
+    fixture fx;
+    solve(&fx, t, 1.0, 1);
+    rad_illuminance *il = evaluate(&fx, "{\"grids\": [{\"name\": \"L\", \"surface\": \"floor\", \"spacing\": 0.5}]}");
+    const rad_grid_result *r = rad_illuminance_grid(il, 0);
+    assert_int_equal(r->columns, 6);
+    assert_int_equal(r->rows, 6);
+    assert_int_equal(r->point_count, 20);
+    for (size_t k = 0; k < r->point_count; k++) {
+        double x = r->points[k].position[0], z = r->points[k].position[2];
+        assert_true(z < 2.0 || x < 1.5);
+        assert_true(fabs(r->points[k].position[1]) < 1e-12);
+    }
     rad_illuminance_destroy(il);
     release(&fx);
     free(t);
@@ -939,6 +978,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_spacing),
         cmocka_unit_test(test_placement),
+        cmocka_unit_test(test_footprint_l),
         cmocka_unit_test(test_closed_box),
         cmocka_unit_test(test_square_emitter),
         cmocka_unit_test(test_occluder),
