@@ -20,6 +20,7 @@
  *   statistics     Eavg, Emin, Emax, U0 of free points by the closed form
  *   bad files      each with its message
  *   threads        1 and 2 threads give the same numbers, bit for bit
+ *   progress       reported to the end; a cancel stops it (interrupted, no result)
  *   outputs        CSV and JSON read back
  *   command        radiosity illuminance: both files and the table; a bad
  *                  grid file refused before the work, nothing written;
@@ -735,6 +736,69 @@ static void test_threads(void **state)
     free(t);
 }
 
+/* ---- progress and cancellation ---- */
+
+typedef struct progress_log {
+    int calls;
+    unsigned long long last_done, last_total;
+    bool cancel_at_first;
+    rad_context *ctx;
+} progress_log;
+
+static void on_progress(void *user, const char *phase, uint64_t done, uint64_t total)
+{
+    progress_log *log = user;
+    if (strcmp(phase, "illuminance") != 0)
+        return;
+    log->calls++;
+    log->last_done = done;
+    log->last_total = total;
+    if (log->cancel_at_first && log->ctx)
+        rad_context_cancel(log->ctx, true);
+}
+
+static void test_progress_cancel(void **state)
+{
+    (void)state;
+    scene_text *t = malloc(sizeof *t);
+    emitter_scene(t, true, true);
+    const char *json = "{\"grids\": [{\"name\": \"wp\", \"rectangle\": {\"origin\": [-1, 0.4, -1], \"u\": [2, 0, 0], "
+                       "\"v\": [0, 0, 2]}, \"facing\": \"up\", \"spacing\": 0.1}]}";
+    for (int cancel = 0; cancel < 2; cancel++) {
+        progress_log log = {0, 0, 0, cancel != 0, NULL};
+        fixture fx;
+        rad_context_options co = {0};
+        co.threads = 1;
+        co.progress = on_progress;
+        co.progress_user = &log;
+        assert_int_equal(rad_context_create(&co, &fx.ctx), RAD_OK);
+        assert_int_equal(rad_scene_load_memory(fx.ctx, "scene.obj", t->obj, t->on, t->mtl, t->mn, &fx.scene), RAD_OK);
+        rad_options o = {0};
+        o.mesh_size = 0.25;
+        o.solver = "direct";
+        assert_int_equal(rad_solution_create(fx.ctx, fx.scene, &o, &fx.sol), RAD_OK);
+        assert_int_equal(rad_solution_solve(fx.ctx, fx.sol), RAD_OK);
+        log.ctx = fx.ctx;
+        rad_illuminance *il = NULL;
+        rad_result r = rad_illuminance_evaluate_memory(fx.ctx, fx.sol, "g.json", json, strlen(json), &il);
+        if (cancel) {
+            /* Cancelled at the first report: interrupted, nothing returned. */
+            assert_int_equal(r, RAD_ERROR_INTERRUPTED);
+            assert_null(il);
+            assert_non_null(strstr(rad_context_error(fx.ctx), "illuminance: interrupted"));
+        } else {
+            /* 400 points: reported from 0 to 400 of 400. */
+            assert_int_equal(r, RAD_OK);
+            assert_true(log.calls >= 2);
+            assert_int_equal(log.last_done, 400);
+            assert_int_equal(log.last_total, 400);
+        }
+        rad_illuminance_destroy(il);
+        release(&fx);
+    }
+    free(t);
+}
+
 /* ---- outputs ---- */
 
 static char *slurp(const char *path)
@@ -987,6 +1051,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_statistics),
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_threads),
+        cmocka_unit_test(test_progress_cancel),
         cmocka_unit_test(test_outputs),
         cmocka_unit_test(test_command),
         cmocka_unit_test(cie171_interreflection_rho50),
