@@ -264,6 +264,7 @@ typedef struct run_outputs {
     const char *main;      /* the image, view-factor or mesh file: its temporary */
     const char *stats, *history;
     const char *gebhart;   /* thermal --gebhart: its temporary */
+    const char *second;    /* illuminance's second -o: its temporary */
 } run_outputs;
 
 /* Plan the outputs and name the scene file as an input.  Returns -1 to go
@@ -272,6 +273,7 @@ typedef struct run_outputs {
 static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
 {
     rad_output_kind kind = s->command == CLI_THERMAL       ? RAD_OUTPUT_THERMAL
+                           : s->command == CLI_ILLUMINANCE ? RAD_OUTPUT_ILLUMINANCE
                            : s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS
                            : s->command == CLI_SOLVE     ? RAD_OUTPUT_SOLUTION
                            : s->command == CLI_EXPORT    ? RAD_OUTPUT_MESH
@@ -286,6 +288,10 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
         r = rad_output_set_add(ctx, o->set, s->output, kind, &o->main);
     if (r == RAD_OK && s->gebhart)
         r = rad_output_set_add(ctx, o->set, s->gebhart, RAD_OUTPUT_THERMAL, &o->gebhart);
+    if (r == RAD_OK && s->grid)
+        r = rad_output_set_add_input(ctx, o->set, s->grid);
+    if (r == RAD_OK && s->output2)
+        r = rad_output_set_add(ctx, o->set, s->output2, RAD_OUTPUT_ILLUMINANCE, &o->second);
     /* bake: the first atlas's lightmaps (there is always one); others are
      * added when the packing knows them. */
     static const char *const lightmap_ext[2] = {"hdr", "png"};
@@ -389,6 +395,55 @@ static int run_thermal(rad_context *ctx, const settings *s, const rad_scene *sce
                b.net_power, b.environment_power, b.imbalance, b.relative_imbalance, b.power_scale);
     }
     rad_thermal_destroy(heat);
+    return cancel_signal ? interrupted_status() : 0;
+}
+
+/* The illuminance command after the solve: the grid file's points
+ * evaluated, a summary line per grid, the CSV / JSON (and stats, history)
+ * put in place together.  Returns the exit status. */
+static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *sol, run_outputs *out,
+                           progress_state *progress, double t0)
+{
+    rad_illuminance *il = NULL;
+    rad_result r = rad_illuminance_evaluate_file(ctx, sol, s->grid, &il);
+    progress_end(progress);
+    if (r == RAD_ERROR_INTERRUPTED) {
+        fprintf(stderr, "radiosity: interrupted while computing the illuminance; nothing written\n");
+        return interrupted_status();
+    }
+    if (r != RAD_OK)
+        return fail(ctx, r);
+    begin_saving(ctx);
+    r = rad_illuminance_write(ctx, il, out->main);
+    if (r == RAD_OK && out->second)
+        r = rad_illuminance_write(ctx, il, out->second);
+    if (r == RAD_OK && s->stats)
+        r = rad_solution_write_stats(ctx, sol, out->stats, 0);
+    if (r == RAD_OK && s->history)
+        r = rad_solution_write_history(ctx, sol, out->history);
+    if (r == RAD_OK && !s->quiet) {
+        printf("%-24s %8s %12s %12s %12s %7s\n", "grid", "points", "Eavg lux", "Emin lux", "Emax lux", "U0");
+        for (size_t g = 0; g < rad_illuminance_grid_count(il); g++) {
+            const rad_grid_result *res = rad_illuminance_grid(il, g);
+            printf("%-24.24s %8zu %12.1f %12.1f %12.1f %7.3f\n", res->name, res->point_count, res->average,
+                   res->minimum, res->maximum, res->uniformity);
+        }
+        fflush(stdout);
+    }
+    if (r == RAD_OK)
+        r = rad_output_set_commit(ctx, out->set);
+    if (r != RAD_OK) {
+        rad_illuminance_destroy(il);
+        return fail(ctx, r);
+    }
+    rad_illuminance_stats st;
+    rad_illuminance_get_stats(il, &st);
+    rad_illuminance_destroy(il);
+    char full[PATH_MAX];
+    if (!s->quiet)
+        printf("wrote %s%s%s (%zu points in %.2f s, %.0f points/s; %zu elements, %.1f s)\n", where(s->output, full),
+               s->output2 ? " and " : "", s->output2 ? s->output2 : "", st.points, st.seconds, st.points_per_second,
+               rad_solution_element_count(sol), now_seconds() - t0);
     return cancel_signal ? interrupted_status() : 0;
 }
 
@@ -558,6 +613,11 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
                         "heat fluxes (see radiosity thermal --help)\n");
         return EXIT_USAGE;
     }
+    if (s.command == CLI_ILLUMINANCE && !s.grid) {
+        fprintf(stderr, "radiosity: illuminance needs --grid FILE.json: the calculation grids and points (see "
+                        "radiosity illuminance --help)\n");
+        return EXIT_USAGE;
+    }
     if (s.command == CLI_THERMAL &&
         (strcmp(s.solve.solver, "hierarchical") == 0 || strcmp(s.solve.solver, "shooting") == 0)) {
         fprintf(stderr, "radiosity: --solver %s keeps no form-factor matrix: thermal takes direct, gauss-seidel, "
@@ -655,7 +715,8 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
      * signature), which is solved already */
     double t0 = now_seconds();
     bool saved = s.scene_path && rad_file_is_solution(s.scene_path);
-    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT && s.command != CLI_BAKE) {
+    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT && s.command != CLI_BAKE &&
+        s.command != CLI_ILLUMINANCE) {
         fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it and `radiosity "
                         "export` writes its lit mesh; %s needs the scene it was solved for\n",
                 s.scene_path, cli_command_name(s.command));
@@ -702,6 +763,10 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
     if (status >= 0)
         goto done;
     status = 1;
+    if (s.command == CLI_ILLUMINANCE && rad_illuminance_check_file(ctx, scene, s.grid, NULL) != RAD_OK) {
+        status = fail(ctx, RAD_ERROR_PARSE); /* a bad grid file: before any work */
+        goto done;
+    }
     if (s.command == CLI_THERMAL && rad_thermal_conditions_load_file(ctx, scene, s.bc, &bc) != RAD_OK) {
         status = fail(ctx, RAD_ERROR_PARSE); /* a bad file: before any work */
         goto done;
@@ -728,7 +793,10 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
     }
     if (s.command != CLI_VIEWFACTORS && s.command != CLI_THERMAL && !s.quiet && !s.scene_path)
         printf("radiosity: no scene given, %s the built-in Cornell box\n",
-               s.command == CLI_EXPORT ? "exporting" : s.command == CLI_BAKE ? "baking" : "rendering");
+               s.command == CLI_EXPORT        ? "exporting"
+               : s.command == CLI_BAKE        ? "baking"
+               : s.command == CLI_ILLUMINANCE ? "lighting"
+                                              : "rendering");
 
     /* Progressive display keeps one exposure for all frames (the user's, or
      * the first frame's automatic one), so the picture visibly brightens as
@@ -834,6 +902,17 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 
     if (s.command == CLI_SOLVE) {
         status = write_solution(ctx, &s, sol, &out, partial, t0);
+        goto done;
+    }
+
+    if (s.command == CLI_ILLUMINANCE) {
+        /* 5'. illuminance at the calculation points */
+        if (partial) {
+            fprintf(stderr, "radiosity: interrupted while solving; no illuminance written\n");
+            status = interrupted_status();
+        } else {
+            status = run_illuminance(ctx, &s, sol, &out, &progress, t0);
+        }
         goto done;
     }
 

@@ -24,7 +24,8 @@
 
 /* The commands, as bits: a flag lists those that take it. */
 enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32,
-       CLI_VIEW = 64, CLI_THERMAL = 128, CLI_PHOTOMETRY = 256 };
+       CLI_VIEW = 64, CLI_THERMAL = 128, CLI_PHOTOMETRY = 256,
+       CLI_ILLUMINANCE = 512 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -74,7 +75,9 @@ typedef struct cli_settings {
     char *const *photometry_files; /* photometry: the files (into argv, consecutive) */
     size_t photometry_file_count;
     const char *daylight;     /* --daylight: the daylight file (sky, sun, openings), or NULL */
-    const char *luminaires;   /* render, export, solve, bake, view: a layout file (docs/lighting.md) */
+    const char *luminaires;   /* render, export, solve, bake, view, illuminance: a layout file (docs/lighting.md) */
+    const char *grid;         /* illuminance: the grid file (--grid) */
+    const char *output2;      /* illuminance: a second -o (CSV and JSON both), or NULL */
 } cli_settings;
 
 /* Where a flag's value goes. */

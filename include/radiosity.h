@@ -843,7 +843,8 @@ typedef enum rad_output_kind {
     RAD_OUTPUT_MESH = 3,         /* .glb, .gltf, .ply (rad_solution_write_mesh) */
     RAD_OUTPUT_BAKE = 4,         /* .glb, .gltf (rad_solution_bake) */
     RAD_OUTPUT_THERMAL = 8,      /* .csv, .json (rad_thermal_write, rad_thermal_write_gebhart) */
-    RAD_OUTPUT_SOLUTION = 16     /* .radsol (rad_solution_save) */
+    RAD_OUTPUT_SOLUTION = 16,    /* .radsol (rad_solution_save) */
+    RAD_OUTPUT_ILLUMINANCE = 32  /* .csv, .json (rad_illuminance_write) */
 } rad_output_kind;
 
 /* An empty set.  Fails with RAD_ERROR_OUT_OF_MEMORY; NULL ctx or out:
@@ -1126,6 +1127,106 @@ RAD_API rad_result rad_thermal_write_stats(rad_context *ctx, const rad_thermal *
  * row per emitting surface) or .json ({"surfaces": [...], "G": [[...]]}).
  * Fails as rad_thermal_gebhart and rad_thermal_write. */
 RAD_API rad_result rad_thermal_write_gebhart(rad_context *ctx, const rad_thermal *thermal, const char *path);
+
+/* ------------------------------------------------------------------------
+ * Calculation grids and points: illuminance (docs/lighting.md,
+ * "Calculation grids and points")
+ *
+ * A grid file (JSON) names work planes (rectangles, or a surface's
+ * footprint at a height, spaced by EN 12464-1 or as given) and free points.
+ * rad_illuminance_evaluate computes at every point, on a solved solution,
+ * the illuminance in lux (docs/units.md: lux = 179 Y(H)): the direct light
+ * of luminaires, daylight and emitting surfaces, plus the interreflection
+ * gathered from the elements' radiosities with exact point-to-polygon
+ * factors and visibility.
+ * ---------------------------------------------------------------------- */
+
+typedef struct rad_illuminance rad_illuminance;
+
+/* One point's values. */
+typedef struct rad_grid_point_value {
+    double position[3];            /* m */
+    double normal[3];              /* unit: light from behind counts zero */
+    double u, v;                   /* m, in the grid's plane from its origin (the rectangle's
+                                      origin, the footprint's lower corner); 0 for free points */
+    double illuminance;            /* lux: direct + indirect */
+    double direct;                 /* lux: luminaires, daylight, emitting surfaces */
+    double indirect;               /* lux: light reflected by the scene's surfaces */
+    double daylight_factor;        /* %: illuminance / the unobstructed sky's horizontal
+                                      illuminance; NAN without daylight */
+    const char *name;              /* a free point's name; NULL for grid points */
+} rad_grid_point_value;
+
+/* One grid's points and statistics (the free points form one, "points"). */
+typedef struct rad_grid_result {
+    const char *name;
+    bool free_points;              /* the file's "points" */
+    size_t point_count;
+    const rad_grid_point_value *points; /* rows of v, u fastest (a footprint skips cells off it) */
+    unsigned columns, rows;        /* cells along u and v; 0 for free points */
+    double spacing_u, spacing_v;   /* m, the cells' sides; 0 for free points */
+    double width, height;          /* m, the calculation area's sides after the border */
+    double border;                 /* m */
+    bool automatic;                /* spacing by EN 12464-1: p = 0.2 x 5^log10(d) m, <= 10 m */
+    double average, minimum, maximum; /* lux: Eavg, Emin, Emax */
+    double uniformity;             /* U0 = Emin / Eavg (0 when Eavg is 0) */
+    double min_over_max;           /* Emin / Emax (0 when Emax is 0) */
+} rad_grid_result;
+
+/* What the evaluation cost. */
+typedef struct rad_illuminance_stats {
+    size_t points;
+    double seconds;                /* the gathering, wall clock */
+    double points_per_second;
+    unsigned long long shadow_rays; /* cast by the gathering */
+    unsigned long long exact_pairs; /* point-element pairs with exact visibility (no ray) */
+    unsigned long long ray_pairs;   /* ... with visibility from shadow rays */
+    double light_seconds;          /* thread-seconds spent in the direct light of luminaires and
+                                      daylight at the points, summed over threads */
+    double thread_seconds;         /* thread-seconds of all the points' work, summed over threads */
+} rad_illuminance_stats;
+
+/* Evaluate the grid file at `grid_path` (or `size` bytes at `data`, named
+ * `name` in messages) on a solved solution; *out holds every point's
+ * values.  Threads: the context's; the numbers are the same whatever
+ * their count (rays keyed on rad_options.seed).  Progress phase
+ * "illuminance"; cancellable.  The solution and its scene must outlive
+ * *out.  Fails with RAD_ERROR_PARSE (a bad file: the message names the
+ * file and the entry and key), RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY,
+ * RAD_ERROR_INTERRUPTED; an unsolved solution or a NULL argument:
+ * RAD_ERROR_INVALID_ARGUMENT.  *out is NULL on failure. */
+RAD_API rad_result rad_illuminance_evaluate_file(rad_context *ctx, const rad_solution *solution,
+                                                 const char *grid_path, rad_illuminance **out);
+RAD_API rad_result rad_illuminance_evaluate_memory(rad_context *ctx, const rad_solution *solution,
+                                                   const char *name, const void *data, size_t size,
+                                                   rad_illuminance **out);
+/* Read and check the grid file at `path` against `scene` without solving
+ * (a command checks its input before the work); *points (may be NULL) the
+ * points it places.  Fails as rad_illuminance_evaluate_file. */
+RAD_API rad_result rad_illuminance_check_file(rad_context *ctx, const rad_scene *scene, const char *path,
+                                              size_t *points);
+/* NULL: no-op. */
+RAD_API void rad_illuminance_destroy(rad_illuminance *illuminance);
+
+/* The grids, in the file's order, the free points last; 0 for NULL. */
+RAD_API size_t rad_illuminance_grid_count(const rad_illuminance *illuminance);
+/* Grid `grid`, owned by *illuminance and valid for its life; NULL out of
+ * range or for NULL. */
+RAD_API const rad_grid_result *rad_illuminance_grid(const rad_illuminance *illuminance, size_t grid);
+/* Whether the scene has daylight (the daylight factors are numbers). */
+RAD_API bool rad_illuminance_has_daylight(const rad_illuminance *illuminance);
+/* The cost into *out (zeros for NULL illuminance); NULL out: no-op. */
+RAD_API void rad_illuminance_get_stats(const rad_illuminance *illuminance, rad_illuminance_stats *out);
+
+/* Write the values by extension (docs/lighting.md): .csv, one row per point
+ * (grid, index, name, x, y, z, normal, u, v, E, E_direct, E_indirect in
+ * lux, and the daylight factor in % with daylight), or .json (per grid:
+ * Eavg, Emin, Emax, U0, Emin/Emax, points, spacing, and every point).
+ * Atomic like the other writers (a path an output set gave is written in
+ * place by the set's commit).  Fails with RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY; an unknown extension or a NULL argument:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_illuminance_write(rad_context *ctx, const rad_illuminance *illuminance, const char *path);
 
 /* ------------------------------------------------------------------------
  * Method registries
