@@ -24,6 +24,7 @@
 #include "viewer.h"
 #endif
 
+#include <ctype.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -484,6 +485,57 @@ static int stream_rank(rad_context *ctx, const settings *s, const rad_stream_ran
     return r == RAD_OK ? 0 : fail(ctx, r);
 }
 
+/* The false colour options of render's flags (--false-colour, --scale,
+ * --range, --contours), checked by the library before any work; returns
+ * -1 when good, else the exit status (the message printed). */
+static int false_colour_options(rad_context *ctx, const settings *s, rad_false_colour_options *fo)
+{
+    memset(fo, 0, sizeof *fo);
+    if (!s->false_colour) {
+        if (s->log_scale || s->range || s->contours) {
+            fprintf(stderr, "radiosity: --%s: only with --false-colour luminance|illuminance (see radiosity "
+                            "render --help)\n", s->range ? "range" : s->contours ? "contours" : "scale");
+            return EXIT_USAGE;
+        }
+        return -1;
+    }
+    fo->quantity = (rad_false_colour_quantity)s->false_colour;
+    fo->log_scale = s->log_scale;
+    fo->contours = s->contours;
+    if (s->range) {
+        char *end = NULL;
+        fo->range_min = strtod(s->range, &end);
+        bool good = end != s->range && *end == ':';
+        if (good) {
+            const char *max = end + 1;
+            fo->range_max = strtod(max, &end);
+            good = end != max && *end == '\0';
+        }
+        if (!good) {
+            fprintf(stderr, "radiosity: --range: expected MIN:MAX (two numbers), got '%s'\n", s->range);
+            return EXIT_USAGE;
+        }
+        if (fo->range_min == 0.0 && fo->range_max == 0.0) {
+            fprintf(stderr, "radiosity: --range: 0:0 is empty; leave --range out for the automatic range\n");
+            return EXIT_USAGE;
+        }
+    }
+    char ext[8];
+    const char *dot = strrchr(s->output, '.');
+    snprintf(ext, sizeof ext, "%s", dot ? dot + 1 : "");
+    for (char *c = ext; *c; c++)
+        *c = (char)tolower((unsigned char)*c);
+    if (strcmp(ext, "png") != 0) {
+        fprintf(stderr, "radiosity: --false-colour writes PNG: the output must end in .png, got %s\n", s->output);
+        return EXIT_USAGE;
+    }
+    if (rad_false_colour_check(ctx, fo) != RAD_OK) {
+        fprintf(stderr, "radiosity: --%s\n", rad_context_error(ctx));
+        return EXIT_USAGE;
+    }
+    return -1;
+}
+
 static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 {
     /* Every command's flags come from the one table in options.c;
@@ -563,6 +615,10 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 
     /* 0. every output path checked before any work */
     status = plan_outputs(ctx, &s, &out);
+    if (status >= 0)
+        goto done;
+    rad_false_colour_options false_colour;
+    status = false_colour_options(ctx, &s, &false_colour);
     if (status >= 0)
         goto done;
     status = 1;
@@ -760,6 +816,9 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
         rad_bake_options bo = {s.texels_per_metre, s.atlas_size, (rad_lightmap_quantity)s.lightmap_quantity,
                                s.render.exposure};
         r = rad_solution_bake(ctx, sol, &bo, out.set, output, &baked);
+    } else if (s.false_colour) {
+        r = rad_solution_write_false_colour(ctx, sol, &s.render, &false_colour, out.main);
+        progress_end(&progress);
     } else {
         r = rad_solution_render(ctx, sol, &s.render, &image);
         progress_end(&progress);
@@ -800,7 +859,9 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
                    now_seconds() - t0, partial ? " [partial]" : "");
         else
             printf("wrote %s (%dx%d, %zu elements, %s, %.1f s)%s\n", where(output, full),
-                   rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
+                   image ? rad_image_width(image) : s.render.width ? s.render.width : 512,
+                   image ? rad_image_height(image) : s.render.height ? s.render.height : 512,
+                   rad_solution_element_count(sol),
                    measure, now_seconds() - t0, partial ? " [partial]" : "");
     }
     if (cancel_signal && !partial)

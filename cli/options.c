@@ -88,6 +88,11 @@ static const rad_option_word lightmap_words[] = {{"radiosity", RAD_LIGHTMAP_RADI
                                                  {"irradiance", RAD_LIGHTMAP_IRRADIANCE},
                                                  {NULL, 0}};
 
+static const rad_option_word false_colour_words[] = {{"luminance", RAD_FALSE_COLOUR_LUMINANCE},
+                                                     {"illuminance", RAD_FALSE_COLOUR_ILLUMINANCE},
+                                                     {NULL, 0}};
+static const rad_option_word scale_words[] = {{"linear", 0}, {"log", 1}, {NULL, 0}};
+
 static const rad_option_word missing_texture_words[] = {{"error", 0}, {"flat", 1}, {NULL, 0}};
 
 static const cli_flag FLAGS[] = {
@@ -201,6 +206,18 @@ static const cli_flag FLAGS[] = {
     {"flat", 0, NULL, CLI_RENDER | CLI_VIEW, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
     {"vpl", 0, "N", CLI_RENDER, RENDER(vpl_paths)},
+    {"false-colour", 0, "WHAT", CLI_RENDER, OWN(false_colour, RAD_OPTION_ENUM), .own.words = false_colour_words,
+     .own.help = "write a false colour PNG instead of the image: luminance (cd/m^2 of the rendered "
+                 "radiance) or illuminance (lux on the surfaces seen), with a legend (docs/lighting.md "
+                 "\"Pictures\")"},
+    {"scale", 0, "WHICH", CLI_RENDER, OWN(log_scale, RAD_OPTION_ENUM), .own.words = scale_words,
+     .own.default_text = "linear", .own.help = "with --false-colour: the colour scale, linear or log"},
+    {"range", 0, "MIN:MAX", CLI_RENDER, OWN(range, RAD_OPTION_STRING),
+     .own.default_text = "automatic: 0 (log: max/1000) to the 99th percentile rounded up to a nice number",
+     .own.help = "with --false-colour: the values at the two ends of the colour scale (cd/m^2 or lx)"},
+    {"contours", 0, NULL, CLI_RENDER, OWN(contours, RAD_OPTION_FLAG),
+     .own.help = "with --false-colour: black lines where the value crosses a legend tick (isolux, "
+                 "isoluminance)"},
     {"specular-depth", 0, "N", CLI_RENDER, RENDER(specular_depth)},
     {"glossy-samples", 0, "N", CLI_RENDER, RENDER(glossy_samples)},
     {"seed", 0, "S", RV, SOLVE(seed)},

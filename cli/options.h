@@ -71,6 +71,10 @@ typedef struct cli_settings {
     int offscreen;            /* view: one frame to --output, no window */
     int no_ambient;           /* view: B without the ambient term while shooting */
     const char *keys;         /* view: keys the window presses itself */
+    int false_colour;         /* render: 0 none, else rad_false_colour_quantity (--false-colour) */
+    int log_scale;            /* render --scale: 0 linear, 1 log */
+    const char *range;        /* render --range MIN:MAX, NULL = automatic */
+    int contours;             /* render --contours: isolines at the legend's ticks */
 } cli_settings;
 
 /* Where a flag's value goes. */

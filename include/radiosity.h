@@ -1315,6 +1315,47 @@ RAD_API size_t rad_solution_link_count(const rad_solution *solution);
 RAD_API rad_result rad_image_from_pixels(rad_context *ctx, int width, int height, const float *rgb,
                                          rad_image **out);
 
+/* ------------------------------------------------------------------------
+ * Pictures people read (issue #16; docs/lighting.md "Pictures"): false
+ * colour images of luminance or illuminance with a legend.
+ * ---------------------------------------------------------------------- */
+
+typedef enum rad_false_colour_quantity {
+    RAD_FALSE_COLOUR_LUMINANCE = 1,   /* cd/m^2 = 179 Y(L) of the rendered radiance */
+    RAD_FALSE_COLOUR_ILLUMINANCE = 2  /* lux = 179 Y(H) on the surfaces seen */
+} rad_false_colour_quantity;
+
+typedef struct rad_false_colour_options {
+    rad_false_colour_quantity quantity; /* 0 = luminance */
+    int log_scale;                /* nonzero: logarithmic, else linear */
+    /* The range, in the quantity's unit; both 0 = automatic (the 99th
+     * percentile of the pixels' values rounded up to a nice number; linear
+     * from 0, log over three decades).  Else min < max, and min > 0 on a
+     * log scale.  Values outside take the end colours. */
+    double range_min, range_max;
+    int contours;                 /* nonzero: lines where the value crosses a legend tick */
+} rad_false_colour_options;
+
+/* Refuse bad options before any work: RAD_ERROR_INVALID_ARGUMENT with a
+ * message naming the field ("false colour: range min 5 must be below max
+ * 2").  NULL options: RAD_OK (the defaults). */
+RAD_API rad_result rad_false_colour_check(rad_context *ctx, const rad_false_colour_options *options);
+
+/* Render the solution with `render` (as rad_solution_render; the camera,
+ * size and shading) and write its false colour picture as a PNG at `path`
+ * (atomically, as rad_image_write): the image coloured by the quantity,
+ * the background (what no ray hits) white, and a legend bar at the right
+ * with tick values and the unit.  Illuminance is each element's
+ * irradiance, (B - E) / rho plus the direct light (gathered from the
+ * others where rho is 0), interpolated to the vertices as smooth shading
+ * does.  The solution is modified as by rad_solution_render.  Fails as
+ * rad_solution_render and rad_image_write, and with
+ * RAD_ERROR_INVALID_ARGUMENT for bad options (rad_false_colour_check) or
+ * a NULL ctx, solution or path. */
+RAD_API rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *solution,
+                                                   const rad_render_options *render,
+                                                   const rad_false_colour_options *options, const char *path);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,158 @@
+/*
+ * pictures.c -- the public entry of the false colour pictures
+ * (docs/lighting.md "Pictures"): one value per pixel from a render of the
+ * solution, then output/falsecolour.c colours it and draws the legend.
+ *
+ *   luminance    the rendered radiance (textures, the second pass, all of
+ *                rad_solution_render), 179 Y(L) cd/m^2 per pixel, over the
+ *                pixels a second, flat render finds covered
+ *   illuminance  each element's lux (rad_view_illuminance), smoothed to
+ *                the vertices, rendered with the coverage in a second
+ *                channel: one render gives both
+ *
+ * A pixel is the background when fewer than half of its rays met the
+ * front of a surface; else its value is the mean over those that did (the
+ * pixel's sum over its coverage), so edges keep the surface's value.
+ */
+#include "api/solution.h"
+#include "output/picture.h"
+#include "scene/photometry.h"
+
+#include <stdlib.h>
+
+rad_result rad_false_colour_check(rad_context *ctx, const rad_false_colour_options *o)
+{
+    rad_api_enter(ctx);
+    if (!o)
+        return RAD_OK;
+    if (o->quantity != 0 && o->quantity != RAD_FALSE_COLOUR_LUMINANCE && o->quantity != RAD_FALSE_COLOUR_ILLUMINANCE)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "false colour: unknown quantity %d (luminance or illuminance)", (int)o->quantity);
+    if (!isfinite(o->range_min) || !isfinite(o->range_max))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "false colour: the range %g:%g is not finite",
+                        o->range_min, o->range_max);
+    if (o->range_min == 0.0 && o->range_max == 0.0)
+        return RAD_OK; /* automatic */
+    if (!(o->range_min < o->range_max))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "false colour: range min %g must be below max %g",
+                        o->range_min, o->range_max);
+    if (o->log_scale && !(o->range_min > 0.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "false colour: a log scale needs range min > 0, got %g", o->range_min);
+    return RAD_OK;
+}
+
+/* The camera rad_solution_render would use. */
+static rad_camera chosen_camera(const rad_solution *s, const rad_render_options *o, int w, int h)
+{
+    rad_camera camera;
+    if (o->camera)
+        return *o->camera;
+    if (!rad_scene_camera(s->scene, &camera))
+        camera = rad_camera_frame(s->scene->bounds_min, s->scene->bounds_max, (double)w / h);
+    return camera;
+}
+
+/* A render of per-element values `element` (3n) with their smooth vertex
+ * values: no textures, no second pass, no VPLs. */
+static rad_result render_values(rad_context *ctx, const rad_solution *s, const rad_render_options *o,
+                                const double *element, rad_image **out)
+{
+    const rad_mesh *mesh = s->view.mesh;
+    double *vertex = rad_alloc(ctx, RAD_MEM_RENDER, mesh->vertex_count ? mesh->vertex_count : 1,
+                               3 * sizeof *vertex, "false colour: vertex values");
+    if (!vertex)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_result r = rad_vertex_values(ctx, mesh, element, vertex);
+    if (r == RAD_OK) {
+        int w = o->width > 0 ? o->width : 512, h = o->height > 0 ? o->height : 512;
+        rad_render_input in = {0};
+        in.mesh = mesh;
+        in.vis = s->view.vis;
+        in.element_radiosity = element;
+        in.vertex_radiosity = vertex;
+        in.camera = chosen_camera(s, o, w, h);
+        in.seed = s->options.seed;
+        rad_render_options plain = *o;
+        plain.vpl_paths = 0;
+        r = rad_render_image(ctx, &in, &plain, out);
+    }
+    rad_free(vertex);
+    return r;
+}
+
+rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *s, const rad_render_options *render,
+                                           const rad_false_colour_options *options, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_result r = rad_false_colour_check(ctx, options);
+    if (r != RAD_OK)
+        return r;
+    rad_false_colour_options fo = options ? *options : (rad_false_colour_options){0};
+    bool illuminance = fo.quantity == RAD_FALSE_COLOUR_ILLUMINANCE;
+    rad_render_options o = render ? *render : (rad_render_options){0};
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes);
+    size_t n = s->view.mesh->element_count;
+
+    /* Per element: (pi value, pi, 0) for illuminance, (0, pi, 0) for the
+     * coverage of a luminance picture; the renderer divides by pi. */
+    double *element = rad_alloc(ctx, RAD_MEM_RENDER, n ? n : 1, 3 * sizeof *element, "false colour: element values");
+    if (!element)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_image *radiance = NULL, *coverage = NULL;
+    float *values = NULL;
+    if (illuminance) {
+        double *lux = rad_alloc(ctx, RAD_MEM_RENDER, n ? n : 1, sizeof *lux, "false colour: illuminance");
+        r = lux ? rad_view_illuminance(ctx, &s->view, lux) : RAD_ERROR_OUT_OF_MEMORY;
+        for (size_t i = 0; i < n && r == RAD_OK; i++) {
+            element[3 * i] = M_PI * lux[i];
+            element[3 * i + 1] = M_PI;
+            element[3 * i + 2] = 0.0;
+        }
+        rad_free(lux);
+    } else {
+        for (size_t i = 0; i < n; i++) {
+            element[3 * i] = element[3 * i + 2] = 0.0;
+            element[3 * i + 1] = M_PI;
+        }
+        r = rad_solution_render(ctx, s, &o, &radiance);
+    }
+    if (r == RAD_OK)
+        r = render_values(ctx, s, &o, element, &coverage);
+    rad_free(element);
+    size_t pixels = 0;
+    if (r == RAD_OK) {
+        pixels = (size_t)coverage->width * (size_t)coverage->height;
+        values = rad_alloc(ctx, RAD_MEM_RENDER, pixels, sizeof *values, "false colour: pixel values");
+        if (!values)
+            r = RAD_ERROR_OUT_OF_MEMORY;
+    }
+    for (size_t p = 0; p < pixels && r == RAD_OK; p++) {
+        const float *c = &coverage->pixels[3 * p];
+        double covered = c[1];
+        if (!(covered >= 0.5)) {
+            values[p] = NAN;
+            continue;
+        }
+        double value;
+        if (illuminance) {
+            value = c[0] / covered;
+        } else {
+            const float *L = &radiance->pixels[3 * p];
+            value = RAD_LUMINOUS_EFFICACY * (RAD_Y_R * L[0] + RAD_Y_G * L[1] + RAD_Y_B * L[2]) / covered;
+        }
+        values[p] = (float)value;
+    }
+    rad_colour_scale scale = {fo.log_scale != 0, fo.range_min, fo.range_max};
+    if (r == RAD_OK && fo.range_min == 0.0 && fo.range_max == 0.0)
+        r = rad_scale_automatic(ctx, scale.log, values, pixels, &scale);
+    if (r == RAD_OK)
+        r = rad_false_colour_write(ctx, values, coverage->width, coverage->height, &scale,
+                                   illuminance ? "lx" : "cd/m\xc2\xb2", fo.contours != 0, path);
+    rad_free(values);
+    rad_image_destroy(radiance);
+    rad_image_destroy(coverage);
+    return r;
+}
