@@ -214,17 +214,14 @@ void rad_format_value(double value, char *text, size_t size)
     int decimals = magnitude > 0.0 ? 2 - (int)floor(log10(magnitude)) : 0;
     decimals = decimals < 0 ? 0 : decimals > 6 ? 6 : decimals;
     /* ...and no more than the value needs (0.5, not 0.500). */
-    double scaled = value;
-    for (int d = 0; d < decimals; d++)
-        scaled *= 10.0;
-    while (decimals > 0) {
-        double fewer = scaled / 10.0;
-        if (fabs(fewer - round(fewer)) > 1e-6 * fmax(1.0, fabs(fewer)))
-            break;
-        scaled = fewer;
-        decimals--;
-    }
     snprintf(text, size, "%.*f", decimals, value);
+    if (strchr(text, '.')) {
+        size_t n = strlen(text);
+        while (n > 0 && text[n - 1] == '0')
+            text[--n] = '\0';
+        if (n > 0 && text[n - 1] == '.')
+            text[--n] = '\0';
+    }
     if (strcmp(text, "-0") == 0)
         snprintf(text, size, "0");
 }

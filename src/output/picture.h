@@ -106,6 +106,28 @@ static inline uint32_t rad_cairo_pixel(const unsigned char rgb[3])
  * RAD_ERROR_OUT_OF_MEMORY when cairo failed to draw or encode. */
 rad_result rad_write_cairo_png(rad_context *ctx, cairo_surface_t *surface, const char *path);
 
+/* Where a grid plot puts things (plot.c): the canvas, the plan's frame
+ * and scale, the cells and the labels' font. */
+typedef struct rad_plot_layout {
+    int width, height;        /* px: the canvas */
+    double x0m, y1m;          /* m: the plan's left edge (u) and top edge (v) */
+    double metres_w, metres_h;/* m: the plan's extent */
+    double px0, py0;          /* px: where the plan's top-left corner is drawn */
+    double pixels_per_metre;
+    double du, dv;            /* m: a cell (regular grids; free points: the margin x 2) */
+    double title_font, font;  /* px */
+    bool labelled;            /* font >= RAD_PLOT_MIN_FONT */
+    rad_colour_scale scale;   /* the range used */
+} rad_plot_layout;
+
+/* The layout of `grid` with `options` (checked: RAD_ERROR_INVALID_ARGUMENT
+ * as rad_plot_grid_write says; `path` names the output in messages).
+ * Fails also for memory (the automatic range). */
+rad_result rad_plot_layout_make(rad_context *ctx, const rad_plot_grid *grid, const rad_plot_options *options,
+                                const char *path, rad_plot_layout *layout);
+/* The pixel (x right, y down) of plan point (u, v).  Cannot fail. */
+void rad_plot_pixel(const rad_plot_layout *layout, double u, double v, double *x, double *y);
+
 /* Font family for every text (fontconfig picks what is installed). */
 #define RAD_PICTURE_FONT "DejaVu Sans"
 

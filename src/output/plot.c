@@ -101,9 +101,28 @@ static void text_colour_for(cairo_t *cr, const unsigned char rgb[3])
     cairo_set_source_rgb(cr, grey, grey, grey);
 }
 
-rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, const rad_plot_options *options,
-                               const char *path)
+void rad_plot_pixel(const rad_plot_layout *layout, double u, double v, double *x, double *y)
 {
+    *x = layout->px0 + (u - layout->x0m) * layout->pixels_per_metre;
+    *y = layout->py0 + (layout->y1m - v) * layout->pixels_per_metre;
+}
+
+/* The characters of the longest value label. */
+static size_t longest_label(const rad_plot_grid *grid)
+{
+    size_t longest = 1;
+    char label[32];
+    for (size_t k = 0; k < grid->count; k++) {
+        rad_plot_grid_label(grid, k, label, sizeof label);
+        longest = strlen(label) > longest ? strlen(label) : longest;
+    }
+    return longest;
+}
+
+rad_result rad_plot_layout_make(rad_context *ctx, const rad_plot_grid *grid, const rad_plot_options *options,
+                                const char *path, rad_plot_layout *layout)
+{
+    memset(layout, 0, sizeof *layout);
     rad_plot_options o = options ? *options : (rad_plot_options){0};
     rad_result r = check_grid(ctx, grid, &o, path);
     if (r != RAD_OK)
@@ -121,11 +140,13 @@ rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, cons
         rad_free(values);
         if (r != RAD_OK)
             return r;
-    } else if (!(o.range_min < o.range_max) || (o.log_scale && !(o.range_min > 0.0))) {
+    } else if (!isfinite(o.range_min) || !isfinite(o.range_max) || !(o.range_min < o.range_max) ||
+               (o.log_scale && !(o.range_min > 0.0))) {
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: grid plot: range %g:%g must have min < max (and min > 0 on a log scale)", path,
                         o.range_min, o.range_max);
     }
+    layout->scale = scale;
 
     /* The plan's extent in metres: the cells' (or points', with a margin). */
     double umin = INFINITY, umax = -INFINITY, vmin = INFINITY, vmax = -INFINITY;
@@ -135,7 +156,7 @@ rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, cons
         vmin = fmin(vmin, grid->v[k]);
         vmax = fmax(vmax, grid->v[k]);
     }
-    double du = 0.0, dv = 0.0;
+    double du, dv;
     if (regular) {
         du = grid->nu > 1 ? (umax - umin) / (double)(grid->nu - 1) : 0.0;
         dv = grid->nv > 1 ? (vmax - vmin) / (double)(grid->nv - 1) : 0.0;
@@ -147,29 +168,52 @@ rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, cons
         double pad = 0.08 * fmax(fmax(umax - umin, vmax - vmin), 1e-3);
         du = dv = 2.0 * pad;
     }
-    double x0m = umin - 0.5 * du, x1m = umax + 0.5 * du, y0m = vmin - 0.5 * dv, y1m = vmax + 0.5 * dv;
+    layout->du = du;
+    layout->dv = dv;
+    layout->x0m = umin - 0.5 * du;
+    layout->y1m = vmax + 0.5 * dv;
+    layout->metres_w = umax - umin + du;
+    layout->metres_h = vmax - vmin + dv;
 
     int width = o.width ? o.width : 900;
     double title_font = fmin(fmax(width / 60.0, 10.0), 24.0);
     double margin = 1.5 * title_font, title_band = 2.4 * title_font;
-    int legend_width = rad_legend_width((int)(0.75 * width));
+    int legend_width = rad_legend_width(1 << 20); /* the widest legend, whatever the height */
     double plan_w = width - legend_width - 2.0 * margin;
-    double metres_w = x1m - x0m, metres_h = y1m - y0m;
-    double pixels_per_metre = plan_w / metres_w;
-    if (metres_h * pixels_per_metre > 1.5 * plan_w) /* a tall grid: no taller than 1.5 x its width */
-        pixels_per_metre = 1.5 * plan_w / metres_h;
-    double plan_h = metres_h * pixels_per_metre;
-    int height = (int)ceil(title_band + plan_h + margin);
-    if (height < 240)
-        height = 240;
-    double px0 = margin, py0 = title_band;
+    double ppm = plan_w / layout->metres_w;
+    if (layout->metres_h * ppm > 1.5 * plan_w) /* a tall grid: no taller than 1.5 x its width */
+        ppm = 1.5 * plan_w / layout->metres_h;
+    int height = (int)ceil(title_band + layout->metres_h * ppm + margin);
+    layout->width = width;
+    layout->height = height < 240 ? 240 : height;
+    layout->px0 = margin;
+    layout->py0 = title_band;
+    layout->pixels_per_metre = ppm;
+    layout->title_font = title_font;
+    /* The labels' font: the largest that fits a cell (0.62 em a digit, a
+     * DejaVu Sans figure's advance), at most 22 px. */
+    double cell_w = du * ppm, cell_h = dv * ppm;
+    layout->font = regular ? fmin(fmin(0.85 * cell_w / (0.62 * (double)longest_label(grid)), 0.45 * cell_h), 22.0)
+                           : fmin(fmax(title_font * 0.8, RAD_PLOT_MIN_FONT), 18.0);
+    layout->labelled = layout->font >= RAD_PLOT_MIN_FONT;
+    return RAD_OK;
+}
 
+rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, const rad_plot_options *options,
+                               const char *path)
+{
+    rad_plot_layout lay;
+    rad_result r = rad_plot_layout_make(ctx, grid, options, path, &lay);
+    if (r != RAD_OK)
+        return r;
+    bool regular = grid->nu > 0;
+    int legend_width = rad_legend_width(lay.height);
     rad_colour_map map;
     rad_colour_map_make(&map);
     rad_legend_layout legend;
-    rad_legend_layout_make(&scale, width - legend_width, height, &legend);
+    rad_legend_layout_make(&lay.scale, lay.width - legend_width, lay.height, &legend);
 
-    cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height);
+    cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, lay.width, lay.height);
     cairo_t *cr = cairo_create(surface);
     cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
     cairo_paint(cr);
@@ -179,27 +223,17 @@ rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, cons
     char title[512];
     rad_plot_grid_title(grid, title, sizeof title);
     cairo_set_source_rgb(cr, 0.0, 0.0, 0.0);
-    cairo_set_font_size(cr, title_font);
-    cairo_move_to(cr, margin, 1.5 * title_font);
+    cairo_set_font_size(cr, lay.title_font);
+    cairo_move_to(cr, lay.px0, 1.5 * lay.title_font);
     cairo_show_text(cr, title);
 
-    /* The longest label sets the cells' font. */
-    size_t longest = 1;
+    double font = lay.font, cell_w = lay.du * lay.pixels_per_metre, cell_h = lay.dv * lay.pixels_per_metre;
+    cairo_set_font_size(cr, font);
     char label[32];
     for (size_t k = 0; k < grid->count; k++) {
-        rad_plot_grid_label(grid, k, label, sizeof label);
-        longest = strlen(label) > longest ? strlen(label) : longest;
-    }
-    double cell_w = du * pixels_per_metre, cell_h = dv * pixels_per_metre;
-    double font = regular ? fmin(fmin(0.85 * cell_w / (0.62 * (double)longest), 0.45 * cell_h), 22.0)
-                          : fmin(fmax(title_font * 0.8, RAD_PLOT_MIN_FONT), 18.0);
-    bool labelled = font >= RAD_PLOT_MIN_FONT;
-    cairo_set_font_size(cr, font);
-
-    for (size_t k = 0; k < grid->count; k++) {
-        double x = px0 + (grid->u[k] - x0m) * pixels_per_metre;
-        double y = py0 + (y1m - grid->v[k]) * pixels_per_metre;
-        const unsigned char *c = map.rgb[rad_scale_level(&scale, grid->value[k])];
+        double x, y;
+        rad_plot_pixel(&lay, grid->u[k], grid->v[k], &x, &y);
+        const unsigned char *c = map.rgb[rad_scale_level(&lay.scale, grid->value[k])];
         cairo_set_source_rgb(cr, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
         rad_plot_grid_label(grid, k, label, sizeof label);
         if (regular) {
@@ -211,18 +245,19 @@ rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, cons
             cairo_rectangle(cr, left, top, right - left, bottom - top);
             cairo_fill(cr);
             cairo_restore(cr);
-            if (labelled) {
+            if (lay.labelled) {
                 text_colour_for(cr, c);
                 centred_text(cr, x, y, label);
             }
         } else {
             double radius = fmax(0.45 * font, 3.0);
+            cairo_new_path(cr); /* no line from the last label's end */
             cairo_arc(cr, x, y, radius, 0.0, 2.0 * M_PI);
             cairo_fill_preserve(cr);
             cairo_set_source_rgb(cr, 0.0, 0.0, 0.0);
             cairo_set_line_width(cr, 1.0);
             cairo_stroke(cr);
-            if (labelled) {
+            if (lay.labelled) {
                 cairo_move_to(cr, x + radius + 0.3 * font, y + 0.35 * font);
                 cairo_show_text(cr, label);
             }
@@ -231,7 +266,8 @@ rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, cons
     /* The outline: the grid's cells (free points: their frame). */
     cairo_set_source_rgb(cr, 0.0, 0.0, 0.0);
     cairo_set_line_width(cr, 1.5);
-    cairo_rectangle(cr, round(px0), round(py0), round(metres_w * pixels_per_metre), round(plan_h));
+    cairo_rectangle(cr, round(lay.px0), round(lay.py0), round(lay.metres_w * lay.pixels_per_metre),
+                    round(lay.metres_h * lay.pixels_per_metre));
     cairo_stroke(cr);
 
     rad_legend_draw(cr, &legend, &map, grid->unit ? grid->unit : "");
