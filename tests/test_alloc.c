@@ -114,7 +114,7 @@ static void clear_outputs(void)
 
 /* ---- one run: the outputs its writers finished ---- */
 
-#define MAX_OUTPUTS 16
+#define MAX_OUTPUTS 24
 
 typedef struct outputs {
     const char *written[MAX_OUTPUTS]; /* names in the output folder */
@@ -289,6 +289,16 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     if (r == RAD_OK) {
         output_path("image.pfm", path, sizeof path);
         r = write_done(rad_image_write(ctx, image, path), out, "image.pfm");
+    }
+    /* False colour pictures (api/pictures.c): a render, the coverage, the
+     * range, cairo's PNG through an atomic file. */
+    for (int q = RAD_FALSE_COLOUR_LUMINANCE; q <= RAD_FALSE_COLOUR_ILLUMINANCE && r == RAD_OK; q++) {
+        rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0};
+        rad_false_colour_options fo = {(rad_false_colour_quantity)q, q == RAD_FALSE_COLOUR_ILLUMINANCE, 0, 0, 1};
+        const char *name = q == RAD_FALSE_COLOUR_LUMINANCE ? "luminance.png" : "illuminance.png";
+        output_path(name, path, sizeof path);
+        r = write_done(rad_solution_write_false_colour(ctx, s, &ro, &fo, path), out, name);
     }
     if (r == RAD_OK) {
         output_path("stats.json", path, sizeof path);
