@@ -67,9 +67,9 @@ rad_result rad_scale_automatic(rad_context *ctx, bool log, const float *values, 
  * m x 10^k in the range for m in {1, 2, 5}, or {1, ..., 9} when that gives
  * fewer than 3, or {1} when more than 12.  Cannot fail. */
 size_t rad_legend_ticks(const rad_colour_scale *scale, double *ticks);
-/* A number as the legend and the plots print it: with the fewest
- * decimals (0 to 6) that show it within 1e-6 of its size... and at most
- * three significant figures below 100 (docs/lighting.md).  Cannot fail. */
+/* A number as the legend and the plots print it: three significant
+ * figures below 100, an integer above, at most 6 decimals, trailing zeros
+ * dropped (1234, 56.8, 0.75, 0; docs/lighting.md).  Cannot fail. */
 void rad_format_value(double value, char *text, size_t size);
 
 /* Where the legend goes on a canvas of height `height` with the picture
