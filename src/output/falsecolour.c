@@ -395,18 +395,28 @@ rad_result rad_false_colour_write(rad_context *ctx, const float *values, int wid
 
 /* ---- illuminance on the surfaces ---- */
 
-/* sum_j F_ij B_j (channel c) without F: the unoccluded factor from the
- * lifted centroid of i to each element j it faces, counted when the
- * segment to j's lifted centroid is clear. */
-static double gather_black(const rad_solution_view *view, size_t i, int c)
+/* gathered[c] = sum_j F_ij B_j for the channels where black[c]: from the
+ * view's F, or without it the unoccluded factor from the lifted centroid
+ * of i to each element j it faces, counted when the segment to j's lifted
+ * centroid is clear (one ray a pair for all channels). */
+static void gather(const rad_solution_view *view, size_t i, const bool black[3], double gathered[3])
 {
     const rad_mesh *mesh = view->mesh;
+    gathered[0] = gathered[1] = gathered[2] = 0.0;
+    if (view->F) {
+        const double *row = view->F + i * view->n;
+        for (size_t j = 0; j < view->n; j++)
+            for (int c = 0; c < 3; c++)
+                if (black[c])
+                    gathered[c] += row[j] * view->radiosity[3 * j + (size_t)c];
+        return;
+    }
     const rad_element *ei = &mesh->elements[i];
     double eps = rad_vis_epsilon(mesh);
     vec3 p = v3_mad(ei->centroid, ei->normal, eps);
-    double sum = 0.0;
     for (size_t j = 0; j < view->n; j++) {
-        if (j == i || view->radiosity[3 * j + (size_t)c] == 0.0)
+        const double *B = &view->radiosity[3 * j];
+        if (j == i || !((black[0] && B[0] != 0.0) || (black[1] && B[1] != 0.0) || (black[2] && B[2] != 0.0)))
             continue;
         const rad_element *ej = &mesh->elements[j];
         vec3 poly[4];
@@ -416,13 +426,13 @@ static double gather_black(const rad_solution_view *view, size_t i, int c)
         if (!(f > 0.0))
             continue;
         vec3 q = v3_mad(ej->centroid, ej->normal, eps);
-        rad_ray ray = {p, v3_sub(q, p), 0.0, 1.0 - 1e-6};
+        rad_ray ray = {p, v3_sub(q, p), 0.0, 1.0 - 1e-6}; /* stops short of j itself */
         uint8_t blocked = 0;
         view->vis->backend->occluded(view->vis->state, &ray, 1, &blocked);
-        if (!blocked)
-            sum += f * view->radiosity[3 * j + (size_t)c];
+        for (int c = 0; c < 3 && !blocked; c++)
+            if (black[c])
+                gathered[c] += f * B[c];
     }
-    return sum;
 }
 
 rad_result rad_view_illuminance(rad_context *ctx, const rad_solution_view *view, double *lux)
@@ -440,24 +450,17 @@ rad_result rad_view_illuminance(rad_context *ctx, const rad_solution_view *view,
             cancelled = 1;
             continue;
         }
-        double H[3];
+        double H[3], gathered[3] = {0.0, 0.0, 0.0};
+        bool black[3];
+        for (int c = 0; c < 3; c++)
+            black[c] = !(view->reflectance[3 * i + (size_t)c] > 0.0);
+        if (black[0] || black[1] || black[2])
+            gather(view, i, black, gathered);
         for (int c = 0; c < 3; c++) {
             size_t k = 3 * i + (size_t)c;
             double direct = view->direct ? view->direct[k] : 0.0;
-            double rho = view->reflectance[k];
-            if (rho > 0.0)
-                H[c] = (view->radiosity[k] - view->emission[k]) / rho + direct;
-            else if (view->F)
-                H[c] = 0.0;
-            else
-                H[c] = gather_black(view, i, c) + direct;
-            if (!(rho > 0.0) && view->F) {
-                const double *row = view->F + i * n;
-                for (size_t j = 0; j < n; j++)
-                    H[c] += row[j] * view->radiosity[3 * j + (size_t)c];
-                H[c] += direct;
-            }
-            H[c] = fmax(H[c], 0.0); /* round-off of B - E where nothing arrives */
+            double indirect = black[c] ? gathered[c] : (view->radiosity[k] - view->emission[k]) / view->reflectance[k];
+            H[c] = fmax(indirect + direct, 0.0); /* round-off of B - E where nothing arrives */
         }
         lux[i] = RAD_LUMINOUS_EFFICACY * (RAD_Y_R * H[0] + RAD_Y_G * H[1] + RAD_Y_B * H[2]);
     }
