@@ -523,7 +523,7 @@ static void test_grid_plot(void **state)
     /* 3 x 2 cells of 1 m: the point iu + 3 iv at (0.5 + iu, 0.5 + iv). */
     const double u[6] = {0.5, 1.5, 2.5, 0.5, 1.5, 2.5}, v[6] = {0.5, 0.5, 0.5, 1.5, 1.5, 1.5};
     const double value[6] = {100.0, 250.0, 400.0, 12.345, 300.0, 0.5};
-    rad_plot_grid grid = {"desk", 6, u, v, value, "lx", 3, 2};
+    rad_plot_grid grid = {"desk", 6, u, v, value, "lx", 3, 2, 0.0, 0.0};
     rad_plot_options po = {0, 0.0, 500.0, 900};
     const char *path = work_path("grid.png");
     assert_int_equal(rad_plot_grid_write(ctx, &grid, &po, path), RAD_OK);
@@ -571,9 +571,28 @@ static void test_grid_plot(void **state)
     assert_true(ink > 50);
     stbi_image_free(p.rgb);
 
+    /* A footprint: 3 x 2 cells of 1 m given, the last one off it (no
+     * point): white, the others their colours. */
+    rad_plot_grid foot = {"footprint", 5, u, v, value, "lx", 3, 2, 1.0, 1.0};
+    const char *path3 = work_path("footprint.png");
+    assert_int_equal(rad_plot_grid_write(ctx, &foot, &po, path3), RAD_OK);
+    assert_int_equal(rad_plot_layout_make(ctx, &foot, &po, path3, &lay), RAD_OK);
+    assert_near(lay.pixels_per_metre, cell, 1e-9); /* the same extent as the full grid */
+    p = read_png(path3);
+    for (size_t k = 0; k < 6; k++) {
+        double x, y;
+        rad_plot_pixel(&lay, u[k], v[k], &x, &y);
+        const unsigned char *at = pixel_at(&p, (int)(x - 0.35 * cell), (int)(y - 0.35 * cell));
+        if (k == 5)
+            assert_true(is_white(at));
+        else
+            assert_colour(at, map.rgb[rad_scale_level(&scale, value[k])], "footprint cell");
+    }
+    stbi_image_free(p.rgb);
+
     /* Free points: labelled dots of their colour. */
     const double fu[3] = {0.0, 2.0, 4.0}, fv[3] = {0.0, 1.0, 0.5}, fval[3] = {50.0, 450.0, 250.0};
-    rad_plot_grid points = {"points", 3, fu, fv, fval, "lx", 0, 0};
+    rad_plot_grid points = {"points", 3, fu, fv, fval, "lx", 0, 0, 0.0, 0.0};
     const char *path2 = work_path("points.png");
     assert_int_equal(rad_plot_grid_write(ctx, &points, &po, path2), RAD_OK);
     assert_int_equal(rad_plot_layout_make(ctx, &points, &po, path2, &lay), RAD_OK);
@@ -619,22 +638,26 @@ static void test_bad_options(void **state)
 
     /* Grid plots: each refusal leaves no file. */
     const double u[2] = {0, 1}, v[2] = {0, 0}, good[2] = {1, 2}, bad[2] = {1, NAN};
+    const double u3[3] = {0, 1, 2}, v3[3] = {0, 0, 0}, good3[3] = {1, 2, 3};
     const char *path = work_path("bad_grid.png");
     size_t before = count_files(cli_workdir());
     rad_api_enter(ctx); /* the internal calls below keep the first error otherwise */
-    rad_plot_grid g = {"g", 2, u, v, good, "lx", 3, 1};
+    rad_plot_grid g = {"g", 3, u3, v3, good3, "lx", 2, 1, 0.0, 0.0};
     assert_int_equal(rad_plot_grid_write(ctx, &g, NULL, path), RAD_ERROR_INVALID_ARGUMENT);
-    if (!strstr(rad_context_error(ctx), "3 x 1 cells for 2 points"))
+    if (!strstr(rad_context_error(ctx), "2 x 1 cells for 3 points"))
         fail_msg("message: %s", rad_context_error(ctx));
     rad_api_enter(ctx);
-    g = (rad_plot_grid){"g", 2, u, v, bad, "lx", 0, 0};
+    g = (rad_plot_grid){"g", 2, u, v, good, "lx", 2, 1, -1.0, 0.0};
+    assert_int_equal(rad_plot_grid_write(ctx, &g, NULL, path), RAD_ERROR_INVALID_ARGUMENT);
+    rad_api_enter(ctx);
+    g = (rad_plot_grid){"g", 2, u, v, bad, "lx", 0, 0, 0.0, 0.0};
     assert_int_equal(rad_plot_grid_write(ctx, &g, NULL, path), RAD_ERROR_INVALID_ARGUMENT);
     assert_non_null(strstr(rad_context_error(ctx), "not finite"));
     rad_api_enter(ctx);
-    g = (rad_plot_grid){"g", 0, u, v, good, "lx", 0, 0};
+    g = (rad_plot_grid){"g", 0, u, v, good, "lx", 0, 0, 0.0, 0.0};
     assert_int_equal(rad_plot_grid_write(ctx, &g, NULL, path), RAD_ERROR_INVALID_ARGUMENT);
     rad_api_enter(ctx);
-    g = (rad_plot_grid){"g", 2, u, v, good, "lx", 0, 0};
+    g = (rad_plot_grid){"g", 2, u, v, good, "lx", 0, 0, 0.0, 0.0};
     assert_int_equal(rad_plot_grid_write(ctx, &g, &(rad_plot_options){1, 0.0, 10.0, 0}, path),
                      RAD_ERROR_INVALID_ARGUMENT);
     rad_api_enter(ctx);

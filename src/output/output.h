@@ -303,9 +303,11 @@ typedef struct rad_plot_grid {
     const double *u, *v;     /* m: each point's in-plane coordinates (v up the page) */
     const double *value;     /* the values, in `unit` */
     const char *unit;        /* "lx" */
-    /* A regular grid: point iu + nu x iv at the centre of cell (iu, iv),
-     * count = nu x nv; 0 x 0: free points, drawn as labelled dots. */
+    /* A regular grid: nu x nv cells, each point at the centre of its cell
+     * (count <= nu x nv: a footprint's cells off it have no point and are
+     * not drawn); 0 x 0: free points, drawn as labelled dots. */
     size_t nu, nv;
+    double cell_u, cell_v;   /* m: a cell's sides; 0: the points' spread over nu - 1 (nv - 1) */
 } rad_plot_grid;
 
 typedef struct rad_plot_options {
@@ -318,7 +320,8 @@ typedef struct rad_plot_options {
  * coloured by value with the value printed in each (when it fits: a font
  * of at least RAD_PLOT_MIN_FONT px), the outline, the legend, and a title
  * line with the average, minimum, maximum and uniformity U0 = min / avg.
- * RAD_ERROR_INVALID_ARGUMENT for an empty grid, nu x nv != count, values
+ * RAD_ERROR_INVALID_ARGUMENT for an empty grid, more points than nu x nv
+ * cells, a cell side negative or not finite, values
  * or coordinates not finite, bad range; RAD_ERROR_IO,
  * RAD_ERROR_OUT_OF_MEMORY. */
 rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, const rad_plot_options *options,

@@ -67,9 +67,13 @@ static rad_result check_grid(rad_context *ctx, const rad_plot_grid *grid, const 
     if (grid->count == 0 || !grid->u || !grid->v || !grid->value)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: grid plot: the grid '%s' has no points", path,
                         grid->name ? grid->name : "");
-    if ((grid->nu || grid->nv) && grid->nu * grid->nv != grid->count)
+    if ((grid->nu || grid->nv) && (grid->nu == 0 || grid->nv == 0 || grid->count / grid->nu > grid->nv ||
+                                   grid->nu * grid->nv < grid->count))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "%s: grid plot: %zu x %zu cells for %zu points", path, grid->nu, grid->nv, grid->count);
+    if (!(grid->cell_u >= 0.0 && grid->cell_v >= 0.0 && isfinite(grid->cell_u) && isfinite(grid->cell_v)))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: grid plot: cell sides %g x %g m", path,
+                        grid->cell_u, grid->cell_v);
     for (size_t k = 0; k < grid->count; k++)
         if (!isfinite(grid->u[k]) || !isfinite(grid->v[k]) || !isfinite(grid->value[k]))
             return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
@@ -158,8 +162,8 @@ rad_result rad_plot_layout_make(rad_context *ctx, const rad_plot_grid *grid, con
     }
     double du, dv;
     if (regular) {
-        du = grid->nu > 1 ? (umax - umin) / (double)(grid->nu - 1) : 0.0;
-        dv = grid->nv > 1 ? (vmax - vmin) / (double)(grid->nv - 1) : 0.0;
+        du = grid->cell_u > 0.0 ? grid->cell_u : grid->nu > 1 ? (umax - umin) / (double)(grid->nu - 1) : 0.0;
+        dv = grid->cell_v > 0.0 ? grid->cell_v : grid->nv > 1 ? (vmax - vmin) / (double)(grid->nv - 1) : 0.0;
         if (du == 0.0)
             du = dv > 0.0 ? dv : 1.0; /* one column: square cells (or 1 m) */
         if (dv == 0.0)
