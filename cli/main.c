@@ -210,7 +210,12 @@ static int run_view(rad_context *ctx, const settings *s)
         fprintf(stderr, "radiosity: --%s (see radiosity view --help)\n", rad_context_error(ctx));
         return EXIT_USAGE;
     }
-    rv_args a = {.input = s->scene_path, .solve = s->solve, .width = s->render.width,
+    if (s->luminaires && s->scene_path && rad_file_is_solution(s->scene_path)) {
+        fprintf(stderr, "radiosity: --luminaires: %s is a solution file, solved already (give the layout with "
+                        "the scene)\n", s->scene_path);
+        return EXIT_USAGE;
+    }
+    rv_args a = {.input = s->scene_path, .luminaires = s->luminaires, .solve = s->solve, .width = s->render.width,
                  .height = s->render.height, .camera = s->camera ? &camera : NULL,
                  .shading = s->render.shading, .exposure = s->render.exposure, .output = s->output,
                  .offscreen = s->offscreen != 0, .no_ambient = s->no_ambient != 0, .keys = s->keys,
@@ -260,6 +265,7 @@ typedef struct run_outputs {
     const char *main;      /* the image, view-factor or mesh file: its temporary */
     const char *stats, *history;
     const char *gebhart;   /* thermal --gebhart: its temporary */
+    const char *second;    /* illuminance's second -o: its temporary */
 } run_outputs;
 
 /* Plan the outputs and name the scene file as an input.  Returns -1 to go
@@ -268,6 +274,7 @@ typedef struct run_outputs {
 static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
 {
     rad_output_kind kind = s->command == CLI_THERMAL       ? RAD_OUTPUT_THERMAL
+                           : s->command == CLI_ILLUMINANCE ? RAD_OUTPUT_ILLUMINANCE
                            : s->command == CLI_VIEWFACTORS ? RAD_OUTPUT_VIEW_FACTORS
                            : s->command == CLI_SOLVE     ? RAD_OUTPUT_SOLUTION
                            : s->command == CLI_EXPORT    ? RAD_OUTPUT_MESH
@@ -282,6 +289,10 @@ static int plan_outputs(rad_context *ctx, const settings *s, run_outputs *o)
         r = rad_output_set_add(ctx, o->set, s->output, kind, &o->main);
     if (r == RAD_OK && s->gebhart)
         r = rad_output_set_add(ctx, o->set, s->gebhart, RAD_OUTPUT_THERMAL, &o->gebhart);
+    if (r == RAD_OK && s->grid)
+        r = rad_output_set_add_input(ctx, o->set, s->grid);
+    if (r == RAD_OK && s->output2)
+        r = rad_output_set_add(ctx, o->set, s->output2, RAD_OUTPUT_ILLUMINANCE, &o->second);
     /* bake: the first atlas's lightmaps (there is always one); others are
      * added when the packing knows them. */
     static const char *const lightmap_ext[2] = {"hdr", "png"};
@@ -385,6 +396,55 @@ static int run_thermal(rad_context *ctx, const settings *s, const rad_scene *sce
                b.net_power, b.environment_power, b.imbalance, b.relative_imbalance, b.power_scale);
     }
     rad_thermal_destroy(heat);
+    return cancel_signal ? interrupted_status() : 0;
+}
+
+/* The illuminance command after the solve: the grid file's points
+ * evaluated, a summary line per grid, the CSV / JSON (and stats, history)
+ * put in place together.  Returns the exit status. */
+static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *sol, run_outputs *out,
+                           progress_state *progress, double t0)
+{
+    rad_illuminance *il = NULL;
+    rad_result r = rad_illuminance_evaluate_file(ctx, sol, s->grid, &il);
+    progress_end(progress);
+    if (r == RAD_ERROR_INTERRUPTED) {
+        fprintf(stderr, "radiosity: interrupted while computing the illuminance; nothing written\n");
+        return interrupted_status();
+    }
+    if (r != RAD_OK)
+        return fail(ctx, r);
+    begin_saving(ctx);
+    r = rad_illuminance_write(ctx, il, out->main);
+    if (r == RAD_OK && out->second)
+        r = rad_illuminance_write(ctx, il, out->second);
+    if (r == RAD_OK && s->stats)
+        r = rad_solution_write_stats(ctx, sol, out->stats, 0);
+    if (r == RAD_OK && s->history)
+        r = rad_solution_write_history(ctx, sol, out->history);
+    if (r == RAD_OK && !s->quiet) {
+        printf("%-24s %8s %12s %12s %12s %7s\n", "grid", "points", "Eavg lux", "Emin lux", "Emax lux", "U0");
+        for (size_t g = 0; g < rad_illuminance_grid_count(il); g++) {
+            const rad_grid_result *res = rad_illuminance_grid(il, g);
+            printf("%-24.24s %8zu %12.1f %12.1f %12.1f %7.3f\n", res->name, res->point_count, res->average,
+                   res->minimum, res->maximum, res->uniformity);
+        }
+        fflush(stdout);
+    }
+    if (r == RAD_OK)
+        r = rad_output_set_commit(ctx, out->set);
+    if (r != RAD_OK) {
+        rad_illuminance_destroy(il);
+        return fail(ctx, r);
+    }
+    rad_illuminance_stats st;
+    rad_illuminance_get_stats(il, &st);
+    rad_illuminance_destroy(il);
+    char full[PATH_MAX];
+    if (!s->quiet)
+        printf("wrote %s%s%s (%zu points in %.2f s, %.0f points/s; %zu elements, %.1f s)\n", where(s->output, full),
+               s->output2 ? " and " : "", s->output2 ? s->output2 : "", st.points, st.seconds, st.points_per_second,
+               rad_solution_element_count(sol), now_seconds() - t0);
     return cancel_signal ? interrupted_status() : 0;
 }
 
@@ -550,6 +610,11 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
                         "heat fluxes (see radiosity thermal --help)\n");
         return EXIT_USAGE;
     }
+    if (s.command == CLI_ILLUMINANCE && !s.grid) {
+        fprintf(stderr, "radiosity: illuminance needs --grid FILE.json: the calculation grids and points (see "
+                        "radiosity illuminance --help)\n");
+        return EXIT_USAGE;
+    }
     if (s.command == CLI_THERMAL &&
         (strcmp(s.solve.solver, "hierarchical") == 0 || strcmp(s.solve.solver, "shooting") == 0)) {
         fprintf(stderr, "radiosity: --solver %s keeps no form-factor matrix: thermal takes direct, gauss-seidel, "
@@ -644,7 +709,8 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
      * signature), which is solved already */
     double t0 = now_seconds();
     bool saved = s.scene_path && rad_file_is_solution(s.scene_path);
-    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT && s.command != CLI_BAKE) {
+    if (saved && s.command != CLI_RENDER && s.command != CLI_EXPORT && s.command != CLI_BAKE &&
+        s.command != CLI_ILLUMINANCE) {
         fprintf(stderr, "radiosity: %s is a solution file: `radiosity render` draws it and `radiosity "
                         "export` writes its lit mesh; %s needs the scene it was solved for\n",
                 s.scene_path, cli_command_name(s.command));
@@ -666,10 +732,36 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
         status = fail(ctx, r);
         goto done;
     }
+    if (s.luminaires && saved) {
+        fprintf(stderr, "radiosity: --luminaires: %s is a solution file, solved already (give the layout with "
+                        "the scene)\n", s.scene_path);
+        status = EXIT_USAGE;
+        goto done;
+    }
+    if (s.luminaires) {
+        /* Luminaires placed by the layout (docs/lighting.md), before any work. */
+        r = rad_scene_load_luminaires(ctx, scene, s.luminaires);
+        if (r == RAD_OK)
+            r = rad_output_set_add_input(ctx, out.set, s.luminaires);
+        if (r != RAD_OK) {
+            status = fail(ctx, r);
+            goto done;
+        }
+    }
+    if (s.command == CLI_SOLVE && rad_scene_luminaire_count(scene) > 0) {
+        fprintf(stderr, "radiosity: %s places luminaires (glTF nodes), which a solution file does not hold: "
+                        "render, export or bake it in one run\n", s.scene_path ? s.scene_path : "the scene");
+        status = 1;
+        goto done;
+    }
     status = check_scene_inputs(ctx, scene, &out);
     if (status >= 0)
         goto done;
     status = 1;
+    if (s.command == CLI_ILLUMINANCE && rad_illuminance_check_file(ctx, scene, s.grid, NULL) != RAD_OK) {
+        status = fail(ctx, RAD_ERROR_PARSE); /* a bad grid file: before any work */
+        goto done;
+    }
     if (s.command == CLI_THERMAL && rad_thermal_conditions_load_file(ctx, scene, s.bc, &bc) != RAD_OK) {
         status = fail(ctx, RAD_ERROR_PARSE); /* a bad file: before any work */
         goto done;
@@ -696,7 +788,10 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
     }
     if (s.command != CLI_VIEWFACTORS && s.command != CLI_THERMAL && !s.quiet && !s.scene_path)
         printf("radiosity: no scene given, %s the built-in Cornell box\n",
-               s.command == CLI_EXPORT ? "exporting" : s.command == CLI_BAKE ? "baking" : "rendering");
+               s.command == CLI_EXPORT        ? "exporting"
+               : s.command == CLI_BAKE        ? "baking"
+               : s.command == CLI_ILLUMINANCE ? "lighting"
+                                              : "rendering");
 
     /* Progressive display keeps one exposure for all frames (the user's, or
      * the first frame's automatic one), so the picture visibly brightens as
@@ -805,6 +900,17 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
         goto done;
     }
 
+    if (s.command == CLI_ILLUMINANCE) {
+        /* 5'. illuminance at the calculation points */
+        if (partial) {
+            fprintf(stderr, "radiosity: interrupted while solving; no illuminance written\n");
+            status = interrupted_status();
+        } else {
+            status = run_illuminance(ctx, &s, sol, &out, &progress, t0);
+        }
+        goto done;
+    }
+
     /* 5. image or lit mesh, stats and history, into their temporaries,
      * then all put in place together.  Signals from here on are noted, not
      * acted upon. */
@@ -863,6 +969,14 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
                    image ? rad_image_height(image) : s.render.height ? s.render.height : 512,
                    rad_solution_element_count(sol),
                    measure, now_seconds() - t0, partial ? " [partial]" : "");
+        size_t lights = rad_scene_luminaire_count(scene);
+        if (lights > 0) {
+            double lumens = 0.0;
+            for (size_t k = 0; k < lights; k++)
+                lumens += rad_scene_luminaire_flux(scene, k);
+            printf("luminaires: %zu, %.6g lm; %.6g lm of direct light lands on the surfaces\n", lights, lumens,
+                   rad_solution_direct_lumens(sol));
+        }
     }
     if (cancel_signal && !partial)
         fprintf(stderr, "radiosity: interrupted while writing the outputs; they were completed first\n");

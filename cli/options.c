@@ -53,6 +53,10 @@ static const command_def COMMANDS[] = {
     {CLI_VIEW, "view", "view [SCENE|SOLUTION.radsol] [options]",
      "open a window that shows the solution as the solver refines it (progressive), or with --offscreen "
      "draw one frame with OpenGL without a window (docs/viewer.md; an optional build part)"},
+    {CLI_ILLUMINANCE, "illuminance", "illuminance [SCENE] --grid G.json [-o E.csv] [-o E.json] [options]",
+     "solve the scene and compute the illuminance in lux at the grid file's calculation points (work planes "
+     "spaced by EN 12464-1, a surface's footprint at a height, free points), direct and indirect, with Eavg, "
+     "Emin, Emax and U0 per grid (docs/lighting.md)"},
 };
 #define COMMAND_COUNT (sizeof COMMANDS / sizeof COMMANDS[0])
 
@@ -69,9 +73,10 @@ const char *cli_command_name(int command)
 /* The commands that solve (render, export, solve, bake, view), and those
  * that also mesh and couple (viewfactors, thermal); view writes no stats or
  * history (its rows below take it out). */
-#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW)
-#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW | CLI_THERMAL)
-#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE | CLI_VIEW | CLI_THERMAL)
+#define RS (CLI_RENDER | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW | CLI_ILLUMINANCE)
+#define RV (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_SOLVE | CLI_BAKE | CLI_VIEW | CLI_THERMAL | CLI_ILLUMINANCE)
+#define ALL (CLI_RENDER | CLI_VIEWFACTORS | CLI_EXPORT | CLI_GENERATE | CLI_SOLVE | CLI_BAKE | CLI_VIEW | CLI_THERMAL | \
+             CLI_ILLUMINANCE)
 /* The solver's own flags, for the commands that solve B and for thermal's net-radiation solve. */
 #define RST (RS | CLI_THERMAL)
 #define SOLVE(field_) .target = CLI_TO_SOLVE, .field = #field_
@@ -124,6 +129,13 @@ static const cli_flag FLAGS[] = {
     {"output", 'o', "FILE", CLI_VIEW, OWN(output, RAD_OPTION_STRING),
      .own.help = "with --offscreen: the frame, .png (exposed, sRGB), .hdr or .pfm (linear)",
      .own.default_text = "view.png"},
+    {"output", 'o', "FILE", CLI_ILLUMINANCE, OWN(output, RAD_OPTION_STRING),
+     .own.help = "output illuminance: .csv (one row per point) or .json (per grid: Eavg, Emin, Emax, U0 and "
+                 "the points); give -o twice for both (docs/lighting.md)",
+     .own.default_text = "illuminance.csv"},
+    {"grid", 0, "G.json", CLI_ILLUMINANCE, OWN(grid, RAD_OPTION_STRING),
+     .own.help = "the calculation grids and points: rectangles, surface footprints at a height, free points "
+                 "(docs/lighting.md, \"Calculation grids and points\"); required"},
     {"offscreen", 0, NULL, CLI_VIEW, OWN(offscreen, RAD_OPTION_FLAG),
      .own.help = "draw one frame with OpenGL (EGL, no window or display needed) to --output and exit"},
     {"no-ambient", 0, NULL, CLI_VIEW, OWN(no_ambient, RAD_OPTION_FLAG),
@@ -139,6 +151,10 @@ static const cli_flag FLAGS[] = {
     {"lightmap", 0, "WHICH", CLI_BAKE, OWN(lightmap_quantity, RAD_OPTION_ENUM), .own.words = lightmap_words,
      .own.default_text = "radiosity",
      .own.help = "what the texels hold: radiosity B, or irradiance H = (B - E)/rho (as B/pi, H/pi, W/(m^2 sr))"},
+    {"luminaires", 0, "FILE.json", CLI_RENDER | CLI_EXPORT | CLI_BAKE | CLI_VIEW | CLI_ILLUMINANCE,
+     OWN(luminaires, RAD_OPTION_STRING),
+     .own.help = "place luminaires from a layout file (photometric files, positions, aims; docs/lighting.md): "
+                 "their direct light reaches every element exactly and its reflection enters the solve"},
     {"rooms", 0, "N", CLI_GENERATE, OFFICE(rooms)},
     {"seed", 0, "S", CLI_GENERATE, OFFICE(seed)},
     {"closed-doors", 0, NULL, CLI_GENERATE, OFFICE(closed_doors)},
@@ -492,6 +508,15 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
         if (!value)
             value = argv[++i];
+        /* illuminance takes -o twice: the CSV and the JSON. */
+        if (s->command == CLI_ILLUMINANCE && strcmp(f->name, "output") == 0 && s->output && value[0]) {
+            if (s->output2) {
+                usage_error(e, "--output: illuminance writes at most two files (a .csv and a .json)");
+                return CLI_USAGE_ERROR;
+            }
+            s->output2 = value;
+            continue;
+        }
         const rad_option_info *o = cli_flag_info(f);
         if (value[0] == '\0') {
             usage_error(e, "--%s needs a value (%s)", f->name, f->metavar);
@@ -505,7 +530,7 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         }
     }
     if (!s->command) {
-        usage_error(e, "no command given: use render, solve, viewfactors, export, bake, thermal, generate or view");
+        usage_error(e, "no command given: use render, solve, viewfactors, export, bake, thermal, illuminance, generate or view");
         return CLI_USAGE_ERROR;
     }
     if (s->command == CLI_GENERATE && !s->scene_kind) {

@@ -24,7 +24,7 @@
 
 /* The commands, as bits: a flag lists those that take it. */
 enum { CLI_RENDER = 1, CLI_VIEWFACTORS = 2, CLI_GENERATE = 4, CLI_EXPORT = 8, CLI_SOLVE = 16, CLI_BAKE = 32,
-       CLI_VIEW = 64, CLI_THERMAL = 128 };
+       CLI_VIEW = 64, CLI_THERMAL = 128, CLI_ILLUMINANCE = 256 };
 
 /* What the command line asks for. */
 typedef enum cli_action {
@@ -75,6 +75,9 @@ typedef struct cli_settings {
     int log_scale;            /* render --scale: 0 linear, 1 log */
     const char *range;        /* render --range MIN:MAX, NULL = automatic */
     int contours;             /* render --contours: isolines at the legend's ticks */
+    const char *grid;         /* illuminance: the grid file (--grid) */
+    const char *output2;      /* illuminance: a second -o (CSV and JSON both), or NULL */
+    const char *luminaires;   /* render, export, bake, view, illuminance: a layout file (docs/lighting.md) */
 } cli_settings;
 
 /* Where a flag's value goes. */

@@ -364,7 +364,9 @@ typedef struct rad_options {
 
     const char *solver;           /* NULL = "hierarchical", or "gauss-seidel" when mesh_size,
                                      target_elements, form_factors or an adaptive_* field is
-                                     set (options of the uniform mesh and the matrix) */
+                                     set (options of the uniform mesh and the matrix), or the
+                                     scene has luminaires or daylight (which hierarchical
+                                     refuses) */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */
@@ -630,9 +632,11 @@ RAD_API rad_result rad_solution_point_radiosity(rad_context *ctx, rad_solution *
  * element's and vertex's radiosity in W/m^2 as doubles, the options and the
  * solve's figures; atomically (a temporary, renamed).  The vertex values
  * are the renderer's, so they are computed here if no render did.  Fails
- * with RAD_ERROR_INVALID_ARGUMENT for a solution not solved (or NULL ctx,
- * solution or path), RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY.  Not at the same
- * time as other calls on the same solution. */
+ * with RAD_ERROR_INVALID_ARGUMENT for a solution not solved, one whose
+ * scene has luminaires (rad_scene_load_luminaires) or daylight, which the
+ * file does not hold (or NULL ctx, solution or path), RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY.  Not at the same time as other calls on the
+ * same solution. */
 RAD_API rad_result rad_solution_save(rad_context *ctx, rad_solution *solution, const char *path);
 
 /* Read a solution file: *scene is the scene it was solved for (rebuilt and
@@ -838,7 +842,8 @@ typedef enum rad_output_kind {
     RAD_OUTPUT_MESH = 3,         /* .glb, .gltf, .ply (rad_solution_write_mesh) */
     RAD_OUTPUT_BAKE = 4,         /* .glb, .gltf (rad_solution_bake) */
     RAD_OUTPUT_THERMAL = 8,      /* .csv, .json (rad_thermal_write, rad_thermal_write_gebhart) */
-    RAD_OUTPUT_SOLUTION = 16     /* .radsol (rad_solution_save) */
+    RAD_OUTPUT_SOLUTION = 16,    /* .radsol (rad_solution_save) */
+    RAD_OUTPUT_ILLUMINANCE = 32  /* .csv, .json (rad_illuminance_write) */
 } rad_output_kind;
 
 /* An empty set.  Fails with RAD_ERROR_OUT_OF_MEMORY; NULL ctx or out:
@@ -1123,6 +1128,106 @@ RAD_API rad_result rad_thermal_write_stats(rad_context *ctx, const rad_thermal *
 RAD_API rad_result rad_thermal_write_gebhart(rad_context *ctx, const rad_thermal *thermal, const char *path);
 
 /* ------------------------------------------------------------------------
+ * Calculation grids and points: illuminance (docs/lighting.md,
+ * "Calculation grids and points")
+ *
+ * A grid file (JSON) names work planes (rectangles, or a surface's
+ * footprint at a height, spaced by EN 12464-1 or as given) and free points.
+ * rad_illuminance_evaluate computes at every point, on a solved solution,
+ * the illuminance in lux (docs/units.md: lux = 179 Y(H)): the direct light
+ * of luminaires, daylight and emitting surfaces, plus the interreflection
+ * gathered from the elements' radiosities with exact point-to-polygon
+ * factors and visibility.
+ * ---------------------------------------------------------------------- */
+
+typedef struct rad_illuminance rad_illuminance;
+
+/* One point's values. */
+typedef struct rad_grid_point_value {
+    double position[3];            /* m */
+    double normal[3];              /* unit: light from behind counts zero */
+    double u, v;                   /* m, in the grid's plane from its origin (the rectangle's
+                                      origin, the footprint's lower corner); 0 for free points */
+    double illuminance;            /* lux: direct + indirect */
+    double direct;                 /* lux: luminaires, daylight, emitting surfaces */
+    double indirect;               /* lux: light reflected by the scene's surfaces */
+    double daylight_factor;        /* %: illuminance / the unobstructed sky's horizontal
+                                      illuminance; NAN without daylight */
+    const char *name;              /* a free point's name; NULL for grid points */
+} rad_grid_point_value;
+
+/* One grid's points and statistics (the free points form one, "points"). */
+typedef struct rad_grid_result {
+    const char *name;
+    bool free_points;              /* the file's "points" */
+    size_t point_count;
+    const rad_grid_point_value *points; /* rows of v, u fastest (a footprint skips cells off it) */
+    unsigned columns, rows;        /* cells along u and v; 0 for free points */
+    double spacing_u, spacing_v;   /* m, the cells' sides; 0 for free points */
+    double width, height;          /* m, the calculation area's sides after the border */
+    double border;                 /* m */
+    bool automatic;                /* spacing by EN 12464-1: p = 0.2 x 5^log10(d) m, <= 10 m */
+    double average, minimum, maximum; /* lux: Eavg, Emin, Emax */
+    double uniformity;             /* U0 = Emin / Eavg (0 when Eavg is 0) */
+    double min_over_max;           /* Emin / Emax (0 when Emax is 0) */
+} rad_grid_result;
+
+/* What the evaluation cost. */
+typedef struct rad_illuminance_stats {
+    size_t points;
+    double seconds;                /* the gathering, wall clock */
+    double points_per_second;
+    unsigned long long shadow_rays; /* cast by the gathering */
+    unsigned long long exact_pairs; /* point-element pairs with exact visibility (no ray) */
+    unsigned long long ray_pairs;   /* ... with visibility from shadow rays */
+    double light_seconds;          /* thread-seconds spent in the direct light of luminaires and
+                                      daylight at the points, summed over threads */
+    double thread_seconds;         /* thread-seconds of all the points' work, summed over threads */
+} rad_illuminance_stats;
+
+/* Evaluate the grid file at `grid_path` (or `size` bytes at `data`, named
+ * `name` in messages) on a solved solution; *out holds every point's
+ * values.  Threads: the context's; the numbers are the same whatever
+ * their count (rays keyed on rad_options.seed).  Progress phase
+ * "illuminance"; cancellable.  The solution and its scene must outlive
+ * *out.  Fails with RAD_ERROR_PARSE (a bad file: the message names the
+ * file and the entry and key), RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY,
+ * RAD_ERROR_INTERRUPTED; an unsolved solution or a NULL argument:
+ * RAD_ERROR_INVALID_ARGUMENT.  *out is NULL on failure. */
+RAD_API rad_result rad_illuminance_evaluate_file(rad_context *ctx, const rad_solution *solution,
+                                                 const char *grid_path, rad_illuminance **out);
+RAD_API rad_result rad_illuminance_evaluate_memory(rad_context *ctx, const rad_solution *solution,
+                                                   const char *name, const void *data, size_t size,
+                                                   rad_illuminance **out);
+/* Read and check the grid file at `path` against `scene` without solving
+ * (a command checks its input before the work); *points (may be NULL) the
+ * points it places.  Fails as rad_illuminance_evaluate_file. */
+RAD_API rad_result rad_illuminance_check_file(rad_context *ctx, const rad_scene *scene, const char *path,
+                                              size_t *points);
+/* NULL: no-op. */
+RAD_API void rad_illuminance_destroy(rad_illuminance *illuminance);
+
+/* The grids, in the file's order, the free points last; 0 for NULL. */
+RAD_API size_t rad_illuminance_grid_count(const rad_illuminance *illuminance);
+/* Grid `grid`, owned by *illuminance and valid for its life; NULL out of
+ * range or for NULL. */
+RAD_API const rad_grid_result *rad_illuminance_grid(const rad_illuminance *illuminance, size_t grid);
+/* Whether the scene has daylight (the daylight factors are numbers). */
+RAD_API bool rad_illuminance_has_daylight(const rad_illuminance *illuminance);
+/* The cost into *out (zeros for NULL illuminance); NULL out: no-op. */
+RAD_API void rad_illuminance_get_stats(const rad_illuminance *illuminance, rad_illuminance_stats *out);
+
+/* Write the values by extension (docs/lighting.md): .csv, one row per point
+ * (grid, index, name, x, y, z, normal, u, v, E, E_direct, E_indirect in
+ * lux, and the daylight factor in % with daylight), or .json (per grid:
+ * Eavg, Emin, Emax, U0, Emin/Emax, points, spacing, and every point).
+ * Atomic like the other writers (a path an output set gave is written in
+ * place by the set's commit).  Fails with RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY; an unknown extension or a NULL argument:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_illuminance_write(rad_context *ctx, const rad_illuminance *illuminance, const char *path);
+
+/* ------------------------------------------------------------------------
  * Method registries
  * ---------------------------------------------------------------------- */
 
@@ -1314,6 +1419,113 @@ RAD_API size_t rad_solution_link_count(const rad_solution *solution);
  * NULL). */
 RAD_API rad_result rad_image_from_pixels(rad_context *ctx, int width, int height, const float *rgb,
                                          rad_image **out);
+
+/* ------------------------------------------------------------------------
+ * Photometric files: a luminaire's summary (IES LM-63, EULUMDAT)
+ * ---------------------------------------------------------------------- */
+
+/* What a luminaire's photometric file holds, summarised (docs/lighting.md,
+ * "Photometric files"): a plain struct of values, nothing to free. */
+typedef struct rad_photometry_info {
+    char format[16];          /* "IES" or "EULUMDAT" */
+    char version[24];         /* "LM-63-1986" .. "LM-63-2019", "EULUMDAT" */
+    char label[128];          /* the luminaire's name in the file (cut to fit), may be "" */
+    int type;                 /* the file's photometric type: 1 C, 2 B, 3 A */
+    char symmetry[64];        /* "quadrant (C 0-90)", "C0-C180 plane (Isym 2)", ... */
+    size_t horizontal_count;  /* the file's horizontal angles (EULUMDAT: C planes listed) */
+    size_t vertical_count;    /* the file's vertical angles (EULUMDAT: gamma angles) */
+    double horizontal_min, horizontal_max; /* degrees, as the file gives them */
+    double vertical_min, vertical_max;     /* degrees, as the file gives them */
+    double max_candela;       /* cd, multipliers applied */
+    double max_c, max_gamma;  /* degrees: its direction in the luminaire's C-gamma frame */
+    double flux;              /* lm: the interpolated distribution integrated over the sphere */
+    double rated_lumens;      /* lm: the lamps' rated flux; 0 for absolute photometry */
+    double lor;               /* 1: flux / rated_lumens; 0 without rated lumens */
+    double stated_lor;        /* 1: the file's own light output ratio (EULUMDAT LORL); -1 none */
+    double width, length, height; /* m: the luminous opening's extents along y, x, z */
+    char shape[32];           /* "point", "rectangle", "ellipse", ... (docs/lighting.md) */
+    char tilt[64];            /* "none", "include" or the tilt file's name */
+    size_t tilt_count;        /* tilt angles given; 0 without tilt data */
+    double input_watts;       /* W: the file's input power; 0 if not given */
+} rad_photometry_info;
+
+/* Read the photometric file at `path`, an IES LM-63 (1986 to 2019) or
+ * EULUMDAT file told by its content, and summarise it in *out.  Fails with
+ * RAD_ERROR_IO (unreadable; a TILT file outside the file's folder unless
+ * the context allows reading outside it), RAD_ERROR_PARSE (malformed: the
+ * message names the file and line, "lamp.ies:12: expected 37 vertical
+ * angles, found 12 (the file ends)"), RAD_ERROR_OUT_OF_MEMORY; *out is
+ * zeroed on failure.  A file whose integrated flux disagrees with its
+ * stated light output ratio by more than 2 % is read, with a warning
+ * (rad_context_options.on_warning).  NULL ctx, path or out:
+ * RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_photometry_info_read(rad_context *ctx, const char *path, rad_photometry_info *out);
+
+/* ------------------------------------------------------------------------
+ * Luminaires (docs/lighting.md "Luminaires"): photometric files (IES LM-63,
+ * EULUMDAT) placed in a scene by a layout file, or by glTF nodes whose
+ * extras name one ({"luminaire": "a.ies", "llf": 0.8}, read when the glTF
+ * loads: at the node's origin, nadir along its local -z, C = 0 along its
+ * local x).  A luminaire is a light source, not geometry.  Its direct light
+ * reaches every element exactly (a goniometric point source beyond five
+ * times its luminous size, its opening split into sub-sources nearer, a
+ * shadow ray each) and its first reflection enters the solve as emission;
+ * candela count as cd / 179 W/sr on each channel (docs/units.md
+ * "Photometry").  A scene lit only by luminaires needs no emitting surface.
+ * Hierarchical radiosity refuses luminaires (without a solver named, a lit
+ * scene is solved by gauss-seidel); a solution file does not hold them.
+ *
+ *     rad_scene_load_file(ctx, "office.obj", &scene);
+ *     rad_scene_load_luminaires(ctx, scene, "layout.json");
+ *     rad_solution_create(ctx, scene, NULL, &sol);      (gauss-seidel)
+ *     rad_solution_solve(ctx, sol);
+ * ---------------------------------------------------------------------- */
+
+/* Read a layout file (JSON) and add its luminaires to `scene`:
+ *
+ *     {"up": [0, 0, 1], "llf": 0.8,
+ *      "luminaires": [{"file": "downlight.ies", "position": [2, 3, 2.7],
+ *                      "aim": [0, 0, -1], "spin": 0, "name": "A",
+ *                      "array": {"count": [4, 2], "spacing": [1.5, 2]}}]}
+ *
+ * (all keys: docs/lighting.md).  Each photometric file, named relative to
+ * the layout's folder, is read once per scene.  All or nothing: on failure
+ * the scene is unchanged.  Call it before making solutions of the scene
+ * (they borrow it as it is); it may be called more than once (luminaire
+ * names stay unique).  Fails with RAD_ERROR_PARSE and one line naming the
+ * file, the entry and the key ("layout.json: luminaires[2].aim: must be 3
+ * finite numbers, not all 0"), the photometric reader's errors (naming its
+ * file and line), RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY; NULL ctx, scene or
+ * path: RAD_ERROR_INVALID_ARGUMENT.  The file is read within the memory
+ * limit. */
+RAD_API rad_result rad_scene_load_luminaires(rad_context *ctx, rad_scene *scene, const char *path);
+/* The same from `size` bytes at `data`; `name` stands for the file in
+ * messages and its folder resolves the photometric files' names.  NULL
+ * ctx, scene, name or data: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_scene_load_luminaires_memory(rad_context *ctx, rad_scene *scene, const char *name,
+                                                    const void *data, size_t size);
+
+/* Luminaires in the scene (layouts and glTF nodes).  NULL scene: 0. */
+RAD_API size_t rad_scene_luminaire_count(const rad_scene *scene);
+/* Luminaire `index`'s name (the layout's "name", with "[i,j]" in an array,
+ * "luminaire N" without one, or the glTF node's), owned by the scene.
+ * NULL scene or index out of range: NULL. */
+RAD_API const char *rad_scene_luminaire_name(const rad_scene *scene, size_t index);
+/* Luminaire `index`'s flux in lumens: its distribution's, times its light
+ * loss factor, multiplier, lumens scaling and tilt factor.  NULL scene or
+ * index out of range: 0. */
+RAD_API double rad_scene_luminaire_flux(const rad_scene *scene, size_t index);
+/* Luminaire `index`'s photometric centre (m) and frame: its x (C = 0), y
+ * (C = 90) and z (the nadir being -z) as unit world vectors, 9 numbers;
+ * either array may be NULL.  False (nothing written) for a NULL scene or
+ * an index out of range. */
+RAD_API bool rad_scene_luminaire_placement(const rad_scene *scene, size_t index, double position[3],
+                                           double axes[9]);
+/* The direct light of the scene's luminaires and daylight landing on the
+ * solution's elements, lm (179 x Y of sum A H_direct): in a closed scene
+ * the luminaires' whole flux.  0 for a scene without them or a NULL
+ * solution. */
+RAD_API double rad_solution_direct_lumens(const rad_solution *solution);
 
 /* ------------------------------------------------------------------------
  * Pictures people read (issue #16; docs/lighting.md "Pictures"): false

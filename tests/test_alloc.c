@@ -244,6 +244,29 @@ static rad_result run_thermal(rad_context *ctx, const rad_scene *scene, const ra
     return r;
 }
 
+/* Calculation points (docs/lighting.md): a footprint, a rectangle and a
+ * free point evaluated on the solution, both writers. */
+static rad_result run_illuminance(rad_context *ctx, const rad_solution *s, outputs *out)
+{
+    static const char grid[] = "{\"grids\": [{\"name\": \"f\", \"surface\": \"floor\", \"height\": 0.3, "
+                               "\"spacing\": 0.25, \"border\": 0.1}, {\"name\": \"r\", \"rectangle\": "
+                               "{\"origin\": [0.1, 0.1, 0.1], \"u\": [0.5, 0, 0], \"v\": [0, 0.5, 0.2]}, "
+                               "\"spacing\": 0.25}], \"points\": [{\"name\": \"p\", \"position\": [0.5, 0.5, 0.5]}]}";
+    rad_illuminance *il = NULL;
+    char path[512];
+    rad_result r = rad_illuminance_evaluate_memory(ctx, s, "grid.json", grid, strlen(grid), &il);
+    if (r == RAD_OK) {
+        output_path("illuminance.csv", path, sizeof path);
+        r = write_done(rad_illuminance_write(ctx, il, path), out, "illuminance.csv");
+    }
+    if (r == RAD_OK) {
+        output_path("illuminance.json", path, sizeof path);
+        r = write_done(rad_illuminance_write(ctx, il, path), out, "illuminance.json");
+    }
+    rad_illuminance_destroy(il);
+    return r;
+}
+
 /* A strategy: solve, every accessor that allocates, render, every writer. */
 static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *out)
 {
@@ -323,6 +346,8 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     static const char *const streamed[] = {"stream.mtx", "stream.csv", "stream.json"};
     bool streams = sc->view_factors && !sc->closure_correction && !sc->adaptive_levels &&
                    strcmp(sc->form_factors, "analytic") == 0;
+    if (r == RAD_OK && streams)
+        r = run_illuminance(ctx, s, out);
     for (size_t k = 0; k < 3 && r == RAD_OK && streams; k++) {
         rad_options o = {0};
         o.target_elements = 48;

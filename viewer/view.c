@@ -24,6 +24,8 @@ rad_result rv_load(rad_context *ctx, const rv_args *a, rv_step_slot *slot, rad_s
     if (*saved)
         return rad_solution_load_file(ctx, a->input, scene, solution);
     rad_result r = a->input ? rad_scene_load_file(ctx, a->input, scene) : rad_scene_create_cornell_box(ctx, scene);
+    if (r == RAD_OK && a->luminaires)
+        r = rad_scene_load_luminaires(ctx, *scene, a->luminaires);
     rad_options options = a->solve;
     options.on_step = rv_step_forward;
     options.on_step_user = slot;

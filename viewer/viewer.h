@@ -27,6 +27,7 @@
 
 typedef struct rv_args {
     const char *input;            /* scene or solution file; NULL = the Cornell box */
+    const char *luminaires;       /* a layout file placed in the scene (docs/lighting.md), or NULL */
     rad_options solve;            /* as for `radiosity render` */
     int width, height;            /* window or frame; 0 = 1024 x 768 (window), 512 x 512 (frame) */
     int samples;                  /* off-screen multisampling per pixel; 0 = 4 */

@@ -9,6 +9,7 @@
 #include "api/solution.h"
 #include "strategy/saved.h"
 #include "solve/vpl.h"
+#include "light/light.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -43,6 +44,15 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->ctx = ctx;
     s->scene = scene;
     s->threads = rad_context_threads(ctx);
+    /* Luminaires and daylight light the elements of the uniform-mesh
+     * strategies, not hierarchical radiosity's nodes: without a solver
+     * named, gauss-seidel. */
+    rad_options lit;
+    if (rad_light_present(scene) && (!options || !options->solver)) {
+        lit = options ? *options : (rad_options){0};
+        lit.solver = "gauss-seidel";
+        options = &lit;
+    }
     rad_result r = rad_options_resolve(ctx, options, &s->options, &s->names);
     if (r != RAD_OK) {
         rad_free(s);
@@ -167,9 +177,10 @@ rad_result rad_solution_solve(rad_context *ctx, rad_solution *s)
     if (!ctx || !s)
         return rad_null_argument(ctx, __func__);
     rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
-    if (!rad_scene_has_emitter(s->scene))
+    if (!rad_scene_has_emitter(s->scene) && !rad_light_present(s->scene))
         return rad_fail(ctx, RAD_ERROR_INVALID_SCENE,
-                        "%s: the scene has no emitter (no material with Ke > 0): nothing to light it",
+                        "%s: the scene has no emitter (no material with Ke > 0, no luminaire, no daylight): "
+                        "nothing to light it",
                         s->scene->source);
     rad_step_hook hook = {NULL, s, s->options.on_step != NULL};
     if (s->options.record_history || s->options.on_step)
@@ -540,6 +551,15 @@ rad_result rad_solution_save(rad_context *ctx, rad_solution *s, const char *path
                         "solution file: solver '%s' solves for vertex values, which a solution file "
                         "does not hold (it keeps element values): not saved",
                         s->options.solver);
+    /* The file holds the scene's surfaces and the radiosity, not the
+     * luminaires or daylight that lit it: loaded, their direct light would
+     * be missing from every point (illuminance) and the radiosity would
+     * answer to a scene without light.  Refused rather than loaded wrong. */
+    if (rad_light_present(s->scene))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "solution file: the scene %s is lit by luminaires or daylight, which a solution file "
+                        "does not hold yet: not saved (solve and render, export or bake in one run)",
+                        s->scene->source);
     double *display = NULL;
     rad_result r = display_values(ctx, s, &display);
     if (r == RAD_OK)

@@ -1,10 +1,29 @@
 /*
  * direct.c -- the scene's direct light (light.h): the sum over its kinds of
- * source at a point, and the mean over an element.
+ * source at a point, and the mean over an element by adaptive cubature.
+ *
+ * The element mean: a region (the element's corners; triangle or planar
+ * quad) is integrated with a fixed rule (quads: 2 x 2 Gauss-Legendre on
+ * the bilinear map with its Jacobian; triangles: Strang and Fix's 3-point
+ * rule of degree 2), then as its four children (rad_ff_split4); where the
+ * two disagree by more than REL_TOL of the element's whole estimate the
+ * children are integrated alike, down to MAX_DEPTH levels (4^MAX_DEPTH
+ * regions at most, each of 3 or 4 points: bounded; shadow edges, where the
+ * integrand jumps, are what reach the bottom).  The same order of regions
+ * and points whatever the thread: deterministic.
  */
 #include "light/light.h"
 
+#include "formfactor/formfactor.h"
+
+#include <math.h>
 #include <string.h>
+
+enum { MAX_DEPTH = 4 };
+/* Agreement between a region's estimate and its children's, relative to
+ * the element's first estimate: 1e-3 keeps the mean's error near 1e-4 on
+ * smooth light (the children's estimate is kept, an order better). */
+#define REL_TOL 1e-3
 
 bool rad_light_present(const rad_scene *scene)
 {
@@ -30,11 +49,96 @@ void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const ra
     }
 }
 
-/* PLACEHOLDER (the luminaires engineer replaces it with adaptive cubature):
- * the value at the element's centroid. */
+typedef struct cubature {
+    const rad_scene *scene;
+    const rad_mesh *mesh;
+    const rad_vis *vis;
+    vec3 normal;
+} cubature;
+
+/* The integral (W per channel) of the irradiance over one region. */
+static void region_integral(const cubature *c, const vec3 *q, uint32_t corners, double out[3])
+{
+    double h[3];
+    out[0] = out[1] = out[2] = 0.0;
+    if (corners == 3) {
+        static const double bary[3][2] = {{1.0 / 6.0, 1.0 / 6.0}, {2.0 / 3.0, 1.0 / 6.0}, {1.0 / 6.0, 2.0 / 3.0}};
+        double area = 0.5 * v3_length(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
+        for (int k = 0; k < 3; k++) {
+            vec3 x = v3_add(q[0], v3_add(v3_scale(v3_sub(q[1], q[0]), bary[k][0]),
+                                         v3_scale(v3_sub(q[2], q[0]), bary[k][1])));
+            rad_light_irradiance(c->scene, c->mesh, c->vis, x, c->normal, h);
+            for (int ch = 0; ch < 3; ch++)
+                out[ch] += area / 3.0 * h[ch];
+        }
+        return;
+    }
+    static const double at[2] = {0.21132486540518711775, 0.78867513459481288225};
+    for (int a = 0; a < 2; a++)
+        for (int b = 0; b < 2; b++) {
+            double u = at[a], v = at[b];
+            vec3 x = v3_lerp(v3_lerp(q[0], q[1], u), v3_lerp(q[3], q[2], u), v);
+            vec3 du = v3_add(v3_scale(v3_sub(q[1], q[0]), 1.0 - v), v3_scale(v3_sub(q[2], q[3]), v));
+            vec3 dv = v3_sub(v3_lerp(q[3], q[2], u), v3_lerp(q[0], q[1], u));
+            double jacobian = v3_length(v3_cross(du, dv));
+            rad_light_irradiance(c->scene, c->mesh, c->vis, x, c->normal, h);
+            for (int ch = 0; ch < 3; ch++)
+                out[ch] += 0.25 * jacobian * h[ch];
+        }
+}
+
+/* The children's integral where they agree with `coarse` (the region's
+ * own) within `tol` W, else each child refined alike. */
+static void refine(const cubature *c, const vec3 *q, uint32_t corners, const double coarse[3], int depth,
+                   double tol, double out[3])
+{
+    vec3 sub[4][4];
+    rad_ff_split4(q, corners, sub);
+    double part[4][3], fine[3] = {0, 0, 0};
+    for (int k = 0; k < 4; k++) {
+        region_integral(c, sub[k], corners, part[k]);
+        for (int ch = 0; ch < 3; ch++)
+            fine[ch] += part[k][ch];
+    }
+    double diff = 0.0;
+    for (int ch = 0; ch < 3; ch++)
+        diff = fmax(diff, fabs(fine[ch] - coarse[ch]));
+    if (diff <= tol || depth + 1 >= MAX_DEPTH) {
+        memcpy(out, fine, sizeof fine);
+        return;
+    }
+    out[0] = out[1] = out[2] = 0.0;
+    for (int k = 0; k < 4; k++) {
+        double r[3];
+        /* A quarter of the region: a quarter of its tolerance. */
+        refine(c, sub[k], corners, part[k], depth + 1, 0.25 * tol, r);
+        for (int ch = 0; ch < 3; ch++)
+            out[ch] += r[ch];
+    }
+}
+
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   size_t element, double out[3])
 {
     const rad_element *e = &mesh->elements[element];
-    rad_light_irradiance(scene, mesh, vis, e->centroid, e->normal, out);
+    out[0] = out[1] = out[2] = 0.0;
+    if (!rad_light_present(scene) || !(e->area > 0.0))
+        return;
+    cubature c = {scene, mesh, vis, e->normal};
+    vec3 q[4];
+    for (uint32_t k = 0; k < e->vertex_count; k++)
+        q[k] = mesh->vertices[e->vertex[k]];
+    double whole[3], total[3];
+    region_integral(&c, q, e->vertex_count, whole);
+    double scale = fmax(fmax(whole[0], whole[1]), whole[2]);
+    refine(&c, q, e->vertex_count, whole, 0, REL_TOL * scale, total);
+    /* The region rules integrate over the corners' own area; the mean is
+     * over the element's. */
+    double area = 0.0;
+    if (e->vertex_count == 3)
+        area = 0.5 * v3_length(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
+    else
+        area = 0.5 * v3_length(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[3], q[1])));
+    for (int ch = 0; ch < 3; ch++)
+        out[ch] = area > 0.0 ? total[ch] / area : 0.0;
 }

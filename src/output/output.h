@@ -273,6 +273,13 @@ rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size
  * (thermal_write.c; docs/thermal.md). */
 rad_result rad_write_thermal(rad_context *ctx, const rad_thermal *thermal, const char *path, bool elements);
 rad_result rad_write_gebhart(rad_context *ctx, const rad_thermal *thermal, const double *G, const char *path);
+
+/* The illuminance at calculation points (grid_write.c): .csv, one row per
+ * point, or .json, per grid its statistics and points; atomically.  The
+ * daylight factor's column only when `daylight`.  RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INVALID_ARGUMENT (another extension). */
+rad_result rad_write_illuminance(rad_context *ctx, const rad_grid_result *grids, size_t count, bool daylight,
+                                 const char *path);
 /* The solution's stats with a "thermal" object (rad_thermal_write_stats). */
 rad_result rad_write_thermal_stats(rad_context *ctx, const rad_solution_view *view, const rad_thermal *thermal,
                                    const char *path);

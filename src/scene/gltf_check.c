@@ -33,6 +33,7 @@
  * GLB chunk), a block at a time.
  */
 #include "scene/import_internal.h"
+#include "scene/layout.h"
 
 #include <assimp/cfileio.h>
 #include <cjson/cJSON.h>
@@ -1072,6 +1073,24 @@ static rad_result walk_scene(checker *c, size_t scene, const double *mesh_triang
         *instances += 1.0;
         if (member(json, "mesh"))
             *triangles += mesh_triangles[(size_t)member(json, "mesh")->valuedouble];
+        if (rad_gltf_extras_place_luminaire(member(json, "extras"))) {
+            rad_gltf_luminaire *grown = rad_realloc(c->ctx, RAD_MEM_SCENE, facts->luminaires,
+                                                    facts->luminaire_count + 1, sizeof *grown, c->name);
+            if (!grown) {
+                rad_free(stack);
+                return RAD_ERROR_OUT_OF_MEMORY;
+            }
+            facts->luminaires = grown;
+            rad_gltf_luminaire *l = &grown[facts->luminaire_count++];
+            label(&c->nodes, node, "node", l->label, sizeof l->label);
+            const cJSON *node_name = member(json, "name");
+            if (cJSON_IsString(node_name) && node_name->valuestring[0])
+                snprintf(l->name, sizeof l->name, "%.127s", node_name->valuestring);
+            else
+                snprintf(l->name, sizeof l->name, "node %zu", node);
+            node_world(c, node, l->world);
+            l->extras = member(json, "extras");
+        }
         if (member(json, "camera")) {
             const cJSON *camera = c->cameras.items[(size_t)member(json, "camera")->valuedouble];
             if (first_camera == NONE)

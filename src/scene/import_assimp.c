@@ -52,6 +52,7 @@
  * (a FIFO, /dev/zero) stops there (import_input.c).
  */
 #include "scene/import_internal.h"
+#include "scene/layout.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -739,6 +740,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
                                               ((const import_files *)(const void *)io->UserData)->log != NULL);
         if (checked != RAD_OK) {
             cJSON_Delete(json);
+            rad_free(facts.luminaires);
             return checked;
         }
     }
@@ -746,6 +748,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
     struct aiPropertyStore *properties = aiCreatePropertyStore();
     if (!properties) {
         cJSON_Delete(json);
+        rad_free(facts.luminaires);
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
     /* A skeleton without meshes must not turn into stick-figure polygons. */
@@ -759,6 +762,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
     if (!ai) {
         const char *why = aiGetErrorString();
         cJSON_Delete(json);
+        rad_free(facts.luminaires);
         return rad_fail(ctx, RAD_ERROR_PARSE, "%s: %s", name,
                         why && *why ? why : "assimp could not read it");
     }
@@ -801,6 +805,22 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
         rad_scene_builder_camera(cv.builder, &cv.positions->camera); /* an OBJ's camera comment */
     r = rad_scene_builder_finish(cv.builder, out);
     cv.builder = NULL;
+    if (r == RAD_OK && facts.luminaire_count > 0) {
+        /* Luminaires placed by nodes' extras (layout.c): their files are
+         * read beside the glTF, so only when it was read from a file. */
+        if (cv.log)
+            r = rad_layout_place_gltf(ctx, *out, name, facts.luminaires, facts.luminaire_count,
+                                      rad_layout_load_photometry, NULL);
+        else
+            rad_warn(ctx, "%s: %zu node%s place%s a luminaire (extras.luminaire), which only a glTF read "
+                     "from a file places (its photometric files lie beside it)",
+                     name, facts.luminaire_count, facts.luminaire_count == 1 ? "" : "s",
+                     facts.luminaire_count == 1 ? "s" : "");
+        if (r != RAD_OK) {
+            rad_scene_destroy(*out);
+            *out = NULL;
+        }
+    }
 
 done:
     rad_scene_builder_destroy(cv.builder);
@@ -811,6 +831,7 @@ done:
     rad_free(cv.face);
     aiReleaseImport(ai);
     cJSON_Delete(json);
+    rad_free(facts.luminaires);
     return r;
 }
 

@@ -262,9 +262,14 @@ double import_gltf_emissive_strength(const struct cJSON *materials, unsigned ind
 /* ---- gltf_check.c ---- */
 
 /* What the check learnt for the import. */
+struct rad_gltf_luminaire; /* scene/layout.h */
 typedef struct import_gltf_facts {
     bool has_camera;   /* the scene's first perspective camera, placed */
     rad_camera camera;
+    /* The nodes whose extras place a luminaire, in the walk's order
+     * (rad_alloc'd; the extras point into the checked JSON). */
+    struct rad_gltf_luminaire *luminaires;
+    size_t luminaire_count;
 } import_gltf_facts;
 
 /* Check the glTF `json` (of the file `name`, `size` bytes at `data`; a .glb
@@ -274,7 +279,8 @@ typedef struct import_gltf_facts {
  * accessors inside their buffers (read through `io`, which opens the
  * external ones); what the import will take against the memory limit.
  * Fills `facts` (the camera; an orthographic one is replaced, with a
- * warning).  Fails with a one-line message naming the file and the node,
+ * warning; the nodes whose extras place luminaires, which the caller
+ * rad_frees).  Fails with a one-line message naming the file and the node,
  * mesh, primitive or accessor: RAD_ERROR_PARSE, RAD_ERROR_INVALID_SCENE
  * (non-finite positions, a degenerate camera), RAD_ERROR_IO (a buffer that
  * cannot be read), RAD_ERROR_OUT_OF_MEMORY. */

@@ -272,6 +272,11 @@ static rad_result remesh(rad_context *ctx, rad_adaptive *a, rad_meshed *m)
         r = rad_vis_create(ctx, m->options->visibility, mesh, &vis);
     if (r == RAD_OK)
         r = rad_elements_create(ctx, m->scene, mesh, &elements);
+    if (r == RAD_OK) {
+        r = rad_elements_add_light(ctx, m->scene, mesh, vis, &elements);
+        if (r != RAD_OK)
+            rad_elements_free(&elements);
+    }
     rad_free(en.leaves);
     rad_free(en.tree);
     rad_free(root);
@@ -415,6 +420,18 @@ static bool visibility_varies(const rad_meshed *m, size_t i, size_t j, double li
     return false;
 }
 
+/* Element i's own emission (mean over RGB): its emission without the
+ * first reflection of luminaires' and daylight's direct light, which
+ * makes a lit surface no emitter. */
+static double self_emission(const rad_elements *el, size_t i)
+{
+    double e = mean3(&el->emission[3 * i]);
+    if (el->direct)
+        for (int c = 0; c < 3; c++)
+            e -= el->reflectance[3 * i + (size_t)c] * el->direct[3 * i + (size_t)c] / 3.0;
+    return e > 1e-12 * mean3(&el->emission[3 * i]) ? e : 0.0;
+}
+
 /* What emitter j would add to element i's radiosity per unit of i's
  * reflectance, unoccluded: E_j times the centre-to-centre kernel, at most
  * E_j.  Pairs straddling each other's planes (a cosine <= 0 at the
@@ -429,7 +446,7 @@ static double emitter_share(const rad_elements *el, const rad_element *E, size_t
     double kernel = fmax(ci, 0.0) * fmax(cj, 0.0) * E[j].area / (M_PI * r2 * r2);
     if (kernel == 0.0)
         kernel = E[j].area / (M_PI * r2);
-    return mean3(&el->emission[3 * j]) * fmin(kernel, 1.0);
+    return self_emission(el, j) * fmin(kernel, 1.0);
 }
 
 enum { AD_MARKED = 64 }; /* emitters one receiver marks for splitting, at most */
@@ -447,7 +464,7 @@ static rad_result score_elements(rad_context *ctx, const rad_adaptive *a, const 
     double sum = 0.0, area = 0.0;
     size_t emitters = 0;
     for (size_t i = 0; i < n; i++) {
-        if (mean3(&el->emission[3 * i]) > 0.0) {
+        if (self_emission(el, i) > 0.0) {
             emitters++;
             continue;
         }
@@ -481,7 +498,7 @@ static rad_result score_elements(rad_context *ctx, const rad_adaptive *a, const 
     for (size_t i = 0, k = 0; i < n; i++) {
         for (uint32_t c = 0; c < mesh->elements[i].vertex_count; c++)
             around[start[mesh->elements[i].vertex[c]]++] = (uint32_t)i;
-        if (mean3(&el->emission[3 * i]) > 0.0)
+        if (self_emission(el, i) > 0.0)
             emitter[k++] = (uint32_t)i;
     }
     for (size_t v = V; v > 0; v--)
@@ -503,7 +520,7 @@ static rad_result score_elements(rad_context *ctx, const rad_adaptive *a, const 
 #pragma omp parallel for schedule(dynamic, 16) num_threads(m->threads)
     for (size_t i = 0; i < n; i++) {
         const ad_node *node = &a->nodes[a->leaf_node[i]];
-        if (node->level >= node->max_level || mean3(&el->emission[3 * i]) > 0.0)
+        if (node->level >= node->max_level || self_emission(el, i) > 0.0)
             continue;
         vec3 corner[4];
         for (uint32_t c = 0; c < E[i].vertex_count; c++)

@@ -7,6 +7,8 @@
  */
 #include "strategy/strategy.h"
 
+#include "light/light.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -55,6 +57,15 @@ static rad_result hierarchical_create(rad_context *ctx, const rad_scene *scene, 
                                       void **out)
 {
     *out = NULL;
+    /* Its nodes take their emission from the materials (hier.c), and the
+     * direct light of luminaires and daylight would have to follow every
+     * refinement down to new leaves: refused rather than left dark. */
+    if (rad_light_present(scene))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: the hierarchical solver does not take luminaires or daylight; use a dense "
+                        "solver (e.g. gauss-seidel, with --adaptive for refinement), matrix-free, galerkin "
+                        "or instant-radiosity",
+                        scene->source);
     hierarchical_state *st = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *st, "solution: hierarchical state");
     if (!st)
         return RAD_ERROR_OUT_OF_MEMORY;

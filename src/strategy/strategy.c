@@ -6,6 +6,11 @@
  */
 #include "strategy/strategy.h"
 
+#include "light/light.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 
@@ -113,6 +118,48 @@ rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const r
     return RAD_OK;
 }
 
+rad_result rad_elements_add_light(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
+                                  const rad_vis *vis, rad_elements *e)
+{
+    if (!rad_light_present(scene))
+        return RAD_OK;
+    size_t n = mesh->element_count;
+    double *direct = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * n + 1, sizeof *direct, "solution: direct light");
+    if (!direct)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    uint64_t done = 0;
+    volatile int stop = 0;
+    rad_progress(ctx, "direct light", 0, n);
+    /* Each element alone: its values do not depend on the schedule. */
+#pragma omp parallel for schedule(dynamic, 16) num_threads(rad_context_threads(ctx))
+    for (size_t i = 0; i < n; i++) {
+        if (stop)
+            continue;
+        rad_light_element_irradiance(scene, mesh, vis, i, direct + 3 * i);
+        uint64_t now;
+#pragma omp atomic capture
+        now = ++done;
+#ifdef _OPENMP
+        if (omp_get_thread_num() == 0)
+#endif
+            rad_progress(ctx, "direct light", now, n);
+        if (rad_cancelled(ctx))
+            stop = 1;
+    }
+    if (stop) {
+        rad_free(direct);
+        return RAD_ERROR_INTERRUPTED;
+    }
+    rad_progress(ctx, "direct light", n, n);
+    for (size_t k = 0; k < 3 * n; k++) {
+        e->emission[k] += e->reflectance[k] * direct[k];
+        e->radiosity[k] = e->emission[k];
+    }
+    rad_free(e->direct);
+    e->direct = direct;
+    return RAD_OK;
+}
+
 void rad_elements_free(rad_elements *e)
 {
     rad_free(e->area);
@@ -201,6 +248,8 @@ rad_result rad_meshed_init(rad_context *ctx, const rad_scene *scene, const rad_o
     rad_result r = rad_strategy_mesh_and_vis(ctx, scene, o, &mo, &m->mesh, &m->vis, &m->seconds);
     if (r == RAD_OK)
         r = rad_elements_create(ctx, scene, m->mesh, &m->elements);
+    if (r == RAD_OK)
+        r = rad_elements_add_light(ctx, scene, m->mesh, m->vis, &m->elements);
     if (r != RAD_OK)
         rad_meshed_free(m);
     return r;
@@ -320,16 +369,38 @@ rad_result rad_view_surface_view_factors(rad_context *ctx, const rad_solution_vi
     return RAD_OK;
 }
 
+/* The direct light of luminaires and daylight landing on the elements,
+ * sum A H_d, and the part of it absorbed at once, sum A (1 - rho) H_d (W,
+ * means over RGB): the solve sees only the reflected part rho H_d, as
+ * emission. */
+static void direct_power(const rad_solution_view *v, double *landing, double *absorbed)
+{
+    double land = 0.0, ab = 0.0;
+    for (size_t i = 0; v->direct && i < v->n; i++)
+        for (int c = 0; c < 3; c++) {
+            double p = v->area[i] * v->direct[3 * i + c];
+            land += p;
+            ab += (1.0 - v->reflectance[3 * i + c]) * p;
+        }
+    *landing = land / 3.0;
+    *absorbed = ab / 3.0;
+}
+
 rad_result rad_view_power(rad_context *ctx, const rad_solution_view *v, double *emitted, double *absorbed)
 {
     size_t n = v->n;
-    double em = 0.0;
+    double em = 0.0, landing, direct_absorbed;
+    /* With luminaires or daylight, the power entering is the surfaces' own
+     * emission and the direct light landing; what the solve calls emission
+     * holds only its reflected part, so the absorbed part is added to both
+     * sides. */
+    direct_power(v, &landing, &direct_absorbed);
     if (!v->F) { /* the strategy counted what it deposited */
         for (size_t i = 0; i < n; i++)
             for (int c = 0; c < 3; c++)
                 em += v->area[i] * v->emission[3 * i + c];
-        *emitted = em / 3.0;
-        *absorbed = v->solve->absorbed;
+        *emitted = em / 3.0 + direct_absorbed;
+        *absorbed = v->solve->absorbed + direct_absorbed;
         return RAD_OK;
     }
     /* Per-element absorption in parallel, summed in order (thread-independent). */
@@ -361,7 +432,7 @@ rad_result rad_view_power(rad_context *ctx, const rad_solution_view *v, double *
             em += v->area[i] * v->emission[3 * i + c];
     }
     rad_free(absorbed_by);
-    *emitted = em / 3.0;
-    *absorbed = ab / 3.0;
+    *emitted = em / 3.0 + direct_absorbed;
+    *absorbed = ab / 3.0 + direct_absorbed;
     return RAD_OK;
 }

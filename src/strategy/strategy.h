@@ -130,6 +130,15 @@ typedef struct rad_elements {
 /* Fill *out for `mesh`; nothing is allocated on failure (out of memory). */
 rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
                                rad_elements *out);
+/* Where the scene has luminaires or daylight (rad_light_present): e->direct
+ * = the mean direct irradiance over each element (light.h), and its first
+ * reflection added, emission += rho x direct and radiosity = emission.
+ * Parallel over elements with the context's threads, the same values
+ * whatever their count; progress as "direct light".  Without light: RAD_OK,
+ * nothing changed.  Fails for memory (e unchanged) or when cancelled
+ * (RAD_ERROR_INTERRUPTED; e unchanged). */
+rad_result rad_elements_add_light(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
+                                  const rad_vis *vis, rad_elements *e);
 void rad_elements_free(rad_elements *e);
 
 /* Fill the view's element part from a mesh and its arrays. */
@@ -226,7 +235,10 @@ const rad_adaptive_stats *rad_adaptive_get_stats(const rad_adaptive *a);
 
 /* Power in W (means over RGB): emitted = sum A_i E_i; absorbed = sum A_i
  * (1 - rho_i) H_i from F where the view has it, else the strategy's own
- * count.  Fails only for memory (n doubles; then NAN, NAN). */
+ * count.  With direct light (view->direct), emitted counts the surfaces' own
+ * emission and the direct light landing (E_i here being the self-emitted
+ * part), absorbed the direct light absorbed at once as well.  Fails only
+ * for memory (n doubles; then NAN, NAN). */
 rad_result rad_view_power(rad_context *ctx, const rad_solution_view *view, double *emitted, double *absorbed);
 
 /* Area-weighted mean radiosity of one surface. */

@@ -1,0 +1,88 @@
+/*
+ * grid.h -- calculation grids and points (docs/lighting.md, "Calculation
+ * grids and points"): the grid file, the points it places, and the
+ * illuminance at each point computed at the point.
+ *
+ *   grid file (JSON)  ->  rad_grid_set: named grids of points (position,
+ *                         unit normal, in-plane u, v) and free points
+ *   solved view       ->  E at each point = direct (luminaires, daylight:
+ *                         light.h) + what the elements' radiosities B_j
+ *                         send it (exact point-to-polygon factors and
+ *                         visibility): the emitters' direct light and the
+ *                         interreflection
+ *
+ * EN 12464-1:2011 (4.4 and its grid rule, after ISO/CIE 8995): a grid's
+ * spacing is p = 0.2 x 5^log10(d) m (d the longer side of the calculation
+ * area, p <= 10 m), the points at the centres of cells of at most p on a
+ * side, and a border band of 0.5 m from the walls left out of room areas.
+ *
+ * Folder order: ... strategy -> thermal -> grid -> interp -> output -> api.
+ */
+#ifndef RAD_GRID_H
+#define RAD_GRID_H
+
+#include "strategy/strategy.h"
+
+/* One grid of the file, or the free points (one group, `points` true). */
+typedef struct rad_grid_def {
+    char *name;                 /* as the file gives it ("points" for the free points) */
+    size_t first_point;         /* into rad_grid_set's point arrays */
+    size_t point_count;
+    uint32_t columns, rows;     /* along u and v; 0 for free points */
+    double spacing_u, spacing_v;/* m, the cells' sides (0 for free points) */
+    double width, height;       /* m, the calculation area's sides after the border */
+    double border;              /* m */
+    bool automatic;             /* spacing by EN 12464-1 */
+    bool points;                /* the free points */
+} rad_grid_def;
+
+typedef struct rad_grid_set {
+    char *source;               /* the file's name, for messages */
+    rad_grid_def *grids;
+    size_t grid_count;
+    vec3 *position;             /* per point, m */
+    vec3 *normal;               /* per point, unit: light from behind counts zero */
+    double *u, *v;              /* per point, m: in-plane coordinates from the grid's origin
+                                   (the rectangle's origin; the footprint's lower corner) */
+    char **point_name;          /* per point: the free point's name, NULL for grid points */
+    size_t point_count;
+    int up_axis;                /* 0, 1, 2: x, y, z (default y, the generator's and glTF's) */
+} rad_grid_set;
+
+/* EN 12464-1's largest spacing for a calculation area whose longer side is
+ * d m: 0.2 x 5^log10(d), at most 10 m.  d > 0. */
+double rad_grid_en12464_spacing(double d);
+/* The number of points along a side of `length` m at spacing at most p:
+ * the smallest n >= 1 with length / n <= p. */
+uint32_t rad_grid_point_count(double length, double p);
+
+/* Parse a grid file (`name` for messages) against the scene: the set of
+ * points.  Errors are RAD_ERROR_PARSE naming the file and the entry and
+ * key ("g.json: grids[1].spacing: ..."); RAD_ERROR_OUT_OF_MEMORY.  *out
+ * is NULL on failure and nothing leaks. */
+rad_result rad_grid_parse(rad_context *ctx, const rad_scene *scene, const char *name, const char *text,
+                          size_t size, rad_grid_set **out);
+void rad_grid_set_destroy(rad_grid_set *set);
+
+/* What the gathering counted. */
+typedef struct rad_grid_gather_stats {
+    uint64_t rays;              /* shadow rays cast */
+    uint64_t exact_pairs;       /* point-element pairs whose visibility was exact (occluders.c) */
+    uint64_t ray_pairs;         /* ... estimated by shadow rays */
+    double seconds;             /* wall clock of the gathering */
+    double light_seconds;       /* thread-seconds in the direct light of luminaires and daylight
+                                   (rad_light_irradiance), summed over threads */
+    double thread_seconds;      /* thread-seconds of all the points' work, summed over threads */
+} rad_grid_gather_stats;
+
+/* Irradiance (W/m^2 RGB, 3 per point) at every point of `set` from a
+ * solved view: `direct` the luminaires' and daylight's (light.h) plus the
+ * emitters' self-emission gathered; `indirect` the rest of the elements'
+ * radiosity gathered.  Parallel over points (view->threads), the same
+ * numbers whatever the thread count (shadow rays keyed on the seed, the
+ * point and the element); progress "illuminance"; RAD_ERROR_INTERRUPTED
+ * when cancelled (outputs then incomplete).  RAD_ERROR_OUT_OF_MEMORY. */
+rad_result rad_grid_gather(rad_context *ctx, const rad_solution_view *view, const rad_grid_set *set,
+                           double *direct, double *indirect, rad_grid_gather_stats *stats);
+
+#endif /* RAD_GRID_H */
