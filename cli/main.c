@@ -32,6 +32,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -402,8 +403,22 @@ static int run_thermal(rad_context *ctx, const settings *s, const rad_scene *sce
 /* The illuminance command after the solve: the grid file's points
  * evaluated, a summary line per grid, the CSV / JSON (and stats, history)
  * put in place together.  Returns the exit status. */
+/* One of illuminance's outputs: the values (.csv, .json), or the grids'
+ * plans (.png: the path given leaves the set, each grid's picture joins
+ * it). */
+static rad_result write_illuminance_output(rad_context *ctx, const rad_illuminance *il, run_outputs *out,
+                                           const char *given, const char *temp,
+                                           const rad_false_colour_options *plots)
+{
+    const char *dot = strrchr(given, '.');
+    if (!dot || strcasecmp(dot, ".png") != 0)
+        return rad_illuminance_write(ctx, il, temp);
+    rad_output_set_drop(out->set, given);
+    return rad_illuminance_write_plots(ctx, il, plots, out->set, given);
+}
+
 static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *sol, run_outputs *out,
-                           progress_state *progress, double t0)
+                           progress_state *progress, double t0, const rad_false_colour_options *plots)
 {
     rad_illuminance *il = NULL;
     rad_result r = rad_illuminance_evaluate_file(ctx, sol, s->grid, &il);
@@ -415,9 +430,9 @@ static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *so
     if (r != RAD_OK)
         return fail(ctx, r);
     begin_saving(ctx);
-    r = rad_illuminance_write(ctx, il, out->main);
+    r = write_illuminance_output(ctx, il, out, s->output, out->main, plots);
     if (r == RAD_OK && out->second)
-        r = rad_illuminance_write(ctx, il, out->second);
+        r = write_illuminance_output(ctx, il, out, s->output2, out->second, plots);
     if (r == RAD_OK && s->stats)
         r = rad_solution_write_stats(ctx, sol, out->stats, 0);
     if (r == RAD_OK && s->history)
@@ -439,6 +454,15 @@ static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *so
     }
     rad_illuminance_stats st;
     rad_illuminance_get_stats(il, &st);
+    for (int k = 0; k < 2 && !s->quiet; k++) { /* the plans, by name */
+        const char *given = k ? s->output2 : s->output, *dot = given ? strrchr(given, '.') : NULL;
+        for (size_t g = 0; dot && strcasecmp(dot, ".png") == 0 && g < rad_illuminance_grid_count(il); g++) {
+            char name[PATH_MAX];
+            if (rad_illuminance_grid(il, g)->point_count &&
+                rad_illuminance_plot_path(il, given, g, name, sizeof name) < sizeof name)
+                printf("wrote %s\n", name);
+        }
+    }
     rad_illuminance_destroy(il);
     char full[PATH_MAX];
     if (!s->quiet)
@@ -551,7 +575,19 @@ static int stream_rank(rad_context *ctx, const settings *s, const rad_stream_ran
 static int false_colour_options(rad_context *ctx, const settings *s, rad_false_colour_options *fo)
 {
     memset(fo, 0, sizeof *fo);
-    if (!s->false_colour) {
+    if (s->command == CLI_ILLUMINANCE) {
+        /* The grids' plans: an output ending in .png. */
+        bool png = false;
+        for (int k = 0; k < 2; k++) {
+            const char *o = k ? s->output2 : s->output, *dot = o ? strrchr(o, '.') : NULL;
+            png = png || (dot && strcasecmp(dot, ".png") == 0);
+        }
+        if ((s->log_scale || s->range) && !png) {
+            fprintf(stderr, "radiosity: --%s: only for the grids' plans, an output ending in .png (see radiosity "
+                            "illuminance --help)\n", s->range ? "range" : "scale");
+            return EXIT_USAGE;
+        }
+    } else if (!s->false_colour) {
         if (s->log_scale || s->range || s->contours) {
             fprintf(stderr, "radiosity: --%s: only with --false-colour luminance|illuminance (see radiosity "
                             "render --help)\n", s->range ? "range" : s->contours ? "contours" : "scale");
@@ -559,7 +595,8 @@ static int false_colour_options(rad_context *ctx, const settings *s, rad_false_c
         }
         return -1;
     }
-    fo->quantity = (rad_false_colour_quantity)s->false_colour;
+    fo->quantity = s->command == CLI_ILLUMINANCE ? RAD_FALSE_COLOUR_ILLUMINANCE
+                                                 : (rad_false_colour_quantity)s->false_colour;
     fo->log_scale = s->log_scale;
     fo->contours = s->contours;
     if (s->range) {
@@ -585,7 +622,7 @@ static int false_colour_options(rad_context *ctx, const settings *s, rad_false_c
     snprintf(ext, sizeof ext, "%s", dot ? dot + 1 : "");
     for (char *c = ext; *c; c++)
         *c = (char)tolower((unsigned char)*c);
-    if (strcmp(ext, "png") != 0) {
+    if (s->command != CLI_ILLUMINANCE && strcmp(ext, "png") != 0) {
         fprintf(stderr, "radiosity: --false-colour writes PNG: the output must end in .png, got %s\n", s->output);
         return EXIT_USAGE;
     }
@@ -906,7 +943,7 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
             fprintf(stderr, "radiosity: interrupted while solving; no illuminance written\n");
             status = interrupted_status();
         } else {
-            status = run_illuminance(ctx, &s, sol, &out, &progress, t0);
+            status = run_illuminance(ctx, &s, sol, &out, &progress, t0, &false_colour);
         }
         goto done;
     }

@@ -130,8 +130,9 @@ static const cli_flag FLAGS[] = {
      .own.help = "with --offscreen: the frame, .png (exposed, sRGB), .hdr or .pfm (linear)",
      .own.default_text = "view.png"},
     {"output", 'o', "FILE", CLI_ILLUMINANCE, OWN(output, RAD_OPTION_STRING),
-     .own.help = "output illuminance: .csv (one row per point) or .json (per grid: Eavg, Emin, Emax, U0 and "
-                 "the points); give -o twice for both (docs/lighting.md)",
+     .own.help = "output illuminance: .csv (one row per point), .json (per grid: Eavg, Emin, Emax, U0 and "
+                 "the points) or .png (each grid's plan, FILE_GRID.png: cells coloured and labelled in lux, "
+                 "--scale, --range); give -o twice for two of them (docs/lighting.md)",
      .own.default_text = "illuminance.csv"},
     {"grid", 0, "G.json", CLI_ILLUMINANCE, OWN(grid, RAD_OPTION_STRING),
      .own.help = "the calculation grids and points: rectangles, surface footprints at a height, free points "
@@ -226,11 +227,13 @@ static const cli_flag FLAGS[] = {
      .own.help = "write a false colour PNG instead of the image: luminance (cd/m^2 of the rendered "
                  "radiance) or illuminance (lux on the surfaces seen), with a legend (docs/lighting.md "
                  "\"Pictures\")"},
-    {"scale", 0, "WHICH", CLI_RENDER, OWN(log_scale, RAD_OPTION_ENUM), .own.words = scale_words,
-     .own.default_text = "linear", .own.help = "with --false-colour: the colour scale, linear or log"},
-    {"range", 0, "MIN:MAX", CLI_RENDER, OWN(range, RAD_OPTION_STRING),
+    {"scale", 0, "WHICH", CLI_RENDER | CLI_ILLUMINANCE, OWN(log_scale, RAD_OPTION_ENUM), .own.words = scale_words,
+     .own.default_text = "linear",
+     .own.help = "with --false-colour, or illuminance's .png plans: the colour scale, linear or log"},
+    {"range", 0, "MIN:MAX", CLI_RENDER | CLI_ILLUMINANCE, OWN(range, RAD_OPTION_STRING),
      .own.default_text = "automatic: 0 (log: max/1000) to the 99th percentile rounded up to a nice number",
-     .own.help = "with --false-colour: the values at the two ends of the colour scale (cd/m^2 or lx)"},
+     .own.help = "with --false-colour, or illuminance's .png plans: the values at the two ends of the colour "
+                 "scale (cd/m^2 or lx)"},
     {"contours", 0, NULL, CLI_RENDER, OWN(contours, RAD_OPTION_FLAG),
      .own.help = "with --false-colour: black lines where the value crosses a legend tick (isolux, "
                  "isoluminance)"},

@@ -1568,6 +1568,31 @@ RAD_API rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solutio
                                                    const rad_render_options *render,
                                                    const rad_false_colour_options *options, const char *path);
 
+/* Plans of the calculation grids of `illuminance` (docs/lighting.md "Grid
+ * plots"): one PNG per grid that has points, at rad_illuminance_plot_path,
+ * each cell (a free point: a dot) coloured by its lux on the false colour
+ * map with the value printed, the grid's outline, the legend and a title
+ * with Eavg, Emin, Emax and U0.  `options` gives the scale and the range
+ * (its quantity and contours are not used; NULL: linear, automatic).  With
+ * `set` the pictures are added to it (rad_output_set_add, RAD_OUTPUT_IMAGE)
+ * and written into their temporaries, to appear at its commit; without,
+ * each is written atomically.  Fails with RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY; bad options (rad_false_colour_check), a path not
+ * ending in .png, an output the set refuses, or a NULL ctx, illuminance or
+ * path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_illuminance_write_plots(rad_context *ctx, const rad_illuminance *illuminance,
+                                               const rad_false_colour_options *options, rad_output_set *set,
+                                               const char *path);
+/* Where grid `grid`'s plan goes for `path`: STEM_NAME.png, STEM the path
+ * without its extension, NAME the grid's name with every character but
+ * letters, digits, '-', '.' and '_' made '_' (the free points: "points"),
+ * and _K (the grid's index, from 0) after it when an earlier grid gives the
+ * same NAME.  Written into `out` (`size` bytes, NUL-terminated, truncated
+ * when short); returns the length it needs (as snprintf), 0 for a grid out
+ * of range or a NULL illuminance or path.  Cannot fail otherwise. */
+RAD_API size_t rad_illuminance_plot_path(const rad_illuminance *illuminance, const char *path, size_t grid,
+                                         char *out, size_t size);
+
 #ifdef __cplusplus
 }
 #endif

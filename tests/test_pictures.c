@@ -751,6 +751,56 @@ static void test_cli_false_colour(void **state)
     stbi_image_free(p.rgb);
 }
 
+/* `radiosity illuminance ... -o plan.png`: one plan per grid, named
+ * plan_NAME.png, in the closed uniform box where every point's illuminance
+ * is 179 E / (1 - rho) lx (H = B there): every cell that colour. */
+static void test_cli_grid_plots(void **state)
+{
+    (void)state;
+    const char *scene = write_uniform_box(0.5, 1.0);
+    const char *grid = work_path("grids.json");
+    FILE *f = fopen(grid, "w");
+    assert_non_null(f);
+    fputs("{\"up\": \"y\", \"grids\": [{\"name\": \"work plane\", \"rectangle\": {\"origin\": [0.1, 0.5, 0.1], "
+          "\"u\": [0, 0, 0.8], \"v\": [0.8, 0, 0]}, \"facing\": \"up\", \"spacing\": 0.2, \"border\": 0}], "
+          "\"points\": [{\"name\": \"p\", \"position\": [0.3, 0.2, 0.4]}, {\"name\": \"q\", \"position\": [0.7, 0.6, 0.5]}]}",
+          f);
+    fclose(f);
+    const char *csv = work_path("E.csv"), *plan = work_path("plan.png");
+    int status = cli_run("illuminance %s --grid %s --solver direct --mesh-size 0.25 --range 0:500 -o %s -o %s", scene,
+                         grid, csv, plan);
+    assert_int_equal(status, 0);
+    assert_int_not_equal(access(plan, F_OK), 0); /* the name given is the stem */
+    double lux = RAD_LUMINOUS_EFFICACY * 1.0 / (1.0 - 0.5);
+    rad_colour_map map;
+    rad_colour_map_make(&map);
+    rad_colour_scale scale = {false, 0.0, 500.0};
+    int want = rad_scale_level(&scale, lux);
+    const char *names[2] = {"plan_work_plane.png", "plan_points.png"};
+    for (int k = 0; k < 2; k++) {
+        picture p = read_png(work_path(names[k]));
+        /* The map's colour of the closed form, within a level (the
+         * gathering's error, 1e-5, is far below one). */
+        int found = 0;
+        for (int y = 0; y < p.height; y++)
+            for (int x = 0; x < p.width * 3 / 4; x++) { /* left of the legend */
+                int level = level_of(&map, pixel_at(&p, x, y));
+                found += level >= 0 && abs(level - want) <= 1;
+            }
+        assert_true(found > (k == 0 ? 10000 : 20)); /* the cells (16 of them) or the two dots */
+        stbi_image_free(p.rgb);
+    }
+    /* --scale and --range are for .png outputs only, and checked first. */
+    const char *errors = work_path("plots.err");
+    assert_int_equal(cli_run_capture(errors, "illuminance %s --grid %s --range 0:500 -o %s", scene, grid, csv), 2);
+    assert_int_equal(cli_run_capture(errors, "illuminance %s --grid %s --scale log --range 0:5 -o %s", scene, grid,
+                                     plan),
+                     2);
+    char *text = cli_read_text(errors);
+    assert_non_null(strstr(text, "log scale needs range min > 0"));
+    free(text);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -780,6 +830,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_atomic),
         cmocka_unit_test(test_cli_false_colour),
+        cmocka_unit_test(test_cli_grid_plots),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

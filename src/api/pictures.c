@@ -10,6 +10,9 @@
  *                the vertices, rendered with the coverage in a second
  *                channel: one render gives both
  *
+ * The plans of the calculation grids (rad_illuminance_write_plots): one
+ * PNG per grid through output/plot.c, named STEM_NAME.png.
+ *
  * A pixel is the background when fewer than half of its rays met the
  * front of a surface; else its value is the mean over those that did (the
  * pixel's sum over its coverage), so edges keep the surface's value.
@@ -18,7 +21,10 @@
 #include "output/picture.h"
 #include "scene/photometry.h"
 
+#include <ctype.h>
+#include <limits.h>
 #include <stdlib.h>
+#include <string.h>
 
 rad_result rad_false_colour_check(rad_context *ctx, const rad_false_colour_options *o)
 {
@@ -154,5 +160,110 @@ rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *s, co
     rad_free(values);
     rad_image_destroy(radiance);
     rad_image_destroy(coverage);
+    return r;
+}
+
+/* ---- plans of the calculation grids (rad_illuminance_write_plots) ---- */
+
+/* The grid's name as it goes into a file name: letters, digits, '-', '.'
+ * and '_' kept, anything else '_' (empty: "grid"). */
+static void file_name_part(const char *name, char *out, size_t size)
+{
+    size_t n = 0;
+    for (const char *c = name ? name : ""; *c && n + 1 < size; c++)
+        out[n++] = (isalnum((unsigned char)*c) || *c == '-' || *c == '.' || *c == '_') ? *c : '_';
+    out[n] = '\0';
+    if (n == 0)
+        snprintf(out, size, "grid");
+}
+
+size_t rad_illuminance_plot_path(const rad_illuminance *illuminance, const char *path, size_t grid, char *out,
+                                 size_t size)
+{
+    if (size)
+        out[0] = '\0';
+    const rad_grid_result *g = rad_illuminance_grid(illuminance, grid);
+    if (!g || !path)
+        return 0;
+    size_t stem = strlen(path);
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    if (dot && (!slash || dot > slash))
+        stem = (size_t)(dot - path);
+    char name[256], earlier[256];
+    file_name_part(g->name, name, sizeof name);
+    /* A name an earlier grid's already gives: its index added. */
+    bool taken = false;
+    for (size_t k = 0; k < grid && !taken; k++) {
+        file_name_part(rad_illuminance_grid(illuminance, k)->name, earlier, sizeof earlier);
+        taken = strcmp(earlier, name) == 0;
+    }
+    int n = taken ? snprintf(out, size, "%.*s_%s_%zu.png", (int)stem, path, name, grid)
+                  : snprintf(out, size, "%.*s_%s.png", (int)stem, path, name);
+    return n < 0 ? 0 : (size_t)n;
+}
+
+/* Grid g's points as a plot: grid points at their (u, v), free points
+ * projected along their mean normal (the plan seen from the side it
+ * faces). */
+static rad_result plot_one(rad_context *ctx, const rad_grid_result *g, const rad_plot_options *po, const char *path)
+{
+    size_t n = g->point_count;
+    double *uvw = rad_alloc(ctx, RAD_MEM_OUTPUT, n ? n : 1, 3 * sizeof *uvw, "grid plot: points");
+    if (!uvw)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    double *u = uvw, *v = uvw + n, *value = uvw + 2 * n;
+    double mean[3] = {0.0, 0.0, 0.0};
+    for (size_t k = 0; k < n; k++)
+        for (int c = 0; c < 3; c++)
+            mean[c] += g->points[k].normal[c];
+    int axis = fabs(mean[0]) >= fabs(mean[1]) && fabs(mean[0]) >= fabs(mean[2]) ? 0 : fabs(mean[1]) >= fabs(mean[2]) ? 1 : 2;
+    int b = (axis + 1) % 3, c = (axis + 2) % 3; /* b x c = the axis: seen from the normal's side */
+    double flip = mean[axis] < 0.0 ? -1.0 : 1.0;
+    for (size_t k = 0; k < n; k++) {
+        const rad_grid_point_value *p = &g->points[k];
+        u[k] = g->free_points ? flip * p->position[b] : p->u;
+        v[k] = g->free_points ? p->position[c] : p->v;
+        value[k] = p->illuminance;
+    }
+    rad_plot_grid plot = {g->name, n, u, v, value, "lx", g->free_points ? 0 : g->columns,
+                          g->free_points ? 0 : g->rows, g->free_points ? 0.0 : g->spacing_u,
+                          g->free_points ? 0.0 : g->spacing_v};
+    rad_result r = rad_plot_grid_write(ctx, &plot, po, path);
+    rad_free(uvw);
+    return r;
+}
+
+rad_result rad_illuminance_write_plots(rad_context *ctx, const rad_illuminance *illuminance,
+                                       const rad_false_colour_options *options, rad_output_set *set, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !illuminance || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_result r = rad_false_colour_check(ctx, options);
+    if (r != RAD_OK)
+        return r;
+    char ext[8];
+    rad_path_extension(path, ext, sizeof ext);
+    if (strcmp(ext, "png") != 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: grid plots are PNG: the path must end in .png", path);
+    rad_plot_options po = {0};
+    if (options) {
+        po.log_scale = options->log_scale;
+        po.range_min = options->range_min;
+        po.range_max = options->range_max;
+    }
+    for (size_t g = 0; g < rad_illuminance_grid_count(illuminance) && r == RAD_OK; g++) {
+        const rad_grid_result *grid = rad_illuminance_grid(illuminance, g);
+        if (grid->point_count == 0)
+            continue; /* nothing to draw */
+        char name[PATH_MAX];
+        if (rad_illuminance_plot_path(illuminance, path, g, name, sizeof name) >= sizeof name)
+            return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: the plot's path is too long", path);
+        const char *target = name;
+        if (set)
+            r = rad_output_set_add(ctx, set, name, RAD_OUTPUT_IMAGE, &target);
+        if (r == RAD_OK)
+            r = plot_one(ctx, grid, &po, target);
+    }
     return r;
 }

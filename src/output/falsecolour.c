@@ -228,20 +228,29 @@ void rad_format_value(double value, char *text, size_t size)
 
 /* ---- the legend ---- */
 
+double rad_legend_font(int height)
+{
+    return fmin(fmax(height / 30.0, 10.0), 28.0);
+}
+
 int rad_legend_width(int height)
 {
-    double font = fmin(fmax(height / 30.0, 10.0), 28.0);
-    return (int)lround(6.5 * font);
+    return (int)lround(6.5 * rad_legend_font(height));
 }
 
 void rad_legend_layout_make(const rad_colour_scale *scale, int picture_width, int height,
                             rad_legend_layout *layout)
 {
+    rad_legend_layout_make_font(scale, picture_width, height, rad_legend_font(height), layout);
+}
+
+void rad_legend_layout_make_font(const rad_colour_scale *scale, int picture_width, int height, double font,
+                                 rad_legend_layout *layout)
+{
     memset(layout, 0, sizeof *layout);
-    double font = fmin(fmax(height / 30.0, 10.0), 28.0);
     layout->font_size = font;
     layout->x = picture_width;
-    layout->width = rad_legend_width(height);
+    layout->width = (int)lround(6.5 * font);
     layout->bar_x = picture_width + (int)lround(0.8 * font);
     layout->bar_width = (int)lround(1.4 * font);
     layout->bar_top = (int)lround(2.6 * font);

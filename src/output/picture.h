@@ -88,7 +88,11 @@ typedef struct rad_legend_layout {
 
 void rad_legend_layout_make(const rad_colour_scale *scale, int picture_width, int height,
                             rad_legend_layout *layout);
-/* The legend's width for a canvas of `height` (px). */
+/* The same with the text size given (px) instead of taken from the height. */
+void rad_legend_layout_make_font(const rad_colour_scale *scale, int picture_width, int height, double font,
+                                 rad_legend_layout *layout);
+/* The legend's text size (px) and width for a canvas of `height` (px). */
+double rad_legend_font(int height);
 int rad_legend_width(int height);
 /* The colour level of bar row y (bar_top <= y < bar_bottom). */
 int rad_legend_row_level(const rad_legend_layout *layout, int y);

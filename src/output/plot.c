@@ -182,7 +182,7 @@ rad_result rad_plot_layout_make(rad_context *ctx, const rad_plot_grid *grid, con
     int width = o.width ? o.width : 900;
     double title_font = fmin(fmax(width / 60.0, 10.0), 24.0);
     double margin = 1.5 * title_font, title_band = 2.4 * title_font;
-    int legend_width = rad_legend_width(1 << 20); /* the widest legend, whatever the height */
+    int legend_width = (int)lround(6.5 * title_font); /* the legend's text as large as the title's */
     double plan_w = width - legend_width - 2.0 * margin;
     double ppm = plan_w / layout->metres_w;
     if (layout->metres_h * ppm > 1.5 * plan_w) /* a tall grid: no taller than 1.5 x its width */
@@ -211,11 +211,11 @@ rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, cons
     if (r != RAD_OK)
         return r;
     bool regular = grid->nu > 0;
-    int legend_width = rad_legend_width(lay.height);
+    int legend_width = (int)lround(6.5 * lay.title_font);
     rad_colour_map map;
     rad_colour_map_make(&map);
     rad_legend_layout legend;
-    rad_legend_layout_make(&lay.scale, lay.width - legend_width, lay.height, &legend);
+    rad_legend_layout_make_font(&lay.scale, lay.width - legend_width, lay.height, lay.title_font, &legend);
 
     cairo_surface_t *surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, lay.width, lay.height);
     cairo_t *cr = cairo_create(surface);
