@@ -465,10 +465,18 @@ static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *so
     }
     rad_illuminance_destroy(il);
     char full[PATH_MAX];
+    /* The value files by name (the plans were named above). */
+    const char *files[2] = {NULL, NULL};
+    int nfiles = 0;
+    for (int k = 0; k < 2; k++) {
+        const char *given = k ? s->output2 : s->output, *dot = given ? strrchr(given, '.') : NULL;
+        if (given && !(dot && strcasecmp(dot, ".png") == 0))
+            files[nfiles++] = k ? given : where(given, full);
+    }
     if (!s->quiet)
-        printf("wrote %s%s%s (%zu points in %.2f s, %.0f points/s; %zu elements, %.1f s)\n", where(s->output, full),
-               s->output2 ? " and " : "", s->output2 ? s->output2 : "", st.points, st.seconds, st.points_per_second,
-               rad_solution_element_count(sol), now_seconds() - t0);
+        printf("wrote %s%s%s (%zu points in %.2f s, %.0f points/s; %zu elements, %.1f s)\n",
+               nfiles ? files[0] : "the plans", nfiles > 1 ? " and " : "", nfiles > 1 ? files[1] : "", st.points,
+               st.seconds, st.points_per_second, rad_solution_element_count(sol), now_seconds() - t0);
     return cancel_signal ? interrupted_status() : 0;
 }
 

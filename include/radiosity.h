@@ -1576,7 +1576,8 @@ RAD_API rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solutio
  * (its quantity and contours are not used; NULL: linear, automatic).  With
  * `set` the pictures are added to it (rad_output_set_add, RAD_OUTPUT_IMAGE)
  * and written into their temporaries, to appear at its commit; without,
- * each is written atomically.  Fails with RAD_ERROR_IO,
+ * each is written atomically as it is drawn (those drawn before a failure
+ * stay).  Fails with RAD_ERROR_IO,
  * RAD_ERROR_OUT_OF_MEMORY; bad options (rad_false_colour_check), a path not
  * ending in .png, an output the set refuses, or a NULL ctx, illuminance or
  * path: RAD_ERROR_INVALID_ARGUMENT. */

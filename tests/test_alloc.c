@@ -263,6 +263,23 @@ static rad_result run_illuminance(rad_context *ctx, const rad_solution *s, outpu
         output_path("illuminance.json", path, sizeof path);
         r = write_done(rad_illuminance_write(ctx, il, path), out, "illuminance.json");
     }
+    /* The grids' plans (api/pictures.c), through an output set: all three
+     * or none. */
+    rad_output_set *set = NULL;
+    if (r == RAD_OK)
+        r = rad_output_set_create(ctx, &set);
+    if (r == RAD_OK) {
+        output_path("plan.png", path, sizeof path);
+        r = rad_illuminance_write_plots(ctx, il, NULL, set, path);
+    }
+    if (r == RAD_OK)
+        r = rad_output_set_commit(ctx, set);
+    if (r == RAD_OK) {
+        write_done(r, out, "plan_f.png");
+        write_done(r, out, "plan_r.png");
+        write_done(r, out, "plan_points.png");
+    }
+    rad_output_set_destroy(set);
     rad_illuminance_destroy(il);
     return r;
 }
