@@ -24,6 +24,7 @@
 #include "viewer.h"
 #endif
 
+#include <ctype.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -31,6 +32,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -401,8 +403,22 @@ static int run_thermal(rad_context *ctx, const settings *s, const rad_scene *sce
 /* The illuminance command after the solve: the grid file's points
  * evaluated, a summary line per grid, the CSV / JSON (and stats, history)
  * put in place together.  Returns the exit status. */
+/* One of illuminance's outputs: the values (.csv, .json), or the grids'
+ * plans (.png: the path given leaves the set, each grid's picture joins
+ * it). */
+static rad_result write_illuminance_output(rad_context *ctx, const rad_illuminance *il, run_outputs *out,
+                                           const char *given, const char *temp,
+                                           const rad_false_colour_options *plots)
+{
+    const char *dot = strrchr(given, '.');
+    if (!dot || strcasecmp(dot, ".png") != 0)
+        return rad_illuminance_write(ctx, il, temp);
+    rad_output_set_drop(out->set, given);
+    return rad_illuminance_write_plots(ctx, il, plots, out->set, given);
+}
+
 static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *sol, run_outputs *out,
-                           progress_state *progress, double t0)
+                           progress_state *progress, double t0, const rad_false_colour_options *plots)
 {
     rad_illuminance *il = NULL;
     rad_result r = rad_illuminance_evaluate_file(ctx, sol, s->grid, &il);
@@ -414,9 +430,9 @@ static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *so
     if (r != RAD_OK)
         return fail(ctx, r);
     begin_saving(ctx);
-    r = rad_illuminance_write(ctx, il, out->main);
+    r = write_illuminance_output(ctx, il, out, s->output, out->main, plots);
     if (r == RAD_OK && out->second)
-        r = rad_illuminance_write(ctx, il, out->second);
+        r = write_illuminance_output(ctx, il, out, s->output2, out->second, plots);
     if (r == RAD_OK && s->stats)
         r = rad_solution_write_stats(ctx, sol, out->stats, 0);
     if (r == RAD_OK && s->history)
@@ -438,12 +454,29 @@ static int run_illuminance(rad_context *ctx, const settings *s, rad_solution *so
     }
     rad_illuminance_stats st;
     rad_illuminance_get_stats(il, &st);
+    for (int k = 0; k < 2 && !s->quiet; k++) { /* the plans, by name */
+        const char *given = k ? s->output2 : s->output, *dot = given ? strrchr(given, '.') : NULL;
+        for (size_t g = 0; dot && strcasecmp(dot, ".png") == 0 && g < rad_illuminance_grid_count(il); g++) {
+            char name[PATH_MAX];
+            if (rad_illuminance_grid(il, g)->point_count &&
+                rad_illuminance_plot_path(il, given, g, name, sizeof name) < sizeof name)
+                printf("wrote %s\n", name);
+        }
+    }
     rad_illuminance_destroy(il);
     char full[PATH_MAX];
+    /* The value files by name (the plans were named above). */
+    const char *files[2] = {NULL, NULL};
+    int nfiles = 0;
+    for (int k = 0; k < 2; k++) {
+        const char *given = k ? s->output2 : s->output, *dot = given ? strrchr(given, '.') : NULL;
+        if (given && !(dot && strcasecmp(dot, ".png") == 0))
+            files[nfiles++] = k ? given : where(given, full);
+    }
     if (!s->quiet)
-        printf("wrote %s%s%s (%zu points in %.2f s, %.0f points/s; %zu elements, %.1f s)\n", where(s->output, full),
-               s->output2 ? " and " : "", s->output2 ? s->output2 : "", st.points, st.seconds, st.points_per_second,
-               rad_solution_element_count(sol), now_seconds() - t0);
+        printf("wrote %s%s%s (%zu points in %.2f s, %.0f points/s; %zu elements, %.1f s)\n",
+               nfiles ? files[0] : "the plans", nfiles > 1 ? " and " : "", nfiles > 1 ? files[1] : "", st.points,
+               st.seconds, st.points_per_second, rad_solution_element_count(sol), now_seconds() - t0);
     return cancel_signal ? interrupted_status() : 0;
 }
 
@@ -599,6 +632,58 @@ static int run_photometry(rad_context *ctx, const settings *s)
 }
 
 
+/* The false colour options of render's flags (--false-colour, --scale,
+ * --range, --contours), checked by the library before any work; returns
+ * -1 when good, else the exit status (the message printed). */
+static int false_colour_options(rad_context *ctx, const settings *s, rad_false_colour_options *fo)
+    memset(fo, 0, sizeof *fo);
+    if (s->command == CLI_ILLUMINANCE) {
+        /* The grids' plans: an output ending in .png. */
+        bool png = false;
+        for (int k = 0; k < 2; k++) {
+            const char *o = k ? s->output2 : s->output, *dot = o ? strrchr(o, '.') : NULL;
+            png = png || (dot && strcasecmp(dot, ".png") == 0);
+        if ((s->log_scale || s->range) && !png) {
+            fprintf(stderr, "radiosity: --%s: only for the grids' plans, an output ending in .png (see radiosity "
+                            "illuminance --help)\n", s->range ? "range" : "scale");
+            return EXIT_USAGE;
+    } else if (!s->false_colour) {
+        if (s->log_scale || s->range || s->contours) {
+            fprintf(stderr, "radiosity: --%s: only with --false-colour luminance|illuminance (see radiosity "
+                            "render --help)\n", s->range ? "range" : s->contours ? "contours" : "scale");
+            return EXIT_USAGE;
+        return -1;
+    fo->quantity = s->command == CLI_ILLUMINANCE ? RAD_FALSE_COLOUR_ILLUMINANCE
+                                                 : (rad_false_colour_quantity)s->false_colour;
+    fo->log_scale = s->log_scale;
+    fo->contours = s->contours;
+    if (s->range) {
+        char *end = NULL;
+        fo->range_min = strtod(s->range, &end);
+        bool good = end != s->range && *end == ':';
+        if (good) {
+            const char *max = end + 1;
+            fo->range_max = strtod(max, &end);
+            good = end != max && *end == '\0';
+        if (!good) {
+            fprintf(stderr, "radiosity: --range: expected MIN:MAX (two numbers), got '%s'\n", s->range);
+            return EXIT_USAGE;
+        if (fo->range_min == 0.0 && fo->range_max == 0.0) {
+            fprintf(stderr, "radiosity: --range: 0:0 is empty; leave --range out for the automatic range\n");
+            return EXIT_USAGE;
+    char ext[8];
+    const char *dot = strrchr(s->output, '.');
+    snprintf(ext, sizeof ext, "%s", dot ? dot + 1 : "");
+    for (char *c = ext; *c; c++)
+        *c = (char)tolower((unsigned char)*c);
+    if (s->command != CLI_ILLUMINANCE && strcmp(ext, "png") != 0) {
+        fprintf(stderr, "radiosity: --false-colour writes PNG: the output must end in .png, got %s\n", s->output);
+        return EXIT_USAGE;
+    if (rad_false_colour_check(ctx, fo) != RAD_OK) {
+        fprintf(stderr, "radiosity: --%s\n", rad_context_error(ctx));
+        return EXIT_USAGE;
+    return -1;
+
 static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 {
     /* Every command's flags come from the one table in options.c;
@@ -690,6 +775,10 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 
     /* 0. every output path checked before any work */
     status = plan_outputs(ctx, &s, &out);
+    if (status >= 0)
+        goto done;
+    rad_false_colour_options false_colour;
+    status = false_colour_options(ctx, &s, &false_colour);
     if (status >= 0)
         goto done;
     status = 1;
@@ -911,7 +1000,7 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
             fprintf(stderr, "radiosity: interrupted while solving; no illuminance written\n");
             status = interrupted_status();
         } else {
-            status = run_illuminance(ctx, &s, sol, &out, &progress, t0);
+            status = run_illuminance(ctx, &s, sol, &out, &progress, t0, &false_colour);
         }
         goto done;
     }
@@ -927,6 +1016,9 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
         rad_bake_options bo = {s.texels_per_metre, s.atlas_size, (rad_lightmap_quantity)s.lightmap_quantity,
                                s.render.exposure};
         r = rad_solution_bake(ctx, sol, &bo, out.set, output, &baked);
+    } else if (s.false_colour) {
+        r = rad_solution_write_false_colour(ctx, sol, &s.render, &false_colour, out.main);
+        progress_end(&progress);
     } else {
         r = rad_solution_render(ctx, sol, &s.render, &image);
         progress_end(&progress);
@@ -967,7 +1059,9 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
                    now_seconds() - t0, partial ? " [partial]" : "");
         else
             printf("wrote %s (%dx%d, %zu elements, %s, %.1f s)%s\n", where(output, full),
-                   rad_image_width(image), rad_image_height(image), rad_solution_element_count(sol),
+                   image ? rad_image_width(image) : s.render.width ? s.render.width : 512,
+                   image ? rad_image_height(image) : s.render.height ? s.render.height : 512,
+                   rad_solution_element_count(sol),
                    measure, now_seconds() - t0, partial ? " [partial]" : "");
         size_t lights = rad_scene_luminaire_count(scene);
         if (lights > 0) {

@@ -97,6 +97,11 @@ static const rad_option_word lightmap_words[] = {{"radiosity", RAD_LIGHTMAP_RADI
                                                  {"irradiance", RAD_LIGHTMAP_IRRADIANCE},
                                                  {NULL, 0}};
 
+static const rad_option_word false_colour_words[] = {{"luminance", RAD_FALSE_COLOUR_LUMINANCE},
+                                                     {"illuminance", RAD_FALSE_COLOUR_ILLUMINANCE},
+                                                     {NULL, 0}};
+static const rad_option_word scale_words[] = {{"linear", 0}, {"log", 1}, {NULL, 0}};
+
 static const rad_option_word missing_texture_words[] = {{"error", 0}, {"flat", 1}, {NULL, 0}};
 
 static const cli_flag FLAGS[] = {
@@ -132,8 +137,9 @@ static const cli_flag FLAGS[] = {
      .own.help = "with --offscreen: the frame, .png (exposed, sRGB), .hdr or .pfm (linear)",
      .own.default_text = "view.png"},
     {"output", 'o', "FILE", CLI_ILLUMINANCE, OWN(output, RAD_OPTION_STRING),
-     .own.help = "output illuminance: .csv (one row per point) or .json (per grid: Eavg, Emin, Emax, U0 and "
-                 "the points); give -o twice for both (docs/lighting.md)",
+     .own.help = "output illuminance: .csv (one row per point), .json (per grid: Eavg, Emin, Emax, U0 and "
+                 "the points) or .png (each grid's plan, FILE_GRID.png: cells coloured and labelled in lux, "
+                 "--scale, --range); give -o twice for two of them (docs/lighting.md)",
      .own.default_text = "illuminance.csv"},
     {"grid", 0, "G.json", CLI_ILLUMINANCE, OWN(grid, RAD_OPTION_STRING),
      .own.help = "the calculation grids and points: rectangles, surface footprints at a height, free points "
@@ -224,6 +230,20 @@ static const cli_flag FLAGS[] = {
     {"flat", 0, NULL, CLI_RENDER | CLI_VIEW, RENDER(shading), .word = "flat",
      .help = "flat shading: one colour per element"},
     {"vpl", 0, "N", CLI_RENDER, RENDER(vpl_paths)},
+    {"false-colour", 0, "WHAT", CLI_RENDER, OWN(false_colour, RAD_OPTION_ENUM), .own.words = false_colour_words,
+     .own.help = "write a false colour PNG instead of the image: luminance (cd/m^2 of the rendered "
+                 "radiance) or illuminance (lux on the surfaces seen), with a legend (docs/lighting.md "
+                 "\"Pictures\")"},
+    {"scale", 0, "WHICH", CLI_RENDER | CLI_ILLUMINANCE, OWN(log_scale, RAD_OPTION_ENUM), .own.words = scale_words,
+     .own.default_text = "linear",
+     .own.help = "with --false-colour, or illuminance's .png plans: the colour scale, linear or log"},
+    {"range", 0, "MIN:MAX", CLI_RENDER | CLI_ILLUMINANCE, OWN(range, RAD_OPTION_STRING),
+     .own.default_text = "automatic: 0 (log: max/1000) to the 99th percentile rounded up to a nice number",
+     .own.help = "with --false-colour, or illuminance's .png plans: the values at the two ends of the colour "
+                 "scale (cd/m^2 or lx)"},
+    {"contours", 0, NULL, CLI_RENDER, OWN(contours, RAD_OPTION_FLAG),
+     .own.help = "with --false-colour: black lines where the value crosses a legend tick (isolux, "
+                 "isoluminance)"},
     {"specular-depth", 0, "N", CLI_RENDER, RENDER(specular_depth)},
     {"glossy-samples", 0, "N", CLI_RENDER, RENDER(glossy_samples)},
     {"seed", 0, "S", RV, SOLVE(seed)},

@@ -76,6 +76,10 @@ typedef struct cli_settings {
     size_t photometry_file_count;
     const char *daylight;     /* --daylight: the daylight file (sky, sun, openings), or NULL */
     const char *luminaires;   /* render, export, solve, bake, view, illuminance: a layout file (docs/lighting.md) */
+    int false_colour;         /* render: 0 none, else rad_false_colour_quantity (--false-colour) */
+    int log_scale;            /* render --scale: 0 linear, 1 log */
+    const char *range;        /* render --range MIN:MAX, NULL = automatic */
+    int contours;             /* render --contours: isolines at the legend's ticks */
     const char *grid;         /* illuminance: the grid file (--grid) */
     const char *output2;      /* illuminance: a second -o (CSV and JSON both), or NULL */
 } cli_settings;

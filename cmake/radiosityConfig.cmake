@@ -2,7 +2,7 @@
 #
 #   radiosity::radiosity         the shared library; needs nothing else
 #   radiosity::radiosity_static  the static library; its dependencies (Embree 3,
-#                                OpenMP, assimp, cJSON; LAPACKE and OpenBLAS are
+#                                OpenMP, assimp, cJSON, cairo; LAPACKE and OpenBLAS are
 #                                opened at run time by the direct solver) are
 #                                found here, so their development files must be
 #                                installed (on Debian: scripts/setup.sh's list)
@@ -10,7 +10,7 @@ include(CMakeFindDependencyMacro)
 find_dependency(embree 3)
 find_dependency(OpenMP COMPONENTS C)
 find_dependency(PkgConfig)
-foreach(rad_dependency ASSIMP=assimp CJSON=libcjson)
+foreach(rad_dependency ASSIMP=assimp CJSON=libcjson CAIRO=cairo)
   string(REPLACE "=" ";" rad_dependency "${rad_dependency}")
   list(GET rad_dependency 0 rad_prefix)
   list(GET rad_dependency 1 rad_module)

@@ -1571,6 +1571,73 @@ RAD_API bool rad_scene_luminaire_placement(const rad_scene *scene, size_t index,
  * solution. */
 RAD_API double rad_solution_direct_lumens(const rad_solution *solution);
 
+/* ------------------------------------------------------------------------
+ * Pictures people read (issue #16; docs/lighting.md "Pictures"): false
+ * colour images of luminance or illuminance with a legend.
+ * ---------------------------------------------------------------------- */
+
+typedef enum rad_false_colour_quantity {
+    RAD_FALSE_COLOUR_LUMINANCE = 1,   /* cd/m^2 = 179 Y(L) of the rendered radiance */
+    RAD_FALSE_COLOUR_ILLUMINANCE = 2  /* lux = 179 Y(H) on the surfaces seen */
+} rad_false_colour_quantity;
+
+typedef struct rad_false_colour_options {
+    rad_false_colour_quantity quantity; /* 0 = luminance */
+    int log_scale;                /* nonzero: logarithmic, else linear */
+    /* The range, in the quantity's unit; both 0 = automatic (the 99th
+     * percentile of the pixels' values rounded up to a nice number; linear
+     * from 0, log over three decades).  Else min < max, and min > 0 on a
+     * log scale.  Values outside take the end colours. */
+    double range_min, range_max;
+    int contours;                 /* nonzero: lines where the value crosses a legend tick */
+} rad_false_colour_options;
+
+/* Refuse bad options before any work: RAD_ERROR_INVALID_ARGUMENT with a
+ * message naming the field ("false colour: range min 5 must be below max
+ * 2").  NULL options: RAD_OK (the defaults). */
+RAD_API rad_result rad_false_colour_check(rad_context *ctx, const rad_false_colour_options *options);
+
+/* Render the solution with `render` (as rad_solution_render; the camera,
+ * size and shading) and write its false colour picture as a PNG at `path`
+ * (atomically, as rad_image_write): the image coloured by the quantity,
+ * the background (what no ray hits) white, and a legend bar at the right
+ * with tick values and the unit.  Illuminance is each element's
+ * irradiance, (B - E) / rho plus the direct light (gathered from the
+ * others where rho is 0), interpolated to the vertices as smooth shading
+ * does.  The solution is modified as by rad_solution_render.  Fails as
+ * rad_solution_render and rad_image_write, and with
+ * RAD_ERROR_INVALID_ARGUMENT for bad options (rad_false_colour_check) or
+ * a NULL ctx, solution or path. */
+RAD_API rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *solution,
+                                                   const rad_render_options *render,
+                                                   const rad_false_colour_options *options, const char *path);
+
+/* Plans of the calculation grids of `illuminance` (docs/lighting.md "Grid
+ * plots"): one PNG per grid that has points, at rad_illuminance_plot_path,
+ * each cell (a free point: a dot) coloured by its lux on the false colour
+ * map with the value printed, the grid's outline, the legend and a title
+ * with Eavg, Emin, Emax and U0.  `options` gives the scale and the range
+ * (its quantity and contours are not used; NULL: linear, automatic).  With
+ * `set` the pictures are added to it (rad_output_set_add, RAD_OUTPUT_IMAGE)
+ * and written into their temporaries, to appear at its commit; without,
+ * each is written atomically as it is drawn (those drawn before a failure
+ * stay).  Fails with RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY; bad options (rad_false_colour_check), a path not
+ * ending in .png, an output the set refuses, or a NULL ctx, illuminance or
+ * path: RAD_ERROR_INVALID_ARGUMENT. */
+RAD_API rad_result rad_illuminance_write_plots(rad_context *ctx, const rad_illuminance *illuminance,
+                                               const rad_false_colour_options *options, rad_output_set *set,
+                                               const char *path);
+/* Where grid `grid`'s plan goes for `path`: STEM_NAME.png, STEM the path
+ * without its extension, NAME the grid's name with every character but
+ * letters, digits, '-', '.' and '_' made '_' (the free points: "points"),
+ * and _K (the grid's index, from 0) after it when an earlier grid gives the
+ * same NAME.  Written into `out` (`size` bytes, NUL-terminated, truncated
+ * when short); returns the length it needs (as snprintf), 0 for a grid out
+ * of range or a NULL illuminance or path.  Cannot fail otherwise. */
+RAD_API size_t rad_illuminance_plot_path(const rad_illuminance *illuminance, const char *path, size_t grid,
+                                         char *out, size_t size);
+
 #ifdef __cplusplus
 }
 #endif

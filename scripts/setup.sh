@@ -16,6 +16,7 @@ cd "$(dirname "$0")/.."
 
 packages=(build-essential g++ cmake pkg-config libembree-dev libassimp-dev libstb-dev
           libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev
+          libcairo2-dev fonts-dejavu-core  # false colour and plots: cairo, and a font for its text
           libopenmpi-dev openmpi-bin
           libsdl2-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri)  # the last five: the viewer
 if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then

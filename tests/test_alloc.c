@@ -265,6 +265,23 @@ static rad_result run_illuminance(rad_context *ctx, const rad_solution *s, outpu
         output_path("illuminance.json", path, sizeof path);
         r = write_done(rad_illuminance_write(ctx, il, path), out, "illuminance.json");
     }
+    /* The grids' plans (api/pictures.c), through an output set: all three
+     * or none. */
+    rad_output_set *set = NULL;
+    if (r == RAD_OK)
+        r = rad_output_set_create(ctx, &set);
+    if (r == RAD_OK) {
+        output_path("plan.png", path, sizeof path);
+        r = rad_illuminance_write_plots(ctx, il, NULL, set, path);
+    }
+    if (r == RAD_OK)
+        r = rad_output_set_commit(ctx, set);
+    if (r == RAD_OK) {
+        write_done(r, out, "plan_f.png");
+        write_done(r, out, "plan_r.png");
+        write_done(r, out, "plan_points.png");
+    }
+    rad_output_set_destroy(set);
     rad_illuminance_destroy(il);
     return r;
 }
@@ -320,6 +337,16 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     if (r == RAD_OK) {
         output_path("image.pfm", path, sizeof path);
         r = write_done(rad_image_write(ctx, image, path), out, "image.pfm");
+    }
+    /* False colour pictures (api/pictures.c): a render, the coverage, the
+     * range, cairo's PNG through an atomic file. */
+    for (int q = RAD_FALSE_COLOUR_LUMINANCE; q <= RAD_FALSE_COLOUR_ILLUMINANCE && r == RAD_OK; q++) {
+        rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0};
+        rad_false_colour_options fo = {(rad_false_colour_quantity)q, q == RAD_FALSE_COLOUR_ILLUMINANCE, 0, 0, 1};
+        const char *name = q == RAD_FALSE_COLOUR_LUMINANCE ? "luminance.png" : "illuminance.png";
+        output_path(name, path, sizeof path);
+        r = write_done(rad_solution_write_false_colour(ctx, s, &ro, &fo, path), out, name);
     }
     if (r == RAD_OK) {
         output_path("stats.json", path, sizeof path);

@@ -142,9 +142,10 @@ static rad_result check_format(rad_context *ctx, const char *path, rad_output_ki
     if (kind == RAD_OUTPUT_THERMAL && strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown heat-exchange format (use .csv or .json)",
                         path);
-    if (kind == RAD_OUTPUT_ILLUMINANCE && strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown illuminance format (use .csv or .json)",
-                        path);
+    if (kind == RAD_OUTPUT_ILLUMINANCE && strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0 &&
+        strcmp(ext, "png") != 0)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "%s: unknown illuminance format (use .csv, .json, or .png for the grids' plans)", path);
     if (kind != RAD_OUTPUT_FILE && kind != RAD_OUTPUT_IMAGE && kind != RAD_OUTPUT_VIEW_FACTORS &&
         kind != RAD_OUTPUT_SOLUTION && kind != RAD_OUTPUT_MESH && kind != RAD_OUTPUT_BAKE &&
         kind != RAD_OUTPUT_THERMAL && kind != RAD_OUTPUT_ILLUMINANCE)

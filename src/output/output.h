@@ -284,4 +284,61 @@ rad_result rad_write_illuminance(rad_context *ctx, const rad_grid_result *grids,
 rad_result rad_write_thermal_stats(rad_context *ctx, const rad_solution_view *view, const rad_thermal *thermal,
                                    const char *path);
 
+/* ---- pictures people read (falsecolour.c, plot.c; docs/lighting.md
+ * "Pictures"); the colour map, scale and legend: picture.h ---- */
+
+struct rad_colour_scale;
+
+/* Each element's illuminance in lux (n), 179 Y(H) with H = (B - E) / rho
+ * + direct per channel, a black channel gathered from the others
+ * (falsecolour.c says how).  Parallel; RAD_ERROR_INTERRUPTED when cancelled. */
+rad_result rad_view_illuminance(rad_context *ctx, const rad_solution_view *view, double *lux);
+
+/* The false colour picture of `values` (width x height, row 0 at the top;
+ * NaN = background, drawn white) on `scale`, the legend at the right with
+ * `unit` (UTF-8), isolines at the ticks with `contours`, as a PNG at
+ * `path`, atomically.  RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY. */
+rad_result rad_false_colour_write(rad_context *ctx, const float *values, int width, int height,
+                                  const struct rad_colour_scale *scale, const char *unit, bool contours,
+                                  const char *path);
+
+/* One calculation grid or set of points, as its plan is drawn
+ * (rad_plot_grid_write): the caller's arrays, read during the call. */
+typedef struct rad_plot_grid {
+    const char *name;        /* the title's first word(s) (UTF-8) */
+    size_t count;            /* points */
+    const double *u, *v;     /* m: each point's in-plane coordinates (v up the page) */
+    const double *value;     /* the values, in `unit` */
+    const char *unit;        /* "lx" */
+    /* A regular grid: nu x nv cells, each point at the centre of its cell
+     * (count <= nu x nv: a footprint's cells off it have no point and are
+     * not drawn); 0 x 0: free points, drawn as labelled dots. */
+    size_t nu, nv;
+    double cell_u, cell_v;   /* m: a cell's sides; 0: the points' spread over nu - 1 (nv - 1) */
+} rad_plot_grid;
+
+typedef struct rad_plot_options {
+    int log_scale;           /* nonzero: logarithmic */
+    double range_min, range_max; /* 0 and 0: automatic (as false colour) */
+    int width;               /* the picture's width in pixels, legend included; 0 = 900 */
+} rad_plot_options;
+
+/* The plan of `grid` as a PNG at `path`, atomically: cells (or dots)
+ * coloured by value with the value printed in each (when it fits: a font
+ * of at least RAD_PLOT_MIN_FONT px), the outline, the legend, and a title
+ * line with the average, minimum, maximum and uniformity U0 = min / avg.
+ * RAD_ERROR_INVALID_ARGUMENT for an empty grid, more points than nu x nv
+ * cells, a cell side negative or not finite, values
+ * or coordinates not finite, bad range; RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY. */
+rad_result rad_plot_grid_write(rad_context *ctx, const rad_plot_grid *grid, const rad_plot_options *options,
+                               const char *path);
+#define RAD_PLOT_MIN_FONT 7.0
+
+/* What rad_plot_grid_write prints: the value labels (label(k) for point
+ * k, count of them, each as rad_format_value) and the title line into
+ * `title`.  Cannot fail. */
+void rad_plot_grid_label(const rad_plot_grid *grid, size_t k, char *text, size_t size);
+void rad_plot_grid_title(const rad_plot_grid *grid, char *text, size_t size);
+
 #endif /* RAD_OUTPUT_H */
