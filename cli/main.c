@@ -631,11 +631,11 @@ static int run_photometry(rad_context *ctx, const settings *s)
     return status;
 }
 
-
 /* The false colour options of render's flags (--false-colour, --scale,
  * --range, --contours), checked by the library before any work; returns
  * -1 when good, else the exit status (the message printed). */
 static int false_colour_options(rad_context *ctx, const settings *s, rad_false_colour_options *fo)
+{
     memset(fo, 0, sizeof *fo);
     if (s->command == CLI_ILLUMINANCE) {
         /* The grids' plans: an output ending in .png. */
@@ -643,16 +643,20 @@ static int false_colour_options(rad_context *ctx, const settings *s, rad_false_c
         for (int k = 0; k < 2; k++) {
             const char *o = k ? s->output2 : s->output, *dot = o ? strrchr(o, '.') : NULL;
             png = png || (dot && strcasecmp(dot, ".png") == 0);
+        }
         if ((s->log_scale || s->range) && !png) {
             fprintf(stderr, "radiosity: --%s: only for the grids' plans, an output ending in .png (see radiosity "
                             "illuminance --help)\n", s->range ? "range" : "scale");
             return EXIT_USAGE;
+        }
     } else if (!s->false_colour) {
         if (s->log_scale || s->range || s->contours) {
             fprintf(stderr, "radiosity: --%s: only with --false-colour luminance|illuminance (see radiosity "
                             "render --help)\n", s->range ? "range" : s->contours ? "contours" : "scale");
             return EXIT_USAGE;
+        }
         return -1;
+    }
     fo->quantity = s->command == CLI_ILLUMINANCE ? RAD_FALSE_COLOUR_ILLUMINANCE
                                                  : (rad_false_colour_quantity)s->false_colour;
     fo->log_scale = s->log_scale;
@@ -665,12 +669,16 @@ static int false_colour_options(rad_context *ctx, const settings *s, rad_false_c
             const char *max = end + 1;
             fo->range_max = strtod(max, &end);
             good = end != max && *end == '\0';
+        }
         if (!good) {
             fprintf(stderr, "radiosity: --range: expected MIN:MAX (two numbers), got '%s'\n", s->range);
             return EXIT_USAGE;
+        }
         if (fo->range_min == 0.0 && fo->range_max == 0.0) {
             fprintf(stderr, "radiosity: --range: 0:0 is empty; leave --range out for the automatic range\n");
             return EXIT_USAGE;
+        }
+    }
     char ext[8];
     const char *dot = strrchr(s->output, '.');
     snprintf(ext, sizeof ext, "%s", dot ? dot + 1 : "");
@@ -679,10 +687,13 @@ static int false_colour_options(rad_context *ctx, const settings *s, rad_false_c
     if (s->command != CLI_ILLUMINANCE && strcmp(ext, "png") != 0) {
         fprintf(stderr, "radiosity: --false-colour writes PNG: the output must end in .png, got %s\n", s->output);
         return EXIT_USAGE;
+    }
     if (rad_false_colour_check(ctx, fo) != RAD_OK) {
         fprintf(stderr, "radiosity: --%s\n", rad_context_error(ctx));
         return EXIT_USAGE;
+    }
     return -1;
+}
 
 static int run(int argc, char **argv, const rad_stream_ranks *ranks)
 {
