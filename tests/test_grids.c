@@ -973,7 +973,13 @@ static void test_command(void **state)
  * irradiance integrates to Phi rho / (1 - rho)).  The mean over grids of
  * equal cells on all six faces (points on the surfaces) must agree within
  * 1%, the report's bound for exact cases; the direct part's mean is Phi / A. */
-static void interreflection_case(double rho)
+/* With `obstruction`, a 2 x 2 m plate hangs in the middle of the room at
+ * 1.5 m, both faces part of the enclosure (CIE 171's case of diffuse
+ * reflections with an internal obstruction): the integrating-sphere
+ * formula still holds for the area-weighted mean over every surface, since
+ * sum_i A_i H_i = Phi / (1 - rho) in any closed enclosure of one
+ * reflectance (reciprocity and closure), whatever blocks what. */
+static void interreflection_case(double rho, bool obstruction)
 {
     scene_text *t = malloc(sizeof *t);
     begin(t);
@@ -982,38 +988,57 @@ static void interreflection_case(double rho)
     material(t, "lamp", rho, rho, rho, E);
     const char *const mats[6] = {"wall", "wall", "wall", "lamp", "wall", "wall"};
     box(t, L, mats);
+    if (obstruction) {
+        const double o[3] = {1, 1.5, 1}, u[3] = {2, 0, 0}, v[3] = {0, 0, 2}, up[3] = {0, 1, 0}, down[3] = {0, -1, 0};
+        rect(t, "plate_top", "wall", o, u, v, up);
+        rect(t, "plate_bottom", "wall", o, u, v, down);
+    }
     fixture fx;
     solve(&fx, t, 0.5, 0);
-    /* Six 4 x 4 faces, 16 x 16 cells each (spacing 0.25 m), on the surfaces. */
-    rad_illuminance *il = evaluate(&fx, "{\"grids\": ["
+    /* Six 4 x 4 faces, 16 x 16 cells each (spacing 0.25 m), on the
+     * surfaces; the plate's faces 8 x 8 cells each: every point stands for
+     * 1/16 m^2, so the plain mean is the area-weighted one. */
+    char json[2048];
+    snprintf(json, sizeof json, "{\"grids\": ["
         "{\"name\": \"floor\", \"surface\": \"y0\", \"spacing\": 0.25, \"border\": 0},"
         "{\"name\": \"ceiling\", \"surface\": \"y1\", \"facing\": \"down\", \"spacing\": 0.25, \"border\": 0},"
         "{\"name\": \"x0\", \"rectangle\": {\"origin\": [0, 0, 0], \"u\": [0, 0, 4], \"v\": [0, 4, 0]}, \"facing\": \"back\", \"spacing\": 0.25},"
         "{\"name\": \"x1\", \"rectangle\": {\"origin\": [4, 0, 0], \"u\": [0, 4, 0], \"v\": [0, 0, 4]}, \"facing\": \"back\", \"spacing\": 0.25},"
         "{\"name\": \"z0\", \"rectangle\": {\"origin\": [0, 0, 0], \"u\": [0, 4, 0], \"v\": [4, 0, 0]}, \"facing\": \"back\", \"spacing\": 0.25},"
-        "{\"name\": \"z1\", \"rectangle\": {\"origin\": [0, 0, 4], \"u\": [4, 0, 0], \"v\": [0, 4, 0]}, \"facing\": \"back\", \"spacing\": 0.25}]}");
-    double indirect = 0.0, direct = 0.0;
+        "{\"name\": \"z1\", \"rectangle\": {\"origin\": [0, 0, 4], \"u\": [4, 0, 0], \"v\": [0, 4, 0]}, \"facing\": \"back\", \"spacing\": 0.25}%s]}",
+        obstruction ? ","
+        "{\"name\": \"plate top\", \"rectangle\": {\"origin\": [1, 1.5, 1], \"u\": [2, 0, 0], \"v\": [0, 0, 2]}, \"facing\": \"up\", \"spacing\": 0.25},"
+        "{\"name\": \"plate bottom\", \"rectangle\": {\"origin\": [1, 1.5, 1], \"u\": [2, 0, 0], \"v\": [0, 0, 2]}, \"facing\": \"down\", \"spacing\": 0.25}"
+        : "");
+    rad_illuminance *il = evaluate(&fx, json);
+    double indirect = 0.0, direct = 0.0, plate_lowest = INFINITY, plate_highest = 0.0;
     size_t count = 0;
     for (size_t g = 0; g < rad_illuminance_grid_count(il); g++) {
         const rad_grid_result *r = rad_illuminance_grid(il, g);
-        assert_int_equal(r->point_count, 256);
+        assert_int_equal(r->point_count, g < 6 ? 256 : 64);
         for (size_t k = 0; k < r->point_count; k++) {
             const rad_grid_point_value *p = &r->points[k];
-            /* every point faces into the room */
-            double into = (p->position[0] - 2) * p->normal[0] + (p->position[1] - 2) * p->normal[1] +
-                          (p->position[2] - 2) * p->normal[2];
-            assert_true(into < 0.0);
+            if (g < 6) { /* every point of the box faces into the room */
+                double into = (p->position[0] - 2) * p->normal[0] + (p->position[1] - 2) * p->normal[1] +
+                              (p->position[2] - 2) * p->normal[2];
+                assert_true(into < 0.0);
+            } else {
+                plate_lowest = fmin(plate_lowest, p->direct);
+                plate_highest = fmax(plate_highest, p->direct);
+            }
             indirect += p->indirect;
             direct += p->direct;
             count++;
         }
     }
+    if (obstruction) /* the plate's underside sees no emitter: no direct light at all */
+        assert_true(plate_lowest == 0.0 && plate_highest > 0.0);
     indirect /= (double)count;
     direct /= (double)count;
-    double A = 6 * L * L, Phi = 179.0 * E * L * L; /* lm */
+    double A = 6 * L * L + (obstruction ? 8.0 : 0.0), Phi = 179.0 * E * L * L; /* lm */
     double reference = Phi * rho / (A * (1 - rho));
-    printf("cie171 rho %.2f: mean indirect %.6g lux, sphere formula %.6g (%.3g%%); direct %.6g, Phi/A %.6g\n", rho,
-           indirect, reference, 100 * (indirect / reference - 1), direct, Phi / A);
+    printf("cie171 rho %.2f%s: mean indirect %.6g lux, sphere formula %.6g (%.3g%%); direct %.6g, Phi/A %.6g\n", rho,
+           obstruction ? " with the plate" : "", indirect, reference, 100 * (indirect / reference - 1), direct, Phi / A);
     assert_true(fabs(indirect / reference - 1.0) < 0.01);
     assert_true(fabs(direct / (Phi / A) - 1.0) < 0.01);
     rad_illuminance_destroy(il);
@@ -1024,13 +1049,19 @@ static void interreflection_case(double rho)
 static void cie171_interreflection_rho50(void **state)
 {
     (void)state;
-    interreflection_case(0.5);
+    interreflection_case(0.5, false);
 }
 
 static void cie171_interreflection_rho80(void **state)
 {
     (void)state;
-    interreflection_case(0.8);
+    interreflection_case(0.8, false);
+}
+
+static void cie171_interreflection_obstruction(void **state)
+{
+    (void)state;
+    interreflection_case(0.5, true);
 }
 
 /* argv[1], if given, is a cmocka filter ("cie171_*": the CTest test
@@ -1056,6 +1087,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_command),
         cmocka_unit_test(cie171_interreflection_rho50),
         cmocka_unit_test(cie171_interreflection_rho80),
+        cmocka_unit_test(cie171_interreflection_obstruction),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
