@@ -243,6 +243,18 @@ int main(int argc, char **argv)
         u0 = fmin(u0, r->uniformity);
     }
     printf("illuminance: Eavg %.1f lux over all points, lowest room U0 %.3f\n", eavg / (double)st.points, u0);
+    /* Where each room's lowest point is: the floor footprints run under and
+     * through the furniture, so a point between a shelf's boards gets a few
+     * lux; that is the grid's placement, not the light. */
+    for (size_t g = 0; g < rad_illuminance_grid_count(il); g++) {
+        const rad_grid_result *r = rad_illuminance_grid(il, g);
+        size_t lo = 0;
+        for (size_t k = 1; k < r->point_count; k++)
+            lo = r->points[k].illuminance < r->points[lo].illuminance ? k : lo;
+        printf("  %s: Emin %.1f at (%.2f, %.2f, %.2f) direct %.1f indirect %.1f\n", r->name, r->points[lo].illuminance,
+                   r->points[lo].position[0], r->points[lo].position[1], r->points[lo].position[2], r->points[lo].direct,
+                   r->points[lo].indirect);
+    }
     /* The gathering's own time: all the points' thread-seconds less the
      * direct light's (luminaires, daylight). */
     double gathering = st.thread_seconds - st.light_seconds;
