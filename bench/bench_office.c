@@ -243,9 +243,11 @@ int main(int argc, char **argv)
         u0 = fmin(u0, r->uniformity);
     }
     printf("illuminance: Eavg %.1f lux over all points, lowest room U0 %.3f\n", eavg / (double)st.points, u0);
-    /* Where each room's lowest point is: the floor footprints run under and
-     * through the furniture, so a point between a shelf's boards gets a few
-     * lux; that is the grid's placement, not the light. */
+    /* Where each room's lowest point is: the floor footprints run through
+     * the furniture, and the lowest points of seed 1 lie on a chair back's
+     * rear face (z of the face, 0.8 m between its 0.45 and 0.9), half their
+     * hemisphere inside the back: a few lux.  That is the grid's placement,
+     * not the light. */
     for (size_t g = 0; g < rad_illuminance_grid_count(il); g++) {
         const rad_grid_result *r = rad_illuminance_grid(il, g);
         size_t lo = 0;
