@@ -612,6 +612,43 @@ static void test_daylight_only_solve(void **state)
     rad_context_destroy(ctx);
 }
 
+/* A camera under the skylight looking straight up sees the sky: each
+ * pixel the overcast sky's radiance L(Z) / 179 = Lz (1 + 2 cos Z) / (3 x
+ * 179) in its direction (rays that leave the scene see the daylight's sky,
+ * output/render.c), within 5 degrees of the zenith. */
+static void test_sky_seen_through_opening(void **state)
+{
+    (void)state;
+    rad_context *ctx = context();
+    rad_scene *scene = room(ctx, ROOF);
+    const char *json = "{\"sky\": {\"type\": \"cie-overcast\", \"zenith_luminance\": 1000}, "
+                       "\"openings\": {\"surfaces\": [\"skylight\"]}}";
+    assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "sky.json", json, strlen(json)), RAD_OK);
+    rad_solution *sol = NULL;
+    assert_int_equal(rad_solution_create(ctx, scene, &(rad_options){.target_elements = 200}, &sol), RAD_OK);
+    assert_int_equal(rad_solution_solve(ctx, sol), RAD_OK);
+    rad_camera cam = {{2, 1, 2}, {2, 3, 2}, {1, 0, 0}, 10.0};
+    rad_render_options ro = {.width = 16, .height = 16, .camera = &cam};
+    rad_image *image = NULL;
+    assert_int_equal(rad_solution_render(ctx, sol, &ro, &image), RAD_OK);
+    const float *px = rad_image_pixels(image);
+    double zenith = 1000.0 / 179.0;
+    for (int k = 0; k < 16 * 16; k++)
+        for (int c = 0; c < 3; c++) {
+            /* Z < 7.1 degrees at the corners: (1 + 2 cos Z) / 3 > 0.9949 */
+            assert_true(px[3 * k + c] <= zenith * (1.0 + 1e-6));
+            assert_true(px[3 * k + c] >= zenith * 0.9949);
+        }
+    /* the four central pixels: Z < 0.5 degrees */
+    double centre = px[3 * (7 * 16 + 7)];
+    printf("sky through the skylight: %.9g W/(m^2 sr) at the centre, zenith %.9g\n", centre, zenith);
+    assert_true(fabs(centre / zenith - 1.0) < 1e-4);
+    rad_image_destroy(image);
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+    rad_context_destroy(ctx);
+}
+
 /* The room lit by daylight alone, solved here on the engine's own mesh
  * and form factors: each element's direct daylight H_i (its mean,
  * rad_light_element_irradiance) emits rho_i H_i, and B = rho H + rho F B
@@ -1033,6 +1070,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_daylight_factor),
         cmocka_unit_test(test_flux_through_roof),
         cmocka_unit_test(test_daylight_only_solve),
+        cmocka_unit_test(test_sky_seen_through_opening),
         cmocka_unit_test(test_daylight_room_energy),
         cmocka_unit_test(test_openings_leave_the_scene),
         cmocka_unit_test(test_opening_in_the_open),

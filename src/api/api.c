@@ -427,6 +427,7 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
     in.element_radiosity = display;
     in.vertex_radiosity = s->vertex_radiosity;
     in.materials = rad_scene_has_specular(s->scene) ? s->scene->materials : NULL;
+    in.daylight = s->scene->daylight;
     int w = o.width > 0 ? o.width : 512, h = o.height > 0 ? o.height : 512;
     /* The image (3 floats a pixel) and its 8-bit copy for PNG. */
     double image_bytes = 15.0 * (double)w * (double)h;

@@ -43,6 +43,9 @@ typedef struct rad_render_input {
     const rad_scene *scene;
     const rad_material *materials;   /* per patch->material: the specular parts the second pass
                                         follows; NULL: the first pass alone */
+    /* Rays that leave the scene (through its openings, or past an outdoor
+     * model) see this daylight's sky and ground (light/sky.h); NULL: black. */
+    const struct rad_daylight *daylight;
 } rad_render_input;
 
 /* Ray-cast the mesh from the camera; each sample takes the radiance B/pi of

@@ -56,6 +56,7 @@
  * RENDER_MIN_WEIGHT.
  */
 #include "output/output.h"
+#include "light/sky.h"
 #include "solve/vpl.h"
 
 #include <stdlib.h>
@@ -332,8 +333,11 @@ static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit
     const rad_render_input *input = pass->input;
     rad_shading shading = pass->shading;
     rgb[0] = rgb[1] = rgb[2] = 0.0;
-    if (!isfinite(hit->t))
+    if (!isfinite(hit->t)) {
+        if (input->daylight) /* the sky (or ground) in that direction, white, as pi L like B (divided at the end) */
+            rgb[0] = rgb[1] = rgb[2] = M_PI * rad_daylight_radiance(input->daylight, v3_normalize(ray->direction));
         return RENDER_MISS;
+    }
     const rad_mesh *mesh = input->mesh;
     const rad_patch *patch = &mesh->patches[hit->patch];
     vec3 p = v3_mad(ray->origin, ray->direction, hit->t);
