@@ -284,7 +284,7 @@ static void point_shadow(void **state)
     for (size_t k = 0; k < 4; k++) {
         double a[3], b[3], c[3];
         rad_light_irradiance(scene, mesh, vis, beside[k], up, a);
-        rad_light_irradiance_lifted(scene, mesh, vis, rad_vis_epsilon(mesh), beside[k], up, b);
+        rad_light_irradiance_lifted(scene, vis, rad_vis_epsilon(mesh), beside[k], up, b);
         rad_luminaires_irradiance(scene, mesh, vis, beside[k], up, c);
         assert_memory_equal(a, b, sizeof a);
         assert_memory_equal(a, c, sizeof a);

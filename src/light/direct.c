@@ -36,10 +36,10 @@ void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const ra
     out[0] = out[1] = out[2] = 0.0;
     if (!rad_light_present(scene))
         return;
-    rad_light_irradiance_lifted(scene, mesh, vis, mesh ? rad_vis_epsilon(mesh) : 0.0, p, n, out);
+    rad_light_irradiance_lifted(scene, vis, mesh ? rad_vis_epsilon(mesh) : 0.0, p, n, out);
 }
 
-void rad_light_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, double lift,
+void rad_light_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift,
                                  vec3 p, vec3 n, double out[3])
 {
     out[0] = out[1] = out[2] = 0.0;
@@ -52,7 +52,7 @@ void rad_light_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, c
             out[c] += part[c];
     }
     if (scene->daylight) {
-        rad_daylight_irradiance(scene, mesh, vis, p, n, part);
+        rad_daylight_irradiance_lifted(scene, vis, lift, p, n, part);
         for (int c = 0; c < 3; c++)
             out[c] += part[c];
     }
@@ -68,7 +68,7 @@ typedef struct cubature {
 
 static void light_at(const cubature *c, vec3 x, double out[3])
 {
-    rad_light_irradiance_lifted(c->scene, c->mesh, c->vis, c->lift, x, c->normal, out);
+    rad_light_irradiance_lifted(c->scene, c->vis, c->lift, x, c->normal, out);
 }
 
 /* The integral (W per channel) of the irradiance over one region. */

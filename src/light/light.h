@@ -40,8 +40,8 @@ void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const ra
  * (rad_vis_epsilon(mesh) walks the whole mesh: a caller asking at many
  * points, calculation grids, computes it once).  Thread-safe,
  * deterministic. */
-void rad_light_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, double lift,
-                                 vec3 p, vec3 n, double out[3]);
+void rad_light_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift, vec3 p, vec3 n,
+                                 double out[3]);
 
 /* The mean of rad_light_irradiance over element `element` of mesh
  * (adaptive cubature over its polygon).  Thread-safe, deterministic. */
@@ -62,6 +62,9 @@ void rad_luminaires_irradiance_lifted(const rad_scene *scene, const rad_vis *vis
                                       double out[3]);            /* light/luminaire.c */
 void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                              vec3 n, double out[3]);             /* light/daylight.c */
+/* rad_daylight_irradiance with the shadow rays' lift given, as above. */
+void rad_daylight_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift, vec3 p, vec3 n,
+                                    double out[3]);              /* light/daylight.c */
 
 /* The horizontal irradiance (W/m^2 RGB) outdoors under the unobstructed sky
  * of the scene's daylight, the sun excluded: the daylight factor's

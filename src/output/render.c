@@ -137,14 +137,14 @@ static rad_result make_view(rad_context *ctx, const rad_camera *camera, int widt
  * camera ray: B = E + rho (direct + VPLs + near field), the VPLs clamped
  * as the strategy's (solve/vpl.h); the direct light's shadow rays and the
  * near-field rays from the stream keyed on `key` (pixel and stratum). */
-static void shade_vpl(const rad_render_input *input, uint32_t e, const rad_patch *patch, vec3 p, uint64_t key,
-                      double rgb[3])
+static void shade_vpl(const rad_render_input *input, double epsilon, uint32_t e, const rad_patch *patch, vec3 p,
+                      uint64_t key, double rgb[3])
 {
     enum { BLOCK = 64, DIRECT_RAYS = 4 };
     const rad_mesh *mesh = input->mesh;
     const rad_vpl_set *set = input->vpls;
     vec3 n = patch->normal;
-    vec3 x = v3_mad(p, n, rad_vis_epsilon(mesh) + rad_element_bend(mesh, &mesh->elements[e]));
+    vec3 x = v3_mad(p, n, epsilon + rad_element_bend(mesh, &mesh->elements[e]));
     rad_rng rng = rad_rng_keyed(input->seed, 0x52454e44u, key); /* "REND" */
     double H[3], h[3], h_raw[3];
     rad_vpl_direct(set, mesh, input->vis, input->emission, x, n, DIRECT_RAYS, &rng, H);
@@ -361,7 +361,7 @@ static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit
         /* Keyed on (pixel, stratum, stream) from the eye; a path's later
          * diffuse ends on a draw of its own stream. */
         uint64_t k = depth == 0 ? key : (uint64_t)(rad_rng_uniform(rng) * 9007199254740992.0);
-        shade_vpl(input, e, patch, p, k, diffuse);
+        shade_vpl(input, pass->epsilon, e, patch, p, k, diffuse);
         for (int c = 0; c < 3; c++)
             rgb[c] += diffuse[c];
         return m ? RENDER_MIXED : hit->patch;
