@@ -112,6 +112,12 @@ rad_result rad_fail(rad_context *ctx, rad_result result, const char *fmt, ...)
 #endif
     ;
 
+/* A JSON input file's text parsed strictly (core/json.c): *out the root
+ * (cJSON_Delete it), or NULL and RAD_ERROR_PARSE naming `name` and the
+ * line ("bc.json:3: not valid JSON", "...: text after the JSON object"). */
+struct cJSON;
+rad_result rad_json_parse(rad_context *ctx, const char *name, const char *text, size_t size, struct cJSON **out);
+
 /* Tell the warning callback, if there is one, of input read differently
  * from the file (one line, as rad_fail's).  Not a failure: nothing is
  * latched.  ctx may be NULL. */

@@ -543,14 +543,6 @@ static rad_result read_points(builder *b, const cJSON *list)
     return RAD_OK;
 }
 
-static int line_of(const char *text, size_t at)
-{
-    int line = 1;
-    for (size_t k = 0; k < at; k++)
-        line += text[k] == '\n';
-    return line;
-}
-
 static rad_result parse_tree(builder *b, const rad_scene *scene, const cJSON *root)
 {
     rad_context *ctx = b->ctx;
@@ -607,20 +599,10 @@ rad_result rad_grid_parse(rad_context *ctx, const rad_scene *scene, const char *
     }
     builder b = {ctx, name, set, 0};
     rad_result r;
-    const char *end = NULL;
-    cJSON *root = size > 0 ? cJSON_ParseWithLengthOpts(text, size, &end, false) : NULL;
-    if (!root) {
-        size_t at = end && end >= text && end <= text + size ? (size_t)(end - text) : 0;
-        r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: not valid JSON", name, line_of(text, at));
-    } else {
-        size_t at = (size_t)(end - text);
-        while (at < size && (text[at] == ' ' || text[at] == '\t' || text[at] == '\n' || text[at] == '\r'))
-            at++;
-        if (at < size && !(at + 1 == size && text[at] == '\0'))
-            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: text after the JSON object", name, line_of(text, at));
-        else
-            r = parse_tree(&b, scene, root);
-    }
+    cJSON *root = NULL;
+    r = rad_json_parse(ctx, name, text, size, &root);
+    if (r == RAD_OK)
+        r = parse_tree(&b, scene, root);
     cJSON_Delete(root);
     if (r != RAD_OK) {
         rad_grid_set_destroy(set);

@@ -370,14 +370,6 @@ static rad_result parse_tree(const reader *rd, const cJSON *root, rad_daylight *
     return RAD_OK;
 }
 
-static int line_of(const char *text, size_t at)
-{
-    int line = 1;
-    for (size_t k = 0; k < at; k++)
-        line += text[k] == '\n';
-    return line;
-}
-
 rad_result rad_daylight_parse(rad_context *ctx, const rad_scene *scene, const char *name, const char *text,
                               size_t size, rad_daylight **out)
 {
@@ -394,20 +386,10 @@ rad_result rad_daylight_parse(rad_context *ctx, const rad_scene *scene, const ch
     }
     reader rd = {ctx, name, scene};
     rad_result r;
-    const char *end = NULL;
-    cJSON *root = cJSON_ParseWithLengthOpts(text, size, &end, false);
-    if (!root) {
-        size_t at = end && end >= text && end <= text + size ? (size_t)(end - text) : 0;
-        r = FAIL(&rd, "%s:%d: not valid JSON", name, line_of(text, at));
-    } else {
-        size_t at = (size_t)(end - text);
-        while (at < size && (text[at] == ' ' || text[at] == '\t' || text[at] == '\n' || text[at] == '\r'))
-            at++;
-        if (at < size && !(at + 1 == size && text[at] == '\0'))
-            r = FAIL(&rd, "%s:%d: text after the JSON object", name, line_of(text, at));
-        else
-            r = parse_tree(&rd, root, d);
-    }
+    cJSON *root = NULL;
+    r = rad_json_parse(ctx, name, text, size, &root);
+    if (r == RAD_OK)
+        r = parse_tree(&rd, root, d);
     cJSON_Delete(root);
     if (r != RAD_OK) {
         rad_daylight_free(d);

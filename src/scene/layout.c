@@ -499,35 +499,16 @@ static rad_result parse_layout(additions *a, const cJSON *root)
     return RAD_OK;
 }
 
-/* 1-based line of byte `at` of text. */
-static int line_of(const char *text, size_t at)
-{
-    int line = 1;
-    for (size_t k = 0; k < at; k++)
-        line += text[k] == '\n';
-    return line;
-}
-
 rad_result rad_layout_parse(rad_context *ctx, rad_scene *scene, const char *name, const char *text, size_t size,
                             rad_photometry_loader load, void *user)
 {
     additions add = {ctx, scene, name, load, user, NULL, 0, 0, NULL, 0, 0};
     additions *a = &add;
-    const char *end = NULL;
-    cJSON *root = cJSON_ParseWithLengthOpts(text, size, &end, false);
     rad_result r;
-    if (!root) {
-        size_t at = end && end >= text && end <= text + size ? (size_t)(end - text) : 0;
-        r = BAD("%s:%d: not valid JSON", name, line_of(text, at));
-    } else {
-        size_t at = (size_t)(end - text);
-        while (at < size && (text[at] == ' ' || text[at] == '\t' || text[at] == '\n' || text[at] == '\r'))
-            at++;
-        if (at < size && !(at + 1 == size && text[at] == '\0'))
-            r = BAD("%s:%d: text after the JSON object", name, line_of(text, at));
-        else
-            r = parse_layout(a, root);
-    }
+    cJSON *root = NULL;
+    r = rad_json_parse(ctx, name, text, size, &root);
+    if (r == RAD_OK)
+        r = parse_layout(a, root);
     cJSON_Delete(root);
     if (r == RAD_OK)
         r = commit(a);

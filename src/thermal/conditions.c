@@ -104,15 +104,6 @@ static size_t surface_named(const rad_scene *scene, const char *text)
     return SIZE_MAX;
 }
 
-/* 1-based line of byte `at` of text. */
-static int line_of(const char *text, size_t at)
-{
-    int line = 1;
-    for (size_t k = 0; k < at; k++)
-        line += text[k] == '\n';
-    return line;
-}
-
 static rad_result parse_tree(rad_context *ctx, const char *name, const cJSON *root, rad_thermal_conditions *c)
 {
     const rad_scene *scene = c->scene;
@@ -186,21 +177,10 @@ rad_result rad_thermal_conditions_parse(rad_context *ctx, const rad_scene *scene
         rad_thermal_conditions_destroy(c);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    const char *end = NULL;
-    cJSON *root = cJSON_ParseWithLengthOpts(text, size, &end, false);
-    if (!root) {
-        size_t at = end && end >= text && end <= text + size ? (size_t)(end - text) : 0;
-        r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: not valid JSON", name, line_of(text, at));
-    } else {
-        /* Nothing but blanks after the object. */
-        size_t at = (size_t)(end - text);
-        while (at < size && (text[at] == ' ' || text[at] == '\t' || text[at] == '\n' || text[at] == '\r'))
-            at++;
-        if (at < size && !(at + 1 == size && text[at] == '\0'))
-            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s:%d: text after the JSON object", name, line_of(text, at));
-        else
-            r = parse_tree(ctx, name, root, c);
-    }
+    cJSON *root = NULL;
+    r = rad_json_parse(ctx, name, text, size, &root);
+    if (r == RAD_OK)
+        r = parse_tree(ctx, name, root, c);
     cJSON_Delete(root);
     if (r != RAD_OK) {
         rad_thermal_conditions_destroy(c);
