@@ -20,7 +20,7 @@
  * element size used (m).
  */
 #include "strategy/strategy.h"
-#include "api/options.h"
+#include "strategy/options.h"
 #include "interp/interp.h"
 
 #include <cjson/cJSON.h>

@@ -1,5 +1,5 @@
 /*
- * fuzz_layout.c -- the luminaire layout file (scene/layout.c,
+ * fuzz_layout.c -- the luminaire layout file (photometry/layout.c,
  * rad_layout_parse) against the built-in Cornell box, its photometric
  * files served from tables (names ending ".ies": an I0 cos gamma
  * distribution with a 0.3 x 0.2 m opening; anything else: not found, so no
@@ -12,8 +12,8 @@
 #include "fuzz.h"
 #include "light/light.h"
 #include "radiosity.h"
-#include "scene/layout.h"
-#include "scene/photometry.h"
+#include "photometry/layout.h"
+#include "photometry/photometry.h"
 
 #include <math.h>
 #include <string.h>
@@ -46,27 +46,27 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         rad_context_destroy(ctx);
         return 0;
     }
-    rad_result r = rad_layout_parse(ctx, scene, "layout.json", (const char *)data, size, loader, NULL);
+    rad_result r = rad_layout_parse(ctx, &scene->luminaires, "layout.json", (const char *)data, size, loader, NULL);
     if (r != RAD_OK) {
         const char *msg = rad_context_error(ctx);
         FUZZ_CHECK(r == RAD_ERROR_PARSE || r == RAD_ERROR_IO || r == RAD_ERROR_OUT_OF_MEMORY);
         FUZZ_CHECK(strncmp(msg, "layout.json", 11) == 0 || r != RAD_ERROR_PARSE);
         FUZZ_CHECK(strchr(msg, '\n') == NULL);
-        FUZZ_CHECK(scene->luminaire_count == 0 && scene->photometry_count == 0);
+        FUZZ_CHECK(scene->luminaires.count == 0 && scene->luminaires.photometry_count == 0);
     } else {
-        for (size_t k = 0; k < scene->luminaire_count; k++) {
-            const rad_luminaire *L = &scene->luminaires[k];
+        for (size_t k = 0; k < scene->luminaires.count; k++) {
+            const rad_luminaire *L = &scene->luminaires.items[k];
             FUZZ_CHECK(v3_finite(L->position));
             FUZZ_CHECK(isfinite(L->multiplier) && L->multiplier >= 0.0);
-            FUZZ_CHECK(L->photometry < scene->photometry_count);
+            FUZZ_CHECK(L->photometry < scene->luminaires.photometry_count);
             for (int a = 0; a < 3; a++)
                 for (int b = 0; b < 3; b++)
                     FUZZ_CHECK(fabs(v3_dot(L->axis[a], L->axis[b]) - (a == b)) < 1e-9);
             FUZZ_CHECK(v3_dot(v3_cross(L->axis[0], L->axis[1]), L->axis[2]) > 0.0);
             for (size_t j = 0; j < k && j < 200; j++)
-                FUZZ_CHECK(strcmp(L->name, scene->luminaires[j].name) != 0);
+                FUZZ_CHECK(strcmp(L->name, scene->luminaires.items[j].name) != 0);
         }
-        if (scene->luminaire_count > 0 && scene->luminaire_count <= 1000) {
+        if (scene->luminaires.count > 0 && scene->luminaires.count <= 1000) {
             double h[3];
             rad_luminaires_irradiance(scene, NULL, NULL, v3(0.3, 0.0, 0.2), v3(0, 1, 0), h);
             FUZZ_CHECK(isfinite(h[0]) && h[0] >= 0.0 && h[0] == h[1] && h[1] == h[2]);

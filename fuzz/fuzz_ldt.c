@@ -1,5 +1,5 @@
 /*
- * fuzz_ldt.c -- an EULUMDAT photometric file (scene/eulumdat.c) from
+ * fuzz_ldt.c -- an EULUMDAT photometric file (photometry/eulumdat.c) from
  * memory, through the reader itself (not the by-content dispatch, so
  * every input reaches it).  A failure must leave a one-line message and no
  * distribution; a success a table as photometry.h describes it: C from 0
@@ -7,7 +7,7 @@
  * row, candela finite and >= 0, a finite flux, finite intensities.
  */
 #include "fuzz.h"
-#include "scene/photometry_internal.h"
+#include "photometry/photometry_internal.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,5 +1,5 @@
 /*
- * fuzz_texture.c -- a reflectance texture's file (scene/texture.c,
+ * fuzz_texture.c -- a reflectance texture's file (import/texture.c,
  * import_texture_read: stb_image behind a header check against the memory
  * limit): a failure says why in a few words and is one of the three
  * results it promises; a success is a width x height image of linear
@@ -7,7 +7,7 @@
  * map_Kd does.
  */
 #include "fuzz.h"
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,5 +1,5 @@
 /*
- * fuzz_vs3.c -- a View3D .vs3 file from memory (scene/import_vs3.c): the
+ * fuzz_vs3.c -- a View3D .vs3 file from memory (import/import_vs3.c): the
  * records, the control line, the surface relations and the holes cut for
  * sub-surfaces and null surfaces, then scene validation.  A failure must
  * leave a one-line message; a scene must be usable (fuzz_check_load).

@@ -26,7 +26,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "api/options.h"
+#include "strategy/options.h"
 #include "api/solution.h"
 #include "interp/interp.h"
 #include "strategy/strategy.h"

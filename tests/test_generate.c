@@ -1,5 +1,5 @@
 /*
- * test_generate.c -- the procedural office floor (src/scene/generate.c) and
+ * test_generate.c -- the procedural office floor (src/generate/generate.c) and
  * the OBJ + MTL writer: the same seed gives the same scene bit for bit and
  * another seed another; polygons grow linearly with rooms; every polygon is
  * valid and every name unique; walls, floors, ceilings, windows and lights

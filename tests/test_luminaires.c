@@ -29,8 +29,8 @@
 #include "api/solution.h"
 #include "formfactor/formfactor.h"
 #include "light/light.h"
-#include "scene/layout.h"
-#include "scene/photometry.h"
+#include "photometry/layout.h"
+#include "photometry/photometry.h"
 #include "strategy/strategy.h"
 #include "vis/vis.h"
 
@@ -133,7 +133,7 @@ static rad_result test_loader(rad_context *ctx, const char *path, void *user, ra
 static rad_result layout(rad_context *ctx, rad_scene *scene, const char *json)
 {
     rad_api_enter(ctx); /* a new call: its first failure is the one kept */
-    return rad_layout_parse(ctx, scene, "mem/layout.json", json, strlen(json), test_loader, NULL);
+    return rad_layout_parse(ctx, &scene->luminaires, "mem/layout.json", json, strlen(json), test_loader, NULL);
 }
 
 /* ---- scenes ---- */
@@ -384,10 +384,10 @@ static void flux_closed_black_box(void **state)
                                         "\"multiplier\": 2.5, \"aim\": [0.2, 0.1, -1]},"
                                         "{\"file\": \"iso.ies\", \"position\": [0.7, 1.2, 1], \"llf\": 0.8}]}"),
                      RAD_OK);
-    double flux = rad_luminaire_flux(scene, 0) + rad_luminaire_flux(scene, 1);
+    double flux = rad_luminaire_flux(&scene->luminaires, 0) + rad_luminaire_flux(&scene->luminaires, 1);
     /* The tables' own flux: 2 pi I0 / (k + 1) for cos^k, 4 pi I0 isotropic. */
-    assert_close(rad_luminaire_flux(scene, 1), 0.8 * 4 * M_PI * 1000.0, 1e-9, "isotropic flux");
-    assert_close(rad_luminaire_flux(scene, 0), 2.5 * 2 * M_PI * 2000.0 / 4.0, 2e-3, "cos^3 flux");
+    assert_close(rad_luminaire_flux(&scene->luminaires, 1), 0.8 * 4 * M_PI * 1000.0, 1e-9, "isotropic flux");
+    assert_close(rad_luminaire_flux(&scene->luminaires, 0), 2.5 * 2 * M_PI * 2000.0 / 4.0, 2e-3, "cos^3 flux");
     rad_solution *sol = NULL;
     rad_options o = {.solver = "jacobi", .target_elements = 600};
     assert_int_equal(rad_solution_create(ctx, scene, &o, &sol), RAD_OK);
@@ -450,7 +450,7 @@ static void solve_energy_balance(void **state)
     rad_solution_power(sol, &em, &ab);
     print_message("adaptive: %zu -> %zu elements, %.6g lm landed\n", before, rad_solution_element_count(sol),
                   rad_solution_direct_lumens(sol));
-    assert_close(rad_solution_direct_lumens(sol), rad_luminaire_flux(scene, 0), 1e-3, "adaptive: flux landed");
+    assert_close(rad_solution_direct_lumens(sol), rad_luminaire_flux(&scene->luminaires, 0), 1e-3, "adaptive: flux landed");
     /* The solution file holds the light: read back, the luminaires, the
      * direct light and the radiosity are the same bits. */
     char path[] = "/tmp/rad_test_luminaires_XXXXXX";
@@ -527,9 +527,9 @@ static void direct_thread_determinism(void **state)
 static double lobe_lux(const rad_scene *scene, size_t k, vec3 d)
 {
     rad_scene alone = *scene; /* luminaire k only: the others' lobes reach its points too */
-    alone.luminaires = &scene->luminaires[k];
-    alone.luminaire_count = 1;
-    vec3 p = v3_mad(scene->luminaires[k].position, v3_normalize(d), 2.0);
+    alone.luminaires.items = &scene->luminaires.items[k];
+    alone.luminaires.count = 1;
+    vec3 p = v3_mad(scene->luminaires.items[k].position, v3_normalize(d), 2.0);
     return lux_at(&alone, NULL, NULL, p, v3_scale(d, -1.0));
 }
 
@@ -547,8 +547,8 @@ static void layout_placement(void **state)
                             "{\"file\": \"lobe.ies\", \"position\": [80, 0, 10], \"spin\": 90, \"name\": \"row\","
                             " \"array\": {\"count\": [3, 2], \"spacing\": [1, 2]}}]}"),
                      RAD_OK);
-    assert_int_equal(scene->luminaire_count, 4 + 6);
-    assert_int_equal(scene->photometry_count, 1); /* one file, loaded once */
+    assert_int_equal(scene->luminaires.count, 4 + 6);
+    assert_int_equal(scene->luminaires.photometry_count, 1); /* one file, loaded once */
     double s60 = sin(60 * DEG), c60 = 0.5, peak = 1000.0 / 4.0;
     /* plain: C = 0 along +x, the nadir -z */
     assert_close(lobe_lux(scene, 0, v3(s60, 0, -c60)), peak, 1e-9, "plain peak");
@@ -563,7 +563,7 @@ static void layout_placement(void **state)
     /* the array: along the luminaire's x (= +y after the spin) and y (= -x) */
     for (int j = 0; j < 2; j++)
         for (int i = 0; i < 3; i++) {
-            const rad_luminaire *L = &scene->luminaires[4 + (size_t)(3 * j + i)];
+            const rad_luminaire *L = &scene->luminaires.items[4 + (size_t)(3 * j + i)];
             char name[32];
             snprintf(name, sizeof name, "row[%d,%d]", i, j);
             assert_string_equal(L->name, name);
@@ -577,7 +577,7 @@ static void layout_placement(void **state)
                                         "\"position\": [0, 10, 0]}]}"),
                      RAD_OK);
     assert_close(lobe_lux(other, 0, v3(s60, -c60, 0)), 0.5 * peak, 1e-9, "y-up peak with the layout's llf");
-    assert_string_equal(other->luminaires[0].name, "luminaire 1");
+    assert_string_equal(other->luminaires.items[0].name, "luminaire 1");
     rad_scene_destroy(other);
     /* The file's TILT factor at the angle between the aim and straight
      * down (interpolated: 0.75 at 45 degrees, 0.5 at 90, 1 aimed down). */
@@ -587,16 +587,16 @@ static void layout_placement(void **state)
                                          "{\"file\": \"tilt.ies\", \"position\": [0, 0, 3], \"aim_at\": [0, 5, 3]}]}"),
                      RAD_OK);
     double iso = 4 * M_PI * 1000.0;
-    assert_close(rad_luminaire_flux(tilted, 0), iso, 1e-9, "not tilted");
-    assert_close(rad_luminaire_flux(tilted, 1), 0.75 * iso, 1e-9, "tilted 45 degrees");
-    assert_close(rad_luminaire_flux(tilted, 2), 0.5 * iso, 1e-9, "tilted 90 degrees");
+    assert_close(rad_luminaire_flux(&tilted->luminaires, 0), iso, 1e-9, "not tilted");
+    assert_close(rad_luminaire_flux(&tilted->luminaires, 1), 0.75 * iso, 1e-9, "tilted 45 degrees");
+    assert_close(rad_luminaire_flux(&tilted->luminaires, 2), 0.5 * iso, 1e-9, "tilted 90 degrees");
     rad_scene_destroy(tilted);
     /* lumens: scaled to the flux asked for */
     rad_scene *third = box(ctx, 1.0, 0.5);
     assert_int_equal(layout(ctx, third, "{\"luminaires\": [{\"file\": \"iso.ies\", \"position\": [0, 0, 3], "
                                         "\"lumens\": 1000, \"multiplier\": 3}]}"),
                      RAD_OK);
-    assert_close(rad_luminaire_flux(third, 0), 3000.0, 1e-12, "lumens x multiplier");
+    assert_close(rad_luminaire_flux(&third->luminaires, 0), 3000.0, 1e-12, "lumens x multiplier");
     rad_scene_destroy(third);
     rad_scene_destroy(scene);
     rad_context_destroy(ctx);
@@ -679,8 +679,8 @@ static void layout_errors(void **state)
         }
         assert_int_equal(r, strstr(cases[k].message, "cannot open") ? RAD_ERROR_IO : RAD_ERROR_PARSE);
         /* all or nothing: the scene keeps what it had */
-        assert_int_equal(scene->luminaire_count, 1);
-        assert_int_equal(scene->photometry_count, 1);
+        assert_int_equal(scene->luminaires.count, 1);
+        assert_int_equal(scene->luminaires.photometry_count, 1);
     }
     /* A second layout may not reuse a name the scene has. */
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"iso.ies\", \"position\": [0, 0, 1], "
@@ -701,13 +701,13 @@ static void layout_and_gltf_files(void **state)
     assert_int_equal(rad_scene_load_file(ctx, RAD_TEST_DATA "/luminaires/room.obj", &scene), RAD_OK);
     assert_int_equal(rad_scene_load_luminaires(ctx, scene, RAD_TEST_DATA "/luminaires/layout.json"), RAD_OK);
     assert_int_equal(rad_scene_luminaire_count(scene), 5);
-    assert_int_equal(scene->photometry_count, 1);
+    assert_int_equal(scene->luminaires.photometry_count, 1);
     assert_string_equal(rad_scene_luminaire_name(scene, 3), "grid[1,1]");
     assert_string_equal(rad_scene_luminaire_name(scene, 4), "wallwash");
     assert_null(rad_scene_luminaire_name(scene, 5));
     /* The file's 1000 lm (I = 1000 / pi cos gamma, tabulated every 10
      * degrees: the bilinear table's flux is 0.25 % below). */
-    double flux = scene->photometries[0]->flux;
+    double flux = scene->luminaires.photometries[0]->flux;
     assert_close(flux, 1000.0, 3e-3, "the downlight's flux");
     assert_close(rad_scene_luminaire_flux(scene, 0), 0.8 * flux, 1e-12, "the layout's llf");
     assert_close(rad_scene_luminaire_flux(scene, 4), flux, 1e-12, "the entry's llf");
@@ -744,7 +744,7 @@ static void layout_and_gltf_files(void **state)
     assert_true(rad_scene_luminaire_placement(scene, 0, position, axes));
     assert_true(fabs(position[0] - 2) < 1e-12 && fabs(position[1] - 2.5) < 1e-12 && fabs(position[2] - 2) < 1e-12);
     assert_true(fabs(axes[7] - 1.0) < 1e-12); /* its z is world +y: the nadir down */
-    assert_close(rad_scene_luminaire_flux(scene, 0), 0.9 * scene->photometries[0]->flux, 1e-12, "extras' llf");
+    assert_close(rad_scene_luminaire_flux(scene, 0), 0.9 * scene->luminaires.photometries[0]->flux, 1e-12, "extras' llf");
     /* The floor's centre, 2.5 m below the nadir: 1000 / pi cd x 0.9 / 2.5^2. */
     double h[3];
     rad_luminaires_irradiance(scene, NULL, NULL, v3(2, 0, 2), v3(0, 1, 0), h);

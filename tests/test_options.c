@@ -14,7 +14,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
-#include "api/options.h"
+#include "strategy/options.h"
 #include "options.h"
 
 #include <float.h>

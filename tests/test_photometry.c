@@ -1,5 +1,5 @@
 /*
- * test_photometry.c -- luminaire photometric files (src/scene/photometry.c,
+ * test_photometry.c -- luminaire photometric files (src/photometry/photometry.c,
  * ies.c, eulumdat.c; docs/lighting.md, "Photometric files").
  *
  *   - flux: an isotropic I gives 4 pi I exactly; I0 cos(gamma) over the
@@ -31,7 +31,7 @@
 #include <cmocka.h>
 
 #include "radiosity.h"
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -19,7 +19,7 @@
 
 #include "cli_support.h"
 #include "output/picture.h"
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <dirent.h>
 #include <stdlib.h>

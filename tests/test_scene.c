@@ -12,7 +12,7 @@
 #include <cmocka.h>
 
 #include "formfactor/formfactor.h"
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 #include "scene/scene.h"
 
 #include <float.h>

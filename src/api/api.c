@@ -602,47 +602,6 @@ rad_result rad_solution_load_memory(rad_context *ctx, const char *name, const vo
 }
 
 /* As solution.h says. */
-rad_result rad_read_whole_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size)
-{
-    *data = NULL;
-    *size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    size_t capacity = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) ? (size_t)st.st_size + 1 : 65536;
-    if (S_ISDIR(st.st_mode)) {
-        fclose(f);
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: Is a directory", path);
-    }
-    unsigned char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, "input file");
-    size_t used = 0;
-    while (buffer) {
-        size_t got = fread(buffer + used, 1, capacity - used, f);
-        used += got;
-        if (used < capacity) {
-            if (ferror(f)) {
-                rad_free(buffer);
-                fclose(f);
-                return rad_fail(ctx, rad_cancelled(ctx) ? RAD_ERROR_INTERRUPTED : RAD_ERROR_IO,
-                                "%s: cannot read: %s", path, strerror(errno));
-            }
-            break;
-        }
-        unsigned char *grown = rad_realloc(ctx, RAD_MEM_SCENE, buffer, 2 * capacity, 1, "input file");
-        if (!grown)
-            rad_free(buffer);
-        buffer = grown;
-        capacity *= 2;
-    }
-    fclose(f);
-    if (!buffer)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    *data = buffer;
-    *size = used;
-    return RAD_OK;
-}
-
 rad_result rad_solution_load_file(rad_context *ctx, const char *path, rad_scene **scene, rad_solution **out)
 {
     rad_api_enter(ctx);

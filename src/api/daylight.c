@@ -1,11 +1,11 @@
 /*
  * daylight.c -- the public daylight calls (radiosity.h "Daylight"): read
- * the file against the scene (scene/daylight.c), scale the sky
+ * the file against the scene (light/daylight_file.c), scale the sky
  * (light/sky.c), move the openings out of the scene.
  */
 #include "api/solution.h"
 #include "light/sky.h"
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 rad_result rad_scene_daylight_load_memory(rad_context *ctx, rad_scene *scene, const char *name, const void *data,
                                           size_t size)

@@ -7,7 +7,7 @@
 #include "api/solution.h"
 #include "grid/grid.h"
 #include "light/light.h"
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <string.h>
 

@@ -1,12 +1,12 @@
 /*
  * luminaires.c -- the public calls of luminaires placed in scenes
  * (radiosity.h, "Luminaires"): layout files read through the scene's
- * layout parser (scene/layout.c) with the photometric readers, and what a
+ * layout parser (photometry/layout.c) with the photometric readers, and what a
  * program reads back.
  */
 #include "api/solution.h"
-#include "scene/layout.h"
-#include "scene/photometry.h"
+#include "photometry/layout.h"
+#include "photometry/photometry.h"
 
 #include <string.h>
 
@@ -16,7 +16,7 @@ rad_result rad_scene_load_luminaires_memory(rad_context *ctx, rad_scene *scene, 
     rad_api_enter(ctx);
     if (!ctx || !scene || !name || !data)
         return rad_null_argument(ctx, __func__);
-    return rad_layout_parse(ctx, scene, name, data, size, rad_layout_load_photometry, NULL);
+    return rad_layout_parse(ctx, &scene->luminaires, name, data, size, rad_layout_load_photometry, NULL);
 }
 
 rad_result rad_scene_load_luminaires(rad_context *ctx, rad_scene *scene, const char *path)
@@ -28,28 +28,28 @@ rad_result rad_scene_load_luminaires(rad_context *ctx, rad_scene *scene, const c
     size_t size = 0;
     rad_result r = rad_read_whole_file(ctx, path, &data, &size);
     if (r == RAD_OK)
-        r = rad_layout_parse(ctx, scene, path, (const char *)data, size, rad_layout_load_photometry, NULL);
+        r = rad_layout_parse(ctx, &scene->luminaires, path, (const char *)data, size, rad_layout_load_photometry, NULL);
     rad_free(data);
     return r;
 }
 
-size_t rad_scene_luminaire_count(const rad_scene *scene) { return scene ? scene->luminaire_count : 0; }
+size_t rad_scene_luminaire_count(const rad_scene *scene) { return scene ? scene->luminaires.count : 0; }
 
 const char *rad_scene_luminaire_name(const rad_scene *scene, size_t index)
 {
-    return scene && index < scene->luminaire_count ? scene->luminaires[index].name : NULL;
+    return scene && index < scene->luminaires.count ? scene->luminaires.items[index].name : NULL;
 }
 
 double rad_scene_luminaire_flux(const rad_scene *scene, size_t index)
 {
-    return scene && index < scene->luminaire_count ? rad_luminaire_flux(scene, index) : 0.0;
+    return scene && index < scene->luminaires.count ? rad_luminaire_flux(&scene->luminaires, index) : 0.0;
 }
 
 bool rad_scene_luminaire_placement(const rad_scene *scene, size_t index, double position[3], double axes[9])
 {
-    if (!scene || index >= scene->luminaire_count)
+    if (!scene || index >= scene->luminaires.count)
         return false;
-    const rad_luminaire *L = &scene->luminaires[index];
+    const rad_luminaire *L = &scene->luminaires.items[index];
     if (position) {
         position[0] = L->position.x, position[1] = L->position.y, position[2] = L->position.z;
     }

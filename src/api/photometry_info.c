@@ -1,10 +1,10 @@
 /*
  * photometry_info.c -- the public summary of a photometric file
- * (radiosity.h, "Photometric files"): scene/photometry.c reads it, this
+ * (radiosity.h, "Photometric files"): photometry/photometry.c reads it, this
  * copies what a program or the `radiosity photometry` command shows.
  */
 #include "core/core.h"
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <stdio.h>
 #include <string.h>

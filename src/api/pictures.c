@@ -19,7 +19,7 @@
  */
 #include "api/solution.h"
 #include "output/picture.h"
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <ctype.h>
 #include <limits.h>

@@ -7,7 +7,7 @@
 #ifndef RAD_SOLUTION_H
 #define RAD_SOLUTION_H
 
-#include "api/options.h"
+#include "strategy/options.h"
 #include "output/output.h"
 #include "strategy/strategy.h"
 
@@ -31,12 +31,5 @@ struct rad_solution {
     double *point_values;          /* 3 per vertex: the radiosity itself, for point queries
                                       (computed on the first one after a solve) */
 };
-
-/* The whole file at `path` in a block of the context (rad_free it), within
- * its memory limit: a regular file by its size, a stream as it comes
- * (api.c; the solution file's and the thermal conditions' reader).  Fails
- * with RAD_ERROR_IO naming the path, RAD_ERROR_OUT_OF_MEMORY,
- * RAD_ERROR_INTERRUPTED. */
-rad_result rad_read_whole_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size);
 
 #endif /* RAD_SOLUTION_H */

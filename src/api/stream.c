@@ -13,7 +13,7 @@
  * and rank 0 takes the blocks in order, so the rows reach the sink in the
  * same order and with the same bits whatever the number of ranks.
  */
-#include "api/options.h"
+#include "strategy/options.h"
 #include "output/output.h"
 
 #include <stdlib.h>

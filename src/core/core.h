@@ -261,6 +261,66 @@ static inline double rad_rng_uniform(rad_rng *r)
     return (double)(z >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/* ---- the engine's limits ---- */
+
+/* The lengths the engine works in, m.  Radiosity is scale-free, so any
+ * unit would do, but lengths are squared (areas), raised to the fourth
+ * power (the kernel's r^4 with cosines unnormalised) and summed over 10^8
+ * elements: within [1e-30, 1e30] m every such product stays inside
+ * double's range (1e-308 to 1e308) with a wide margin, whatever the scale.
+ * A coordinate beyond RAD_MAX_COORDINATE or a polygon smaller across than
+ * RAD_MIN_LENGTH is refused, naming it (the limits are 40 and 60 orders of
+ * magnitude from anything physical: a unit mix-up, or hostile input).
+ * Rays are traced in a frame scaled to the scene (vis_embree.c), so single
+ * precision does not narrow this range. */
+#define RAD_MAX_COORDINATE 1e30
+#define RAD_MIN_LENGTH 1e-30
+
+/* The largest exitance a material may have, W/m^2 (the Sun's is 6.3e7).
+ * Radiosity reaches 10^6 E at a reflectance of 0.999999, and pictures hold
+ * radiance in float (3.4e38 at most): within 1e30 W/m^2 every value an
+ * image can show stays finite.  With the lengths above, the emitted power
+ * sum A E stays below 1e90 W a polygon, so no sum of it can overflow the
+ * solvers' doubles (which once had to be checked apart: a glTF
+ * emissiveStrength of 5e307). */
+#define RAD_MAX_EXITANCE 1e30
+
+/* ---- reading input files (input.c) ---- */
+
+/* The whole file at `path` in a block of the context (rad_free it), within
+ * its memory limit: a regular file by its size, a stream as it comes.
+ * Fails with RAD_ERROR_IO naming the path, RAD_ERROR_OUT_OF_MEMORY,
+ * RAD_ERROR_INTERRUPTED. */
+rad_result rad_read_whole_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size);
+
+/* The files a load opened: the scene file, an OBJ's libraries, every file
+ * assimp opens for reading (a glTF's buffers), a layout's photometric
+ * files, so the scene can list its inputs; and the folder they must lie in. */
+typedef struct rad_input_log {
+    char **paths;     /* rad_alloc'd, each rad_alloc'd; no repeats */
+    size_t count, capacity;
+    bool failed;      /* a name could not be kept (out of memory) */
+    /* Confinement: when root is set, files outside it are refused. */
+    rad_context *ctx; /* where a refusal is reported */
+    const char *scene;/* the file that names the others, for the message */
+    char *root;       /* realpath of that file's folder (rad_alloc'd), or NULL */
+    bool refused;     /* a file was refused (the context has the message) */
+} rad_input_log;
+
+/* Confine `log` to the folder of `scene_path` unless the context allows
+ * reading outside it.  Fails only for memory; a folder that cannot be
+ * resolved confines to nothing looser: every reference is then refused. */
+rad_result rad_input_log_confine(rad_context *ctx, rad_input_log *log, const char *scene_path);
+/* Whether `path` may be read (inside the root, or no root); a refusal is
+ * reported once to the context ("scene.gltf: refers to '../x.bin' outside
+ * its folder ...") and sets log->refused. */
+bool rad_input_allowed(rad_input_log *log, const char *path);
+/* Note a file read outside assimp (the scene, an OBJ's libraries); sets
+ * log->failed when out of memory. */
+void rad_input_log_add(rad_input_log *log, const char *path);
+/* Free the names.  Cannot fail. */
+void rad_input_log_free(rad_input_log *log);
+
 /* ---- file output (file.c): where an output really goes, its identity,
  * temporaries that cannot be hijacked, and atomic replacement ----
  *

@@ -27,7 +27,7 @@ enum { MAX_DEPTH = 4 };
 
 bool rad_light_present(const rad_scene *scene)
 {
-    return scene && (scene->luminaire_count > 0 || scene->daylight != NULL);
+    return scene && (scene->luminaires.count > 0 || scene->daylight != NULL);
 }
 
 void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
@@ -46,7 +46,7 @@ void rad_light_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, dou
     if (!rad_light_present(scene))
         return;
     double part[3];
-    if (scene->luminaire_count > 0) {
+    if (scene->luminaires.count > 0) {
         rad_luminaires_irradiance_lifted(scene, vis, lift, p, n, part);
         for (int c = 0; c < 3; c++)
             out[c] += part[c];

@@ -37,7 +37,7 @@
  */
 #include "light/light.h"
 
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <math.h>
 #include <string.h>
@@ -188,7 +188,7 @@ static opening opening_of(const rad_photometry *ph)
 /* One luminaire's irradiance at p into q. */
 static void one_luminaire(pending *q, const rad_scene *scene, const rad_luminaire *L, vec3 p, vec3 n, double eps)
 {
-    const rad_photometry *ph = scene->photometries[L->photometry];
+    const rad_photometry *ph = scene->luminaires.photometries[L->photometry];
     opening o = opening_of(ph);
     double size = fmax(fmax(ph->length, ph->width), ph->height);
     double d = v3_length(v3_sub(L->position, p));
@@ -243,8 +243,8 @@ void rad_luminaires_irradiance_lifted(const rad_scene *scene, const rad_vis *vis
     q.count = 0;
     q.vis = vis;
     q.sum = 0.0;
-    for (size_t k = 0; k < scene->luminaire_count; k++)
-        one_luminaire(&q, scene, &scene->luminaires[k], p, n, lift);
+    for (size_t k = 0; k < scene->luminaires.count; k++)
+        one_luminaire(&q, scene, &scene->luminaires.items[k], p, n, lift);
     flush(&q);
     out[0] = out[1] = out[2] = q.sum;
 }

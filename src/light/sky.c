@@ -10,7 +10,7 @@
  *                                            phi(0) = 1 + a exp(b))
  *     f(chi)   = 1 + c (exp(d chi) - exp(d pi/2)) + e cos^2 chi
  *
- * the 15 types' (a, b, c, d, e) in scene/daylight.c.  Traditional CIE
+ * the 15 types' (a, b, c, d, e) in light/daylight_file.c.  Traditional CIE
  * overcast sky (Moon & Spencer 1942; CIE 1955): L = Lz (1 + 2 cos Z) / 3,
  * whose horizontal illuminance is exactly 7 pi Lz / 9.
  *
@@ -19,7 +19,7 @@
  */
 #include "light/sky.h"
 
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <math.h>
 

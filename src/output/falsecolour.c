@@ -27,7 +27,7 @@
  */
 #include "output/picture.h"
 #include "formfactor/formfactor.h"
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -165,8 +165,8 @@ rad_result rad_write_solution(rad_context *ctx, const rad_solution_view *v, cons
         rad_bytes_f64(&payload, vertex_radiosity[i]);
     /* The luminaires (saved.h "light"): their tables and placements, then
      * each element's direct irradiance, so a loaded solution has its light. */
-    cJSON *light = v->scene->luminaire_count > 0 ? rad_saved_put_light(&payload, v->scene, v->direct, v->n) : NULL;
-    if (v->scene->luminaire_count > 0 && !light)
+    cJSON *light = v->scene->luminaires.count > 0 ? rad_saved_put_light(&payload, v->scene, v->direct, v->n) : NULL;
+    if (v->scene->luminaires.count > 0 && !light)
         payload.failed = true;
     char hex[17];
     snprintf(hex, sizeof hex, "%016" PRIx64, rad_fnv1a(RAD_FNV_OFFSET, payload.data, payload.size));

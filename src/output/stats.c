@@ -15,8 +15,8 @@
  */
 #include "output/output.h"
 #include "output/view3d.h"
-#include "scene/layout.h"
-#include "scene/photometry.h"
+#include "photometry/layout.h"
+#include "photometry/photometry.h"
 
 #include <cjson/cJSON.h>
 #include <inttypes.h>
@@ -296,18 +296,18 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
     cJSON_AddNumberToObject(power, "emitted", emitted);
     cJSON_AddNumberToObject(power, "absorbed", absorbed);
     cJSON_AddNumberToObject(power, "escaped", emitted - absorbed);
-    if (s->scene->luminaire_count > 0) {
+    if (s->scene->luminaires.count > 0) {
         /* The luminaires (docs/lighting.md): their flux, and the direct
          * light landing on the elements, lm = 179 Y(A H_d). */
         double lumens = 0.0, landing = 0.0;
-        for (size_t k = 0; k < s->scene->luminaire_count; k++)
-            lumens += rad_luminaire_flux(s->scene, k);
+        for (size_t k = 0; k < s->scene->luminaires.count; k++)
+            lumens += rad_luminaire_flux(&s->scene->luminaires, k);
         for (size_t i = 0; s->direct && i < s->n; i++) {
             const double *h = s->direct + 3 * i;
             landing += s->area[i] * (RAD_Y_R * h[0] + RAD_Y_G * h[1] + RAD_Y_B * h[2]);
         }
         cJSON *lum = cJSON_AddObjectToObject(root, "luminaires");
-        cJSON_AddNumberToObject(lum, "count", (double)s->scene->luminaire_count);
+        cJSON_AddNumberToObject(lum, "count", (double)s->scene->luminaires.count);
         cJSON_AddNumberToObject(lum, "lumens", lumens);
         cJSON_AddNumberToObject(lum, "direct_lumens", RAD_LUMINOUS_EFFICACY * landing);
     }

@@ -3,7 +3,7 @@
  * CIE sky, optionally the sun as parallel light, optionally a uniform
  * ground below the horizon, and the openings through which they enter.
  *
- * The daylight file (scene/daylight.c) is read against a loaded scene: the
+ * This is the model; the daylight file (light/daylight_file.c) is read against a loaded scene: the
  * surfaces it marks as openings (by name, or by material) leave the scene
  * -- they are holes, meshed by nothing and blocking no ray -- and are kept
  * here, split into triangles and quads, for the integration of the sky
@@ -72,37 +72,7 @@ struct rad_daylight {
 
 typedef struct rad_daylight rad_daylight;
 
-/* The general sky's parameters (a, b, c, d, e) of type 1..15 into p[5];
- * false for another type.  Cannot fail otherwise. */
-bool rad_sky_type_parameters(int type, double p[5]);
-
-/* The sun's position by the NOAA solar calculator's formulas (Spencer's
- * 1971 series for the declination and the equation of time): latitude
- * (deg, north > 0), longitude (deg, east > 0), day of year 1..366, local
- * clock time in hours, time zone in hours east of UTC.  Out: the zenith
- * angle and the azimuth from north through east, rad.  Cannot fail. */
-void rad_sun_position(double latitude, double longitude, int day_of_year, double hours, double timezone,
-                      double *zenith, double *azimuth);
-
-/* Read a daylight file's text against `scene` (name: the file, for
- * messages) into a new rad_daylight (*out), the sky not yet scaled
- * (rad_sky_prepare).  The scene is not changed.  Fails with
- * RAD_ERROR_PARSE, a one-line message naming the file and the key;
- * RAD_ERROR_OUT_OF_MEMORY.  On failure *out is NULL. */
-rad_result rad_daylight_parse(rad_context *ctx, const rad_scene *scene, const char *name, const char *text,
-                              size_t size, rad_daylight **out);
-
-/* Move the openings out of `scene` into `daylight` and attach it
- * (scene->daylight; a previous one is freed, its openings carried over
- * into `daylight`): the marked polygons leave
- * the scene, surfaces left with none are removed (the others renumbered),
- * the bounds are recomputed, the file is added to the scene's inputs.
- * Fails with RAD_ERROR_INVALID_SCENE when nothing would be left,
- * RAD_ERROR_OUT_OF_MEMORY; on failure the scene is unchanged and
- * `daylight` is freed. */
-rad_result rad_scene_attach_daylight(rad_context *ctx, rad_scene *scene, rad_daylight *daylight,
-                                     const char *path);
-
+/* Free the daylight and what it holds (scene/daylight.c).  NULL: no-op. */
 void rad_daylight_free(rad_daylight *daylight);
 
 #endif

@@ -1,6 +1,6 @@
 /*
  * scene.c -- the scene builder, its validation, and the public scene
- * accessors and loaders.
+ * accessors (the loaders are import/load.c's).
  *
  * Importers hand the builder materials, named surfaces and polygons one at
  * a time, and each is checked as it arrives, so that an error can name the
@@ -20,7 +20,6 @@
  * shared vertices is the mesher's job, which knows the crease angle.
  */
 #include "scene/scene.h"
-#include "scene/photometry.h"
 #include "scene/daylight.h"
 
 #include <limits.h>
@@ -725,48 +724,6 @@ done:
 
 /* ---- the public scene ---- */
 
-rad_result rad_scene_load_file(rad_context *ctx, const char *path, rad_scene **out)
-{
-    rad_api_enter(ctx);
-    if (out)
-        *out = NULL;
-    if (!ctx || !path || !out)
-        return rad_null_argument(ctx, __func__);
-    double start = rad_seconds();
-    /* View3D's .vs3, by its extension or its first record. */
-    char head[512];
-    size_t head_size = 0;
-    struct stat st;
-    FILE *peek = stat(path, &st) == 0 && S_ISREG(st.st_mode) ? fopen(path, "rb") : NULL;
-    if (peek) { /* regular files only: a FIFO's bytes are read once */
-        head_size = fread(head, 1, sizeof head, peek);
-        fclose(peek);
-    }
-    rad_result r = rad_vs3_detect(path, head, head_size) ? rad_import_vs3_file(ctx, path, out)
-                                                          : rad_import_assimp_file(ctx, path, out);
-    if (r == RAD_OK)
-        (*out)->load_seconds = rad_seconds() - start;
-    return r;
-}
-
-rad_result rad_scene_load_memory(rad_context *ctx, const char *name, const void *data,
-                                 size_t size, const void *mtl, size_t mtl_size,
-                                 rad_scene **out)
-{
-    rad_api_enter(ctx);
-    if (out)
-        *out = NULL;
-    if (!ctx || !name || !out || (!data && size > 0) || (!mtl && mtl_size > 0))
-        return rad_null_argument(ctx, __func__);
-    double start = rad_seconds();
-    rad_result r = rad_vs3_detect(name, data, size)
-                       ? rad_import_vs3_memory(ctx, name, data, size, out)
-                       : rad_import_assimp_memory(ctx, name, data, size, mtl, mtl_size, out);
-    if (r == RAD_OK)
-        (*out)->load_seconds = rad_seconds() - start;
-    return r;
-}
-
 void rad_scene_destroy(rad_scene *scene)
 {
     if (!scene)
@@ -788,12 +745,7 @@ void rad_scene_destroy(rad_scene *scene)
     }
     rad_free(scene->textures);
     rad_free(scene->uv_maps);
-    for (size_t i = 0; i < scene->photometry_count; i++)
-        rad_photometry_free(scene->photometries[i]);
-    rad_free(scene->photometries);
-    for (size_t i = 0; i < scene->luminaire_count; i++)
-        rad_free(scene->luminaires[i].name);
-    rad_free(scene->luminaires);
+    rad_luminaire_set_free(&scene->luminaires);
     rad_daylight_free(scene->daylight);
     rad_free(scene);
 }

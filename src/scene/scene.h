@@ -11,6 +11,7 @@
 #define RAD_SCENE_H
 
 #include "core/core.h"
+#include "photometry/layout.h"
 
 /* The specular part of a material (docs/units.md "Specular materials"):
  * what the first pass folds into extended form factors (mirrors) and the
@@ -59,7 +60,7 @@ typedef struct rad_surface {
 } rad_surface;
 
 /* What a View3D .vs3 file's control line asks of the view-factor output
- * (scene/import_vs3.c, docs/formats.md "View3D"); present is false for
+ * (import/import_vs3.c, docs/formats.md "View3D"); present is false for
  * every other format. */
 typedef struct rad_view3d_control {
     bool present;
@@ -95,18 +96,6 @@ void rad_scene_reflectance_at(const rad_scene *scene, uint32_t polygon, vec3 p, 
 /* Whether polygon `polygon` is textured (a texture and coordinates). */
 bool rad_scene_textured(const rad_scene *scene, uint32_t polygon);
 
-/* A luminaire placed in the scene (docs/lighting.md "Luminaires"): a
- * photometric distribution at a position, turned by its frame.  It is a
- * light source, not geometry: it has no elements and blocks no rays. */
-struct rad_photometry; /* scene/photometry.h */
-typedef struct rad_luminaire {
-    char *name;               /* unique: the layout's name (with its index in an array) or the glTF node's */
-    uint32_t photometry;      /* index into rad_scene.photometries */
-    vec3 position;            /* m: the photometric centre */
-    vec3 axis[3];             /* unit, world: the luminaire's x (C = 0), y (C = 90), z (up; nadir = -z) */
-    double multiplier;        /* on the file's candela: light loss factor x lumens override ratio x
-                                 the tilt factor for this orientation */
-} rad_luminaire;
 
 struct rad_daylight; /* scene/daylight.h: the sky, the sun, the openings */
 
@@ -136,10 +125,7 @@ struct rad_scene {
     /* Light that is not emitted by surfaces (docs/lighting.md): luminaires
      * (photometric files placed by a layout or by glTF nodes) and daylight;
      * none by default. */
-    struct rad_photometry **photometries; /* each file once */
-    size_t photometry_count;
-    rad_luminaire *luminaires;
-    size_t luminaire_count;
+    rad_luminaire_set luminaires;
     struct rad_daylight *daylight;        /* NULL: no daylight */
 };
 
@@ -208,49 +194,11 @@ void rad_scene_builder_surface_mask(rad_scene_builder *b, int surface, int base)
  * way.  Fails on an empty scene. */
 rad_result rad_scene_builder_finish(rad_scene_builder *b, rad_scene **out);
 
-/* ---- importers ---- */
-
-/* assimp: OBJ(+MTL) and glTF 2.0, from a file or memory (scene/import_assimp.c). */
-rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene **out);
-rad_result rad_import_assimp_memory(rad_context *ctx, const char *name, const void *data,
-                                    size_t size, const void *mtl, size_t mtl_size,
-                                    rad_scene **out);
-
-/* View3D's .vs3 vertex/surface format (scene/import_vs3.c). */
-rad_result rad_import_vs3_memory(rad_context *ctx, const char *name, const char *text, size_t size,
-                                 rad_scene **out);
-rad_result rad_import_vs3_file(rad_context *ctx, const char *path, rad_scene **out);
-/* True when a file's name ends in .vs3 (any case) or its text begins, after
- * blank and comment lines, with a View3D title or control line ("T ", "C "). */
-bool rad_vs3_detect(const char *name, const char *text, size_t size);
-
 /* ---- queries used downstream ---- */
 
 /* True if some material emits. */
 bool rad_scene_has_emitter(const rad_scene *scene);
 double rad_scene_diagonal(const rad_scene *scene); /* m */
-
-/* The lengths the engine works in, m.  Radiosity is scale-free, so any
- * unit would do, but lengths are squared (areas), raised to the fourth
- * power (the kernel's r^4 with cosines unnormalised) and summed over 10^8
- * elements: within [1e-30, 1e30] m every such product stays inside
- * double's range (1e-308 to 1e308) with a wide margin, whatever the scale.
- * A coordinate beyond RAD_MAX_COORDINATE or a polygon smaller across than
- * RAD_MIN_LENGTH is refused, naming it (the limits are 40 and 60 orders of
- * magnitude from anything physical: a unit mix-up, or hostile input).
- * Rays are traced in a frame scaled to the scene (vis_embree.c), so single
- * precision does not narrow this range. */
-#define RAD_MAX_COORDINATE 1e30
-#define RAD_MIN_LENGTH 1e-30
-
-/* The largest exitance a material may have, W/m^2 (the Sun's is 6.3e7).
- * Radiosity reaches 10^6 E at a reflectance of 0.999999, and pictures hold
- * radiance in float (3.4e38 at most): within 1e30 W/m^2 every value an
- * image can show stays finite.  With the lengths above, the emitted power
- * sum A E stays below 1e90 W a polygon, so no sum of it can overflow the
- * solvers' doubles (which once had to be checked apart: a glTF
- * emissiveStrength of 5e307). */
-#define RAD_MAX_EXITANCE 1e30
 
 /* Bytes of working space rad_triangulate_polygon needs for n vertices: the
  * projected points and seven words per vertex (a multiple of 4, so what

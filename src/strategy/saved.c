@@ -14,8 +14,8 @@
  */
 #include "strategy/saved.h"
 
-#include "api/options.h"
-#include "scene/photometry.h"
+#include "strategy/options.h"
+#include "photometry/photometry.h"
 
 #include <cjson/cJSON.h>
 #include <inttypes.h>
@@ -218,8 +218,8 @@ cJSON *rad_saved_put_light(rad_bytes *b, const rad_scene *scene, const double *d
         return NULL;
     }
     bool ok = true;
-    for (size_t k = 0; k < scene->photometry_count; k++) {
-        const rad_photometry *p = scene->photometries[k];
+    for (size_t k = 0; k < scene->luminaires.photometry_count; k++) {
+        const rad_photometry *p = scene->luminaires.photometries[k];
         cJSON *o = cJSON_CreateObject();
         ok = ok && o && cJSON_AddItemToArray(ph, o) && cJSON_AddStringToObject(o, "source", p->source ? p->source : "") &&
              cJSON_AddNumberToObject(o, "c_count", (double)p->c_count) &&
@@ -235,8 +235,8 @@ cJSON *rad_saved_put_light(rad_bytes *b, const rad_scene *scene, const double *d
         for (size_t i = 0; i < p->c_count * p->gamma_count; i++)
             rad_bytes_f64(b, p->candela[i]);
     }
-    for (size_t k = 0; k < scene->luminaire_count; k++) {
-        const rad_luminaire *L = &scene->luminaires[k];
+    for (size_t k = 0; k < scene->luminaires.count; k++) {
+        const rad_luminaire *L = &scene->luminaires.items[k];
         cJSON *o = cJSON_CreateObject();
         ok = ok && o && cJSON_AddItemToArray(lu, o) && cJSON_AddStringToObject(o, "name", L->name) &&
              cJSON_AddNumberToObject(o, "photometry", (double)L->photometry);
@@ -747,9 +747,9 @@ static rad_result read_light(rad_context *ctx, const char *name, rad_scene *scen
                              cursor *c, size_t elements, double **direct)
 {
     size_t P = (size_t)cJSON_GetArraySize(ph), L = (size_t)cJSON_GetArraySize(lu);
-    scene->photometries = rad_alloc(ctx, RAD_MEM_SCENE, P + 1, sizeof *scene->photometries, "solution file: light");
-    scene->luminaires = rad_alloc(ctx, RAD_MEM_SCENE, L + 1, sizeof *scene->luminaires, "solution file: light");
-    if (!scene->photometries || !scene->luminaires)
+    scene->luminaires.photometries = rad_alloc(ctx, RAD_MEM_SCENE, P + 1, sizeof *scene->luminaires.photometries, "solution file: light");
+    scene->luminaires.items = rad_alloc(ctx, RAD_MEM_SCENE, L + 1, sizeof *scene->luminaires.items, "solution file: light");
+    if (!scene->luminaires.photometries || !scene->luminaires.items)
         return RAD_ERROR_OUT_OF_MEMORY;
     size_t k = 0;
     for (const cJSON *o = ph->child; o; o = o->next, k++) {
@@ -769,7 +769,7 @@ static rad_result read_light(rad_context *ctx, const char *name, rad_scene *scen
         if (!p)
             return err == RAD_ERROR_OUT_OF_MEMORY ? RAD_ERROR_OUT_OF_MEMORY
                                                   : BAD("%s: light: distribution %zu is not a valid table", name, k);
-        scene->photometries[scene->photometry_count++] = p;
+        scene->luminaires.photometries[scene->luminaires.photometry_count++] = p;
         for (int d = 0; d < 3; d++)
             if (!(isfinite(dims[d]) && dims[d] >= 0.0))
                 return BAD("%s: light: distribution %zu has an opening of %g m", name, k, dims[d]);
@@ -780,13 +780,13 @@ static rad_result read_light(rad_context *ctx, const char *name, rad_scene *scen
     }
     k = 0;
     for (const cJSON *o = lu->child; o; o = o->next, k++) {
-        rad_luminaire *l = &scene->luminaires[k];
+        rad_luminaire *l = &scene->luminaires.items[k];
         memset(l, 0, sizeof *l);
         l->name = rad_strdup(ctx, RAD_MEM_SCENE, cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(o, "name")),
                              "solution file: light");
         if (!l->name)
             return RAD_ERROR_OUT_OF_MEMORY;
-        scene->luminaire_count = k + 1;
+        scene->luminaires.count = k + 1;
         l->photometry = (uint32_t)number_in(o, "photometry");
         l->position = get_vec3(c);
         for (int a = 0; a < 3; a++)
@@ -803,7 +803,7 @@ static rad_result read_light(rad_context *ctx, const char *name, rad_scene *scen
     if (!names)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t i = 0; i < L; i++)
-        names[i] = scene->luminaires[i].name;
+        names[i] = scene->luminaires.items[i].name;
     qsort(names, L, sizeof *names, compare_names);
     bool unique = true;
     for (size_t i = 1; i < L; i++)

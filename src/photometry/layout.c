@@ -24,9 +24,9 @@
  * Every error names the file, the entry (cJSON keeps no lines) and the key;
  * the scene changes only when the whole layout is good.
  */
-#include "scene/layout.h"
+#include "photometry/layout.h"
 
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <cjson/cJSON.h>
 #include <math.h>
@@ -86,17 +86,28 @@ double rad_layout_tilt_degrees(const vec3 axis[3], vec3 up)
     return acos(fmax(-1.0, fmin(1.0, c))) / DEG;
 }
 
-double rad_luminaire_flux(const rad_scene *scene, size_t k)
+double rad_luminaire_flux(const rad_luminaire_set *set, size_t k)
 {
-    const rad_luminaire *L = &scene->luminaires[k];
-    return scene->photometries[L->photometry]->flux * L->multiplier;
+    const rad_luminaire *L = &set->items[k];
+    return set->photometries[L->photometry]->flux * L->multiplier;
+}
+
+void rad_luminaire_set_free(rad_luminaire_set *set)
+{
+    for (size_t k = 0; k < set->photometry_count; k++)
+        rad_photometry_free(set->photometries[k]);
+    rad_free(set->photometries);
+    for (size_t k = 0; k < set->count; k++)
+        rad_free(set->items[k].name);
+    rad_free(set->items);
+    memset(set, 0, sizeof *set);
 }
 
 /* ---- what a layout adds, kept aside until all of it is good ---- */
 
 typedef struct additions {
     rad_context *ctx;
-    rad_scene *scene;
+    rad_luminaire_set *set;
     const char *name;        /* the layout (or glTF), for messages */
     rad_photometry_loader load;
     void *user;
@@ -121,7 +132,7 @@ static void additions_free(additions *a)
  * loaded if new. */
 static rad_result photometry_of(additions *a, const char *path, uint32_t *index)
 {
-    const rad_scene *s = a->scene;
+    const rad_luminaire_set *s = a->set;
     for (size_t k = 0; k < s->photometry_count; k++)
         if (s->photometries[k]->source && strcmp(s->photometries[k]->source, path) == 0) {
             *index = (uint32_t)k;
@@ -163,8 +174,8 @@ static rad_result photometry_of(additions *a, const char *path, uint32_t *index)
 
 static const rad_photometry *photometry_at(const additions *a, uint32_t index)
 {
-    return index < a->scene->photometry_count ? a->scene->photometries[index]
-                                              : a->photometries[index - a->scene->photometry_count];
+    return index < a->set->photometry_count ? a->set->photometries[index]
+                                              : a->photometries[index - a->set->photometry_count];
 }
 
 static rad_result add_luminaire(additions *a, char *name, uint32_t photometry, vec3 position, const vec3 axis[3],
@@ -200,15 +211,15 @@ static int compare_names(const void *x, const void *y)
  * ones appended to the scene. */
 static rad_result commit(additions *a)
 {
-    rad_scene *s = a->scene;
-    size_t total = s->luminaire_count + a->luminaire_count;
+    rad_luminaire_set *s = a->set;
+    size_t total = s->count + a->luminaire_count;
     const char **names = rad_alloc(a->ctx, RAD_MEM_SCENE, total + 1, sizeof *names, "luminaires: names");
     if (!names)
         return RAD_ERROR_OUT_OF_MEMORY;
-    for (size_t k = 0; k < s->luminaire_count; k++)
-        names[k] = s->luminaires[k].name;
+    for (size_t k = 0; k < s->count; k++)
+        names[k] = s->items[k].name;
     for (size_t k = 0; k < a->luminaire_count; k++)
-        names[s->luminaire_count + k] = a->luminaires[k].name;
+        names[s->count + k] = a->luminaires[k].name;
     qsort(names, total, sizeof *names, compare_names);
     for (size_t k = 1; k < total; k++)
         if (strcmp(names[k - 1], names[k]) == 0) {
@@ -224,14 +235,14 @@ static rad_result commit(additions *a)
     if (!ph)
         return RAD_ERROR_OUT_OF_MEMORY;
     s->photometries = ph;
-    rad_luminaire *lu = rad_realloc(a->ctx, RAD_MEM_SCENE, s->luminaires, total + 1, sizeof *lu, "luminaires");
+    rad_luminaire *lu = rad_realloc(a->ctx, RAD_MEM_SCENE, s->items, total + 1, sizeof *lu, "luminaires");
     if (!lu)
         return RAD_ERROR_OUT_OF_MEMORY;
-    s->luminaires = lu;
+    s->items = lu;
     memcpy(s->photometries + s->photometry_count, a->photometries, a->photometry_count * sizeof *ph);
     s->photometry_count += a->photometry_count;
-    memcpy(s->luminaires + s->luminaire_count, a->luminaires, a->luminaire_count * sizeof *lu);
-    s->luminaire_count = total;
+    memcpy(s->items + s->count, a->luminaires, a->luminaire_count * sizeof *lu);
+    s->count = total;
     rad_free(a->photometries);
     rad_free(a->luminaires);
     memset(a, 0, sizeof *a);
@@ -499,10 +510,10 @@ static rad_result parse_layout(additions *a, const cJSON *root)
     return RAD_OK;
 }
 
-rad_result rad_layout_parse(rad_context *ctx, rad_scene *scene, const char *name, const char *text, size_t size,
+rad_result rad_layout_parse(rad_context *ctx, rad_luminaire_set *set, const char *name, const char *text, size_t size,
                             rad_photometry_loader load, void *user)
 {
-    additions add = {ctx, scene, name, load, user, NULL, 0, 0, NULL, 0, 0};
+    additions add = {ctx, set, name, load, user, NULL, 0, 0, NULL, 0, 0};
     additions *a = &add;
     rad_result r;
     cJSON *root = NULL;
@@ -556,11 +567,11 @@ static rad_result read_extras(additions *a, const rad_gltf_luminaire *node, ligh
     return RAD_OK;
 }
 
-rad_result rad_layout_place_gltf(rad_context *ctx, rad_scene *scene, const char *name,
+rad_result rad_layout_place_gltf(rad_context *ctx, rad_luminaire_set *set, const char *name,
                                  const rad_gltf_luminaire *nodes, size_t count, rad_photometry_loader load,
                                  void *user)
 {
-    additions add = {ctx, scene, name, load, user, NULL, 0, 0, NULL, 0, 0};
+    additions add = {ctx, set, name, load, user, NULL, 0, 0, NULL, 0, 0};
     additions *a = &add;
     rad_result r = RAD_OK;
     const vec3 up = v3(0, 1, 0); /* glTF is +y up */

@@ -24,7 +24,7 @@
  * then one line counting the rest: a file of 500 textured materials says
  * so in 11 lines, not 500.
  */
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 
 #include <cjson/cJSON.h>
 

@@ -32,8 +32,8 @@
  * confined and logged one; a memory import has only its data: URIs and its
  * GLB chunk), a block at a time.
  */
-#include "scene/import_internal.h"
-#include "scene/layout.h"
+#include "import/import_internal.h"
+#include "photometry/layout.h"
 
 #include <assimp/cfileio.h>
 #include <cjson/cJSON.h>

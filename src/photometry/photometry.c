@@ -10,7 +10,7 @@
  * its flux is the integral of that same surface, in closed form per cell
  * (below), so the flux and the evaluation never disagree.
  */
-#include "scene/photometry_internal.h"
+#include "photometry/photometry_internal.h"
 
 #include <errno.h>
 #include <stdlib.h>

@@ -43,7 +43,7 @@
  * sees, and is served all the libraries' text there: the OBJ it reads has
  * its later `mtllib` statements made comments.
  */
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 
 #include <errno.h>
 #include <string.h>
@@ -267,7 +267,7 @@ typedef struct libraries {
     rad_context *ctx;
     const char *obj_path;
     size_t folder;          /* bytes of obj_path up to its last '/', included */
-    import_file_log *log;
+    rad_input_log *log;
     double read;            /* bytes of the scene's text read so far */
     library_text all;
     import_material_names names;
@@ -318,7 +318,7 @@ static rad_result read_library(libraries *l, const char *name, size_t name_lengt
         }
         l->seen[l->seen_count++] = (library_seen){device, inode};
     }
-    if (!import_file_allowed(l->log, path)) {
+    if (!rad_input_allowed(l->log, path)) {
         rad_free(path);
         return RAD_ERROR_IO;
     }
@@ -327,7 +327,7 @@ static rad_result read_library(libraries *l, const char *name, size_t name_lengt
     rad_result r = read_whole(l->ctx, path, what, l->read, &text, &size);
     const char *start = text;
     if (r == RAD_OK) {
-        import_file_log_add(l->log, path);
+        rad_input_log_add(l->log, path);
         l->read += (double)size;
         skip_byte_order_mark(&start, &size);
         l->names.textures_read = true; /* a file load: its textures are read */
@@ -409,7 +409,7 @@ static rad_result exact_positions(rad_context *ctx, const char *name, import_inp
 
 /* ---- the two ways in ---- */
 
-rad_result import_input_read_file(rad_context *ctx, const char *path, import_file_log *log,
+rad_result import_input_read_file(rad_context *ctx, const char *path, rad_input_log *log,
                                   import_input *in)
 {
     memset(in, 0, sizeof *in);

@@ -17,11 +17,10 @@
 #ifndef RAD_SCENE_IMPORT_INTERNAL_H
 #define RAD_SCENE_IMPORT_INTERNAL_H
 
-#include "scene/scene.h"
+#include "import/import.h"
 
 struct aiFileIO;
 struct cJSON;
-typedef struct import_file_log import_file_log; /* assimp_io.c */
 
 /* ---- unused.c ---- */
 
@@ -204,7 +203,7 @@ typedef struct import_input {
  * library it names (each file passing `log`'s confinement and noted in
  * it).  Fails with RAD_ERROR_IO, RAD_ERROR_PARSE, RAD_ERROR_INVALID_SCENE,
  * RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INTERRUPTED; `in` is then empty. */
-rad_result import_input_read_file(rad_context *ctx, const char *path, import_file_log *log,
+rad_result import_input_read_file(rad_context *ctx, const char *path, rad_input_log *log,
                                   import_input *in);
 /* The same from memory: `mtl` (NULL: none) holds every library an OBJ
  * names.  The buffers are borrowed, or copied where an OBJ's text is
@@ -262,7 +261,7 @@ double import_gltf_emissive_strength(const struct cJSON *materials, unsigned ind
 /* ---- gltf_check.c ---- */
 
 /* What the check learnt for the import. */
-struct rad_gltf_luminaire; /* scene/layout.h */
+struct rad_gltf_luminaire; /* photometry/layout.h */
 typedef struct import_gltf_facts {
     bool has_camera;   /* the scene's first perspective camera, placed */
     rad_camera camera;
@@ -290,34 +289,6 @@ rad_result import_gltf_check(rad_context *ctx, const char *name, const char *dat
 
 /* ---- assimp_io.c ---- */
 
-/* The files a file import opened: the scene file, an OBJ's libraries and
- * every file assimp opens for reading (a glTF's buffers), so the scene can
- * list its inputs. */
-struct import_file_log {
-    char **paths;     /* rad_alloc'd, each rad_alloc'd; no repeats */
-    size_t count, capacity;
-    bool failed;      /* a name could not be kept (out of memory) */
-    /* Confinement: when root is set, files outside it are refused. */
-    rad_context *ctx; /* where a refusal is reported */
-    const char *scene;/* the scene file, for the message */
-    char *root;       /* realpath of the scene's folder (rad_alloc'd), or NULL */
-    bool refused;     /* a file was refused (the context has the message) */
-};
-
-/* Confine `log` to the folder of `scene_path` unless the context allows
- * reading outside it.  Fails only for memory; a folder that cannot be
- * resolved confines to nothing looser: every reference is then refused. */
-rad_result import_file_log_confine(rad_context *ctx, import_file_log *log, const char *scene_path);
-/* Whether `path` may be read (inside the root, or no root); a refusal is
- * reported once to the context ("scene.gltf: refers to '../x.bin' outside
- * its folder ...") and sets log->refused. */
-bool import_file_allowed(import_file_log *log, const char *path);
-/* Note a file read outside assimp (the scene, an OBJ's libraries); sets
- * log->failed when out of memory. */
-void import_file_log_add(import_file_log *log, const char *path);
-/* Free the names.  Cannot fail. */
-void import_file_log_free(import_file_log *log);
-
 /* What assimp reads through import_io: the input from memory under its
  * alias; for an OBJ, the libraries' text under any other name (assimp
  * opens only the `mtllib` it sees, the first); for glTF, other files from
@@ -325,7 +296,7 @@ void import_file_log_free(import_file_log *log);
 typedef struct import_files {
     rad_context *ctx;        /* the open files' handles are allocated in it */
     const import_input *in;
-    import_file_log *log;
+    rad_input_log *log;
     bool out_of_memory;      /* an open failed for memory: assimp may carry on without the file */
 } import_files;
 

@@ -11,10 +11,10 @@
  * (0, 1), got 2".
  *
  * The checks of rad_render_options and rad_office_options stay where those
- * structs are used (output/render.c, scene/generate.c); their rows here
+ * structs are used (output/render.c, generate/generate.c); their rows here
  * describe those checks, and tests/test_options.c holds the two together.
  */
-#include "api/options.h"
+#include "strategy/options.h"
 
 #include "strategy/strategy.h"
 

@@ -29,7 +29,7 @@
  * alternatives and only reported.  From line 27 on, numbers may share
  * lines; a decimal comma is read as a point.
  */
-#include "scene/photometry_internal.h"
+#include "photometry/photometry_internal.h"
 
 #include <stdlib.h>
 #include <string.h>

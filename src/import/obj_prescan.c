@@ -17,7 +17,7 @@
  * and B2 of the Advanced Visualizer manual.  Works on buffers (which need
  * not end in NUL), so the fuzzers drive it from memory.
  */
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -776,7 +776,7 @@ rad_result import_mtl_prescan(rad_context *ctx, const char *path, const char *te
         if (strcasecmp(token, "map_Kd") == 0) { /* its line for the importer's messages */
             names->entries[names->count - 1].map_kd_line = lines.number;
             if (names->textures_read)
-                continue; /* read (scene/texture.c), so not noted as unused */
+                continue; /* read (import/texture.c), so not noted as unused */
         }
         if (!is_kd && !is_ke) {
             int property = mtl_property_of(token);

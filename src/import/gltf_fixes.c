@@ -12,7 +12,7 @@
  *
  * (Khronos, glTF 2.0 specification, section "Binary glTF Layout".)
  */
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 
 #include <cjson/cJSON.h>
 

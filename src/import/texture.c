@@ -8,7 +8,7 @@
  * and the texels' floats (12 bytes a texel, plus stb's 3 bytes) must fit
  * the memory limit before anything is decoded.
  */
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 
 #include <errno.h>
 #include <stdlib.h>

@@ -23,8 +23,8 @@
  * onto a type C grid at least as fine as the file's angles (down to 0.25
  * degrees), the photometric axis on the nadir (photometry.h, "Frame").
  */
-#include "scene/import_internal.h"
-#include "scene/photometry_internal.h"
+#include "import/import_internal.h"
+#include "photometry/photometry_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -72,12 +72,12 @@ static rad_result read_tilt_file(rad_context *ctx, const char *name, size_t line
     if (!path)
         return RAD_ERROR_OUT_OF_MEMORY;
     snprintf(path, n, "%s/%s", folder, file);
-    import_file_log log;
+    rad_input_log log;
     memset(&log, 0, sizeof log);
-    rad_result r = import_file_log_confine(ctx, &log, name);
-    if (r == RAD_OK && !import_file_allowed(&log, path))
+    rad_result r = rad_input_log_confine(ctx, &log, name);
+    if (r == RAD_OK && !rad_input_allowed(&log, path))
         r = RAD_ERROR_IO;
-    import_file_log_free(&log);
+    rad_input_log_free(&log);
     FILE *f = r == RAD_OK ? fopen(path, "rb") : NULL;
     if (r == RAD_OK && !f)
         r = rad_fail(ctx, RAD_ERROR_IO, "%s:%zu: TILT=%s: cannot open %s", name, line, file, path);

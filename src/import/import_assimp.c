@@ -51,8 +51,8 @@
  * assimp's own memory is not the allocator's to count), so a stream
  * (a FIFO, /dev/zero) stops there (import_input.c).
  */
-#include "scene/import_internal.h"
-#include "scene/layout.h"
+#include "import/import_internal.h"
+#include "photometry/layout.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -146,7 +146,7 @@ typedef struct converter {
     size_t use_count, use_capacity;
     const import_obj_positions *positions;       /* OBJ: the exact positions; else NULL */
     const import_material_names *materials_exact; /* OBJ: exact Kd and Ke; else NULL */
-    import_file_log *log;        /* a file load's confinement; NULL from memory (no textures read) */
+    rad_input_log *log;        /* a file load's confinement; NULL from memory (no textures read) */
     bool *textured;              /* aiMaterial index -> it got a texture */
 } converter;
 
@@ -199,7 +199,7 @@ static rad_result convert_texture(converter *cv, unsigned index, const char *mat
         snprintf(path, sizeof path, "%s", file.data);
     else
         snprintf(path, sizeof path, "%.*s/%s", (int)(slash - cv->name), cv->name, file.data);
-    if (!import_file_allowed(cv->log, path))
+    if (!rad_input_allowed(cv->log, path))
         return RAD_ERROR_IO; /* the refusal is the context's message */
     float *rgb = NULL;
     int width = 0, height = 0;
@@ -214,7 +214,7 @@ static rad_result convert_texture(converter *cv, unsigned index, const char *mat
         return rad_fail(cv->ctx, r, "%s: %s '%s': cannot read %s: %s%s", where, statement, file.data, path, why,
                         r == RAD_ERROR_OUT_OF_MEMORY ? "" : " (--missing-textures flat uses its flat colour)");
     }
-    import_file_log_add(cv->log, path);
+    rad_input_log_add(cv->log, path);
     r = rad_scene_builder_texture(cv->builder, cv->material_of[index], file.data, rgb, width, height);
     if (r == RAD_OK)
         cv->textured[index] = true;
@@ -809,7 +809,7 @@ static rad_result import_scene(rad_context *ctx, const char *name, import_input 
         /* Luminaires placed by nodes' extras (layout.c): their files are
          * read beside the glTF, so only when it was read from a file. */
         if (cv.log)
-            r = rad_layout_place_gltf(ctx, *out, name, facts.luminaires, facts.luminaire_count,
+            r = rad_layout_place_gltf(ctx, &(*out)->luminaires, name, facts.luminaires, facts.luminaire_count,
                                       rad_layout_load_photometry, NULL);
         else
             rad_warn(ctx, "%s: %zu node%s place%s a luminaire (extras.luminaire), which only a glTF read "
@@ -840,10 +840,10 @@ done:
 rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene **out)
 {
     *out = NULL;
-    import_file_log log = {0};
-    import_file_log_add(&log, path);
-    if (import_file_log_confine(ctx, &log, path) != RAD_OK) {
-        import_file_log_free(&log);
+    rad_input_log log = {0};
+    rad_input_log_add(&log, path);
+    if (rad_input_log_confine(ctx, &log, path) != RAD_OK) {
+        rad_input_log_free(&log);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     import_input in;
@@ -877,7 +877,7 @@ rad_result rad_import_assimp_file(rad_context *ctx, const char *path, rad_scene 
         log.count = 0;
         import_notes_warn(ctx, path, &in.notes); /* said once the load stands */
     }
-    import_file_log_free(&log);
+    rad_input_log_free(&log);
     import_input_free(&in);
     return r;
 }

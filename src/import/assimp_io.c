@@ -22,7 +22,7 @@
 /* realpath is an X/Open (XSI) addition to POSIX. */
 #define _XOPEN_SOURCE 700
 
-#include "scene/import_internal.h"
+#include "import/import_internal.h"
 
 #include <errno.h>
 
@@ -106,7 +106,7 @@ static struct aiFile *memory_file_open(import_files *files, const char *path, co
     return &m->file;
 }
 
-static struct aiFile *disk_open(import_file_log *log, const char *path);
+static struct aiFile *disk_open(rad_input_log *log, const char *path);
 
 static struct aiFile *import_open(struct aiFileIO *io, const char *path, const char *mode)
 {
@@ -140,82 +140,6 @@ void import_io(struct aiFileIO *io, import_files *files)
     io->OpenProc = import_open;
     io->CloseProc = import_close;
     io->UserData = (aiUserData)(void *)files;
-}
-
-/* ---- the logging file system ---- */
-
-void import_file_log_add(import_file_log *log, const char *path)
-{
-    for (size_t i = 0; i < log->count; i++)
-        if (strcmp(log->paths[i], path) == 0)
-            return;
-    if (log->count == log->capacity) {
-        size_t grown = log->capacity ? 2 * log->capacity : 4;
-        char **paths = rad_realloc(NULL, RAD_MEM_SCENE, log->paths, grown, sizeof *paths, "input file names");
-        if (!paths) {
-            log->failed = true;
-            return;
-        }
-        log->paths = paths;
-        log->capacity = grown;
-    }
-    char *copy = rad_strdup(NULL, RAD_MEM_SCENE, path, "input file name");
-    if (!copy) {
-        log->failed = true;
-        return;
-    }
-    log->paths[log->count++] = copy;
-}
-
-void import_file_log_free(import_file_log *log)
-{
-    for (size_t i = 0; i < log->count; i++)
-        rad_free(log->paths[i]);
-    rad_free(log->paths);
-    rad_free(log->root);
-    memset(log, 0, sizeof *log);
-}
-
-rad_result import_file_log_confine(rad_context *ctx, import_file_log *log, const char *scene_path)
-{
-    log->ctx = ctx;
-    log->scene = scene_path;
-    if (ctx && ctx->read_outside_scene_folder)
-        return RAD_OK;
-    const char *slash = strrchr(scene_path, '/');
-    char *folder = slash ? rad_strdup(ctx, RAD_MEM_SCENE, scene_path, scene_path)
-                         : rad_strdup(ctx, RAD_MEM_SCENE, ".", scene_path);
-    if (!folder)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    if (slash)
-        folder[slash == scene_path ? 1 : slash - scene_path] = '\0';
-    char *resolved = realpath(folder, NULL);
-    rad_free(folder);
-    /* Unresolvable: an empty root, under which nothing lies. */
-    log->root = rad_strdup(ctx, RAD_MEM_SCENE, resolved ? resolved : "", scene_path);
-    free(resolved); /* realpath's copy is libc's */
-    return log->root ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
-}
-
-bool import_file_allowed(import_file_log *log, const char *path)
-{
-    if (!log->root)
-        return true;
-    char *resolved = realpath(path, NULL);
-    if (!resolved)
-        return true; /* not there: the open fails and says so */
-    size_t n = strlen(log->root);
-    bool inside = n > 0 && strncmp(resolved, log->root, n) == 0 &&
-                  (resolved[n] == '/' || (n == 1 && log->root[0] == '/'));
-    if (!inside && !log->refused) {
-        log->refused = true;
-        rad_fail(log->ctx, RAD_ERROR_IO,
-                 "%s: refers to '%s' (%s), outside the scene's folder %s: refused "
-                 "(rad_context_options.read_outside_scene_folder allows it)",
-                 log->scene, path, resolved, log->root[0] ? log->root : "(unresolvable)");
-    }
-    free(resolved);
-    return inside;
 }
 
 static FILE *stdio_of(struct aiFile *file) { return (FILE *)(void *)file->UserData; }
@@ -252,9 +176,9 @@ static enum aiReturn stdio_seek(struct aiFile *file, size_t offset, enum aiOrigi
 static void stdio_flush(struct aiFile *file) { fflush(stdio_of(file)); }
 
 /* A file a glTF refers to, from the disk: confined, and logged. */
-static struct aiFile *disk_open(import_file_log *log, const char *path)
+static struct aiFile *disk_open(rad_input_log *log, const char *path)
 {
-    if (!import_file_allowed(log, path))
+    if (!rad_input_allowed(log, path))
         return NULL;
     struct aiFile *file = rad_alloc(NULL, RAD_MEM_SCENE, 1, sizeof *file, "input file");
     FILE *f = file ? fopen(path, "rb") : NULL;
@@ -262,7 +186,7 @@ static struct aiFile *disk_open(import_file_log *log, const char *path)
         rad_free(file);
         return NULL;
     }
-    import_file_log_add(log, path);
+    rad_input_log_add(log, path);
     file->ReadProc = stdio_read;
     file->WriteProc = memory_write;
     file->TellProc = stdio_tell;

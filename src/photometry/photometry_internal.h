@@ -7,7 +7,7 @@
 #ifndef RAD_PHOTOMETRY_INTERNAL_H
 #define RAD_PHOTOMETRY_INTERNAL_H
 
-#include "scene/photometry.h"
+#include "photometry/photometry.h"
 
 #include <stdbool.h>
 

@@ -44,7 +44,7 @@
  *
  * Every malformed record is an error naming the file and line.
  */
-#include "scene/scene.h"
+#include "import/import.h"
 
 #include <ctype.h>
 #include <errno.h>

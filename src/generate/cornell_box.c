@@ -22,7 +22,7 @@
  *               |              short_block  |
  *               +---------------------------+            y = 0
  */
-#include "scene/scene.h"
+#include "import/import.h"
 
 #include <stdlib.h>
 
