@@ -744,41 +744,6 @@ rad_result rad_scene_check_camera(rad_context *ctx, const rad_scene *scene, cons
     return rad_camera_check_distance(ctx, camera, scene->bounds_min, scene->bounds_max);
 }
 
-bool rad_method_info(rad_method_kind kind, size_t index, const char **name, const char **description)
-{
-    size_t count = 0;
-    const char *method_name = NULL, *method_description = NULL;
-    switch (kind) {
-    case RAD_METHOD_FORM_FACTOR:
-        while (rad_ff_methods[count])
-            count++;
-        if (index >= count)
-            return false;
-        method_name = rad_ff_methods[index]->name;
-        method_description = rad_ff_methods[index]->description;
-        break;
-    case RAD_METHOD_SOLVER:
-        if (!rad_strategy_solver_info(index, &method_name, &method_description))
-            return false;
-        break;
-    case RAD_METHOD_VISIBILITY:
-        while (rad_vis_backends[count])
-            count++;
-        if (index >= count)
-            return false;
-        method_name = rad_vis_backends[index]->name;
-        method_description = rad_vis_backends[index]->description;
-        break;
-    default:
-        return false;
-    }
-    if (name)
-        *name = method_name;
-    if (description)
-        *description = method_description;
-    return true;
-}
-
 rad_result rad_solution_display_radiosity(rad_context *ctx, const rad_solution *s, bool ambient,
                                           double *element_rgb, double *vertex_rgb)
 {

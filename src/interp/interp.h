@@ -25,4 +25,13 @@ rad_result rad_vertex_values(rad_context *ctx, const rad_mesh *mesh,
 void rad_element_interpolate(const rad_mesh *mesh, const rad_element *e,
                              const double *vertex_value, double s, double t, double rgb[3]);
 
+struct rad_solution_view; /* strategy/strategy.h */
+
+/* Vertex values of a view: the strategy's own (view->vertex_radiosity,
+ * copied as they are: Galerkin's linear elements), else rad_vertex_values
+ * of element_value (3 per element; the view's radiosity or a display of
+ * it).  vertex_value: 3 per mesh vertex.  Fails only for memory. */
+rad_result rad_view_vertex_values(rad_context *ctx, const struct rad_solution_view *view, const double *element_value,
+                                  double *vertex_value);
+
 #endif /* RAD_INTERP_H */

@@ -34,6 +34,7 @@
  * edge (a, b) and its pieces through the T-vertices) are not boundary.
  */
 #include "interp/interp.h"
+#include "strategy/strategy.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -320,4 +321,14 @@ void rad_element_interpolate(const rad_mesh *mesh, const rad_element *e,
         for (int c = 0; c < 3; c++)
             rgb[c] = w0 * v0[c] + s * v1[c] + t * v2[c];
     }
+}
+
+rad_result rad_view_vertex_values(rad_context *ctx, const rad_solution_view *view, const double *element_value,
+                                  double *vertex_value)
+{
+    if (view->vertex_radiosity) {
+        memcpy(vertex_value, view->vertex_radiosity, 3 * view->mesh->vertex_count * sizeof *vertex_value);
+        return RAD_OK;
+    }
+    return rad_vertex_values(ctx, view->mesh, element_value, vertex_value);
 }

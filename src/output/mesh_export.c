@@ -66,16 +66,6 @@ static void lit_vertices_free(lit_vertices *lit)
     rad_free(lit->radiance);
 }
 
-rad_result rad_view_vertex_values(rad_context *ctx, const rad_solution_view *view, const double *element_value,
-                                  double *vertex_value)
-{
-    if (view->vertex_radiosity) {
-        memcpy(vertex_value, view->vertex_radiosity, 3 * view->mesh->vertex_count * sizeof *vertex_value);
-        return RAD_OK;
-    }
-    return rad_vertex_values(ctx, view->mesh, element_value, vertex_value);
-}
-
 /* Vertex radiosities as rad_solution_vertex_radiosity gives them, and the
  * exposure (`exposure`, or automatic when 0).  Fails only for memory. */
 static rad_result lit_vertices_make(rad_context *ctx, const rad_solution_view *view, double exposure,

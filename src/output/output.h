@@ -17,13 +17,6 @@ struct rad_image {
 
 rad_image *rad_image_create(rad_context *ctx, int width, int height);
 
-/* Vertex values of a view: the strategy's own (view->vertex_radiosity,
- * copied as they are: Galerkin's linear elements), else rad_vertex_values
- * of element_value (3 per element; the view's radiosity or a display of
- * it).  vertex_value: 3 per mesh vertex.  Fails only for memory. */
-rad_result rad_view_vertex_values(rad_context *ctx, const rad_solution_view *view, const double *element_value,
-                                  double *vertex_value);
-
 /* What the renderer needs from a solution. */
 typedef struct rad_render_input {
     const rad_mesh *mesh;

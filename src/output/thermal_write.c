@@ -247,3 +247,43 @@ rad_result rad_write_thermal_stats(rad_context *ctx, const rad_solution_view *vi
 {
     return rad_write_stats_extra(ctx, view, path, false, add_thermal, t);
 }
+
+/* ---- the public writers (radiosity.h) ---- */
+
+rad_result rad_thermal_write(rad_context *ctx, const rad_thermal *t, const char *path, bool elements)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !t || !path)
+        return rad_null_argument(ctx, __func__);
+    return rad_write_thermal(ctx, t, path, elements);
+}
+
+rad_result rad_thermal_write_gebhart(rad_context *ctx, const rad_thermal *t, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !t || !path)
+        return rad_null_argument(ctx, __func__);
+    char ext[16];
+    rad_path_extension(path, ext, sizeof ext);
+    if (strcmp(ext, "json") != 0 && strcmp(ext, "csv") != 0) /* before the solves */
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: unknown Gebhart-factor format (use .csv or .json)",
+                        path);
+    size_t S = t->scene->surface_count;
+    double *G = rad_alloc(ctx, RAD_MEM_OUTPUT, S ? S * S : 1, sizeof *G, "thermal: Gebhart factors");
+    if (!G)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    rad_result r = rad_thermal_gebhart_factors(ctx, &t->sys, S, t->solver, &t->params, G);
+    if (r == RAD_OK)
+        r = rad_write_gebhart(ctx, t, G, path);
+    rad_free(G);
+    return r;
+}
+
+rad_result rad_thermal_write_stats(rad_context *ctx, const rad_thermal *t, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !t || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_memory_limit_call(ctx, t->max_memory_bytes);
+    return rad_write_thermal_stats(ctx, t->view, t, path);
+}

@@ -55,7 +55,7 @@ typedef struct rad_solution_view {
     /* 3 per mesh vertex, W/m^2: the strategy's own vertex values where they
      * are its unknowns (galerkin-linear, collocation), to be interpolated
      * with the basis as they are; NULL: derived from `radiosity` (interp/,
-     * through rad_view_vertex_values in output.h). */
+     * through rad_view_vertex_values in interp.h). */
     const double *vertex_radiosity;
     const double *F;                 /* n x n; NULL where the strategy stores none */
     const double *F_coupling;        /* the F the solve used: F with the mirror images' factors

@@ -189,3 +189,113 @@ rad_result rad_thermal_conditions_parse(rad_context *ctx, const rad_scene *scene
     *out = c;
     return RAD_OK;
 }
+
+/* ---- the conditions handle (radiosity.h) ---- */
+
+rad_result rad_thermal_conditions_create(rad_context *ctx, const rad_scene *scene, rad_thermal_conditions **out)
+{
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !scene || !out)
+        return rad_null_argument(ctx, __func__);
+    rad_thermal_conditions *c = rad_alloc(ctx, RAD_MEM_SCENE, 1, sizeof *c, "thermal conditions");
+    rad_thermal_surface *s = c ? rad_alloc(ctx, RAD_MEM_SCENE, scene->surface_count ? scene->surface_count : 1,
+                                           sizeof *s, "thermal conditions")
+                               : NULL;
+    if (!s) {
+        rad_free(c);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    c->ctx = ctx;
+    c->scene = scene;
+    c->surface_count = scene->surface_count;
+    c->surfaces = s;
+    for (size_t k = 0; k < scene->surface_count; k++)
+        if (scene->surfaces[k].obstruction || scene->surfaces[k].mask)
+            s[k].condition = RAD_THERMAL_OBSTRUCTION;
+    *out = c;
+    return RAD_OK;
+}
+
+void rad_thermal_conditions_destroy(rad_thermal_conditions *c)
+{
+    if (!c)
+        return;
+    rad_free(c->source);
+    rad_free(c->surfaces);
+    rad_free(c);
+}
+
+rad_result rad_thermal_conditions_load_memory(rad_context *ctx, const rad_scene *scene, const char *name,
+                                              const void *data, size_t size, rad_thermal_conditions **out)
+{
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !scene || !name || !out || (!data && size))
+        return rad_null_argument(ctx, __func__);
+    return rad_thermal_conditions_parse(ctx, scene, name, data ? data : "", size, out);
+}
+
+rad_result rad_thermal_conditions_load_file(rad_context *ctx, const rad_scene *scene, const char *path,
+                                            rad_thermal_conditions **out)
+{
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !scene || !path || !out)
+        return rad_null_argument(ctx, __func__);
+    unsigned char *data = NULL;
+    size_t size = 0;
+    rad_result r = rad_read_whole_file(ctx, path, &data, &size);
+    if (r == RAD_OK)
+        r = rad_thermal_conditions_parse(ctx, scene, path, (const char *)data, size, out);
+    rad_free(data);
+    return r;
+}
+
+rad_result rad_thermal_conditions_set(rad_context *ctx, rad_thermal_conditions *c, size_t surface,
+                                      const rad_thermal_surface *s)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !c || !s)
+        return rad_null_argument(ctx, __func__);
+    if (surface >= c->surface_count)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: surface %zu of %zu", __func__, surface,
+                        c->surface_count);
+    if (c->surfaces[surface].condition == RAD_THERMAL_OBSTRUCTION)
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: surface '%s' is obstruction-only: it takes no "
+                        "condition", __func__, c->scene->surfaces[surface].name);
+    char why[160];
+    if (!rad_thermal_surface_valid(s, why, sizeof why))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: surface '%s': %s", __func__,
+                        c->scene->surfaces[surface].name, why);
+    c->surfaces[surface] = *s;
+    return RAD_OK;
+}
+
+rad_result rad_thermal_conditions_set_environment(rad_context *ctx, rad_thermal_conditions *c, double kelvin)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !c)
+        return rad_null_argument(ctx, __func__);
+    if (!(isfinite(kelvin) && kelvin >= 0.0))
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "%s: the environment temperature must be finite and "
+                        ">= 0 K, got %.6g", __func__, kelvin);
+    c->environment_temperature = kelvin;
+    return RAD_OK;
+}
+
+bool rad_thermal_conditions_get(const rad_thermal_conditions *c, size_t surface, rad_thermal_surface *out)
+{
+    if (!c || !out || surface >= c->surface_count)
+        return false;
+    *out = c->surfaces[surface];
+    return true;
+}
+
+double rad_thermal_conditions_environment(const rad_thermal_conditions *c)
+{
+    return c ? c->environment_temperature : NAN;
+}

@@ -137,7 +137,8 @@ bool rad_thermal_surface_valid(const rad_thermal_surface *s, char *why, size_t s
 
 struct rad_thermal {
     rad_context *ctx;               /* made in */
-    const rad_solution *solution;   /* borrowed: must outlive it */
+    const struct rad_solution_view *view; /* the solution's, borrowed: it must outlive this */
+    double max_memory_bytes;        /* the solution's memory limit, for the writers */
     const rad_scene *scene;         /* the solution's, borrowed */
     const struct rad_mesh *mesh;    /* the solution's elements, borrowed */
     const double *F;                /* the solution's n x n factors, borrowed */
