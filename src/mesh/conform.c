@@ -561,3 +561,26 @@ rad_result mesh_conform_patches(rad_context *ctx, double tol, rad_patch **patche
     *contact_count = ncontact;
     return RAD_OK;
 }
+
+bool rad_mesh_on_contact(const rad_mesh *mesh, uint32_t polygon, vec3 p)
+{
+    /* The polygon's lines: a binary search for the first. */
+    size_t lo = 0, hi = mesh->contact_count;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (mesh->contacts[mid].polygon < polygon)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    double tol = mesh->contact_tol;
+    for (size_t k = lo; k < mesh->contact_count && mesh->contacts[k].polygon == polygon; k++) {
+        vec3 a = mesh->contacts[k].a, ab = v3_sub(mesh->contacts[k].b, a);
+        double len2 = v3_dot(ab, ab);
+        double t = len2 > 0.0 ? v3_dot(v3_sub(p, a), ab) / len2 : 0.0;
+        t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+        if (v3_length(v3_sub(p, v3_mad(a, ab, t))) <= tol)
+            return true;
+    }
+    return false;
+}

@@ -316,3 +316,17 @@ rad_result mesh_patches_from_polygons(rad_context *ctx, const rad_scene *scene, 
     mesh->contact_tol = tol;
     return RAD_OK;
 }
+
+/* As mesh.h says; the welding tolerance and the ray lift size by it. */
+double rad_corners_width(const vec3 *corner, uint32_t count)
+{
+    vec3 n = count == 4 ? v3_cross(v3_sub(corner[2], corner[0]), v3_sub(corner[3], corner[1]))
+                        : v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[2], corner[0]));
+    double area = 0.5 * v3_length(n), longest = 0.0, shortest = HUGE_VAL;
+    for (uint32_t k = 0; k < count; k++) {
+        double edge = v3_length(v3_sub(corner[(k + 1) % count], corner[k]));
+        longest = fmax(longest, edge);
+        shortest = fmin(shortest, edge);
+    }
+    return longest > 0.0 ? fmin(shortest, 2.0 * area / longest) : 0.0;
+}

@@ -103,7 +103,6 @@ static void cell_index_free(cell_index *ix)
 
 /* ---- welding ---- */
 
-
 /* The distance within which grid points are one vertex: 1e-6 x the scene
  * diagonal (far above the round-off of grid points computed from
  * different patches), but below 1e-3 x the narrowest element, so that the
@@ -111,19 +110,6 @@ static void cell_index_free(cell_index *ix)
  * zero-area elements.  The narrowest element is estimated per patch as
  * its width (2 x area / longest edge) or its shortest edge, whichever is
  * less, over its cells along the longest side. */
-double rad_corners_width(const vec3 *corner, uint32_t count)
-{
-    vec3 n = count == 4 ? v3_cross(v3_sub(corner[2], corner[0]), v3_sub(corner[3], corner[1]))
-                        : v3_cross(v3_sub(corner[1], corner[0]), v3_sub(corner[2], corner[0]));
-    double area = 0.5 * v3_length(n), longest = 0.0, shortest = HUGE_VAL;
-    for (uint32_t k = 0; k < count; k++) {
-        double edge = v3_length(v3_sub(corner[(k + 1) % count], corner[k]));
-        longest = fmax(longest, edge);
-        shortest = fmin(shortest, edge);
-    }
-    return longest > 0.0 ? fmin(shortest, 2.0 * area / longest) : 0.0;
-}
-
 double mesh_weld_tolerance(const rad_mesh *mesh, double diag)
 {
     double narrowest = HUGE_VAL;

@@ -114,7 +114,7 @@ const rad_strategy *rad_strategy_for_solver(const char *name);
  * the end (for --list-methods and rad_method_info). */
 bool rad_strategy_solver_info(size_t index, const char **name, const char **description);
 
-/* ---- what the strategies share (strategy.c) ---- */
+/* ---- what the strategies share (shared.c) ---- */
 
 /* Per-element arrays of a mesh: area, reflectance and emission from the
  * scene's materials, radiosity = emission. */
@@ -231,7 +231,7 @@ void rad_adaptive_destroy(rad_adaptive *a);
 /* NULL for NULL. */
 const rad_adaptive_stats *rad_adaptive_get_stats(const rad_adaptive *a);
 
-/* ---- questions answered from a view (strategy.c) ---- */
+/* ---- questions answered from a view (view.c) ---- */
 
 /* Power in W (means over RGB): emitted = sum A_i E_i; absorbed = sum A_i
  * (1 - rho_i) H_i from F where the view has it, else the strategy's own
