@@ -4,7 +4,7 @@
  * which share one renderer, so a test of the off-screen frame tests the
  * window's drawing code.  docs/viewer.md has the keys and the figures.
  *
- *   cli/main.c --view--> rv_main (view.c)
+ *   cli/cmd_view.c --view--> rv_main (view.c)
  *       window.c      SDL2 window, keys and mouse, status line
  *       offscreen.c   EGL surfaceless context + FBO, read back as radiance
  *       renderer.c    the GL renderer: mesh buffers, colour updates, draw
@@ -23,7 +23,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* ---- what the command line asks of the viewer (cli/main.c fills it) ---- */
+/* ---- what the command line asks of the viewer (cli/cmd_view.c fills it) ---- */
 
 typedef struct rv_args {
     const char *input;            /* scene or solution file; NULL = the Cornell box */

@@ -397,7 +397,7 @@ int rv_window_run(rad_context *ctx, const rv_args *a, const rad_scene *scene, ra
     GLsync in_flight = NULL;
     Uint64 last = SDL_GetPerformanceCounter(), last_title = 0;
     while (!quit) {
-        /* Ctrl-C / SIGTERM reach the program's context (cli/main.c). */
+        /* Ctrl-C / SIGTERM reach the program's context (cli/common.c). */
         if (rad_context_cancelled(ctx))
             break;
         script = scripted_key(&w, script, &quit);
