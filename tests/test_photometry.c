@@ -38,6 +38,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <errno.h>
+#include <sys/stat.h>
 
 #define DATA RAD_TEST_DATA "/photometry"
 static const double DEG = M_PI / 180.0;
@@ -611,6 +613,26 @@ static void test_tilt(void **state)
     rad_api_enter(ctx);
     assert_int_equal(rad_photometry_load(ctx, write_ies("tilt_short.ies", &s), &q), RAD_ERROR_PARSE);
     assert_non_null(strstr(rad_context_error(ctx), "short.tlt:3: expected 3 tilt angles, found 2 (the file ends)"));
+
+    /* The readers' bounds (core/input.c): a tilt file of more than 1 MiB
+     * (a sparse one: nothing is written), a folder in place of a file. */
+    FILE *big = fopen(path_of("big.tlt"), "wb");
+    assert_non_null(big);
+    assert_int_equal(ftruncate(fileno(big), (1 << 20) + 1), 0);
+    fclose(big);
+    s.tilt = "big.tlt";
+    rad_api_enter(ctx);
+    assert_int_equal(rad_photometry_load(ctx, write_ies("tilt_big.ies", &s), &q), RAD_ERROR_PARSE);
+    assert_non_null(strstr(rad_context_error(ctx), "tilt_big.ies:4: TILT=big.tlt: more than 1 MiB: not a tilt file"));
+    s.tilt = "folder.tlt";
+    assert_int_equal(mkdir(path_of("folder.tlt"), 0700) == 0 || errno == EEXIST, 1);
+    rad_api_enter(ctx);
+    assert_int_equal(rad_photometry_load(ctx, write_ies("tilt_folder.ies", &s), &q), RAD_ERROR_IO);
+    assert_non_null(strstr(rad_context_error(ctx), "TILT=folder.tlt: is a folder, not a tilt file"));
+    rad_api_enter(ctx);
+    assert_int_equal(rad_photometry_load(ctx, path_of("folder.tlt"), &q), RAD_ERROR_IO);
+    assert_non_null(strstr(rad_context_error(ctx), "folder.tlt: is a folder, not a photometric file"));
+    assert_null(q);
     rad_context_destroy(ctx);
 }
 

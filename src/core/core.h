@@ -293,6 +293,15 @@ static inline double rad_rng_uniform(rad_rng *r)
  * RAD_ERROR_INTERRUPTED. */
 rad_result rad_read_whole_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size);
 
+/* The same, for a reader that knows what it reads: at most `most` bytes
+ * (0: as many as the memory limit allows) of a `kind` of file ("photometric
+ * file"; NULL: any), named `what` in messages (NULL: the path; e.g.
+ * "lamp.ies:2: TILT=t.dat").  A folder is "WHAT: is a folder, not a KIND"
+ * (RAD_ERROR_IO), a longer file "WHAT: more than 64 MiB: not a KIND"
+ * (RAD_ERROR_PARSE); cancellation is polled between pieces of a stream. */
+rad_result rad_read_file(rad_context *ctx, const char *path, const char *what, size_t most, const char *kind,
+                         unsigned char **data, size_t *size);
+
 /* The files a load opened: the scene file, an OBJ's libraries, every file
  * assimp opens for reading (a glTF's buffers), a layout's photometric
  * files, so the scene can list its inputs; and the folder they must lie in. */

@@ -16,45 +16,75 @@
 #include <string.h>
 #include <sys/stat.h>
 
-rad_result rad_read_whole_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size)
+rad_result rad_read_file(rad_context *ctx, const char *path, const char *what, size_t most, const char *kind,
+                         unsigned char **data, size_t *size)
 {
     *data = NULL;
     *size = 0;
+    if (!what)
+        what = path;
     FILE *f = fopen(path, "rb");
     if (!f)
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
+        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", what, strerror(errno));
     struct stat st;
-    size_t capacity = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) ? (size_t)st.st_size + 1 : 65536;
-    if (S_ISDIR(st.st_mode)) {
+    bool regular = fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode);
+    if (!regular && S_ISDIR(st.st_mode)) {
         fclose(f);
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: Is a directory", path);
+        return kind ? rad_fail(ctx, RAD_ERROR_IO, "%s: is a folder, not a %s", what, kind)
+                    : rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: Is a directory", what);
     }
-    unsigned char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, "input file");
+    /* A regular file by its size (+ 1: the read that finds the end needs
+     * no growth), a stream from 64 KiB doubling; never more than one byte
+     * past `most`, that byte being the refusal. */
+    size_t capacity = regular ? (size_t)st.st_size + 1 : 65536;
+    if (most && capacity > most + 1)
+        capacity = most + 1;
+    const char *label = kind ? what : "input file"; /* for the memory accounting */
+    unsigned char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, label);
     size_t used = 0;
-    while (buffer) {
-        size_t got = fread(buffer + used, 1, capacity - used, f);
-        used += got;
+    rad_result r = buffer ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+    while (r == RAD_OK) {
+        used += fread(buffer + used, 1, capacity - used, f);
         if (used < capacity) {
-            if (ferror(f)) {
-                rad_free(buffer);
-                fclose(f);
-                return rad_fail(ctx, rad_cancelled(ctx) ? RAD_ERROR_INTERRUPTED : RAD_ERROR_IO,
-                                "%s: cannot read: %s", path, strerror(errno));
-            }
+            if (ferror(f))
+                r = rad_fail(ctx, rad_cancelled(ctx) ? RAD_ERROR_INTERRUPTED : RAD_ERROR_IO, "%s: cannot read: %s",
+                             what, strerror(errno));
             break;
         }
-        unsigned char *grown = rad_realloc(ctx, RAD_MEM_SCENE, buffer, 2 * capacity, 1, "input file");
-        if (!grown)
-            rad_free(buffer);
-        buffer = grown;
-        capacity *= 2;
+        if (most && used > most) {
+            r = most % (1u << 20) == 0
+                    ? rad_fail(ctx, RAD_ERROR_PARSE, "%s: more than %zu MiB: not a %s", what, most >> 20,
+                               kind ? kind : "file this reads")
+                    : rad_fail(ctx, RAD_ERROR_PARSE, "%s: more than %zu bytes: not a %s", what, most,
+                               kind ? kind : "file this reads");
+            break;
+        }
+        if (rad_cancelled(ctx)) {
+            r = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "%s: interrupted while reading", what);
+            break;
+        }
+        size_t grown = most && 2 * capacity > most + 1 ? most + 1 : 2 * capacity;
+        unsigned char *bigger = rad_realloc(ctx, RAD_MEM_SCENE, buffer, grown, 1, label);
+        if (!bigger)
+            r = RAD_ERROR_OUT_OF_MEMORY;
+        else {
+            buffer = bigger;
+            capacity = grown;
+        }
     }
     fclose(f);
-    if (!buffer)
-        return RAD_ERROR_OUT_OF_MEMORY;
+    if (r != RAD_OK) {
+        rad_free(buffer);
+        return r;
+    }
     *data = buffer;
     *size = used;
     return RAD_OK;
+}
+
+rad_result rad_read_whole_file(rad_context *ctx, const char *path, unsigned char **data, size_t *size)
+{
+    return rad_read_file(ctx, path, NULL, 0, NULL, data, size);
 }
 
 /* ---- the log of files read, and their confinement ---- */

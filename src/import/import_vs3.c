@@ -689,34 +689,11 @@ bool rad_vs3_detect(const char *name, const char *text, size_t size)
 rad_result rad_import_vs3_file(rad_context *ctx, const char *path, rad_scene **out)
 {
     *out = NULL;
-    FILE *file = fopen(path, "rb");
-    if (!file)
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-    size_t capacity = 1 << 16, length = 0;
-    char *text = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, path);
-    rad_result res = text ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
-    while (res == RAD_OK) {
-        length += fread(text + length, 1, capacity - length, file);
-        if (length < capacity) {
-            if (ferror(file))
-                res = rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: %s", path, strerror(errno));
-            break;
-        }
-        if (rad_cancelled(ctx)) {
-            res = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "%s: interrupted while reading", path);
-            break;
-        }
-        char *bigger = rad_realloc(ctx, RAD_MEM_SCENE, text, 2 * capacity, 1, path);
-        if (!bigger)
-            res = RAD_ERROR_OUT_OF_MEMORY;
-        else {
-            text = bigger;
-            capacity *= 2;
-        }
-    }
-    fclose(file);
+    unsigned char *text = NULL;
+    size_t length = 0;
+    rad_result res = rad_read_whole_file(ctx, path, &text, &length);
     if (res == RAD_OK)
-        res = rad_import_vs3_memory(ctx, path, text, length, out);
+        res = rad_import_vs3_memory(ctx, path, (const char *)text, length, out);
     rad_free(text);
     if (res == RAD_OK) {
         char **inputs = rad_alloc(ctx, RAD_MEM_SCENE, 1, sizeof *inputs, path);

@@ -78,29 +78,19 @@ static rad_result read_tilt_file(rad_context *ctx, const char *name, size_t line
     if (r == RAD_OK && !rad_input_allowed(&log, path))
         r = RAD_ERROR_IO;
     rad_input_log_free(&log);
-    FILE *f = r == RAD_OK ? fopen(path, "rb") : NULL;
-    if (r == RAD_OK && !f)
-        r = rad_fail(ctx, RAD_ERROR_IO, "%s:%zu: TILT=%s: cannot open %s", name, line, file, path);
-    char *data = NULL;
+    /* A tilt file is a few lines: 1 MiB is generous. */
+    char what[256];
+    snprintf(what, sizeof what, "%s:%zu: TILT=%.160s", name, line, file);
+    unsigned char *bytes = NULL;
     size_t size = 0;
-    if (f) {
-        /* a tilt file is a few lines: 1 MiB is generous */
-        const size_t most = 1u << 20;
-        data = rad_alloc(ctx, RAD_MEM_SCENE, most + 1, 1, "photometry: tilt file");
-        if (data) {
-            size = fread(data, 1, most + 1, f);
-            if (size > most)
-                r = rad_fail(ctx, RAD_ERROR_PARSE, "%s: more than 1 MiB: not a tilt file", path);
-        } else {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-        }
-        fclose(f);
-    }
+    if (r == RAD_OK)
+        r = rad_read_file(ctx, path, what, 1u << 20, "tilt file", &bytes, &size);
+    const char *data = (const char *)bytes;
     if (r == RAD_OK) {
         ph_text tt = {ctx, path, data, size, 0, 1, true, 0};
         r = read_tilt(&tt, p);
     }
-    rad_free(data);
+    rad_free(bytes);
     rad_free(path);
     return r;
 }

@@ -5,59 +5,11 @@
  */
 #include "photometry/photometry_internal.h"
 
-#include <errno.h>
-#include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
 
 /* Photometric files are small (a dense 1-degree web is 65,000 numbers,
  * under 1 MiB); 64 MiB bounds a file before its counts are read. */
 #define PH_MAX_FILE_BYTES (64u << 20)
-
-static rad_result read_file(rad_context *ctx, const char *path, char **data, size_t *size)
-{
-    *data = NULL;
-    *size = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
-        fclose(f);
-        return rad_fail(ctx, RAD_ERROR_IO, "%s: is a folder, not a photometric file", path);
-    }
-    size_t capacity = 4096, length = 0;
-    char *buffer = rad_alloc(ctx, RAD_MEM_SCENE, capacity, 1, path);
-    rad_result r = buffer ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
-    while (r == RAD_OK) {
-        length += fread(buffer + length, 1, capacity - length, f);
-        if (length < capacity) {
-            if (ferror(f))
-                r = rad_fail(ctx, RAD_ERROR_IO, "%s: cannot read: %s", path, strerror(errno));
-            break;
-        }
-        if (capacity >= PH_MAX_FILE_BYTES) {
-            r = rad_fail(ctx, RAD_ERROR_PARSE, "%s: more than %u MiB: not a photometric file", path,
-                         PH_MAX_FILE_BYTES >> 20);
-            break;
-        }
-        char *bigger = rad_realloc(ctx, RAD_MEM_SCENE, buffer, 2 * capacity, 1, path);
-        if (!bigger) {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-            break;
-        }
-        buffer = bigger;
-        capacity *= 2;
-    }
-    fclose(f);
-    if (r != RAD_OK) {
-        rad_free(buffer);
-        return r;
-    }
-    *data = buffer;
-    *size = length;
-    return RAD_OK;
-}
 
 /* IES by content: its first line names LM-63 ("IESNA", "IES:"), or a line
  * starts with "TILT=" (LM-63-1986 has no first line).  EULUMDAT otherwise:
@@ -104,22 +56,23 @@ rad_result rad_photometry_load(rad_context *ctx, const char *path, rad_photometr
     if (!out || !path)
         return RAD_ERROR_INVALID_ARGUMENT;
     *out = NULL;
-    char *data;
+    unsigned char *bytes;
     size_t size;
-    rad_result r = read_file(ctx, path, &data, &size);
+    rad_result r = rad_read_file(ctx, path, NULL, PH_MAX_FILE_BYTES, "photometric file", &bytes, &size);
     if (r != RAD_OK)
         return r;
+    const char *data = (const char *)bytes;
     const char *slash = strrchr(path, '/');
     char *folder = slash ? rad_strdup(ctx, RAD_MEM_SCENE, path, "photometry: folder")
                          : rad_strdup(ctx, RAD_MEM_SCENE, ".", "photometry: folder");
     if (!folder) {
-        rad_free(data);
+        rad_free(bytes);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     if (slash)
         folder[slash == path ? 1 : slash - path] = '\0';
     r = rad_photometry_parse(ctx, path, folder, data, size, out);
     rad_free(folder);
-    rad_free(data);
+    rad_free(bytes);
     return r;
 }
