@@ -88,38 +88,6 @@ static void diagnostics(const rad_mesh *mesh, const double *F, rad_ff_stats *s)
     s->diagonal_max = diag;
 }
 
-double rad_ff_plane_tolerance(const rad_mesh *mesh)
-{
-    vec3 lo = mesh->vertex_count ? mesh->vertices[0] : v3(0, 0, 0), hi = lo;
-    for (size_t v = 0; v < mesh->vertex_count; v++) {
-        lo = v3_min(lo, mesh->vertices[v]);
-        hi = v3_max(hi, mesh->vertices[v]);
-    }
-    return RAD_FF_PLANE_TOLERANCE * v3_length(v3_sub(hi, lo));
-}
-
-bool rad_ff_in_front(const vec3 *point, size_t count, vec3 origin, vec3 normal, double tol)
-{
-    for (size_t k = 0; k < count; k++)
-        if (v3_dot(normal, v3_sub(point[k], origin)) > tol)
-            return true;
-    return false;
-}
-
-bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol)
-{
-    const rad_element *e[2] = {&mesh->elements[i], &mesh->elements[j]};
-    for (int a = 0; a < 2; a++) {
-        const rad_element *plane = e[a], *other = e[1 - a];
-        vec3 corner[4];
-        for (uint32_t k = 0; k < other->vertex_count; k++)
-            corner[k] = mesh->vertices[other->vertex[k]];
-        if (!rad_ff_in_front(corner, other->vertex_count, plane->centroid, plane->normal, plane_tol))
-            return false;
-    }
-    return true;
-}
-
 /* Count one finished row; the master thread reports progress, and every
  * thread polls cancellation, raising *stop (so that a flag raised before
  * the start stops the loop after one row per thread, whichever threads get
