@@ -223,6 +223,10 @@ double rad_element_bend(const rad_mesh *mesh, const rad_element *e);
  * quad).  Cannot fail. */
 double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
 
+/* An orthonormal tangent pair (u, v) with u x v = n (unit): the frame of
+ * the hemicube's faces and of the hemisphere's directions.  Cannot fail. */
+void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v);
+
 /* The four children of a quad (bilinear midpoints) or a triangle (midpoint
  * subdivision, the middle child last), same orientation as the parent:
  * the adaptive quadratures' refinement step (analytic, hemicube).  A
