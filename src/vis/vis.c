@@ -58,23 +58,8 @@ void rad_vis_destroy(rad_vis *vis)
 
 double rad_vis_epsilon(const rad_mesh *mesh)
 {
-    vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
-    for (size_t i = 0; i < mesh->vertex_count; i++) {
-        lo = v3_min(lo, mesh->vertices[i]);
-        hi = v3_max(hi, mesh->vertices[i]);
-    }
-    /* The patch corners span the same box; they cover a mesh whose
-     * vertices have not been welded (or filled in, as in some tests). */
-    for (size_t i = 0; i < mesh->patch_count; i++)
-        for (uint32_t c = 0; c < mesh->patches[i].corner_count; c++) {
-            lo = v3_min(lo, mesh->patches[i].corner[c]);
-            hi = v3_max(hi, mesh->patches[i].corner[c]);
-        }
-    double diagonal = v3_length(v3_sub(hi, lo));
     /* An empty or single-point mesh has no scale: take 1 m. */
-    if (!(diagonal > 0.0) || !isfinite(diagonal))
-        diagonal = 1.0;
-    return 1e-5 * diagonal;
+    return 1e-5 * (mesh->diagonal > 0.0 ? mesh->diagonal : 1.0);
 }
 
 size_t rad_vis_unresolved(const rad_mesh *mesh, double *narrowest, uint32_t *which)
