@@ -123,6 +123,7 @@ static void add_quad_patch(test_mesh *m, vec3 c0, vec3 c1, vec3 c2, vec3 c3, uin
             element_geometry(m, e);
         }
     m->mesh.patch_count++;
+    rad_mesh_measure(&m->mesh);
 }
 
 /* A triangle patch meshed k^2, in mesh/grid.c's order (mesh.h's sketch). */
@@ -152,6 +153,7 @@ static void add_triangle_patch(test_mesh *m, vec3 c0, vec3 c1, vec3 c2, uint32_t
             }
     }
     m->mesh.patch_count++;
+    rad_mesh_measure(&m->mesh);
 }
 
 /* Record every vertex lying strictly inside an element's edge. */

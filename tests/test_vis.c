@@ -42,6 +42,7 @@ static void add_patch(test_scene *s, const vec3 *corners, uint32_t n)
         p->corner[i] = corners[i];
     p->normal = v3_normalize(v3_cross(v3_sub(corners[1], corners[0]), v3_sub(corners[n - 1], corners[0])));
     p->nu = p->nv = 1;
+    rad_mesh_measure(&s->mesh);
 }
 
 /* An axis-aligned box as six quads, counter-clockwise about outward normals. */

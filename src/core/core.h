@@ -261,6 +261,20 @@ static inline double rad_rng_uniform(rad_rng *r)
     return (double)(z >> 11) * (1.0 / 9007199254740992.0);
 }
 
+/* perm[0 .. n-1] <- a random permutation of 0 .. n-1 (Fisher-Yates), n - 1
+ * draws from r: the strata of one end of a sample paired with those of the
+ * other.  Cannot fail. */
+static inline void rad_rng_shuffle(rad_rng *r, int *perm, int n)
+{
+    for (int k = 0; k < n; k++)
+        perm[k] = k;
+    for (int k = n - 1; k > 0; k--) {
+        int m = (int)(rad_rng_uniform(r) * (k + 1)), t = perm[k];
+        perm[k] = perm[m];
+        perm[m] = t;
+    }
+}
+
 /* ---- the engine's limits ---- */
 
 /* The lengths the engine works in, m.  Radiosity is scale-free, so any

@@ -272,14 +272,6 @@ static void raster_face(const hc_setup *hs, hc_scratch *s, int face, const vec3 
     }
 }
 
-/* An orthonormal tangent pair (u, v) with u x v = n. */
-static void tangent_frame(vec3 n, vec3 *u, vec3 *v)
-{
-    vec3 a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
-    *u = v3_normalize(v3_sub(a, v3_scale(n, v3_dot(a, n))));
-    *v = v3_cross(n, *u);
-}
-
 /* One hemicube with its base at `apex` on element i (the receiver's
  * frame u, v, n): s->sum[j + 1] = F from that point to element j.  Returns
  * the element pairs projected (not behind the base). */
@@ -425,7 +417,7 @@ static void hemicube_row(const rad_ff_request *req, const void *shared, void *sc
     size_t n = mesh->element_count;
     const rad_element *ei = &mesh->elements[i];
     vec3 ux, uy;
-    tangent_frame(ei->normal, &ux, &uy);
+    rad_tangent_frame(ei->normal, &ux, &uy);
     double distance, seen;
     int level = 1;
     uint64_t pairs = hemicube_level(hs, s, mesh, i, level, ux, uy, &distance, &seen);

@@ -54,7 +54,7 @@ typedef struct hs_shared {
 
 /* Per-thread buffers, allocated once per thread. */
 typedef struct hs_scratch {
-    uint32_t *perm;   /* origin stratum of each direction stratum */
+    int *perm;        /* origin stratum of each direction stratum */
     double *sum;      /* n accumulators for the current row */
     rad_ray rays[BATCH];
     rad_hit hits[BATCH];
@@ -79,14 +79,6 @@ static void concentric_disk(double u, double v, double *x, double *y)
     }
     *x = r * cos(phi);
     *y = r * sin(phi);
-}
-
-/* An orthonormal tangent pair (u, v) with u x v = n. */
-static void tangent_frame(vec3 n, vec3 *u, vec3 *v)
-{
-    vec3 a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
-    *u = v3_normalize(v3_sub(a, v3_scale(n, v3_dot(a, n))));
-    *v = v3_cross(n, *u);
 }
 
 /* Cast one batch and add each hit's weight to the element it lands on. */
@@ -126,23 +118,16 @@ static void hemisphere_row(const rad_ff_request *req, const void *shared, void *
         side++;
     int strata = side * side;
     rad_rng rng = rad_rng_keyed(req->seed, i, 0x68656d69ULL /* "hemi" */);
-    for (int k = 0; k < strata; k++)
-        s->perm[k] = (uint32_t)k;
-    for (int k = strata - 1; k > 0; k--) { /* Fisher-Yates */
-        int m = (int)(rad_rng_uniform(&rng) * (k + 1));
-        uint32_t t = s->perm[k];
-        s->perm[k] = s->perm[m];
-        s->perm[m] = t;
-    }
+    rad_rng_shuffle(&rng, s->perm, strata);
     memset(s->sum, 0, n * sizeof *s->sum);
     vec3 nz = e->normal, ux, uy;
-    tangent_frame(nz, &ux, &uy);
+    rad_tangent_frame(nz, &ux, &uy);
     double lift = eps + rad_element_bend(mesh, e);
     size_t batch = 0;
     for (int k = 0; k < N; k++) {
         double du, dv, ou, ov;
         if (k < strata) {
-            int o = (int)s->perm[k];
+            int o = s->perm[k];
             du = ((k % side) + rad_rng_uniform(&rng)) / side;
             dv = ((k / side) + rad_rng_uniform(&rng)) / side;
             ou = ((o % side) + rad_rng_uniform(&rng)) / side;
@@ -203,7 +188,7 @@ static size_t hemisphere_scratch(const rad_ff_request *req, const void *shared, 
     hs_scratch *s = block;
     if (s) {
         s->sum = (double *)(s + 1);
-        s->perm = (uint32_t *)(s->sum + n);
+        s->perm = (int *)(s->sum + n);
     }
     return sizeof *s + n * sizeof *s->sum + (size_t)h->N * sizeof *s->perm;
 }

@@ -223,6 +223,10 @@ double rad_element_bend(const rad_mesh *mesh, const rad_element *e);
  * quad).  Cannot fail. */
 double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
 
+/* An orthonormal tangent pair (u, v) with u x v = n (unit): the frame of
+ * the hemicube's faces and of the hemisphere's directions.  Cannot fail. */
+void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v);
+
 /* The four children of a quad (bilinear midpoints) or a triangle (midpoint
  * subdivision, the middle child last), same orientation as the parent:
  * the adaptive quadratures' refinement step (analytic, hemicube).  A
@@ -383,10 +387,14 @@ double rad_polygon_coupling_to(const vec3 *poly_i, size_t n_i, vec3 normal_i, co
 /* rad_polygon_coupling of elements i and j of the mesh.  Cannot fail. */
 double rad_element_coupling(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_tol);
 
-/* Enclosure smoothing (smooth.c): rad_view_factors_smooth's work, to the
- * row sums `targets` (n values in [0, 1]).  F is unchanged on failure. */
-rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double *F, const double *targets,
-                         rad_smooth_report *report);
+/* Enclosure smoothing (smooth.c): rad_view_factors_smooth's work.  The
+ * rows are brought to 1 (`enclosure`) or to their own sums held to [0, 1],
+ * taken before the pairs whose two factors are both below
+ * sparse_threshold (0: none) are dropped; *dropped (may be NULL) = the
+ * largest row's mass dropped.  On failure F is unchanged but for the
+ * dropped pairs. */
+rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double *F, bool enclosure,
+                         double sparse_threshold, double *dropped, rad_smooth_report *report);
 
 /* ---- rows in blocks, without the n x n matrix (rows.c) ---- */
 

@@ -1,7 +1,8 @@
 /*
- * polygon.c -- the unoccluded point-to-polygon form factor; and two small
- * element helpers the sampling methods share: the bend of a quad (how far
- * ray end points must be lifted) and the density of rad_element_sample.
+ * polygon.c -- the unoccluded point-to-polygon form factor; and the small
+ * helpers the sampling methods share: the bend of a quad (how far ray end
+ * points must be lifted), the density of rad_element_sample, the tangent
+ * frame of an element and the split of a region into four.
  *
  * Lambert's contour formula (Lambert 1760; in radiosity: Baum, Rushmeier &
  * Winget, SIGGRAPH 1989; Cohen & Wallace 1993, sec. 4.6):
@@ -105,6 +106,13 @@ double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, dou
     vec3 du = v3_add(v3_scale(v3_sub(p1, p0), 1.0 - v), v3_scale(v3_sub(p2, p3), v));
     vec3 dv = v3_sub(v3_lerp(p3, p2, u), v3_lerp(p0, p1, u));
     return v3_length(v3_cross(du, dv)) / e->area;
+}
+
+void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v)
+{
+    vec3 a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
+    *u = v3_normalize(v3_sub(a, v3_scale(n, v3_dot(a, n))));
+    *v = v3_cross(n, *u);
 }
 
 void rad_ff_split4(const vec3 *region, uint32_t corners, vec3 sub[4][4])

@@ -23,6 +23,10 @@
  * factor driven below 0 is held at 0 and the system solved again without
  * it (clamp and re-solve, at most n^2 rounds; in practice one or two).
  *
+ * With a sparse threshold (the .mtx of output/view3d.c), the pairs whose
+ * two factors are both below it are dropped first and the rest smoothed on
+ * the kept pattern, to the row sums from before the drop.
+ *
  * The multiplicative closure of formfactor.c (rad_ff_close, Sinkhorn) acts
  * on the element matrix during the solve; this acts on the surface matrix
  * written out, and is the least-squares answer (docs/methods.md).
@@ -112,23 +116,17 @@ static void measure(size_t n, const double *area, const double *F, const double 
     }
 }
 
-rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double *F, const double *targets,
-                         rad_smooth_report *report)
+rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double *F, bool enclosure,
+                         double sparse_threshold, double *dropped, rad_smooth_report *report)
 {
     rad_smooth_report rep;
     memset(&rep, 0, sizeof rep);
+    if (dropped)
+        *dropped = 0.0;
     if (n == 0) {
         if (report)
             *report = rep;
         return RAD_OK;
-    }
-    for (size_t i = 0; i < n; i++) {
-        if (!(area[i] > 0.0 && isfinite(area[i])))
-            return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "smoothing: surface %zu has area %g", i, area[i]);
-        for (size_t j = 0; j < n; j++)
-            if (!(F[i * n + j] >= 0.0 && F[i * n + j] <= 1.0 + 1e-6))
-                return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                                "smoothing: F[%zu][%zu] = %g is not a view factor", i, j, F[i * n + j]);
     }
     if (n > 46340) /* n^2 doubles must be countable; the dense solve is O(n^3) anyway */
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "smoothing: %zu surfaces is too many", n);
@@ -138,35 +136,49 @@ rad_result rad_ff_smooth(rad_context *ctx, size_t n, const double *area, double 
     double *target = lambda ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *target, "smoothing: targets") : NULL;
     double *rhs = target ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *rhs, "smoothing: system") : NULL;
     size_t *col = rhs ? rad_alloc(ctx, RAD_MEM_OUTPUT, n, sizeof *col, "smoothing: system") : NULL;
-    if (!col) {
-        rad_free(g0);
-        rad_free(M);
-        rad_free(lambda);
-        rad_free(target);
-        rad_free(rhs);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
-    for (size_t i = 0; i < n; i++) {
-        if (!(targets[i] >= 0.0 && targets[i] <= 1.0)) {
-            rad_free(g0);
-            rad_free(M);
-            rad_free(lambda);
-            rad_free(target);
-            rad_free(rhs);
-            rad_free(col);
-            return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "smoothing: row %zu's target %g is not in [0, 1]",
-                            i, targets[i]);
-        }
-        target[i] = targets[i];
-    }
-    measure(n, area, F, target, &rep.row_error_before, &rep.reciprocity_before);
-    for (size_t i = 0; i < n; i++)
+    rad_result result = col ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+    /* The targets, from the rows as they came: 1 in an enclosure; an open
+     * set keeps what each row measured. */
+    for (size_t i = 0; result == RAD_OK && i < n; i++) {
+        double sum = 0.0;
         for (size_t j = 0; j < n; j++)
-            g0[i * n + j] = 0.5 * (area[i] * F[i * n + j] + area[j] * F[j * n + i]);
-
-    rad_result result = RAD_OK;
+            sum += F[i * n + j];
+        target[i] = enclosure ? 1.0 : (sum < 1.0 ? (sum > 0.0 ? sum : 0.0) : 1.0);
+    }
+    if (result == RAD_OK && sparse_threshold > 0.0) {
+        /* A pair goes when both of its factors are below the threshold, so
+         * the pattern stays symmetric and reciprocity can hold on it. */
+        double most = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            double row = 0.0;
+            for (size_t j = 0; j < n; j++)
+                if (F[i * n + j] < sparse_threshold && F[j * n + i] < sparse_threshold)
+                    row += F[i * n + j];
+            most = fmax(most, row);
+        }
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = 0; j < n; j++)
+                if (F[i * n + j] < sparse_threshold && F[j * n + i] < sparse_threshold)
+                    F[i * n + j] = F[j * n + i] = 0.0;
+        if (dropped)
+            *dropped = most;
+    }
+    for (size_t i = 0; result == RAD_OK && i < n; i++) {
+        if (!(area[i] > 0.0 && isfinite(area[i])))
+            result = rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "smoothing: surface %zu has area %g", i, area[i]);
+        for (size_t j = 0; result == RAD_OK && j < n; j++)
+            if (!(F[i * n + j] >= 0.0 && F[i * n + j] <= 1.0 + 1e-6))
+                result = rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                                  "smoothing: F[%zu][%zu] = %g is not a view factor", i, j, F[i * n + j]);
+    }
+    if (result == RAD_OK) {
+        measure(n, area, F, target, &rep.row_error_before, &rep.reciprocity_before);
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = 0; j < n; j++)
+                g0[i * n + j] = 0.5 * (area[i] * F[i * n + j] + area[j] * F[j * n + i]);
+    }
     /* Every clamp removes one pair from the pattern: at most n(n+1)/2 rounds. */
-    for (size_t round = 0;; round++) {
+    for (size_t round = 0; result == RAD_OK; round++) {
         for (size_t i = 0; i < n; i++) {
             double s = 0.0;
             for (size_t j = 0; j < n; j++) {
@@ -241,19 +253,5 @@ rad_result rad_view_factors_smooth(rad_context *ctx, size_t n, const double *are
     rad_api_enter(ctx);
     if (!ctx || (n > 0 && (!area || !F)))
         return rad_null_argument(ctx, __func__);
-    if (n > 46340)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "smoothing: %zu surfaces is too many", n);
-    double *targets = rad_alloc(ctx, RAD_MEM_OUTPUT, n ? n : 1, sizeof *targets, "smoothing: targets");
-    if (!targets)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    /* 1 in an enclosure; an open set keeps what each row measured. */
-    for (size_t i = 0; i < n; i++) {
-        double sum = 0.0;
-        for (size_t j = 0; j < n; j++)
-            sum += F[i * n + j];
-        targets[i] = enclosure ? 1.0 : (sum < 1.0 ? (sum > 0.0 ? sum : 0.0) : 1.0);
-    }
-    rad_result r = rad_ff_smooth(ctx, n, area, F, targets, report);
-    rad_free(targets);
-    return r;
+    return rad_ff_smooth(ctx, n, area, F, enclosure, 0.0, NULL, report);
 }

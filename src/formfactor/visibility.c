@@ -58,18 +58,6 @@ static vec3 end_point(const rad_ff_end *end, double u, double v)
     return v3_mad(p, end->normal, end->lift);
 }
 
-/* A random permutation of 0 .. n-1 (Fisher-Yates). */
-static void shuffle_strata(int *perm, int n, rad_rng *rng)
-{
-    for (int k = 0; k < n; k++)
-        perm[k] = k;
-    for (int k = n - 1; k > 0; k--) {
-        int m = (int)(rad_rng_uniform(rng) * (k + 1)), t = perm[k];
-        perm[k] = perm[m];
-        perm[m] = t;
-    }
-}
-
 /* The ray from p (on a) to q (on b) into *ray, when each end is in front
  * of the other's plane; returns 1 if written, else 0.  Ends behind each
  * other's planes carry no energy (a cosine is <= 0): they say nothing
@@ -151,12 +139,12 @@ int rad_ff_pairs(const rad_ff_end *a, const rad_ff_end *b, int count, rad_rng *r
      * and bias the estimate. */
     int perm[RAD_FF_MAX_RAYS], first[RAD_FF_MAX_RAYS];
     int cells = side * side;
-    shuffle_strata(perm, cells, rng);
+    rad_rng_shuffle(rng, perm, cells);
     /* With fewer rays than cells (count not a square), the near end's
      * strata are a random subset too: a fixed subset would never sample
      * the cells left over, and bias the fraction. */
     if (count < cells)
-        shuffle_strata(first, cells, rng);
+        rad_rng_shuffle(rng, first, cells);
     else
         for (int k = 0; k < cells; k++)
             first[k] = k;

@@ -128,7 +128,7 @@ static void gather_point(const gather_shared *g, size_t index, ray_batch *b, dou
     const double *B = view->radiosity;
     vec3 p = g->set->position[index], n = g->set->normal[index];
     double t0 = rad_seconds();
-    rad_light_irradiance_lifted(view->scene, view->vis, g->eps, p, n, direct);
+    rad_light_irradiance(view->scene, mesh, view->vis, p, n, direct);
     *light_seconds += rad_seconds() - t0;
     indirect[0] = indirect[1] = indirect[2] = 0.0;
     int64_t recv = receiver_of(g, p, n);

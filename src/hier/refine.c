@@ -103,16 +103,7 @@ double hr_transfer(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s,
         count = MAX;
     double source_power = hr_cluster_power(t, s);
     *by_power = source_power > 0.0;
-    for (int i = 0; i < count; i++)
-        perm[i] = i;
-    for (int i = count - 1; i > 0; i--) {
-        int j = (int)(rad_rng_uniform(rng) * (i + 1));
-        if (j > i)
-            j = i;
-        int tmp = perm[i];
-        perm[i] = perm[j];
-        perm[j] = tmp;
-    }
+    rad_rng_shuffle(rng, perm, count);
     /* Point i: the patch at stratum i of r's and perm[i] of s's weights. */
     double ur[3 * MAX], us[3 * MAX];
     for (int i = 0; i < count; i++) {

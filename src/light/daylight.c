@@ -295,17 +295,12 @@ static double through_no_opening(const query *q)
 void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                              vec3 n, double out[3])
 {
-    rad_daylight_irradiance_lifted(scene, vis, mesh ? rad_vis_epsilon(mesh) : 0.0, p, n, out);
-}
-
-void rad_daylight_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double eps, vec3 p, vec3 n,
-                                    double out[3])
-{
     out[0] = out[1] = out[2] = 0.0;
     const rad_daylight *day = scene ? scene->daylight : NULL;
     if (!day)
         return;
     n = v3_normalize(n);
+    double eps = mesh ? rad_vis_epsilon(mesh) : 0.0;
     query q = {day, vis, p, n, v3_mad(p, n, eps), day->tolerance * fmax(day->sky.horizontal, 1e-300)};
     double e = 0.0;
     for (size_t k = 0; k < day->opening_count; k++) {

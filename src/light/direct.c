@@ -36,23 +36,14 @@ void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const ra
     out[0] = out[1] = out[2] = 0.0;
     if (!rad_light_present(scene))
         return;
-    rad_light_irradiance_lifted(scene, vis, mesh ? rad_vis_epsilon(mesh) : 0.0, p, n, out);
-}
-
-void rad_light_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift,
-                                 vec3 p, vec3 n, double out[3])
-{
-    out[0] = out[1] = out[2] = 0.0;
-    if (!rad_light_present(scene))
-        return;
     double part[3];
     if (scene->luminaires.count > 0) {
-        rad_luminaires_irradiance_lifted(scene, vis, lift, p, n, part);
+        rad_luminaires_irradiance(scene, mesh, vis, p, n, part);
         for (int c = 0; c < 3; c++)
             out[c] += part[c];
     }
     if (scene->daylight) {
-        rad_daylight_irradiance_lifted(scene, vis, lift, p, n, part);
+        rad_daylight_irradiance(scene, mesh, vis, p, n, part);
         for (int c = 0; c < 3; c++)
             out[c] += part[c];
     }
@@ -63,12 +54,11 @@ typedef struct cubature {
     const rad_mesh *mesh;
     const rad_vis *vis;
     vec3 normal;
-    double lift;          /* m: rad_vis_epsilon(mesh), once (it walks the mesh) */
 } cubature;
 
 static void light_at(const cubature *c, vec3 x, double out[3])
 {
-    rad_light_irradiance_lifted(c->scene, c->vis, c->lift, x, c->normal, out);
+    rad_light_irradiance(c->scene, c->mesh, c->vis, x, c->normal, out);
 }
 
 /* The integral (W per channel) of the irradiance over one region. */
@@ -135,17 +125,11 @@ static void refine(const cubature *c, const vec3 *q, uint32_t corners, const dou
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   size_t element, double out[3])
 {
-    rad_light_element_irradiance_lifted(scene, mesh, vis, rad_vis_epsilon(mesh), element, out);
-}
-
-void rad_light_element_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
-                                         double lift, size_t element, double out[3])
-{
     const rad_element *e = &mesh->elements[element];
     out[0] = out[1] = out[2] = 0.0;
     if (!rad_light_present(scene) || !(e->area > 0.0))
         return;
-    cubature c = {scene, mesh, vis, e->normal, lift};
+    cubature c = {scene, mesh, vis, e->normal};
     vec3 q[4];
     for (uint32_t k = 0; k < e->vertex_count; k++)
         q[k] = mesh->vertices[e->vertex[k]];

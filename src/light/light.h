@@ -32,39 +32,21 @@ bool rad_light_present(const rad_scene *scene);
  * (light from behind it counts zero), from every luminaire and from the
  * daylight of `scene`; shadow rays through vis (built over mesh; vis NULL:
  * no shadows).  p lies on a surface or in free space; rays start
- * rad_vis_epsilon(mesh) off it along n.  Thread-safe, deterministic. */
+ * rad_vis_epsilon(mesh) off it along n (mesh NULL: on it).  Thread-safe,
+ * deterministic. */
 void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                           vec3 n, double out[3]);
-
-/* rad_light_irradiance with the shadow rays' lift given, m
- * (rad_vis_epsilon(mesh) walks the whole mesh: a caller asking at many
- * points, calculation grids, computes it once).  Thread-safe,
- * deterministic. */
-void rad_light_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift, vec3 p, vec3 n,
-                                 double out[3]);
 
 /* The mean of rad_light_irradiance over element `element` of mesh
  * (adaptive cubature over its polygon).  Thread-safe, deterministic. */
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   size_t element, double out[3]);
-/* The same with the shadow rays' lift given (rad_vis_epsilon(mesh), which
- * walks the mesh: a pass over every element computes it once). */
-void rad_light_element_irradiance_lifted(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
-                                         double lift, size_t element, double out[3]);
 
 /* The parts, one file each. */
 void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                                vec3 n, double out[3]);           /* light/luminaire.c */
-/* rad_luminaires_irradiance with the shadow rays' lift given, m
- * (rad_vis_epsilon(mesh), which walks the whole mesh: a caller asking at
- * many points computes it once).  Thread-safe, deterministic. */
-void rad_luminaires_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift, vec3 p, vec3 n,
-                                      double out[3]);            /* light/luminaire.c */
 void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                              vec3 n, double out[3]);             /* light/daylight.c */
-/* rad_daylight_irradiance with the shadow rays' lift given, as above. */
-void rad_daylight_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift, vec3 p, vec3 n,
-                                    double out[3]);              /* light/daylight.c */
 
 /* The horizontal irradiance (W/m^2 RGB) outdoors under the unobstructed sky
  * of the scene's daylight, the sun excluded: the daylight factor's

@@ -236,9 +236,10 @@ static void one_luminaire(pending *q, const rad_scene *scene, const rad_luminair
     }
 }
 
-void rad_luminaires_irradiance_lifted(const rad_scene *scene, const rad_vis *vis, double lift, vec3 p, vec3 n,
-                                      double out[3])
+void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                               vec3 n, double out[3])
 {
+    double lift = mesh ? rad_vis_epsilon(mesh) : 0.0;
     pending q;
     q.count = 0;
     q.vis = vis;
@@ -247,10 +248,4 @@ void rad_luminaires_irradiance_lifted(const rad_scene *scene, const rad_vis *vis
         one_luminaire(&q, scene, &scene->luminaires.items[k], p, n, lift);
     flush(&q);
     out[0] = out[1] = out[2] = q.sum;
-}
-
-void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
-                               vec3 n, double out[3])
-{
-    rad_luminaires_irradiance_lifted(scene, vis, mesh ? rad_vis_epsilon(mesh) : 0.0, p, n, out);
 }

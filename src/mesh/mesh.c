@@ -166,6 +166,7 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
         rad_mesh_destroy(mesh);
         return r;
     }
+    rad_mesh_measure(mesh);
     *out = mesh;
     return RAD_OK;
 }
@@ -275,8 +276,25 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
         rad_mesh_destroy(mesh);
         return r;
     }
+    rad_mesh_measure(mesh);
     *out = mesh;
     return RAD_OK;
+}
+
+void rad_mesh_measure(rad_mesh *mesh)
+{
+    vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    for (size_t i = 0; i < mesh->vertex_count; i++) {
+        lo = v3_min(lo, mesh->vertices[i]);
+        hi = v3_max(hi, mesh->vertices[i]);
+    }
+    for (size_t i = 0; i < mesh->patch_count; i++)
+        for (uint32_t c = 0; c < mesh->patches[i].corner_count; c++) {
+            lo = v3_min(lo, mesh->patches[i].corner[c]);
+            hi = v3_max(hi, mesh->patches[i].corner[c]);
+        }
+    double diagonal = v3_length(v3_sub(hi, lo));
+    mesh->diagonal = diagonal > 0.0 && isfinite(diagonal) ? diagonal : 0.0; /* empty: -inf..inf */
 }
 
 void rad_mesh_destroy(rad_mesh *mesh)

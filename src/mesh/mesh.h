@@ -88,6 +88,8 @@ typedef struct rad_mesh {
     rad_contact *contacts;   /* sorted by polygon; NULL when none */
     size_t contact_count;
     double contact_tol;      /* m: a point this near a contact line is on it */
+    double diagonal;         /* m: of the box around the vertices and the patch corners, 0
+                                when empty (rad_mesh_measure): the scale rad_vis_epsilon takes */
 } rad_mesh;
 
 #define RAD_TREE_LEAF 0x80000000u
@@ -107,6 +109,12 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
                                  const rad_mesh_options *options, double max_memory_bytes,
                                  rad_mesh **out);
 void rad_mesh_destroy(rad_mesh *mesh);
+
+/* Set mesh->diagonal from its vertices and patch corners (the corners
+ * cover a mesh whose vertices are not welded or not filled in).  Every
+ * builder calls it once the geometry is final, as must whatever builds or
+ * moves a mesh by hand (tests).  Cannot fail. */
+void rad_mesh_measure(rad_mesh *mesh);
 
 /* The element of `patch` containing the point with patch parameters (s, t)
  * (quad: bilinear coordinates in [0,1]^2; triangle: barycentrics of c1 and

@@ -192,34 +192,10 @@ rad_result rad_vf_adjust(rad_context *ctx, const rad_scene *scene, char **names,
     *count = n;
     if (!o || (o->smooth == RAD_SMOOTH_NONE && !(o->sparse_threshold > 0.0)))
         return RAD_OK;
-    double *targets = rad_alloc(ctx, RAD_MEM_OUTPUT, n ? n : 1, sizeof *targets, "view factors: targets");
-    if (!targets)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < n; i++) {
-        double sum = 0.0;
-        for (size_t j = 0; j < n; j++)
-            sum += F[i * n + j];
-        targets[i] = o->smooth == RAD_SMOOTH_ENCLOSURE ? 1.0 : fmax(0.0, fmin(sum, 1.0));
-    }
-    double dropped = 0.0;
-    if (o->sparse_threshold > 0.0) {
-        /* A pair goes when both of its factors are below the threshold, so
-         * the pattern stays symmetric and reciprocity can hold on it. */
-        for (size_t i = 0; i < n; i++) {
-            double row = 0.0;
-            for (size_t j = 0; j < n; j++)
-                if (F[i * n + j] < o->sparse_threshold && F[j * n + i] < o->sparse_threshold)
-                    row += F[i * n + j];
-            dropped = fmax(dropped, row);
-        }
-        for (size_t i = 0; i < n; i++)
-            for (size_t j = 0; j < n; j++)
-                if (F[i * n + j] < o->sparse_threshold && F[j * n + i] < o->sparse_threshold)
-                    F[i * n + j] = F[j * n + i] = 0.0;
-    }
     rad_smooth_report report;
-    rad_result r = rad_ff_smooth(ctx, n, area, F, targets, &report);
-    rad_free(targets);
+    double dropped = 0.0;
+    rad_result r = rad_ff_smooth(ctx, n, area, F, o->smooth == RAD_SMOOTH_ENCLOSURE, o->sparse_threshold, &dropped,
+                                 &report);
     if (r != RAD_OK && o->sparse_threshold > 0.0) {
         char why[400];
         snprintf(why, sizeof why, "%s", rad_context_error(ctx));

@@ -199,7 +199,7 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     for (size_t k = n / 2; k-- > 0;) /* heapify */
         heap_fix(&h, h.item[k]);
     double absorbed = 0.0, t0 = rad_seconds();
-    double eps = rad_vis_epsilon(sys->mesh); /* O(vertices): once, not per shot */
+    double eps = rad_vis_epsilon(sys->mesh);
     rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, rad_system_contraction(sys), 1.0, goal,
                                                  ceil((double)n / BATCH));
     long long max_batches = (long long)bound.limit;

@@ -630,7 +630,6 @@ static rad_result collocation_points(rad_context *ctx, galerkin_state *st)
         rad_free(lift);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    double epsilon = rad_vis_epsilon(mesh); /* it walks the mesh: once */
     for (uint32_t e = 0; e < mesh->element_count; e++) {
         const rad_element *el = &mesh->elements[e];
         for (uint32_t a = 0; a < el->vertex_count; a++) {
@@ -638,7 +637,7 @@ static rad_result collocation_points(rad_context *ctx, galerkin_state *st)
             count[i] += 1.0;
             centre[i] = v3_add(centre[i], el->centroid);
             st->point_normal[i] = v3_add(st->point_normal[i], el->normal);
-            lift[i] = fmax(lift[i], epsilon + rad_element_bend(mesh, el));
+            lift[i] = fmax(lift[i], rad_vis_epsilon(mesh) + rad_element_bend(mesh, el));
         }
     }
     for (size_t i = 0; i < st->dofs; i++) {

@@ -729,6 +729,7 @@ static rad_result read_mesh(rad_context *ctx, const char *name, const rad_scene 
         rad_mesh_destroy(m);
         return r;
     }
+    rad_mesh_measure(m);
     *out = m;
     return RAD_OK;
 }

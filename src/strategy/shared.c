@@ -91,14 +91,13 @@ rad_result rad_elements_add_light(rad_context *ctx, const rad_scene *scene, cons
         return RAD_ERROR_OUT_OF_MEMORY;
     uint64_t done = 0;
     volatile int stop = 0;
-    double lift = rad_vis_epsilon(mesh);
     rad_progress(ctx, "direct light", 0, n);
     /* Each element alone: its values do not depend on the schedule. */
 #pragma omp parallel for schedule(dynamic, 16) num_threads(rad_context_threads(ctx))
     for (size_t i = 0; i < n; i++) {
         if (stop)
             continue;
-        rad_light_element_irradiance_lifted(scene, mesh, vis, lift, i, direct + 3 * i);
+        rad_light_element_irradiance(scene, mesh, vis, i, direct + 3 * i);
         uint64_t now;
 #pragma omp atomic capture
         now = ++done;

@@ -63,9 +63,10 @@ typedef struct rad_vis {
 rad_result rad_vis_create(rad_context *ctx, const char *name, const rad_mesh *mesh, rad_vis **out);
 void rad_vis_destroy(rad_vis *vis);
 
-/* Offset for shadow-ray end points, m: 1e-5 x the scene diagonal.  Float
- * rounding in Embree is ~1e-7 relative, so this is well clear of
- * self-intersection yet far below any element size we mesh to. */
+/* Offset for shadow-ray end points, m: 1e-5 x the scene diagonal
+ * (mesh->diagonal, 1 m when 0).  Float rounding in Embree is ~1e-7
+ * relative, so this is well clear of self-intersection yet far below any
+ * element size we mesh to.  O(1); cannot fail. */
 double rad_vis_epsilon(const rad_mesh *mesh);
 
 /* Patches narrower than rad_vis_epsilon: shadow rays end that far off the
