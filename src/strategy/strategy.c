@@ -2,11 +2,13 @@
  * strategy.c -- the strategy table, lookup by solver name, what the
  * strategies share (element arrays, mesh + ray structure), and the
  * questions every solution answers from its view: power balance,
- * per-surface radiosity, surface-to-surface view factors.
+ * per-surface radiosity, surface-to-surface view factors, the direct
+ * lumens landing.
  */
 #include "strategy/strategy.h"
 
 #include "light/light.h"
+#include "photometry/photometry.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -436,6 +438,18 @@ rad_result rad_view_power(rad_context *ctx, const rad_solution_view *v, double *
     *emitted = em / 3.0 + direct_absorbed;
     *absorbed = ab / 3.0 + direct_absorbed;
     return RAD_OK;
+}
+
+double rad_view_direct_lumens(const rad_solution_view *v)
+{
+    if (!v->direct)
+        return 0.0;
+    double landing = 0.0;
+    for (size_t i = 0; i < v->n; i++) {
+        const double *h = v->direct + 3 * i;
+        landing += v->area[i] * (RAD_Y_R * h[0] + RAD_Y_G * h[1] + RAD_Y_B * h[2]);
+    }
+    return RAD_LUMINOUS_EFFICACY * landing;
 }
 
 /* Every registry of the pipeline, for --list-methods and the option
