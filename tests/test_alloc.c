@@ -265,7 +265,7 @@ static rad_result run_illuminance(rad_context *ctx, const rad_solution *s, outpu
         output_path("illuminance.json", path, sizeof path);
         r = write_done(rad_illuminance_write(ctx, il, path), out, "illuminance.json");
     }
-    /* The grids' plans (api/pictures.c), through an output set: all three
+    /* The grids' plans (output/pictures.c), through an output set: all three
      * or none. */
     rad_output_set *set = NULL;
     if (r == RAD_OK)
@@ -338,7 +338,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
         output_path("image.pfm", path, sizeof path);
         r = write_done(rad_image_write(ctx, image, path), out, "image.pfm");
     }
-    /* False colour pictures (api/pictures.c): a render, the coverage, the
+    /* False colour pictures (output/pictures.c): a render, the coverage, the
      * range, cairo's PNG through an atomic file. */
     for (int q = RAD_FALSE_COLOUR_LUMINANCE; q <= RAD_FALSE_COLOUR_ILLUMINANCE && r == RAD_OK; q++) {
         rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
@@ -366,7 +366,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     }
     if (r == RAD_OK && sc->view_factors)
         r = run_thermal(ctx, scene, s, out);
-    /* Streamed view factors (api/stream.c): element rows in blocks of 5 to
+    /* Streamed view factors (output/stream.c): element rows in blocks of 5 to
      * Matrix Market (a temporary joined at the end) and CSV, surfaces to JSON. */
     static const char *const streamed[] = {"stream.mtx", "stream.csv", "stream.json"};
     bool streams = sc->view_factors && !sc->closure_correction && !sc->adaptive_levels &&

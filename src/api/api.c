@@ -2,11 +2,14 @@
  * api.c -- the public solution object: resolves the options, hands the
  * work to the strategy that answers to the solver's name (strategy/), keeps
  * the convergence history, and answers questions through the strategy's
- * read-only view.
+ * read-only view.  The public calls that take a solution and belong to a
+ * room below (the writers, the grids' illuminance, false colour) unpack it
+ * here and hand that room the view.
  *
  *     options --> strategy: mesh -> visibility -> couplings -> B --> view
  */
 #include "api/solution.h"
+#include "grid/grid.h"
 #include "strategy/saved.h"
 #include "solve/vpl.h"
 #include "light/light.h"
@@ -727,6 +730,51 @@ rad_result rad_solution_write_history(rad_context *ctx, const rad_solution *s, c
     rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
     return rad_write_history(ctx, s->history, s->history_count, path);
 }
+
+rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *s, const rad_render_options *render,
+                                           const rad_false_colour_options *options, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !s || !path)
+        return rad_null_argument(ctx, __func__);
+    rad_result r = rad_false_colour_check(ctx, options);
+    if (r != RAD_OK)
+        return r;
+    rad_memory_limit_call(ctx, s->options.max_memory_bytes); /* the solution's limit, where lower */
+    /* Luminance is what the solution's own render shows (textures, the
+     * second pass); illuminance needs no render of the radiance. */
+    rad_image *radiance = NULL;
+    if (!options || options->quantity != RAD_FALSE_COLOUR_ILLUMINANCE)
+        r = rad_solution_render(ctx, s, render, &radiance);
+    if (r == RAD_OK)
+        r = rad_write_false_colour_view(ctx, &s->view, render, options, radiance, path);
+    rad_image_destroy(radiance);
+    return r;
+}
+
+rad_result rad_illuminance_evaluate_memory(rad_context *ctx, const rad_solution *s, const char *name,
+                                           const void *data, size_t size, rad_illuminance **out)
+{
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !s || !name || (!data && size > 0) || !out)
+        return rad_null_argument(ctx, __func__);
+    return rad_illuminance_from_view(ctx, &s->view, name, data, size, out);
+}
+
+rad_result rad_illuminance_evaluate_file(rad_context *ctx, const rad_solution *s, const char *path,
+                                         rad_illuminance **out)
+{
+    rad_api_enter(ctx);
+    if (out)
+        *out = NULL;
+    if (!ctx || !s || !path || !out)
+        return rad_null_argument(ctx, __func__);
+    return rad_illuminance_from_view_file(ctx, &s->view, path, out);
+}
+
+double rad_solution_direct_lumens(const rad_solution *s) { return s ? rad_view_direct_lumens(&s->view) : 0.0; }
 
 rad_result rad_camera_from_string(rad_context *ctx, const char *text, rad_camera *camera)
 {

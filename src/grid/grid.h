@@ -85,4 +85,27 @@ typedef struct rad_grid_gather_stats {
 rad_result rad_grid_gather(rad_context *ctx, const rad_solution_view *view, const rad_grid_set *set,
                            double *direct, double *indirect, rad_grid_gather_stats *stats);
 
+/* ---- the rad_illuminance handle (illuminance.c; radiosity.h) ---- */
+
+struct rad_illuminance {
+    rad_grid_set *set;
+    rad_grid_result *grids;        /* set->grid_count */
+    rad_grid_point_value *values;  /* set->point_count */
+    bool daylight;                 /* the scene has daylight: daylight factors are numbers */
+    rad_illuminance_stats stats;
+};
+
+/* The grid file's text (`name` for messages; NULL data with size 0: an
+ * empty text) parsed against view->scene and gathered from the solved view
+ * with the context's threads: lux per point, each grid's statistics, the
+ * daylight factors.  RAD_ERROR_INVALID_ARGUMENT when the view is not
+ * solved, else as rad_grid_parse and rad_grid_gather fail; *out is NULL on
+ * failure and nothing leaks.  The arguments are not NULL (the public calls
+ * check them). */
+rad_result rad_illuminance_from_view(rad_context *ctx, const rad_solution_view *view, const char *name,
+                                     const void *data, size_t size, rad_illuminance **out);
+/* The same for the file at `path`, read whole first (rad_read_whole_file). */
+rad_result rad_illuminance_from_view_file(rad_context *ctx, const rad_solution_view *view, const char *path,
+                                          rad_illuminance **out);
+
 #endif /* RAD_GRID_H */

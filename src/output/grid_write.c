@@ -3,9 +3,10 @@
  * point) or JSON (per grid: the statistics EN 12464-1 asks for, Eavg, Emin,
  * Emax, U0 = Emin / Eavg, Emin / Emax, and every point), atomically; names
  * carried as the other writers carry them (valid UTF-8; CSV fields quoted
- * per RFC 4180, JSON by cJSON).  docs/lighting.md, "Calculation grids and
- * points".
+ * per RFC 4180, JSON by cJSON): rad_illuminance_write.  docs/lighting.md,
+ * "Calculation grids and points".
  */
+#include "grid/grid.h"
 #include "output/output.h"
 
 #include <cjson/cJSON.h>
@@ -84,8 +85,11 @@ static rad_result write_json(rad_context *ctx, const rad_grid_result *grids, siz
     return res;
 }
 
-rad_result rad_write_illuminance(rad_context *ctx, const rad_grid_result *grids, size_t count, bool daylight,
-                                 const char *path)
+/* .csv, one row per point, or .json, per grid its statistics and points;
+ * the daylight factor's column only when `daylight`.  RAD_ERROR_IO,
+ * RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INVALID_ARGUMENT (another extension). */
+static rad_result write_illuminance(rad_context *ctx, const rad_grid_result *grids, size_t count, bool daylight,
+                                   const char *path)
 {
     char ext[16];
     rad_path_extension(path, ext, sizeof ext);
@@ -133,4 +137,12 @@ rad_result rad_write_illuminance(rad_context *ctx, const rad_grid_result *grids,
         return r;
     }
     return rad_atomic_commit(ctx, &f);
+}
+
+rad_result rad_illuminance_write(rad_context *ctx, const rad_illuminance *il, const char *path)
+{
+    rad_api_enter(ctx);
+    if (!ctx || !il || !path)
+        return rad_null_argument(ctx, __func__);
+    return write_illuminance(ctx, il->grids, il->set->grid_count, il->daylight, path);
 }

@@ -270,20 +270,28 @@ rad_result rad_write_history(rad_context *ctx, const rad_solve_step *steps, size
 rad_result rad_write_thermal(rad_context *ctx, const rad_thermal *thermal, const char *path, bool elements);
 rad_result rad_write_gebhart(rad_context *ctx, const rad_thermal *thermal, const double *G, const char *path);
 
-/* The illuminance at calculation points (grid_write.c): .csv, one row per
- * point, or .json, per grid its statistics and points; atomically.  The
- * daylight factor's column only when `daylight`.  RAD_ERROR_IO,
- * RAD_ERROR_OUT_OF_MEMORY, RAD_ERROR_INVALID_ARGUMENT (another extension). */
-rad_result rad_write_illuminance(rad_context *ctx, const rad_grid_result *grids, size_t count, bool daylight,
-                                 const char *path);
 /* The solution's stats with a "thermal" object (rad_thermal_write_stats). */
 rad_result rad_write_thermal_stats(rad_context *ctx, const rad_solution_view *view, const rad_thermal *thermal,
                                    const char *path);
 
-/* ---- pictures people read (falsecolour.c, plot.c; docs/lighting.md
- * "Pictures"); the colour map, scale and legend: picture.h ---- */
+/* ---- pictures people read (pictures.c, falsecolour.c, plot.c;
+ * docs/lighting.md "Pictures"); the colour map, scale and legend:
+ * picture.h ---- */
 
 struct rad_colour_scale;
+
+/* rad_solution_write_false_colour's picture of a solved view (pictures.c):
+ * `options` already checked (rad_false_colour_check; NULL: luminance,
+ * automatic range), `render` the camera and size (NULL: the defaults).
+ * Luminance takes `radiance`, the solution's own render with `render`
+ * (rad_solution_render: textures, the second pass), and a flat render of
+ * the view for its coverage; illuminance (radiance NULL) renders the
+ * elements' lux with the coverage in one.  Within the running call's
+ * memory limit; RAD_ERROR_IO, RAD_ERROR_OUT_OF_MEMORY,
+ * RAD_ERROR_INTERRUPTED. */
+rad_result rad_write_false_colour_view(rad_context *ctx, const rad_solution_view *view,
+                                       const rad_render_options *render, const rad_false_colour_options *options,
+                                       const rad_image *radiance, const char *path);
 
 /* Each element's illuminance in lux (n), 179 Y(H) with H = (B - E) / rho
  * + direct per channel, a black channel gathered from the others

@@ -1,7 +1,7 @@
 /*
  * vf_stream.c -- the row sinks of streamed view factors: where element
  * rows go, in order, one at a time, when the n x n matrix is never held
- * (api/stream.c drives them; docs/formats.md, "Streamed view factors").
+ * (stream.c drives them; docs/formats.md, "Streamed view factors").
  *
  *     sink                    memory          disk
  *     element .csv            O(n) names      the file (dense: n^2 numbers)

@@ -23,7 +23,6 @@
  * onto a type C grid at least as fine as the file's angles (down to 0.25
  * degrees), the photometric axis on the nadir (photometry.h, "Frame").
  */
-#include "import/import_internal.h"
 #include "photometry/photometry_internal.h"
 
 #include <stdlib.h>

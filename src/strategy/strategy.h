@@ -241,6 +241,12 @@ const rad_adaptive_stats *rad_adaptive_get_stats(const rad_adaptive *a);
  * for memory (n doubles; then NAN, NAN). */
 rad_result rad_view_power(rad_context *ctx, const rad_solution_view *view, double *emitted, double *absorbed);
 
+/* Lumens of direct light (luminaires, daylight: view->direct) landing on
+ * the elements, RAD_LUMINOUS_EFFICACY (179 lm/W, docs/units.md) times
+ * sum A_i Y(direct_i); 0 without any.
+ * Cannot fail. */
+double rad_view_direct_lumens(const rad_solution_view *view);
+
 /* Area-weighted mean radiosity of one surface. */
 void rad_view_surface_radiosity(const rad_solution_view *view, size_t surface, double rgb[3]);
 

@@ -1,9 +1,11 @@
 /*
  * view.c -- the questions every solution answers from its read-only view:
  * the power balance, per-surface radiosity, surface-to-surface view
- * factors.
+ * factors, the direct lumens landing.
  */
 #include "strategy/strategy.h"
+
+#include "photometry/photometry.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -120,3 +122,14 @@ rad_result rad_view_power(rad_context *ctx, const rad_solution_view *v, double *
     return RAD_OK;
 }
 
+double rad_view_direct_lumens(const rad_solution_view *v)
+{
+    if (!v->direct)
+        return 0.0;
+    double landing = 0.0;
+    for (size_t i = 0; i < v->n; i++) {
+        const double *h = v->direct + 3 * i;
+        landing += v->area[i] * (RAD_Y_R * h[0] + RAD_Y_G * h[1] + RAD_Y_B * h[2]);
+    }
+    return RAD_LUMINOUS_EFFICACY * landing;
+}

@@ -1,9 +1,8 @@
 /*
- * photometry_info.c -- the public summary of a photometric file
- * (radiosity.h, "Photometric files"): photometry/photometry.c reads it, this
- * copies what a program or the `radiosity photometry` command shows.
+ * info.c -- the public summary of a photometric file (radiosity.h,
+ * "Photometric files"): photometry.c reads it, this copies what a program
+ * or the `radiosity photometry` command shows.
  */
-#include "core/core.h"
 #include "photometry/photometry.h"
 
 #include <stdio.h>

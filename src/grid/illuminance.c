@@ -1,23 +1,15 @@
 /*
  * illuminance.c -- the rad_illuminance handle (radiosity.h, "Calculation
- * grids and points"): a grid file parsed against the solution's scene
- * (grid/grid.c), the illuminance gathered at its points (grid/gather.c),
- * lux and the statistics per grid, and the writer (output/grid_write.c).
+ * grids and points"): a grid file parsed against a solved view's scene
+ * (grid.c), the illuminance gathered at its points (gather.c), lux and the
+ * statistics per grid.  Its writers are output/'s (grid_write.c, the plans
+ * in pictures.c); the public calls that take a solution unpack it in api/.
  */
-#include "api/solution.h"
 #include "grid/grid.h"
 #include "light/light.h"
 #include "photometry/photometry.h"
 
 #include <string.h>
-
-struct rad_illuminance {
-    rad_grid_set *set;
-    rad_grid_result *grids;        /* set->grid_count */
-    rad_grid_point_value *values;  /* set->point_count */
-    bool daylight;
-    rad_illuminance_stats stats;
-};
 
 /* lux from W/m^2 RGB (docs/units.md "Photometry"). */
 static double lux(const double H[3])
@@ -35,16 +27,16 @@ void rad_illuminance_destroy(rad_illuminance *il)
     rad_free(il);
 }
 
-static rad_result evaluate(rad_context *ctx, const rad_solution *s, const char *name, const char *text,
+static rad_result evaluate(rad_context *ctx, const rad_solution_view *solved, const char *name, const char *text,
                            size_t size, rad_illuminance **out)
 {
-    if (!s->view.solved)
+    if (!solved->solved)
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT, "illuminance: the solution is not solved "
                         "(rad_solution_solve first)");
     rad_illuminance *il = rad_alloc(ctx, RAD_MEM_RENDER, 1, sizeof *il, "illuminance");
     if (!il)
         return RAD_ERROR_OUT_OF_MEMORY;
-    rad_result r = rad_grid_parse(ctx, s->scene, name, text, size, &il->set);
+    rad_result r = rad_grid_parse(ctx, solved->scene, name, text, size, &il->set);
     size_t n = il->set ? il->set->point_count : 0;
     double *H = NULL;
     if (r == RAD_OK) {
@@ -57,7 +49,7 @@ static rad_result evaluate(rad_context *ctx, const rad_solution *s, const char *
     rad_grid_gather_stats gs;
     memset(&gs, 0, sizeof gs);
     if (r == RAD_OK) {
-        rad_solution_view view = s->view;
+        rad_solution_view view = *solved;
         view.threads = rad_context_threads(ctx);
         r = rad_grid_gather(ctx, &view, il->set, H, H + 3 * n, &gs);
     }
@@ -67,9 +59,9 @@ static rad_result evaluate(rad_context *ctx, const rad_solution *s, const char *
         return r;
     }
     double sky[3] = {0, 0, 0};
-    il->daylight = s->scene->daylight != NULL;
+    il->daylight = solved->scene->daylight != NULL;
     if (il->daylight)
-        rad_daylight_sky_horizontal(s->scene, sky);
+        rad_daylight_sky_horizontal(solved->scene, sky);
     double sky_lux = lux(sky);
     const rad_grid_set *set = il->set;
     for (size_t k = 0; k < n; k++) {
@@ -121,30 +113,20 @@ static rad_result evaluate(rad_context *ctx, const rad_solution *s, const char *
     return RAD_OK;
 }
 
-rad_result rad_illuminance_evaluate_memory(rad_context *ctx, const rad_solution *s, const char *name,
-                                           const void *data, size_t size, rad_illuminance **out)
+rad_result rad_illuminance_from_view(rad_context *ctx, const rad_solution_view *view, const char *name,
+                                     const void *data, size_t size, rad_illuminance **out)
 {
-    rad_api_enter(ctx);
-    if (out)
-        *out = NULL;
-    if (!ctx || !s || !name || (!data && size > 0) || !out)
-        return rad_null_argument(ctx, __func__);
-    return evaluate(ctx, s, name, data ? data : "", size, out);
+    return evaluate(ctx, view, name, data ? data : "", size, out);
 }
 
-rad_result rad_illuminance_evaluate_file(rad_context *ctx, const rad_solution *s, const char *path,
-                                         rad_illuminance **out)
+rad_result rad_illuminance_from_view_file(rad_context *ctx, const rad_solution_view *view, const char *path,
+                                          rad_illuminance **out)
 {
-    rad_api_enter(ctx);
-    if (out)
-        *out = NULL;
-    if (!ctx || !s || !path || !out)
-        return rad_null_argument(ctx, __func__);
     unsigned char *data = NULL;
     size_t size = 0;
     rad_result r = rad_read_whole_file(ctx, path, &data, &size);
     if (r == RAD_OK)
-        r = evaluate(ctx, s, path, (const char *)data, size, out);
+        r = evaluate(ctx, view, path, (const char *)data, size, out);
     rad_free(data);
     return r;
 }
@@ -191,12 +173,4 @@ void rad_illuminance_get_stats(const rad_illuminance *il, rad_illuminance_stats 
     memset(out, 0, sizeof *out);
     if (il)
         *out = il->stats;
-}
-
-rad_result rad_illuminance_write(rad_context *ctx, const rad_illuminance *il, const char *path)
-{
-    rad_api_enter(ctx);
-    if (!ctx || !il || !path)
-        return rad_null_argument(ctx, __func__);
-    return rad_write_illuminance(ctx, il->grids, il->set->grid_count, il->daylight, path);
 }

@@ -1,9 +1,10 @@
 /*
- * pictures.c -- the public entry of the false colour pictures
- * (docs/lighting.md "Pictures"): one value per pixel from a render of the
- * solution, then output/falsecolour.c colours it and draws the legend.
+ * pictures.c -- the false colour pictures (docs/lighting.md "Pictures"):
+ * one value per pixel from a render of a solved view, then falsecolour.c
+ * colours it and draws the legend.
  *
- *   luminance    the rendered radiance (textures, the second pass, all of
+ *   luminance    the rendered radiance (the caller's render of the
+ *                solution: textures, the second pass, all of
  *                rad_solution_render), 179 Y(L) cd/m^2 per pixel, over the
  *                pixels a second, flat render finds covered
  *   illuminance  each element's lux (rad_view_illuminance), smoothed to
@@ -11,13 +12,12 @@
  *                channel: one render gives both
  *
  * The plans of the calculation grids (rad_illuminance_write_plots): one
- * PNG per grid through output/plot.c, named STEM_NAME.png.
+ * PNG per grid through plot.c, named STEM_NAME.png.
  *
  * A pixel is the background when fewer than half of its rays met the
  * front of a surface; else its value is the mean over those that did (the
  * pixel's sum over its coverage), so edges keep the surface's value.
  */
-#include "api/solution.h"
 #include "output/picture.h"
 #include "photometry/photometry.h"
 
@@ -49,22 +49,22 @@ rad_result rad_false_colour_check(rad_context *ctx, const rad_false_colour_optio
 }
 
 /* The camera rad_solution_render would use. */
-static rad_camera chosen_camera(const rad_solution *s, const rad_render_options *o, int w, int h)
+static rad_camera chosen_camera(const rad_solution_view *view, const rad_render_options *o, int w, int h)
 {
     rad_camera camera;
     if (o->camera)
         return *o->camera;
-    if (!rad_scene_camera(s->scene, &camera))
-        camera = rad_camera_frame(s->scene->bounds_min, s->scene->bounds_max, (double)w / h);
+    if (!rad_scene_camera(view->scene, &camera))
+        camera = rad_camera_frame(view->scene->bounds_min, view->scene->bounds_max, (double)w / h);
     return camera;
 }
 
 /* A render of per-element values `element` (3n) with their smooth vertex
  * values: no textures, no second pass, no VPLs. */
-static rad_result render_values(rad_context *ctx, const rad_solution *s, const rad_render_options *o,
+static rad_result render_values(rad_context *ctx, const rad_solution_view *view, const rad_render_options *o,
                                 const double *element, rad_image **out)
 {
-    const rad_mesh *mesh = s->view.mesh;
+    const rad_mesh *mesh = view->mesh;
     double *vertex = rad_alloc(ctx, RAD_MEM_RENDER, mesh->vertex_count ? mesh->vertex_count : 1,
                                3 * sizeof *vertex, "false colour: vertex values");
     if (!vertex)
@@ -74,11 +74,11 @@ static rad_result render_values(rad_context *ctx, const rad_solution *s, const r
         int w = o->width > 0 ? o->width : 512, h = o->height > 0 ? o->height : 512;
         rad_render_input in = {0};
         in.mesh = mesh;
-        in.vis = s->view.vis;
+        in.vis = view->vis;
         in.element_radiosity = element;
         in.vertex_radiosity = vertex;
-        in.camera = chosen_camera(s, o, w, h);
-        in.seed = s->options.seed;
+        in.camera = chosen_camera(view, o, w, h);
+        in.seed = view->options->seed;
         rad_render_options plain = *o;
         plain.vpl_paths = 0;
         r = rad_render_image(ctx, &in, &plain, out);
@@ -87,31 +87,26 @@ static rad_result render_values(rad_context *ctx, const rad_solution *s, const r
     return r;
 }
 
-rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *s, const rad_render_options *render,
-                                           const rad_false_colour_options *options, const char *path)
+rad_result rad_write_false_colour_view(rad_context *ctx, const rad_solution_view *view,
+                                       const rad_render_options *render, const rad_false_colour_options *options,
+                                       const rad_image *radiance, const char *path)
 {
-    rad_api_enter(ctx);
-    if (!ctx || !s || !path)
-        return rad_null_argument(ctx, __func__);
-    rad_result r = rad_false_colour_check(ctx, options);
-    if (r != RAD_OK)
-        return r;
     rad_false_colour_options fo = options ? *options : (rad_false_colour_options){0};
     bool illuminance = fo.quantity == RAD_FALSE_COLOUR_ILLUMINANCE;
     rad_render_options o = render ? *render : (rad_render_options){0};
-    rad_memory_limit_call(ctx, s->options.max_memory_bytes);
-    size_t n = s->view.mesh->element_count;
+    size_t n = view->mesh->element_count;
 
     /* Per element: (pi value, pi, 0) for illuminance, (0, pi, 0) for the
      * coverage of a luminance picture; the renderer divides by pi. */
     double *element = rad_alloc(ctx, RAD_MEM_RENDER, n ? n : 1, 3 * sizeof *element, "false colour: element values");
     if (!element)
         return RAD_ERROR_OUT_OF_MEMORY;
-    rad_image *radiance = NULL, *coverage = NULL;
+    rad_result r = RAD_OK;
+    rad_image *coverage = NULL;
     float *values = NULL;
     if (illuminance) {
         double *lux = rad_alloc(ctx, RAD_MEM_RENDER, n ? n : 1, sizeof *lux, "false colour: illuminance");
-        r = lux ? rad_view_illuminance(ctx, &s->view, lux) : RAD_ERROR_OUT_OF_MEMORY;
+        r = lux ? rad_view_illuminance(ctx, view, lux) : RAD_ERROR_OUT_OF_MEMORY;
         for (size_t i = 0; i < n && r == RAD_OK; i++) {
             element[3 * i] = M_PI * lux[i];
             element[3 * i + 1] = M_PI;
@@ -123,10 +118,9 @@ rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *s, co
             element[3 * i] = element[3 * i + 2] = 0.0;
             element[3 * i + 1] = M_PI;
         }
-        r = rad_solution_render(ctx, s, &o, &radiance);
     }
     if (r == RAD_OK)
-        r = render_values(ctx, s, &o, element, &coverage);
+        r = render_values(ctx, view, &o, element, &coverage);
     rad_free(element);
     size_t pixels = 0;
     if (r == RAD_OK) {
@@ -158,7 +152,6 @@ rad_result rad_solution_write_false_colour(rad_context *ctx, rad_solution *s, co
         r = rad_false_colour_write(ctx, values, coverage->width, coverage->height, &scale,
                                    illuminance ? "lx" : "cd/m\xc2\xb2", fo.contours != 0, path);
     rad_free(values);
-    rad_image_destroy(radiance);
     rad_image_destroy(coverage);
     return r;
 }

@@ -1,14 +1,12 @@
 /*
- * luminaires.c -- the public calls of luminaires placed in scenes
- * (radiosity.h, "Luminaires"): layout files read through the scene's
- * layout parser (photometry/layout.c) with the photometric readers, and what a
- * program reads back.
+ * luminaire_set.c -- the public calls of the luminaires placed in a scene
+ * (radiosity.h, "Luminaires"): layout files read into the scene's set
+ * through the layout parser (photometry/layout.c) with the photometric
+ * readers, and what a program reads back.  The direct lumens landing on a
+ * solution's elements are its view's (strategy.c).
  */
-#include "api/solution.h"
-#include "photometry/layout.h"
+#include "scene/scene.h"
 #include "photometry/photometry.h"
-
-#include <string.h>
 
 rad_result rad_scene_load_luminaires_memory(rad_context *ctx, rad_scene *scene, const char *name, const void *data,
                                             size_t size)
@@ -57,16 +55,4 @@ bool rad_scene_luminaire_placement(const rad_scene *scene, size_t index, double 
         axes[3 * k] = L->axis[k].x, axes[3 * k + 1] = L->axis[k].y, axes[3 * k + 2] = L->axis[k].z;
     }
     return true;
-}
-
-double rad_solution_direct_lumens(const rad_solution *s)
-{
-    if (!s || !s->view.direct)
-        return 0.0;
-    double landing = 0.0;
-    for (size_t i = 0; i < s->view.n; i++) {
-        const double *h = s->view.direct + 3 * i;
-        landing += s->view.area[i] * (RAD_Y_R * h[0] + RAD_Y_G * h[1] + RAD_Y_B * h[2]);
-    }
-    return RAD_LUMINOUS_EFFICACY * landing;
 }
