@@ -715,7 +715,7 @@ static int run(int argc, char **argv, const rad_stream_ranks *ranks)
         return EXIT_USAGE;
     }
     if (s.command == CLI_THERMAL &&
-        (strcmp(s.solve.solver, "hierarchical") == 0 || strcmp(s.solve.solver, "shooting") == 0)) {
+        !(rad_method_capabilities(RAD_METHOD_SOLVER, s.solve.solver) & RAD_HAS_FORM_FACTORS)) {
         fprintf(stderr, "radiosity: --solver %s keeps no form-factor matrix: thermal takes direct, gauss-seidel, "
                         "jacobi, southwell or conjugate-gradient (see radiosity thermal --help)\n", s.solve.solver);
         return EXIT_USAGE;
