@@ -19,7 +19,7 @@ int cmd_thermal_check(const cli_settings *s, char *err, size_t err_size)
                                 "heat fluxes");
         return 1;
     }
-    if (strcmp(s->solve.solver, "hierarchical") == 0 || strcmp(s->solve.solver, "shooting") == 0) {
+    if (!(rad_method_capabilities(RAD_METHOD_SOLVER, s->solve.solver) & RAD_HAS_FORM_FACTORS)) {
         snprintf(err, err_size, "--solver %s keeps no form-factor matrix: thermal takes direct, gauss-seidel, "
                                 "jacobi, southwell or conjugate-gradient", s->solve.solver);
         return 1;

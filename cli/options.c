@@ -574,9 +574,10 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
         usage_error(e, "--every needs --progress-images DIR");
         return CLI_USAGE_ERROR;
     }
-    if (s->progress_dir && s->solve.solver && strcmp(s->solve.solver, "hierarchical") == 0) {
-        usage_error(e, "--progress-images is not available with --solver hierarchical "
-                       "(its elements change while it solves; use --history)");
+    if (s->progress_dir && s->solve.solver &&
+        !(rad_method_capabilities(RAD_METHOD_SOLVER, s->solve.solver) & RAD_CAN_PROGRESS_IMAGES)) {
+        usage_error(e, "--progress-images is not available with --solver %s "
+                       "(its elements change while it solves; use --history)", s->solve.solver);
         return CLI_USAGE_ERROR;
     }
     /* The default solver is hierarchical, which meshes as it solves.  What

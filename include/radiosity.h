@@ -1244,6 +1244,43 @@ typedef enum rad_method_kind {
 RAD_API bool rad_method_info(rad_method_kind kind, size_t index, const char **name,
                              const char **description);
 
+/* What a method can do, as bits (rad_method_capabilities), so that a
+ * program asks rather than knowing names.  For solvers, what the solver of
+ * that name (rad_options.solver) does with a solution: */
+typedef enum rad_capability {
+    /* keeps the n x n form-factor matrix F: the view factors of a solution
+     * (rad_solution_write_view_factors), thermal (rad_thermal_solve) */
+    RAD_HAS_FORM_FACTORS = 1 << 0,
+    /* meshes before it solves, to rad_options.mesh_size or target_elements
+     * (hierarchical meshes as it solves) */
+    RAD_HAS_UNIFORM_MESH = 1 << 1,
+    /* adaptive subdivision of its mesh (rad_options.adaptive_levels) */
+    RAD_CAN_ADAPTIVE = 1 << 2,
+    /* carries light through ideal mirrors in its first pass; without it the
+     * solve is the diffuse part alone, with a warning (the render's second
+     * pass shows mirrors with any solver) */
+    RAD_CAN_MIRRORS = 1 << 3,
+    /* refuses scenes with mirrors: it reads F_ji through reciprocity, which
+     * the mirror images' factors do not keep */
+    RAD_REFUSES_MIRRORS = 1 << 4,
+    /* takes luminaires and daylight (direct light that no element emits);
+     * without it a lit scene is refused */
+    RAD_CAN_LIGHTS = 1 << 5,
+    /* takes rad_options.closure_correction (closed scenes); without it the
+     * option is refused */
+    RAD_CAN_CLOSURE_CORRECTION = 1 << 6,
+    /* its elements stay put while it solves, so the iterate can be drawn
+     * after every step (rad_options.on_step; `radiosity --progress-images`);
+     * hierarchical radiosity refines them as it goes */
+    RAD_CAN_PROGRESS_IMAGES = 1 << 7
+} rad_capability;
+
+/* The rad_capability bits of method `name` of `kind`: for
+ * RAD_METHOD_SOLVER, of the solver of that name; 0 for an unknown name, a
+ * NULL name, or a kind that defines none (form factors, visibility).
+ * Reads static tables: any thread, any time. */
+RAD_API unsigned rad_method_capabilities(rad_method_kind kind, const char *name);
+
 /* ------------------------------------------------------------------------
  * Option table: every field of rad_options, rad_render_options and
  * rad_office_options that a user sets, with its type, range, default and

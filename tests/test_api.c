@@ -386,6 +386,113 @@ static void test_null_methods(void **unused)
     assert_false(rad_method_info((rad_method_kind)99, 0, &name, &description));
     assert_null(name);
     assert_null(description);
+    assert_int_equal(rad_method_capabilities(RAD_METHOD_SOLVER, NULL), 0);
+    assert_int_equal(rad_method_capabilities(RAD_METHOD_SOLVER, "no-such-solver"), 0);
+    assert_int_equal(rad_method_capabilities(RAD_METHOD_FORM_FACTOR, "analytic"), 0);
+    assert_int_equal(rad_method_capabilities((rad_method_kind)99, "gauss-seidel"), 0);
+}
+
+/* ---- capabilities: what each solver's bits say it does, it does ---- */
+
+/* A closed unit cube, faces inward, the ceiling emitting; `wall` the
+ * material of the wall at z = 0. */
+static rad_scene *closed_box(rad_context *ctx, const char *wall)
+{
+    char obj[1024];
+    snprintf(obj, sizeof obj,
+             "mtllib box.mtl\n"
+             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+             "o floor\nusemtl white\nf 1 5 6 2\no ceiling\nusemtl light\nf 4 3 7 8\n"
+             "o back\nusemtl %s\nf 1 2 3 4\no front\nusemtl white\nf 5 8 7 6\n"
+             "o left\nusemtl white\nf 1 4 8 5\no right\nusemtl white\nf 2 6 7 3\n",
+             wall);
+    const char *mtl = "newmtl white\nKd 0.5 0.5 0.5\n"
+                      "newmtl light\nKd 0.5 0.5 0.5\nKe 1 1 1\n"
+                      "newmtl mirror\nKd 0.1 0.1 0.1\nKs 0.8 0.8 0.8\nillum 3\n";
+    rad_scene *scene = NULL;
+    if (rad_scene_load_memory(ctx, "box.obj", obj, strlen(obj), mtl, strlen(mtl), &scene) != RAD_OK)
+        fail_msg("%s", rad_context_error(ctx));
+    return scene;
+}
+
+static void keep_warning(void *user, const char *message)
+{
+    snprintf(user, 512, "%s", message);
+}
+
+/* rad_solution_create's result for `solver` with `options` on `scene`;
+ * the solution destroyed again. */
+static rad_result try_create(rad_context *ctx, const rad_scene *scene, const char *solver, rad_options options)
+{
+    options.solver = solver;
+    options.target_elements = 24;
+    rad_solution *s = NULL;
+    rad_result r = rad_solution_create(ctx, scene, &options, &s);
+    rad_solution_destroy(s);
+    return r;
+}
+
+static void test_capabilities(void **unused)
+{
+    (void)unused;
+    char warning[512] = "";
+    rad_context_options co = {0};
+    co.on_warning = keep_warning;
+    co.warning_user = warning;
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
+    rad_scene *plain = closed_box(ctx, "white"), *mirror = closed_box(ctx, "mirror");
+    rad_scene *lit = closed_box(ctx, "white");
+    const char *sky = "{\"sky\": {\"type\": 5, \"diffuse_illuminance\": 10000}}";
+    assert_int_equal(rad_scene_daylight_load_memory(ctx, lit, "sky.json", sky, strlen(sky)), RAD_OK);
+    const char *name;
+    size_t with_f = 0;
+    for (size_t i = 0; rad_method_info(RAD_METHOD_SOLVER, i, &name, NULL); i++) {
+        unsigned can = rad_method_capabilities(RAD_METHOD_SOLVER, name);
+        print_message("%-26s %#x\n", name, can);
+        assert_int_not_equal(can, 0);
+        assert_false((can & RAD_CAN_MIRRORS) && (can & RAD_REFUSES_MIRRORS));
+
+        /* A stored F: the element-level view factors are written. */
+        rad_options o = {0};
+        o.solver = name;
+        o.target_elements = 24;
+        rad_solution *s = NULL;
+        assert_int_equal(rad_solution_create(ctx, plain, &o, &s), RAD_OK);
+        size_t before = rad_solution_element_count(s);
+        assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
+        if (can & RAD_CAN_PROGRESS_IMAGES)
+            assert_int_equal(rad_solution_element_count(s), before);
+        rad_result r = rad_solution_write_view_factors(ctx, s, temp_path("vf.csv"), true);
+        assert_int_equal(r == RAD_OK, (can & RAD_HAS_FORM_FACTORS) != 0);
+        with_f += r == RAD_OK;
+        remove(temp_path("vf.csv"));
+        rad_solution_destroy(s);
+
+        rad_options adaptive = {0}, closure = {0};
+        adaptive.adaptive_levels = 1;
+        closure.closure_correction = 1;
+        r = try_create(ctx, plain, name, adaptive);
+        assert_int_equal(r, (can & RAD_CAN_ADAPTIVE) ? RAD_OK : RAD_ERROR_INVALID_ARGUMENT);
+        r = try_create(ctx, plain, name, closure);
+        assert_int_equal(r, (can & RAD_CAN_CLOSURE_CORRECTION) ? RAD_OK : RAD_ERROR_INVALID_ARGUMENT);
+        r = try_create(ctx, lit, name, (rad_options){0});
+        assert_int_equal(r, (can & RAD_CAN_LIGHTS) ? RAD_OK : RAD_ERROR_INVALID_ARGUMENT);
+
+        /* Mirrors: carried, refused, or the diffuse part alone with a warning. */
+        warning[0] = '\0';
+        r = try_create(ctx, mirror, name, (rad_options){0});
+        assert_int_equal(r, (can & RAD_REFUSES_MIRRORS) ? RAD_ERROR_INVALID_ARGUMENT : RAD_OK);
+        bool warned = strstr(warning, "does not carry light through mirrors") != NULL;
+        assert_int_equal(warned, r == RAD_OK && !(can & RAD_CAN_MIRRORS));
+    }
+    assert_int_equal(with_f, 5); /* the linear solvers of the dense strategy */
+    assert_int_equal(rad_method_capabilities(RAD_METHOD_SOLVER, "southwell") & (RAD_CAN_MIRRORS | RAD_REFUSES_MIRRORS),
+                     RAD_REFUSES_MIRRORS);
+    rad_scene_destroy(plain);
+    rad_scene_destroy(mirror);
+    rad_scene_destroy(lit);
+    rad_context_destroy(ctx);
 }
 
 int main(void)
@@ -401,6 +508,7 @@ int main(void)
         cmocka_unit_test(test_null_solution),
         cmocka_unit_test(test_null_image),
         cmocka_unit_test(test_null_methods),
+        cmocka_unit_test(test_capabilities),
     };
     int failed = cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
     rmdir(temp_dir);

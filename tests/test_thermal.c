@@ -834,6 +834,44 @@ static void test_command(void **state)
                              RAD_TEST_DATA, RAD_TEST_DATA, path), 2);
 }
 
+/* Thermal solves on F: every solver that keeps none is refused before any
+ * work, with one line naming it (a usage error), and nothing is written.
+ * Galerkin, collocation and instant radiosity were let through once (their
+ * names were missing from a list); the capability says it now. */
+static void test_solvers_without_f(void **state)
+{
+    (void)state;
+    const char *dir = cli_workdir();
+    char path[600], errors[600];
+    snprintf(path, sizeof path, "%s/refused.csv", dir);
+    snprintf(errors, sizeof errors, "%s/refused.txt", dir);
+    const char *without[] = {"hierarchical", "shooting", "galerkin-constant", "galerkin-linear", "collocation",
+                             "instant-radiosity", "instant-radiosity-clamped"};
+    for (size_t k = 0; k < sizeof without / sizeof without[0]; k++)
+        assert_int_equal(rad_method_capabilities(RAD_METHOD_SOLVER, without[k]) & RAD_HAS_FORM_FACTORS, 0);
+    size_t refused = 0;
+    const char *name;
+    for (size_t i = 0; rad_method_info(RAD_METHOD_SOLVER, i, &name, NULL); i++) {
+        if (rad_method_capabilities(RAD_METHOD_SOLVER, name) & RAD_HAS_FORM_FACTORS)
+            continue;
+        refused++;
+        assert_int_equal(cli_run_capture(errors, "thermal %s/furnace.obj --bc %s/furnace_bc.json --solver %s -o %s",
+                                         RAD_TEST_DATA, RAD_TEST_DATA, name, path),
+                         2);
+        char expected[300];
+        snprintf(expected, sizeof expected,
+                 "radiosity: --solver %s keeps no form-factor matrix: thermal takes direct, gauss-seidel, jacobi, "
+                 "southwell or conjugate-gradient (see radiosity thermal --help)\n",
+                 name);
+        char *text = cli_read_text(errors);
+        assert_non_null(text);
+        assert_string_equal(text, expected);
+        free(text);
+        assert_null(fopen(path, "r"));
+    }
+    assert_int_equal(refused, sizeof without / sizeof without[0]);
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -866,6 +904,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_obstruction_surfaces),
         cmocka_unit_test(test_bad_conditions),
         cmocka_unit_test(test_command),
+        cmocka_unit_test(test_solvers_without_f),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

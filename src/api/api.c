@@ -4,7 +4,8 @@
  * the convergence history, and answers questions through the strategy's
  * read-only view.  The public calls that take a solution and belong to a
  * room below (the writers, the grids' illuminance, false colour) unpack it
- * here and hand that room the view.
+ * here and hand that room the view.  What a solver can do is asked of its
+ * capability bits (rad_strategy_capabilities), never of its name.
  *
  *     options --> strategy: mesh -> visibility -> couplings -> B --> view
  */
@@ -49,11 +50,11 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->threads = rad_context_threads(ctx);
     /* Luminaires and daylight light the elements of the uniform-mesh
      * strategies, not hierarchical radiosity's nodes: without a solver
-     * named, gauss-seidel. */
+     * named, one that takes them. */
     rad_options lit;
     if (rad_light_present(scene) && (!options || !options->solver)) {
         lit = options ? *options : (rad_options){0};
-        lit.solver = "gauss-seidel";
+        lit.solver = rad_options_default_solver(&lit, RAD_CAN_LIGHTS);
         options = &lit;
     }
     rad_result r = rad_options_resolve(ctx, options, &s->options, &s->names);
@@ -66,19 +67,22 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->options.max_memory_bytes = rad_memory_limit(ctx);
     /* mesh -> visibility -> couplings, as the strategy does them */
     s->strategy = rad_strategy_for_solver(s->options.solver);
-    /* The first pass's light through mirrors is the dense strategy's
-     * (formfactor/ff_mirror.c); the others solve the diffuse part alone. */
+    /* The first pass's light through mirrors is the dense solvers'
+     * (RAD_CAN_MIRRORS; formfactor/ff_mirror.c), a solver that reads F
+     * through reciprocity refuses it, the others solve the diffuse part
+     * alone. */
     bool mirrors = false;
     for (size_t m = 0; m < scene->material_count; m++)
         mirrors |= scene->materials[m].specular_kind == RAD_SPECULAR_MIRROR;
-    if (mirrors && strcmp(s->options.solver, "southwell") == 0) {
+    unsigned can = rad_strategy_capabilities(s->options.solver);
+    if (mirrors && (can & RAD_REFUSES_MIRRORS)) {
         rad_free(s);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: solver 'southwell' reads F_ji through reciprocity, which light through mirrors "
+                        "%s: solver '%s' reads F_ji through reciprocity, which light through mirrors "
                         "does not keep; use gauss-seidel, jacobi, direct or conjugate-gradient",
-                        scene->source);
+                        scene->source, s->options.solver);
     }
-    if (mirrors && strcmp(s->strategy->name, "dense") != 0)
+    if (mirrors && !(can & RAD_CAN_MIRRORS))
         rad_warn(ctx,
                  "%s: solver '%s' does not carry light through mirrors (the first pass's mirror images "
                  "are the dense solvers'); the render's second pass still shows them",

@@ -71,12 +71,21 @@ typedef struct rad_solve_stats {
                                  it converged or was interrupted */
 } rad_solve_stats;
 
+/* What a linear solver reads of F (rad_solver.flags). */
+enum {
+    /* F_ji read as F_ij A_i / A_j (reciprocity) where a shot needs the
+     * column: wrong for a coupling that is not reciprocal (F with the mirror
+     * images' factors, ff_mirror.c) */
+    RAD_SOLVER_RECIPROCAL = 1u << 0
+};
+
 typedef struct rad_solver {
     const char *name;
     const char *description;
     /* B (3n) holds the starting guess (E) and receives the answer. */
     rad_result (*solve)(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
                         double *B, rad_solve_stats *stats);
+    unsigned flags;                 /* RAD_SOLVER_* */
 } rad_solver;
 
 /* The linear solvers: each works on a system with its matrix F (the dense

@@ -298,4 +298,5 @@ const rad_solver rad_solver_conjugate_gradient = {
     "Jacobi-preconditioned CG on the system symmetrised by A/rho, restarted on the true "
     "residual; two parallel O(n^2) passes per iteration",
     conjugate_gradient,
+    0,
 };

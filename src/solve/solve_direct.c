@@ -317,4 +317,5 @@ const rad_solver rad_solver_direct = {
     "LU factorisation (LAPACK dgesv) per colour channel: exact, the reference; O(n^3) time, "
     "8 n^2 bytes beside F (refused above rad_options.max_memory_bytes)",
     direct,
+    0,
 };

@@ -86,4 +86,5 @@ const rad_solver rad_solver_gauss_seidel = {
     "gathering, newest values first, optional SOR (rad_options.relaxation); O(n^2) per sweep, "
     "error shrinks ~rho per sweep",
     gauss_seidel,
+    0,
 };

@@ -101,4 +101,5 @@ const rad_solver rad_solver_jacobi = {
     "Jacobi iteration: all rows from the last sweep, in parallel, optional weighting "
     "(rad_options.relaxation); O(n^2) per sweep, error shrinks ~rho per sweep",
     jacobi,
+    0,
 };

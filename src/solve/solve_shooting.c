@@ -337,4 +337,5 @@ const rad_solver rad_solver_shooting = {
     "matrix-free progressive refinement: form-factor columns sampled by rays from the "
     "shooter (rad_options.samples per shot); O(n) memory, for 10^5-10^6 elements",
     shooting,
+    0,
 };

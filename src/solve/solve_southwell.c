@@ -154,4 +154,5 @@ const rad_solver rad_solver_southwell = {
     "progressive refinement: shoot the largest unshot power (Cohen et al. 1988), "
     "overshooting with rad_options.relaxation > 1, ambient term for display; O(n) per shot",
     southwell,
+    RAD_SOLVER_RECIPROCAL,
 };

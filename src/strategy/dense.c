@@ -178,6 +178,8 @@ static void dense_view(const void *state, rad_solution_view *v)
 const rad_strategy rad_strategy_dense = {
     "dense",
     "the n x n form-factor matrix (rad_options.form_factors), then a linear solver",
+    RAD_HAS_FORM_FACTORS | RAD_HAS_UNIFORM_MESH | RAD_CAN_ADAPTIVE | RAD_CAN_MIRRORS | RAD_CAN_LIGHTS |
+        RAD_CAN_CLOSURE_CORRECTION | RAD_CAN_PROGRESS_IMAGES,
     dense_solver_info,
     dense_create,
     dense_solve,

@@ -1054,6 +1054,7 @@ const rad_strategy rad_strategy_galerkin = {
     "galerkin",
     "basis functions per node (constant, or linear/bilinear per vertex): the Galerkin system "
     "(M - rho K) B = M E, or point collocation at the vertices",
+    RAD_HAS_UNIFORM_MESH | RAD_CAN_LIGHTS | RAD_CAN_PROGRESS_IMAGES,
     galerkin_solver_info,
     galerkin_create,
     galerkin_solve,

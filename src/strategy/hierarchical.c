@@ -205,6 +205,7 @@ static void hierarchical_view(const void *state, rad_solution_view *v)
 const rad_strategy rad_strategy_hierarchical = {
     "hierarchical",
     "links between quadtree nodes and clusters, refined as the radiosity converges",
+    RAD_CAN_CLOSURE_CORRECTION,
     hierarchical_solver_info,
     hierarchical_create,
     hierarchical_solve,

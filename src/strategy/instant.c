@@ -329,6 +329,7 @@ static void instant_view(const void *state, rad_solution_view *v)
 const rad_strategy rad_strategy_instant = {
     "instant-radiosity",
     "virtual point lights from quasi-random light paths, gathered per element by shadow rays; no matrix",
+    RAD_HAS_UNIFORM_MESH | RAD_CAN_LIGHTS | RAD_CAN_PROGRESS_IMAGES,
     instant_solver_info,
     instant_create,
     instant_solve,

@@ -68,6 +68,7 @@ static void matrix_free_view(const void *state, rad_solution_view *v)
 const rad_strategy rad_strategy_matrix_free = {
     "matrix-free",
     "no stored matrix: form-factor columns sampled by rays for each shot; O(n) memory",
+    RAD_HAS_UNIFORM_MESH | RAD_CAN_LIGHTS | RAD_CAN_PROGRESS_IMAGES,
     matrix_free_solver_info,
     matrix_free_create,
     matrix_free_solve,

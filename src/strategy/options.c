@@ -372,14 +372,25 @@ static rad_result resolve_field(rad_context *ctx, const rad_option_info *row, ra
                     got);
 }
 
+const char *rad_options_default_solver(const rad_options *o, unsigned needs)
+{
+    if (o->mesh_size != 0.0 || o->target_elements != 0)
+        needs |= RAD_HAS_UNIFORM_MESH;
+    if (o->form_factors)
+        needs |= RAD_HAS_FORM_FACTORS;
+    if (o->adaptive_levels != 0 || o->adaptive_threshold != 0.0 || o->adaptive_max_elements != 0)
+        needs |= RAD_CAN_ADAPTIVE;
+    const char *solver = rad_option_find(RAD_OPTION_SET_SOLUTION, "solver")->default_text;
+    return (rad_strategy_capabilities(solver) & needs) == needs ? solver : "gauss-seidel";
+}
+
 rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_options *out, rad_method_names *names)
 {
     rad_options o = in ? *in : (rad_options){0};
-    /* No solver named: hierarchical, unless an option of the uniform mesh
-     * or of the matrix is given (hierarchical would ignore it). */
-    if (!o.solver && (o.mesh_size != 0.0 || o.target_elements != 0 || o.form_factors || o.adaptive_levels != 0 ||
-                      o.adaptive_threshold != 0.0 || o.adaptive_max_elements != 0))
-        o.solver = "gauss-seidel";
+    /* No solver named: the table's default, unless an option it would
+     * ignore is given. */
+    if (!o.solver)
+        o.solver = rad_options_default_solver(&o, 0);
     for (size_t i = 0; i < COUNT(solution_rows); i++) {
         rad_result r = resolve_field(ctx, &solution_rows[i], &o);
         if (r != RAD_OK)
@@ -400,7 +411,7 @@ rad_result rad_options_resolve(rad_context *ctx, const rad_options *in, rad_opti
     o.solver = names->solver;
     o.visibility = names->visibility;
     const rad_strategy *strategy = rad_strategy_for_solver(o.solver);
-    if (o.adaptive_levels > 0 && strategy && strcmp(strategy->name, "dense") != 0)
+    if (o.adaptive_levels > 0 && strategy && !(rad_strategy_capabilities(o.solver) & RAD_CAN_ADAPTIVE))
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
                         "rad_options.adaptive_levels subdivides the mesh of the dense solvers; solver '%s' "
                         "(%s) makes its own",

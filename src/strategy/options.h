@@ -15,6 +15,14 @@ typedef struct rad_method_names {
     char visibility[32];
 } rad_method_names;
 
+/* The solver taken when o->solver is NULL: the table's default
+ * (hierarchical), unless it lacks a capability (rad_capability) that
+ * `needs` asks or that o's fields ask for (mesh_size or target_elements: a
+ * uniform mesh; form_factors: a form-factor matrix; the adaptive fields:
+ * adaptive subdivision; the default would ignore them); then gauss-seidel,
+ * which has them all.  Cannot fail. */
+const char *rad_options_default_solver(const rad_options *o, unsigned needs);
+
 /* Fill in the defaults of `in` (NULL = all defaults) and check every field
  * against its row of the option table; on success *out holds the resolved
  * options, whose method names point into *names (which must outlive them).

@@ -348,6 +348,7 @@ static void saved_view(const void *state, rad_solution_view *v)
 const rad_strategy rad_strategy_saved = {
     "saved",
     "a solution read from its file: solved, rendered from any camera",
+    0, /* answers to no solver name */
     saved_solver_info,
     saved_create,
     saved_solve,

@@ -31,6 +31,20 @@ const rad_strategy *rad_strategy_for_solver(const char *name)
     return NULL;
 }
 
+unsigned rad_strategy_capabilities(const char *name)
+{
+    const rad_strategy *strategy = name ? rad_strategy_for_solver(name) : NULL;
+    if (!strategy)
+        return 0;
+    unsigned capabilities = strategy->capabilities;
+    /* The mirror images' factors (ff_mirror.c) break reciprocity: a linear
+     * solver that relies on it cannot take them. */
+    const rad_solver *linear = rad_solver_find(name);
+    if (linear && (linear->flags & RAD_SOLVER_RECIPROCAL) && (capabilities & RAD_CAN_MIRRORS))
+        capabilities = (capabilities & ~(unsigned)RAD_CAN_MIRRORS) | RAD_REFUSES_MIRRORS;
+    return capabilities;
+}
+
 bool rad_strategy_solver_info(size_t index, const char **name, const char **description)
 {
     for (size_t k = 0; rad_strategies[k]; k++) {
@@ -79,4 +93,9 @@ bool rad_method_info(rad_method_kind kind, size_t index, const char **name, cons
     if (description)
         *description = method_description;
     return true;
+}
+
+unsigned rad_method_capabilities(rad_method_kind kind, const char *name)
+{
+    return kind == RAD_METHOD_SOLVER ? rad_strategy_capabilities(name) : 0;
 }

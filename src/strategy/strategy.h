@@ -16,8 +16,11 @@
  *
  * Each strategy answers to one or more solver names (rad_options.solver):
  * dense to every linear solver in the solver table, the others to their
- * own.  Adding a strategy (Galerkin elements, instant radiosity) is one
- * file and one line in rad_strategies[] (strategy.c).
+ * own.  What it can do (mirrors, luminaires, adaptive subdivision, a
+ * stored F, ...) is a set of rad_capability bits in its table line, which
+ * the api, the option checks and the program test instead of its name.
+ * Adding a strategy (Galerkin elements, instant radiosity) is one file and
+ * one line in rad_strategies[] (strategy.c).
  *
  * The elements of a hierarchical solution are the leaves of its hierarchy:
  * the patches until it is solved, the refined leaves after; the view is
@@ -88,6 +91,9 @@ typedef struct rad_step_hook {
 typedef struct rad_strategy {
     const char *name;
     const char *description;
+    /* What the solvers it answers to can do: rad_capability bits
+     * (radiosity.h), tested instead of names (rad_strategy_capabilities). */
+    unsigned capabilities;
     /* The index-th solver name it answers to, and its one-line description;
      * false past the end. */
     bool (*solver_info)(size_t index, const char **name, const char **description);
@@ -109,6 +115,12 @@ extern const rad_strategy *const rad_strategies[]; /* NULL-terminated */
 
 /* The strategy that answers to solver `name`; NULL if none does. */
 const rad_strategy *rad_strategy_for_solver(const char *name);
+
+/* The rad_capability bits of solver `name`: its strategy's, less
+ * RAD_CAN_MIRRORS and with RAD_REFUSES_MIRRORS for a linear solver that
+ * reads F through reciprocity (RAD_SOLVER_RECIPROCAL); 0 for an unknown
+ * name.  rad_method_capabilities for solvers. */
+unsigned rad_strategy_capabilities(const char *name);
 
 /* The index-th solver name over all strategies, in table order; false past
  * the end (for --list-methods and rad_method_info). */
