@@ -54,28 +54,17 @@ static double rel(double a, double b) { return fabs(a - b) / (b != 0.0 ? fabs(b)
 enum { ROOF = 1, FACADE = 2, PLATE = 4, OPENING_MATERIAL = 8 };
 
 typedef struct obj_text {
-    char buf[16384];
-    size_t len;
+    test_text text;
     int vertices;
 } obj_text;
-
-static void put(obj_text *t, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(t->buf + t->len, sizeof t->buf - t->len, fmt, ap);
-    va_end(ap);
-    assert_true(n > 0 && (size_t)n < sizeof t->buf - t->len);
-    t->len += (size_t)n;
-}
 
 /* A quad a, b, c, d as OBJ object `name` of material `mtl`. */
 static void quad(obj_text *t, const char *name, const char *mtl, double q[4][3])
 {
-    put(t, "o %s\nusemtl %s\n", name, mtl);
+    test_put(&t->text, "o %s\nusemtl %s\n", name, mtl);
     for (int k = 0; k < 4; k++)
-        put(t, "v %.17g %.17g %.17g\n", q[k][0], q[k][1], q[k][2]);
-    put(t, "f %d %d %d %d\n", t->vertices + 1, t->vertices + 2, t->vertices + 3, t->vertices + 4);
+        test_put(&t->text, "v %.17g %.17g %.17g\n", q[k][0], q[k][1], q[k][2]);
+    test_put(&t->text, "f %d %d %d %d\n", t->vertices + 1, t->vertices + 2, t->vertices + 3, t->vertices + 4);
     t->vertices += 4;
 }
 
@@ -115,10 +104,9 @@ static const char room_mtl[] = "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl floor\nKd 0.
  * the material "opening" instead of being named. */
 static rad_scene *room(rad_context *ctx, int flags)
 {
-    static obj_text t;
-    memset(&t, 0, sizeof t);
+    obj_text t = {0};
     const char *om = flags & OPENING_MATERIAL ? "opening" : "dark";
-    put(&t, "mtllib room.mtl\n");
+    test_put(&t.text, "mtllib room.mtl\n");
     rect_y(&t, "floor", "floor", 0.0, 0, 4, 0, 4, true);
     if (flags & ROOF) {
         rect_y(&t, "ceiling", "wall", 3.0, 0, 4, 0, 1.5, false);
@@ -144,8 +132,10 @@ static rad_scene *room(rad_context *ctx, int flags)
     if (flags & PLATE)
         rect_y(&t, "plate", "dark", 3.5, -50, 2, -50, 50, false);
     rad_scene *scene = NULL;
-    assert_int_equal(rad_scene_load_memory(ctx, "room.obj", t.buf, t.len, room_mtl, strlen(room_mtl), &scene),
-                     RAD_OK);
+    assert_int_equal(
+        rad_scene_load_memory(ctx, "room.obj", t.text.data, t.text.length, room_mtl, strlen(room_mtl), &scene),
+        RAD_OK);
+    free(t.text.data);
     return scene;
 }
 
@@ -939,9 +929,9 @@ static void test_command(void **state)
 {
     (void)state;
     char out[1024], errors[1024], bad[1024];
-    snprintf(out, sizeof out, "%s/vf.json", cli_workdir());
-    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
-    snprintf(bad, sizeof bad, "%s/bad.json", cli_workdir());
+    snprintf(out, sizeof out, "%s/vf.json", test_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", test_workdir());
+    snprintf(bad, sizeof bad, "%s/bad.json", test_workdir());
     assert_int_equal(cli_run("viewfactors %s/daylight/room.obj --daylight %s/daylight/room.json -o %s",
                              RAD_TEST_DATA, RAD_TEST_DATA, out), 0);
     cJSON *vf = cli_read_json(out);
@@ -952,7 +942,7 @@ static void test_command(void **state)
     /* F(floor -> skylight) = 0.0306 (a 1 x 1 m square 3 m over the 4 x 4 m
      * floor's centre), F(floor -> window) is smaller. */
     assert_true(row < 1.0 - 0.03 && row > 0.9);
-    char *written = cli_read_text(out);
+    char *written = test_read_file(out, NULL);
     assert_null(strstr(written, "\"skylight\""));
     free(written);
     cJSON_Delete(vf);
@@ -961,8 +951,8 @@ static void test_command(void **state)
     fputs("{\"sky\": {\"type\": 3}, \"ground\": {\"reflectance\": \"grey\"}}", f);
     fclose(f);
     assert_int_equal(cli_run_capture(errors, "solve %s/daylight/room.obj --daylight %s -o %s/x.radsol", RAD_TEST_DATA,
-                                     bad, cli_workdir()), 1);
-    char *text = cli_read_text(errors);
+                                     bad, test_workdir()), 1);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(strstr(text, "bad.json: ground.reflectance: must be a number"));
     free(text);
 }

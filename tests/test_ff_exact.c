@@ -319,8 +319,8 @@ static void test_hybrid_switch(void **state)
     check_pair(&w, "hybrid", "--mesh-size 0.125 --near-field 1000", exact, 1e-6, "all near");
 
     char stats[600], out[600];
-    snprintf(stats, sizeof stats, "%s/hybrid_stats.json", cli_workdir());
-    snprintf(out, sizeof out, "%s/hybrid_F.json", cli_workdir());
+    snprintf(stats, sizeof stats, "%s/hybrid_stats.json", test_workdir());
+    snprintf(out, sizeof out, "%s/hybrid_F.json", test_workdir());
     assert_int_equal(cli_run("viewfactors '%s' -o '%s' --stats '%s' --form-factors hybrid --mesh-size 0.125",
                              w.obj_path, out, stats),
                      0);
@@ -460,7 +460,7 @@ static int run_closure(const cli_scene_writer *w, const char *command, const cha
     snprintf(out, sizeof out, "%s.closure.%s", w->obj_path, strcmp(command, "render") == 0 ? "png" : "json");
     unlink(out);
     int status = cli_run_capture(errors, "%s '%s' -o '%s' --closure-correction %s", command, w->obj_path, out, extra);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     snprintf(line, size, "%s", text);
     free(text);
@@ -559,11 +559,11 @@ static void test_closure_open_scene(void **state)
     cJSON_Delete(vf);
 
     char help[600];
-    snprintf(help, sizeof help, "%s/help.txt", cli_workdir());
+    snprintf(help, sizeof help, "%s/help.txt", test_workdir());
     char cmd[1400];
     snprintf(cmd, sizeof cmd, "'%s' --help > '%s' 2>&1", cli_binary(), help);
     assert_int_equal(system(cmd), 0);
-    char *text = cli_read_text(help);
+    char *text = test_read_file(help, NULL);
     assert_non_null(text);
     const char *opt = strstr(text, "--closure-correction");
     assert_non_null(opt);
@@ -581,8 +581,8 @@ static void test_matrix_market_export(void **state)
     cli_scene_writer w;
     write_two_surface_case(&w, "occluded_squares_blocker0.5");
     char mtx[600], json[600];
-    snprintf(mtx, sizeof mtx, "%s/F.mtx", cli_workdir());
-    snprintf(json, sizeof json, "%s/F_elements.json", cli_workdir());
+    snprintf(mtx, sizeof mtx, "%s/F.mtx", test_workdir());
+    snprintf(json, sizeof json, "%s/F_elements.json", test_workdir());
     const char *opts = "--form-factors contour --mesh-size 0.25 --level element";
     assert_int_equal(cli_run("viewfactors '%s' -o '%s' %s", w.obj_path, mtx, opts), 0);
     assert_int_equal(cli_run("viewfactors '%s' -o '%s' %s", w.obj_path, json, opts), 0);
@@ -639,8 +639,8 @@ static void test_thread_count_independent(void **state)
     const char *methods[2] = {"contour", "hybrid"};
     for (int k = 0; k < 2; k++) {
         char a[600], b[600];
-        snprintf(a, sizeof a, "%s/t1.json", cli_workdir());
-        snprintf(b, sizeof b, "%s/t3.json", cli_workdir());
+        snprintf(a, sizeof a, "%s/t1.json", test_workdir());
+        snprintf(b, sizeof b, "%s/t3.json", test_workdir());
         assert_int_equal(cli_run("viewfactors '%s' -o '%s' --form-factors %s --elements 500 --level element "
                                  "--threads 1",
                                  w.obj_path, a, methods[k]),
@@ -649,7 +649,7 @@ static void test_thread_count_independent(void **state)
                                  "--threads 3",
                                  w.obj_path, b, methods[k]),
                          0);
-        char *ta = cli_read_text(a), *tb = cli_read_text(b);
+        char *ta = test_read_file(a, NULL), *tb = test_read_file(b, NULL);
         assert_non_null(ta);
         assert_non_null(tb);
         assert_string_equal(ta, tb);
@@ -663,8 +663,8 @@ static void test_thread_count_independent(void **state)
 static cJSON *cornell_stats(const char *method)
 {
     char stats[600], png[600];
-    snprintf(stats, sizeof stats, "%s/cornell_%s.json", cli_workdir(), method);
-    snprintf(png, sizeof png, "%s/cornell_%s.png", cli_workdir(), method);
+    snprintf(stats, sizeof stats, "%s/cornell_%s.json", test_workdir(), method);
+    snprintf(png, sizeof png, "%s/cornell_%s.png", test_workdir(), method);
     assert_int_equal(cli_run("render -o '%s' --stats '%s' --form-factors %s --elements 1000 --width 16 "
                              "--height 16",
                              png, stats, method),

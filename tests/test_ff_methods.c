@@ -381,8 +381,8 @@ static void test_trapezoids(void **state)
 static cJSON *cornell_stats(const char *method, const char *extra)
 {
     char stats[600], png[600];
-    snprintf(stats, sizeof stats, "%s/cornell_%s.json", cli_workdir(), method);
-    snprintf(png, sizeof png, "%s/cornell_%s.png", cli_workdir(), method);
+    snprintf(stats, sizeof stats, "%s/cornell_%s.json", test_workdir(), method);
+    snprintf(png, sizeof png, "%s/cornell_%s.png", test_workdir(), method);
     assert_int_equal(cli_run("render -o '%s' --stats '%s' --width 16 --height 16 --elements 1000 "
                              "--form-factors %s %s",
                              png, stats, method, extra),

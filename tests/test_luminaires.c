@@ -856,10 +856,10 @@ static void command_luminaires(void **state)
     (void)state;
     assert_int_equal(cli_setup("luminaires"), 0);
     char png[600], stats[600], errors[600], bad[600];
-    snprintf(png, sizeof png, "%s/room.png", cli_workdir());
-    snprintf(stats, sizeof stats, "%s/room.json", cli_workdir());
-    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
-    snprintf(bad, sizeof bad, "%s/bad.json", cli_workdir());
+    snprintf(png, sizeof png, "%s/room.png", test_workdir());
+    snprintf(stats, sizeof stats, "%s/room.json", test_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", test_workdir());
+    snprintf(bad, sizeof bad, "%s/bad.json", test_workdir());
     /* The room lit by its layout only: the stats count the luminaires and
      * the light they land; emitted = absorbed in the closed room. */
     assert_int_equal(cli_run("render %s/luminaires/room.obj --luminaires %s/luminaires/layout.json --elements 300 "
@@ -885,7 +885,7 @@ static void command_luminaires(void **state)
     assert_int_equal(cli_run_capture(errors, "render %s/luminaires/room.obj --luminaires %s -o %s", RAD_TEST_DATA,
                                      bad, png),
                      1);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     assert_non_null(strstr(text, "bad.json: luminaires[0].position: must be 3 finite numbers"));
     free(text);
@@ -894,19 +894,19 @@ static void command_luminaires(void **state)
      * with them; --luminaires again with the file is a usage error. */
     assert_int_equal(cli_run("solve %s/luminaires/room.obj --luminaires %s/luminaires/layout.json --elements 300 "
                              "-o %s/room.radsol",
-                             RAD_TEST_DATA, RAD_TEST_DATA, cli_workdir()),
+                             RAD_TEST_DATA, RAD_TEST_DATA, test_workdir()),
                      0);
-    assert_int_equal(cli_run("render %s/room.radsol -o %s --stats %s", cli_workdir(), png, stats), 0);
+    assert_int_equal(cli_run("render %s/room.radsol -o %s --stats %s", test_workdir(), png, stats), 0);
     json = cli_read_json(stats);
     assert_non_null(json);
     assert_true(cli_stats_number(json, "luminaires", "count") == 5.0);
     cli_assert_relative(cli_stats_number(json, "luminaires", "direct_lumens"), lumens, 1e-3, "loaded direct lumens");
     cJSON_Delete(json);
     assert_int_equal(cli_run_capture(errors, "render %s/room.radsol --luminaires %s/luminaires/layout.json -o %s",
-                                     cli_workdir(), RAD_TEST_DATA, png),
+                                     test_workdir(), RAD_TEST_DATA, png),
                      2);
     assert_int_equal(cli_run("solve %s/luminaires/lamp.gltf --elements 100 -o %s/lamp.radsol", RAD_TEST_DATA,
-                             cli_workdir()),
+                             test_workdir()),
                      0);
     assert_int_equal(cli_teardown(), 0);
 }

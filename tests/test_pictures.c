@@ -46,13 +46,6 @@
 #pragma GCC diagnostic pop
 #endif
 
-#define assert_near(a, b, tol)                                                              \
-    do {                                                                                    \
-        double a_ = (a), b_ = (b), tol_ = (tol);                                            \
-        if (!(fabs(a_ - b_) <= tol_))                                                       \
-            fail_msg("%s = %.17g, %s = %.17g, differ by more than %g", #a, a_, #b, b_, tol_); \
-    } while (0)
-
 static rad_context *make_context(void)
 {
     rad_context_options o = {0};
@@ -67,7 +60,7 @@ static char *work_path(const char *name)
     static char path[4][512];
     static int next;
     char *p = path[next++ % 4];
-    snprintf(p, sizeof path[0], "%s/%s", cli_workdir(), name);
+    snprintf(p, sizeof path[0], "%s/%s", test_workdir(), name);
     return p;
 }
 
@@ -640,7 +633,7 @@ static void test_bad_options(void **state)
     const double u[2] = {0, 1}, v[2] = {0, 0}, good[2] = {1, 2}, bad[2] = {1, NAN};
     const double u3[3] = {0, 1, 2}, v3[3] = {0, 0, 0}, good3[3] = {1, 2, 3};
     const char *path = work_path("bad_grid.png");
-    size_t before = count_files(cli_workdir());
+    size_t before = count_files(test_workdir());
     rad_api_enter(ctx); /* the internal calls below keep the first error otherwise */
     rad_plot_grid g = {"g", 3, u3, v3, good3, "lx", 2, 1, 0.0, 0.0};
     assert_int_equal(rad_plot_grid_write(ctx, &g, NULL, path), RAD_ERROR_INVALID_ARGUMENT);
@@ -663,7 +656,7 @@ static void test_bad_options(void **state)
     rad_api_enter(ctx);
     assert_int_equal(rad_plot_grid_write(ctx, &g, &(rad_plot_options){0, 10.0, 1.0, 0}, path),
                      RAD_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     rad_context_destroy(ctx);
 
     /* The program: usage errors (exit 2) before any work, no output. */
@@ -677,7 +670,7 @@ static void test_bad_options(void **state)
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         int status = cli_run_capture(errors, "render %s -o %s", cases[i].flags, out);
-        char *text = cli_read_text(errors);
+        char *text = test_read_file(errors, NULL);
         assert_non_null(text);
         if (status != 2 || !strstr(text, cases[i].message))
             fail_msg("'%s': exit %d, message '%s' (want 2 and '%s')", cases[i].flags, status, text,
@@ -706,24 +699,24 @@ static void test_atomic(void **state)
     assert_non_null(f);
     fputs("old", f);
     fclose(f);
-    size_t before = count_files(cli_workdir());
+    size_t before = count_files(test_workdir());
     rad_context_cancel(ctx, true);
     assert_int_equal(rad_solution_write_false_colour(ctx, sol, &ro, &fo, path), RAD_ERROR_INTERRUPTED);
     rad_context_cancel(ctx, false);
-    char *text = cli_read_text(path);
+    char *text = test_read_file(path, NULL);
     assert_string_equal(text, "old");
     free(text);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     /* ...or unwritable (a folder under a file). */
     const char *under = work_path("kept.png/x.png");
     assert_int_not_equal(rad_solution_write_false_colour(ctx, sol, &ro, &fo, under), RAD_OK);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     /* And it succeeds in place of the old file. */
     assert_int_equal(rad_solution_write_false_colour(ctx, sol, &ro, &fo, path), RAD_OK);
     picture p = read_png(path);
     assert_true(p.width > 32);
     stbi_image_free(p.rgb);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     rad_solution_destroy(sol);
     rad_scene_destroy(scene);
     rad_context_destroy(ctx);
@@ -796,7 +789,7 @@ static void test_cli_grid_plots(void **state)
     assert_int_equal(cli_run_capture(errors, "illuminance %s --grid %s --scale log --range 0:5 -o %s", scene, grid,
                                      plan),
                      2);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(strstr(text, "log scale needs range min > 0"));
     free(text);
 }

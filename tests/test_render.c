@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "output/output.h"
 
 #include <dirent.h>
@@ -35,13 +37,6 @@
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
-
-#define assert_near(a, b, tol)                                                              \
-    do {                                                                                    \
-        double a_ = (a), b_ = (b), tol_ = (tol);                                            \
-        if (!(fabs(a_ - b_) <= tol_))                                                       \
-            fail_msg("%s = %.17g, %s = %.17g, differ by more than %g", #a, a_, #b, b_, tol_); \
-    } while (0)
 
 static rad_context *make_context(int threads)
 {
@@ -437,20 +432,6 @@ static rad_image *constant_image(int width, int height, float r, float g, float 
     return image;
 }
 
-static unsigned char *read_file(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *data = malloc((size_t)n + 1);
-    assert_int_equal(fread(data, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *size = (size_t)n;
-    return data;
-}
-
 static void test_pfm_round_trip(void **unused)
 {
     (void)unused;
@@ -464,7 +445,7 @@ static void test_pfm_round_trip(void **unused)
     rad_context *ctx = make_context(1);
     assert_int_equal(rad_image_write(ctx, image, path), RAD_OK);
     size_t size;
-    unsigned char *data = read_file(path, &size);
+    unsigned char *data = (unsigned char *)test_read_file(path, &size);
     const char header[] = "PF\n3 2\n-1.0\n";
     assert_int_equal(size, strlen(header) + 18 * 4);
     assert_memory_equal(data, header, strlen(header));
@@ -591,7 +572,7 @@ static void test_write_failures(void **unused)
     rad_image empty = {NULL, 0, 0, NULL};
     assert_int_equal(rad_image_write(ctx, &empty, path), RAD_ERROR_INVALID_ARGUMENT);
     size_t size;
-    unsigned char *data = read_file(path, &size);
+    unsigned char *data = (unsigned char *)test_read_file(path, &size);
     assert_int_equal(size, 3);
     free(data);
     assert_int_equal(temp_dir_entries(&d), 1);

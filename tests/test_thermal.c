@@ -355,9 +355,9 @@ static void test_undetermined(void **state)
 static void write_box(const char *name, double rho_floor, double ke_floor, double rho_walls, double ke_walls,
                       char *path, size_t size)
 {
-    snprintf(path, size, "%s/%s.obj", cli_workdir(), name);
+    snprintf(path, size, "%s/%s.obj", test_workdir(), name);
     char mtl[600];
-    snprintf(mtl, sizeof mtl, "%s/%s.mtl", cli_workdir(), name);
+    snprintf(mtl, sizeof mtl, "%s/%s.mtl", test_workdir(), name);
     FILE *m = fopen(mtl, "w");
     assert_non_null(m);
     fprintf(m, "newmtl f\nKd %.17g %.17g %.17g\nKe %.17g %.17g %.17g\n", rho_floor, rho_floor, rho_floor, ke_floor,
@@ -748,7 +748,7 @@ static double csv_value(const char *text, const char *name, int column)
 static void test_command(void **state)
 {
     (void)state;
-    const char *dir = cli_workdir();
+    const char *dir = test_workdir();
     char cmd_args[2048];
     /* The furnace of docs/thermal.md: the roof gives 30 kW/m^2 x 2 m^2 to
      * the hearth at 700 K through adiabatic walls. */
@@ -759,7 +759,7 @@ static void test_command(void **state)
     assert_int_equal(cli_run("%s", cmd_args), 0);
     char path[600];
     snprintf(path, sizeof path, "%s/heat.csv", dir);
-    char *csv = cli_read_text(path);
+    char *csv = test_read_file(path, NULL);
     assert_non_null(csv);
     assert_true(strncmp(csv, "surface,condition,area_m2,emissivity,temperature_K,radiosity_W_m2,irradiation_W_m2,"
                              "heat_flux_W_m2,heat_W\n", 105) == 0);
@@ -823,7 +823,7 @@ static void test_command(void **state)
     fclose(f);
     snprintf(errors, sizeof errors, "%s/errors.txt", dir);
     assert_int_equal(cli_run_capture(errors, "thermal %s/furnace.obj --bc %s -o %s", RAD_TEST_DATA, bc, path), 1);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     assert_non_null(strstr(text, "bad_bc.json: surfaces.hearth.emissivity: must be in (0, 1], got 2"));
     free(text);

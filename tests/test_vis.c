@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "vis/vis.h"
 
 #include <stdlib.h>
@@ -17,13 +19,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-#define assert_near(a, b, tol)                                                              \
-    do {                                                                                    \
-        double a_ = (a), b_ = (b), tol_ = (tol);                                            \
-        if (!(fabs(a_ - b_) <= tol_))                                                       \
-            fail_msg("%s = %.17g, %s = %.17g, differ by more than %g", #a, a_, #b, b_, tol_); \
-    } while (0)
 
 /* ---- scenes, built by hand (patches only: that is all vis reads) ---- */
 
