@@ -46,15 +46,6 @@
 #pragma GCC diagnostic pop
 #endif
 
-static rad_context *make_context(void)
-{
-    rad_context_options o = {0};
-    o.threads = 2;
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
-    return ctx;
-}
-
 static char *work_path(const char *name)
 {
     static char path[4][512];
@@ -215,7 +206,7 @@ static void test_ticks_and_labels(void **state)
     }
 
     /* Automatic: the 99th percentile (nearest rank) rounded up nicely. */
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     float values[200];
     for (int i = 0; i < 200; i++)
         values[i] = (float)i; /* rank 198 of 200: 197 -> 200 */
@@ -242,7 +233,7 @@ static void test_ticks_and_labels(void **state)
 static void test_legend_and_contours(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     enum { W = 120, H = 300 };
     float *values = malloc(sizeof(float) * W * H);
     for (int y = 0; y < H; y++)
@@ -412,7 +403,7 @@ static void test_luminance_box(void **state)
 {
     (void)state;
     const double rho = 0.5, E = 1.0;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     rad_scene *scene = NULL;
     rad_solution *sol = solve_scene(ctx, write_uniform_box(rho, E), "direct", 0.25, &scene);
     /* B = E / (1 - rho) on every element, grey: Y(B) = B. */
@@ -466,7 +457,7 @@ static const char *write_floor_scene(double rho_floor, double E, double s, doubl
 static void check_floor(const char *solver, double rho_floor, double tolerance_levels)
 {
     const double E = 100.0, s = 0.25, h = 1.0, eye = 0.5;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     rad_scene *scene = NULL;
     rad_solution *sol = solve_scene(ctx, write_floor_scene(rho_floor, E, s, h), solver, 0.05, &scene);
     enum { N = 101 };
@@ -512,7 +503,7 @@ static void test_illuminance_floor(void **state)
 static void test_grid_plot(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     /* 3 x 2 cells of 1 m: the point iu + 3 iv at (0.5 + iu, 0.5 + iv). */
     const double u[6] = {0.5, 1.5, 2.5, 0.5, 1.5, 2.5}, v[6] = {0.5, 0.5, 0.5, 1.5, 1.5, 1.5};
     const double value[6] = {100.0, 250.0, 400.0, 12.345, 300.0, 0.5};
@@ -616,7 +607,7 @@ static void expect_refused(rad_context *ctx, const rad_false_colour_options *o, 
 static void test_bad_options(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     assert_int_equal(rad_false_colour_check(ctx, NULL), RAD_OK);
     assert_int_equal(rad_false_colour_check(ctx, &(rad_false_colour_options){0}), RAD_OK);
     expect_refused(ctx, &(rad_false_colour_options){RAD_FALSE_COLOUR_LUMINANCE, 0, 5.0, 2.0, 0},
@@ -686,7 +677,7 @@ static void test_bad_options(void **state)
 static void test_atomic(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     rad_scene *scene = NULL;
     rad_solution *sol = solve_scene(ctx, write_uniform_box(0.5, 1.0), "direct", 0.5, &scene);
     rad_render_options ro = {0};

@@ -16,6 +16,15 @@
 
 static char workdir[256];
 
+rad_context *test_context(int threads)
+{
+    rad_context_options o = {0};
+    o.threads = threads;
+    rad_context *ctx = NULL;
+    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
+    return ctx;
+}
+
 int test_workdir_make(const char *tag)
 {
     snprintf(workdir, sizeof workdir, "/tmp/radiosity-%s-XXXXXX", tag);

@@ -1,8 +1,8 @@
 /*
  * test_support.h -- helpers every suite may use (the rad_test_support
- * library): a work folder under /tmp and the paths in it, whole files read
- * and written, text that grows as it is printed into, and the comparison
- * of two numbers to a tolerance.
+ * library): a context, a work folder under /tmp and the paths in it, whole
+ * files read and written, text that grows as it is printed into, and the
+ * comparison of two numbers to a tolerance.
  *
  * Failures go through cmocka (fail_msg and the assert_* macros), so these
  * are for use inside a running test, or a group's setup and teardown.
@@ -11,6 +11,8 @@
  */
 #ifndef RAD_TESTS_TEST_SUPPORT_H
 #define RAD_TESTS_TEST_SUPPORT_H
+
+#include <radiosity.h>
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -30,6 +32,12 @@
         if (!(fabs(a_ - b_) <= tol_))                                                       \
             fail_msg("%s = %.17g, %s = %.17g, differ by more than %g", #a, a_, #b, b_, tol_); \
     } while (0)
+
+/* ---- the context ---- */
+
+/* A context with `threads` threads, the other options their defaults;
+ * fails the test if it cannot be made.  The caller destroys it. */
+rad_context *test_context(int threads);
 
 /* ---- the work folder ---- */
 

@@ -59,14 +59,6 @@ static rad_result solve_with(rad_context *ctx, problem *pb, const char *solver, 
     return rad_thermal_solve_system(ctx, &sys, rad_solver_find(solver), &p, &out, &pb->balance, &st);
 }
 
-static rad_context *context(void)
-{
-    rad_context *ctx = NULL;
-    rad_context_options o = {.threads = 1};
-    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
-    return ctx;
-}
-
 /* The floor (A1 = 1) of a closed unit cube against the other five faces
  * as one surface (A2 = 5): F_12 = 1, F_21 = 1/5, F_22 = 4/5. */
 static void two_surface(problem *pb, double eps1, double eps2)
@@ -82,7 +74,7 @@ static void two_surface(problem *pb, double eps1, double eps2)
 static void test_two_surface_enclosure(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     two_surface(&pb, 0.8, 0.5);
     pb.known_t[0] = pb.known_t[1] = 1;
@@ -126,7 +118,7 @@ static void duct_345(problem *pb)
 static void test_reradiating_wall(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     duct_345(&pb);
     double e1 = 0.6, e2 = 0.8, T1 = 800.0, T2 = 400.0;
@@ -162,7 +154,7 @@ static void test_reradiating_wall(void **state)
 static void test_open_plate(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     memset(&pb, 0, sizeof pb);
     pb.n = 1;
@@ -222,7 +214,7 @@ static void mixed_conditions(problem *pb)
 static void test_energy_balance(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb, ref;
     cube(&pb, 6);
     mixed_conditions(&pb);
@@ -272,7 +264,7 @@ static void test_energy_balance(void **state)
 static void test_gebhart(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     cube(&pb, 6);
     mixed_conditions(&pb);
@@ -327,7 +319,7 @@ static void test_gebhart(void **state)
 static void test_undetermined(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     cube(&pb, 6);
     for (size_t i = 0; i < 6; i++)
@@ -383,7 +375,7 @@ typedef struct box_run {
 
 static void box_open(box_run *b, const char *path, double mesh_size, int closure)
 {
-    b->ctx = context();
+    b->ctx = test_context(1);
     assert_int_equal(rad_scene_load_file(b->ctx, path, &b->scene), RAD_OK);
     rad_options o = {.solver = "direct", .mesh_size = mesh_size, .closure_correction = closure};
     assert_int_equal(rad_solution_create(b->ctx, b->scene, &o, &b->sol), RAD_OK);
@@ -542,7 +534,7 @@ static void test_long_duct(void **state)
              "o bottom\nf 1 2 3 4\no top\nf 5 6 7 8\no side0\nf 1 5 8 2\no side1\nf 4 3 7 6\n"
              "o cap0\nf 1 4 6 5\no cap1\nf 2 8 7 3\n",
              L, L, L, L);
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_memory(ctx, "duct.obj", obj, strlen(obj), NULL, 0, &scene), RAD_OK);
     rad_options o = {.solver = "direct", .mesh_size = 1.0};
@@ -604,7 +596,7 @@ static void test_obstruction_surfaces(void **state)
                               "V 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 0 1 0\n"
                               "V 5 -.5 -.5 .2\nV 6 -.5 1.5 .2\nV 7 1.5 1.5 .2\nV 8 1.5 -.5 .2\n"
                               "S 1 1 2 3 4 0 0 0.7 plate\nO 2 5 6 7 8 0 0 0.5 lid\nE\n";
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_memory(ctx, "lid.vs3", vs3, strlen(vs3), NULL, 0, &scene), RAD_OK);
     rad_thermal_conditions *c = NULL;
@@ -649,7 +641,7 @@ static void test_bad_conditions(void **state)
     (void)state;
     char path[600];
     write_box("box_bad", 0.5, 0.0, 0.5, 0.0, path, sizeof path);
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_OK);
     static const struct {
