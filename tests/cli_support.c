@@ -144,6 +144,18 @@ void cli_scene_end(cli_scene_writer *w)
     fclose(w->mtl);
 }
 
+void cli_scene_two_surfaces(cli_scene_writer *w, const char *id, const char *name)
+{
+    const cJSON *g = cJSON_GetObjectItem(cli_find_case(id), "geometry");
+    cli_scene_begin(w, name ? name : id);
+    cli_scene_material(w, "grey", 0.5, 0.0);
+    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
+    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
+    if (cJSON_GetObjectItem(g, "blocker"))
+        cli_scene_case_surface(w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
+    cli_scene_end(w);
+}
+
 /* ---- running ---- */
 
 static int run_args(const char *errors, const char *fmt, va_list ap) CLI_PRINTF(2, 0);

@@ -74,6 +74,10 @@ void cli_scene_case_surface_moved(cli_scene_writer *w, const cJSON *surface, con
                                   const char *material, const double offset[3]);
 /* Closes both files. */
 void cli_scene_end(cli_scene_writer *w);
+/* Case `id` of cases.json as the scene `name` (NULL: id), begun and
+ * ended: its geometry's A1, A2 and blocker (when it has one), grey
+ * (rho 0.5), dark. */
+void cli_scene_two_surfaces(cli_scene_writer *w, const char *id, const char *name);
 
 /* ---- running the binary ---- */
 

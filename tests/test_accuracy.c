@@ -32,15 +32,8 @@
 static void two_surface_case(const char *id, const char *extra, double tol)
 {
     const cJSON *c = cli_find_case(id);
-    const cJSON *g = cJSON_GetObjectItem(c, "geometry");
     cli_scene_writer w;
-    cli_scene_begin(&w, id);
-    cli_scene_material(&w, "grey", 0.5, 0.0);
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
-    if (cJSON_GetObjectItem(g, "blocker"))
-        cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
-    cli_scene_end(&w);
+    cli_scene_two_surfaces(&w, id, NULL);
     cJSON *vf = cli_view_factors(&w, extra);
     double f12 = cli_vf_get(vf, "A1", "A2"), f21 = cli_vf_get(vf, "A2", "A1");
     cli_assert_relative(f12, cli_exact_value(c), tol, id);

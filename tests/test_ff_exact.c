@@ -75,18 +75,6 @@ enum { MESH_SETTINGS = 3 };
 
 /* ---- the scenes ---- */
 
-static void write_two_surface_case(cli_scene_writer *w, const char *id)
-{
-    const cJSON *g = cJSON_GetObjectItem(cli_find_case(id), "geometry");
-    cli_scene_begin(w, id);
-    cli_scene_material(w, "grey", 0.5, 0.0);
-    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
-    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
-    if (cJSON_GetObjectItem(g, "blocker"))
-        cli_scene_case_surface(w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
-    cli_scene_end(w);
-}
-
 /* The perpendicular squares, each cut into four triangles about an
  * off-centre apex: the same surfaces, so the same exact factor, but the
  * elements' edges are skew to each other and meet at shared vertices. */
@@ -198,7 +186,7 @@ static void test_contour_parallel_squares(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "par_rect_1x1_d1");
+    cli_scene_two_surfaces(&w, "par_rect_1x1_d1", NULL);
     double exact = cli_exact_value(cli_find_case("par_rect_1x1_d1"));
     for (int m = 0; m < MESH_SETTINGS; m++)
         check_pair(&w, "contour", mesh_settings[m], exact, 1e-9, "parallel squares");
@@ -208,7 +196,7 @@ static void test_contour_perpendicular_shared_edge(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "perp_rect_1_1_1_cube");
+    cli_scene_two_surfaces(&w, "perp_rect_1_1_1_cube", NULL);
     double exact = cli_exact_value(cli_find_case("perp_rect_1_1_1_cube"));
     for (int m = 0; m < MESH_SETTINGS; m++)
         check_pair(&w, "contour", mesh_settings[m], exact, 1e-9, "perpendicular squares");
@@ -279,7 +267,7 @@ static void test_analytic_defaults(void **state)
     cli_scene_writer w;
     const char *ids[2] = {"par_rect_1x1_d1", "perp_rect_1_1_1_cube"};
     for (int k = 0; k < 2; k++) {
-        write_two_surface_case(&w, ids[k]);
+        cli_scene_two_surfaces(&w, ids[k], NULL);
         check_pair(&w, "analytic", "", cli_exact_value(cli_find_case(ids[k])), 1e-4, ids[k]);
     }
     check_cube("analytic", "", 1e-4);
@@ -297,7 +285,7 @@ static void test_hybrid_documented_error(void **state)
     cli_scene_writer w;
     const char *ids[2] = {"par_rect_1x1_d1", "perp_rect_1_1_1_cube"};
     for (int k = 0; k < 2; k++) {
-        write_two_surface_case(&w, ids[k]);
+        cli_scene_two_surfaces(&w, ids[k], NULL);
         check_pair(&w, "hybrid", "--elements 2000", cli_exact_value(cli_find_case(ids[k])), 2e-3, ids[k]);
     }
     check_cube("hybrid", "--elements 2000", 2e-3);
@@ -314,7 +302,7 @@ static void test_hybrid_switch(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "perp_rect_1_1_1_cube");
+    cli_scene_two_surfaces(&w, "perp_rect_1_1_1_cube", NULL);
     double exact = cli_exact_value(cli_find_case("perp_rect_1_1_1_cube"));
     check_pair(&w, "hybrid", "--mesh-size 0.125 --near-field 1000", exact, 1e-6, "all near");
 
@@ -344,7 +332,7 @@ static void test_occluded_squares(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "occluded_squares_blocker0.5");
+    cli_scene_two_surfaces(&w, "occluded_squares_blocker0.5", NULL);
     double exact = cli_exact_value(cli_find_case("occluded_squares_blocker0.5"));
     const char *methods[3] = {"contour", "hybrid", "analytic"};
     for (int k = 0; k < 3; k++)
@@ -495,7 +483,7 @@ static void test_closure_open_scene(void **state)
     (void)state;
     char line[2048];
     cli_scene_writer squares;
-    write_two_surface_case(&squares, "par_rect_1x1_d1");
+    cli_scene_two_surfaces(&squares, "par_rect_1x1_d1", NULL);
     assert_int_equal(run_closure(&squares, "viewfactors", "--mesh-size 2", line, sizeof line), 1);
     assert_refused(line, &squares, 80.0, 1.0);
 
@@ -579,7 +567,7 @@ static void test_matrix_market_export(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "occluded_squares_blocker0.5");
+    cli_scene_two_surfaces(&w, "occluded_squares_blocker0.5", NULL);
     char mtx[600], json[600];
     snprintf(mtx, sizeof mtx, "%s/F.mtx", test_workdir());
     snprintf(json, sizeof json, "%s/F_elements.json", test_workdir());
@@ -635,7 +623,7 @@ static void test_thread_count_independent(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "occluded_squares_blocker0.5");
+    cli_scene_two_surfaces(&w, "occluded_squares_blocker0.5", NULL);
     const char *methods[2] = {"contour", "hybrid"};
     for (int k = 0; k < 2; k++) {
         char a[600], b[600];

@@ -75,17 +75,10 @@ static void check_factor(const judge *jd, const cJSON *vf, const char *from, con
 static void two_surface_case(const judge *jd, const char *id, bool shared_edge)
 {
     const cJSON *c = cli_find_case(id);
-    const cJSON *g = cJSON_GetObjectItem(c, "geometry");
     char name[128], options[256];
     snprintf(name, sizeof name, "%s_%s", id, jd->method);
     cli_scene_writer w;
-    cli_scene_begin(&w, name);
-    cli_scene_material(&w, "grey", 0.5, 0.0);
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
-    if (cJSON_GetObjectItem(g, "blocker"))
-        cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
-    cli_scene_end(&w);
+    cli_scene_two_surfaces(&w, id, name);
     snprintf(options, sizeof options, "--form-factors %s %s", jd->method, jd->options);
     cJSON *vf = cli_view_factors(&w, options);
     /* Equal areas: F_21 = F_12. */
