@@ -21,19 +21,16 @@
 #endif
 
 static const char *radiosity_bin;
-static char workdir[256];
 static cJSON *cases;
+static char err_text[8192], out_text[65536]; /* what cli_run_here's run printed */
 
 void cli_set_binary(const char *path) { radiosity_bin = path; }
 
 const char *cli_binary(void) { return radiosity_bin; }
 
-const char *cli_workdir(void) { return workdir; }
-
 int cli_setup(const char *tag)
 {
-    snprintf(workdir, sizeof workdir, "/tmp/radiosity-%s-XXXXXX", tag);
-    if (!mkdtemp(workdir))
+    if (test_workdir_make(tag) != 0)
         return -1;
     cases = cli_read_json(RAD_TEST_DATA "/cases.json");
     return cases ? 0 : -1;
@@ -43,35 +40,12 @@ int cli_teardown(void)
 {
     cJSON_Delete(cases);
     cases = NULL;
-    char cmd[400];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", workdir);
-    return system(cmd) == 0 ? 0 : -1;
-}
-
-char *cli_read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        free(buf);
-        buf = NULL;
-    }
-    if (buf)
-        buf[n] = '\0';
-    fclose(f);
-    return buf;
+    return test_workdir_remove();
 }
 
 cJSON *cli_read_json(const char *path)
 {
-    char *text = cli_read_text(path);
-    if (!text)
-        return NULL;
+    char *text = test_read_file(path, NULL);
     cJSON *j = cJSON_Parse(text);
     free(text);
     return j;
@@ -96,8 +70,8 @@ double cli_exact_value(const cJSON *c) { return cJSON_GetObjectItem(c, "exact")-
 void cli_scene_begin(cli_scene_writer *w, const char *name)
 {
     char mtl_path[512];
-    snprintf(w->obj_path, sizeof w->obj_path, "%s/%s.obj", workdir, name);
-    snprintf(mtl_path, sizeof mtl_path, "%s/%s.mtl", workdir, name);
+    snprintf(w->obj_path, sizeof w->obj_path, "%s/%s.obj", test_workdir(), name);
+    snprintf(mtl_path, sizeof mtl_path, "%s/%s.mtl", test_workdir(), name);
     w->obj = fopen(w->obj_path, "w");
     w->mtl = fopen(mtl_path, "w");
     assert_non_null(w->obj);
@@ -170,6 +144,18 @@ void cli_scene_end(cli_scene_writer *w)
     fclose(w->mtl);
 }
 
+void cli_scene_two_surfaces(cli_scene_writer *w, const char *id, const char *name)
+{
+    const cJSON *g = cJSON_GetObjectItem(cli_find_case(id), "geometry");
+    cli_scene_begin(w, name ? name : id);
+    cli_scene_material(w, "grey", 0.5, 0.0);
+    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
+    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
+    if (cJSON_GetObjectItem(g, "blocker"))
+        cli_scene_case_surface(w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
+    cli_scene_end(w);
+}
+
 /* ---- running ---- */
 
 static int run_args(const char *errors, const char *fmt, va_list ap) CLI_PRINTF(2, 0);
@@ -213,6 +199,50 @@ cJSON *cli_view_factors(const cli_scene_writer *w, const char *extra)
     assert_non_null(j);
     return j;
 }
+
+/* ---- running in the work folder ---- */
+
+int cli_run_here(const char *fmt, ...)
+{
+    char args[4096], cmd[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args, sizeof args, fmt, ap);
+    va_end(ap);
+    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >stdout.txt 2>stderr.txt </dev/null", test_workdir(),
+             radiosity_bin, args);
+    int status = system(cmd);
+    test_read_into(test_path("stderr.txt"), err_text, sizeof err_text);
+    test_read_into(test_path("stdout.txt"), out_text, sizeof out_text);
+    unlink(test_path("stderr.txt"));
+    unlink(test_path("stdout.txt"));
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+const char *cli_stdout(void) { return out_text; }
+
+const char *cli_stderr(void) { return err_text; }
+
+void cli_stderr_from(const char *path) { test_read_into(path, err_text, sizeof err_text); }
+
+void cli_assert_one_line_error(const char *needle1, const char *needle2)
+{
+    size_t len = strlen(err_text);
+    if (len == 0 || err_text[len - 1] != '\n' || strchr(err_text, '\n') != err_text + len - 1)
+        fail_msg("expected exactly one line on stderr, got: <%s>", err_text);
+    if (needle1 && !strstr(err_text, needle1))
+        fail_msg("stderr lacks '%s': %s", needle1, err_text);
+    if (needle2 && !strstr(err_text, needle2))
+        fail_msg("stderr lacks '%s': %s", needle2, err_text);
+}
+
+const char cli_good_mtl[] = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
+
+const char cli_good_obj[] = "mtllib good.mtl\n"
+                            "o floor\nusemtl white\n"
+                            "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
+                            "o lamp\nusemtl lamp\n"
+                            "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n";
 
 /* ---- reading output ---- */
 

@@ -1,12 +1,13 @@
 /*
  * cli_support.h -- helpers shared by the suites that drive the `radiosity`
- * program itself (test_accuracy, test_ff_exact, test_ff_methods,
- * test_solvers).
+ * program itself (test_accuracy, test_cli, test_outputs, test_ff_*, ...;
+ * the rad_test_support library, with test_support.h).
  *
  * A suite points these at the binary (argv[1]), makes a work folder and
  * loads tests/data/cases.json in its group setup, writes scenes there as
  * OBJ+MTL, runs the program on them and reads back the view-factor or
- * stats JSON it wrote.  Failures go through cmocka (fail_msg and the
+ * stats JSON it wrote; or runs it in the work folder as a user would and
+ * reads what it printed.  Failures go through cmocka (fail_msg and the
  * assert_* macros), so these are for use inside a running test only.
  */
 #ifndef RAD_TESTS_CLI_SUPPORT_H
@@ -14,6 +15,8 @@
 
 #include <cjson/cJSON.h>
 #include <stdio.h>
+
+#include "test_support.h"
 
 #if defined(__GNUC__)
 #define CLI_PRINTF(fmt, args) __attribute__((format(printf, fmt, args)))
@@ -27,12 +30,11 @@
 void cli_set_binary(const char *path);
 /* The path given to cli_set_binary. */
 const char *cli_binary(void);
-/* Makes /tmp/radiosity-TAG-XXXXXX and loads cases.json; 0, or -1 on failure. */
+/* Makes the work folder /tmp/radiosity-TAG-XXXXXX (test_workdir) and
+ * loads cases.json; 0, or -1 on failure. */
 int cli_setup(const char *tag);
 /* Frees the cases and removes the work folder; 0, or -1 on failure. */
 int cli_teardown(void);
-/* The work folder made by cli_setup. */
-const char *cli_workdir(void);
 /* The case with this id in cases.json; fails the test when missing. */
 const cJSON *cli_find_case(const char *id);
 /* The "exact" value of a case. */
@@ -40,9 +42,8 @@ double cli_exact_value(const cJSON *c);
 
 /* ---- files ---- */
 
-/* A whole file as a NUL-terminated string (caller frees), or NULL. */
-char *cli_read_text(const char *path);
-/* A file parsed as JSON (caller frees with cJSON_Delete), or NULL. */
+/* A file parsed as JSON (caller frees with cJSON_Delete), or NULL when it
+ * is not JSON; fails the test when it cannot be read. */
 cJSON *cli_read_json(const char *path);
 
 /* ---- writing scenes as OBJ+MTL in the work folder ---- */
@@ -73,6 +74,10 @@ void cli_scene_case_surface_moved(cli_scene_writer *w, const cJSON *surface, con
                                   const char *material, const double offset[3]);
 /* Closes both files. */
 void cli_scene_end(cli_scene_writer *w);
+/* Case `id` of cases.json as the scene `name` (NULL: id), begun and
+ * ended: its geometry's A1, A2 and blocker (when it has one), grey
+ * (rho 0.5), dark. */
+void cli_scene_two_surfaces(cli_scene_writer *w, const char *id, const char *name);
 
 /* ---- running the binary ---- */
 
@@ -82,6 +87,26 @@ int cli_run(const char *fmt, ...) CLI_PRINTF(1, 2);
 int cli_run_capture(const char *errors, const char *fmt, ...) CLI_PRINTF(2, 3);
 /* `radiosity viewfactors` on a written scene into OBJ.F.json; the parsed JSON (caller frees). */
 cJSON *cli_view_factors(const cli_scene_writer *w, const char *extra);
+
+/* ---- running the binary in the work folder, as a user does ---- */
+
+/* Runs `radiosity ARGS` in the work folder (no --quiet, stdin /dev/null)
+ * and keeps what it printed for cli_stdout and cli_stderr (their first
+ * 64 KiB and 8 KiB).  Returns its exit status (-1 if it did not exit). */
+int cli_run_here(const char *fmt, ...) CLI_PRINTF(1, 2);
+/* What the last cli_run_here printed on stdout, on stderr. */
+const char *cli_stdout(void);
+const char *cli_stderr(void);
+/* Takes the file at `path` as cli_stderr: a run started by hand. */
+void cli_stderr_from(const char *path);
+/* Fails the test unless cli_stderr is exactly one line and holds needle1
+ * and needle2 (either may be NULL). */
+void cli_assert_one_line_error(const char *needle1, const char *needle2);
+
+/* A scene every command takes: a floor and a lamp above it, as OBJ text
+ * that names the material library good.mtl, and that library. */
+extern const char cli_good_obj[];
+extern const char cli_good_mtl[];
 
 /* ---- reading the output ---- */
 

@@ -8,28 +8,13 @@
 #include <cmocka.h>
 
 #include "gltf_support.h"
+#include "test_support.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-unsigned char *support_read_bytes(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *bytes = malloc((size_t)n + 1);
-    assert_non_null(bytes);
-    assert_int_equal(fread(bytes, 1, (size_t)n, f), (size_t)n);
-    bytes[n] = '\0';
-    fclose(f);
-    *size = (size_t)n;
-    return bytes;
-}
 
 uint32_t support_le_u32(const unsigned char *p)
 {
@@ -60,7 +45,7 @@ void support_validate_gltf(const char *source_dir, const char *modules, const ch
     snprintf(cmd + n, sizeof cmd - (size_t)n, " >'%s' 2>&1", report);
     int status = system(cmd);
     size_t size;
-    unsigned char *text = support_read_bytes(report, &size);
+    unsigned char *text = (unsigned char *)test_read_file(report, &size);
     printf("%s", (const char *)text); /* the counts, and every error and warning */
     fflush(stdout);
     for (size_t k = 0; k < count; k++) {

@@ -1,7 +1,7 @@
 /*
  * gltf_support.h -- what the suites that read back written glTF, PLY and
- * lightmap files share (test_export, test_bake): whole files, little-endian
- * numbers, and the Khronos glTF validator where scripts/setup.sh installed
+ * lightmap files share (test_export, test_bake): little-endian numbers,
+ * and the Khronos glTF validator where scripts/setup.sh installed
  * it.  Failures go through cmocka, so these are for use inside a test.
  */
 #ifndef RAD_TESTS_GLTF_SUPPORT_H
@@ -9,9 +9,6 @@
 
 #include <stddef.h>
 #include <stdint.h>
-
-/* The whole file, with a NUL after its `*size` bytes (free it). */
-unsigned char *support_read_bytes(const char *path, size_t *size);
 
 /* Little-endian numbers at p. */
 uint32_t support_le_u32(const unsigned char *p);

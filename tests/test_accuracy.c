@@ -32,15 +32,8 @@
 static void two_surface_case(const char *id, const char *extra, double tol)
 {
     const cJSON *c = cli_find_case(id);
-    const cJSON *g = cJSON_GetObjectItem(c, "geometry");
     cli_scene_writer w;
-    cli_scene_begin(&w, id);
-    cli_scene_material(&w, "grey", 0.5, 0.0);
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
-    if (cJSON_GetObjectItem(g, "blocker"))
-        cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
-    cli_scene_end(&w);
+    cli_scene_two_surfaces(&w, id, NULL);
     cJSON *vf = cli_view_factors(&w, extra);
     double f12 = cli_vf_get(vf, "A1", "A2"), f21 = cli_vf_get(vf, "A2", "A1");
     cli_assert_relative(f12, cli_exact_value(c), tol, id);
@@ -267,8 +260,8 @@ static void test_embree_matches_brute_force(void **state)
 {
     (void)state;
     char a[600], b[600];
-    snprintf(a, sizeof a, "%s/cornell_embree.json", cli_workdir());
-    snprintf(b, sizeof b, "%s/cornell_brute.json", cli_workdir());
+    snprintf(a, sizeof a, "%s/cornell_embree.json", test_workdir());
+    snprintf(b, sizeof b, "%s/cornell_brute.json", test_workdir());
     assert_int_equal(cli_run("viewfactors -o '%s' --elements 300 --visibility embree", a), 0);
     assert_int_equal(cli_run("viewfactors -o '%s' --elements 300 --visibility brute", b), 0);
     cJSON *ja = cli_read_json(a), *jb = cli_read_json(b);
@@ -299,8 +292,8 @@ static void test_cornell_box_closure_and_energy(void **state)
 {
     (void)state;
     char stats_path[600], png[600];
-    snprintf(stats_path, sizeof stats_path, "%s/cornell_stats.json", cli_workdir());
-    snprintf(png, sizeof png, "%s/cornell.png", cli_workdir());
+    snprintf(stats_path, sizeof stats_path, "%s/cornell_stats.json", test_workdir());
+    snprintf(png, sizeof png, "%s/cornell.png", test_workdir());
     assert_int_equal(
         cli_run("render -o '%s' --stats '%s' --solver gauss-seidel --elements 1000 --width 64 --height 64", png,
                 stats_path),

@@ -14,6 +14,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include <radiosity.h>
 
 #include <math.h>
@@ -21,18 +23,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-static char temp_dir[] = "/tmp/rad_test_api_XXXXXX";
-
-/* A path in the temporary folder (static, overwritten by the next call). */
-static const char *temp_path(const char *name)
-{
-    static char path[512];
-    snprintf(path, sizeof path, "%s/%s", temp_dir, name);
-    return path;
-}
-
-static bool file_exists(const char *path) { return access(path, F_OK) == 0; }
 
 /* A non-NULL pointer the calls must overwrite with NULL on failure. */
 static char sentinel;
@@ -137,7 +127,7 @@ static void test_null_scene(void **state)
 {
     api_fixture *f = *state;
     rad_context *ctx = f->ctx;
-    const char *obj = temp_path("scene.obj");
+    const char *obj = test_path("scene.obj");
     const char text[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
     rad_scene *scene = NOT_NULL(rad_scene);
@@ -173,7 +163,7 @@ static void test_null_scene(void **state)
     assert_invalid(rad_scene_write_obj(ctx, NULL, obj), ctx, "rad_scene_write_obj");
     assert_invalid(rad_scene_write_obj(ctx, f->scene, NULL), ctx, "rad_scene_write_obj");
     assert_invalid(rad_scene_write_obj(ctx, f->scene, ""), ctx, "rad_scene_write_obj");
-    assert_false(file_exists(obj));
+    assert_false(test_file_exists(obj));
 
     rad_scene_destroy(NULL);
     assert_int_equal(rad_scene_surface_count(NULL), 0);
@@ -247,26 +237,26 @@ static void test_null_solution(void **state)
     assert_true(emitted > 0.0);
     rad_solution_power(s, NULL, NULL);
 
-    const char *history = temp_path("history.csv");
+    const char *history = test_path("history.csv");
     assert_invalid(rad_solution_write_history(NULL, s, history), NULL, "rad_solution_write_history");
     assert_invalid(rad_solution_write_history(ctx, NULL, history), ctx, "rad_solution_write_history");
     assert_invalid(rad_solution_write_history(ctx, s, NULL), ctx, "rad_solution_write_history");
-    assert_false(file_exists(history));
+    assert_false(test_file_exists(history));
 
-    const char *stats = temp_path("stats.json");
+    const char *stats = test_path("stats.json");
     assert_invalid(rad_solution_write_stats(NULL, s, stats, false), NULL, "rad_solution_write_stats");
     assert_invalid(rad_solution_write_stats(ctx, NULL, stats, false), ctx, "rad_solution_write_stats");
     assert_invalid(rad_solution_write_stats(ctx, s, NULL, true), ctx, "rad_solution_write_stats");
-    assert_false(file_exists(stats));
+    assert_false(test_file_exists(stats));
 
-    const char *vf = temp_path("vf.json");
+    const char *vf = test_path("vf.json");
     assert_invalid(rad_solution_write_view_factors(NULL, s, vf, false), NULL,
                    "rad_solution_write_view_factors");
     assert_invalid(rad_solution_write_view_factors(ctx, NULL, vf, false), ctx,
                    "rad_solution_write_view_factors");
     assert_invalid(rad_solution_write_view_factors(ctx, s, NULL, true), ctx,
                    "rad_solution_write_view_factors");
-    assert_false(file_exists(vf));
+    assert_false(test_file_exists(vf));
 
     rad_stream_options so = {0};
     rad_stream_stats st;
@@ -276,13 +266,13 @@ static void test_null_solution(void **state)
     assert_invalid(rad_scene_stream_view_factors(ctx, f->scene, NULL, NULL, vf, &st), ctx, fn);
     assert_invalid(rad_scene_stream_view_factors(ctx, f->scene, NULL, &so, NULL, &st), ctx, fn);
     assert_invalid(rad_scene_stream_view_factors(ctx, f->scene, NULL, &so, vf, NULL), ctx, fn);
-    assert_false(file_exists(vf));
+    assert_false(test_file_exists(vf));
 
-    const char *lit = temp_path("lit.glb");
+    const char *lit = test_path("lit.glb");
     assert_invalid(rad_solution_write_mesh(NULL, s, lit, 0.0), NULL, "rad_solution_write_mesh");
     assert_invalid(rad_solution_write_mesh(ctx, NULL, lit, 0.0), ctx, "rad_solution_write_mesh");
     assert_invalid(rad_solution_write_mesh(ctx, s, NULL, 1.0), ctx, "rad_solution_write_mesh");
-    assert_false(file_exists(lit));
+    assert_false(test_file_exists(lit));
 
     /* Element and vertex accessors: NULL solution or output writes nothing. */
     double xyz[3] = {7, 7, 7}, rgb3[3] = {7, 7, 7};
@@ -312,7 +302,7 @@ static void test_null_solution(void **state)
     assert_int_equal(rad_solution_display_radiosity(ctx, s, true, NULL, vertex_rgb), RAD_OK);
     free(vertex_rgb);
 
-    const char *partial = temp_path("partial.json");
+    const char *partial = test_path("partial.json");
     assert_invalid(rad_scene_write_interrupted_stats(NULL, f->scene, "mesh", 1.0, partial), NULL,
                    "rad_scene_write_interrupted_stats");
     assert_invalid(rad_scene_write_interrupted_stats(ctx, NULL, "mesh", 1.0, partial), ctx,
@@ -321,7 +311,7 @@ static void test_null_solution(void **state)
                    "rad_scene_write_interrupted_stats");
     assert_invalid(rad_scene_write_interrupted_stats(ctx, f->scene, "mesh", 1.0, NULL), ctx,
                    "rad_scene_write_interrupted_stats");
-    assert_false(file_exists(partial));
+    assert_false(test_file_exists(partial));
 }
 
 /* ---- images ---- */
@@ -356,17 +346,17 @@ static void test_null_image(void **state)
     assert_true(rad_image_pixels(made)[2] == 3.0f);
     rad_image_destroy(made);
 
-    const char *png = temp_path("image.png");
+    const char *png = test_path("image.png");
     assert_invalid(rad_image_write(NULL, f->image, png), NULL, "rad_image_write");
     assert_invalid(rad_image_write(ctx, NULL, png), ctx, "rad_image_write");
     assert_invalid(rad_image_write(ctx, f->image, NULL), ctx, "rad_image_write");
     assert_invalid(rad_image_write_exposed(NULL, f->image, png, 1.0), NULL, "rad_image_write_exposed");
     assert_invalid(rad_image_write_exposed(ctx, NULL, png, 1.0), ctx, "rad_image_write_exposed");
     assert_invalid(rad_image_write_exposed(ctx, f->image, NULL, 1.0), ctx, "rad_image_write_exposed");
-    assert_false(file_exists(png));
+    assert_false(test_file_exists(png));
     /* The real objects work: the NULL checks turn nothing valid away. */
     assert_int_equal(rad_image_write(ctx, f->image, png), RAD_OK);
-    assert_true(file_exists(png));
+    assert_true(test_file_exists(png));
     remove(png);
 }
 
@@ -463,10 +453,10 @@ static void test_capabilities(void **unused)
         assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
         if (can & RAD_CAN_PROGRESS_IMAGES)
             assert_int_equal(rad_solution_element_count(s), before);
-        rad_result r = rad_solution_write_view_factors(ctx, s, temp_path("vf.csv"), true);
+        rad_result r = rad_solution_write_view_factors(ctx, s, test_path("vf.csv"), true);
         assert_int_equal(r == RAD_OK, (can & RAD_HAS_FORM_FACTORS) != 0);
         with_f += r == RAD_OK;
-        remove(temp_path("vf.csv"));
+        remove(test_path("vf.csv"));
         rad_solution_destroy(s);
 
         rad_options adaptive = {0}, closure = {0};
@@ -497,7 +487,7 @@ static void test_capabilities(void **unused)
 
 int main(void)
 {
-    if (!mkdtemp(temp_dir)) {
+    if (test_workdir_make("api") != 0) {
         perror("mkdtemp");
         return 1;
     }
@@ -511,6 +501,6 @@ int main(void)
         cmocka_unit_test(test_capabilities),
     };
     int failed = cmocka_run_group_tests(tests, fixture_setup, fixture_teardown);
-    rmdir(temp_dir);
+    test_workdir_remove();
     return failed;
 }

@@ -14,6 +14,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "api/solution.h"
 #include "gltf_support.h"
 
@@ -41,23 +43,11 @@
 
 #define PADDING 2 /* lightmap.c's */
 
-static char temp_dir[] = "/tmp/rad_test_bake_XXXXXX";
 static rad_context *ctx;
 static rad_scene *scene;
 static rad_solution *solution;
 static rad_lightmap *lightmap;   /* radiosity at 100 texels per metre (about 55 across a wall) */
 static double *vertex_B;         /* 3 per vertex, W/m^2 */
-
-static const char *temp_path(const char *name)
-{
-    static char path[4][512];
-    static int next;
-    next = (next + 1) % 4;
-    snprintf(path[next], sizeof path[next], "%s/%s", temp_dir, name);
-    return path[next];
-}
-
-static bool file_exists(const char *path) { return access(path, F_OK) == 0; }
 
 static rad_lightmap *bake(double texels_per_metre, int atlas_size, int quantity)
 {
@@ -72,7 +62,7 @@ static rad_lightmap *bake(double texels_per_metre, int atlas_size, int quantity)
 static int setup(void **state)
 {
     (void)state;
-    if (!mkdtemp(temp_dir))
+    if (test_workdir_make("bake") != 0)
         return -1;
     if (rad_context_create(NULL, &ctx) != RAD_OK || rad_scene_create_cornell_box(ctx, &scene) != RAD_OK)
         return -1;
@@ -95,9 +85,7 @@ static int teardown(void **state)
     rad_solution_destroy(solution);
     rad_scene_destroy(scene);
     rad_context_destroy(ctx);
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", temp_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return test_workdir_remove();
 }
 
 /* ---- packing ---- */
@@ -200,16 +188,16 @@ static void test_refused(void **state)
     assert_int_equal(rad_solution_bake(ctx, NULL, NULL, set, "a.glb", NULL), RAD_ERROR_INVALID_ARGUMENT);
     assert_int_equal(rad_solution_bake(ctx, solution, NULL, NULL, "a.glb", NULL), RAD_ERROR_INVALID_ARGUMENT);
     assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, NULL, NULL), RAD_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, temp_path("a.glb"), NULL),
+    assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, test_path("a.glb"), NULL),
                      RAD_ERROR_INVALID_ARGUMENT);
     assert_non_null(strstr(rad_context_error(ctx), "not in the output set"));
-    assert_int_equal(rad_output_set_add(ctx, set, temp_path("a.ply"), RAD_OUTPUT_BAKE, &temp),
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("a.ply"), RAD_OUTPUT_BAKE, &temp),
                      RAD_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(rad_output_set_add(ctx, set, temp_path("a.ply"), RAD_OUTPUT_MESH, &temp), RAD_OK);
-    assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, temp_path("a.ply"), NULL),
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("a.ply"), RAD_OUTPUT_MESH, &temp), RAD_OK);
+    assert_int_equal(rad_solution_bake(ctx, solution, NULL, set, test_path("a.ply"), NULL),
                      RAD_ERROR_INVALID_ARGUMENT);
     rad_output_set_destroy(set);
-    assert_false(file_exists(temp_path("a.ply")));
+    assert_false(test_file_exists(test_path("a.ply")));
     char name[64];
     assert_int_equal(rad_bake_image_path("out/room.v2.glb", 3, "png", name, sizeof name), 25);
     assert_string_equal(name, "out/room.v2_lightmap3.png");
@@ -494,7 +482,7 @@ static void bake_files(const char *glb, size_t *atlases)
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
     assert_int_equal(rad_output_set_add(ctx, set, glb, RAD_OUTPUT_BAKE, &temp), RAD_OK);
     assert_int_equal(rad_solution_bake(ctx, solution, &o, set, glb, &stats), RAD_OK);
-    assert_false(file_exists(glb)); /* not before the commit */
+    assert_false(test_file_exists(glb)); /* not before the commit */
     assert_int_equal(rad_output_set_commit(ctx, set), RAD_OK);
     rad_output_set_destroy(set);
     assert_true(stats.atlases > 1 && stats.chart_texels > 0.0 && stats.chart_texels < stats.atlas_texels);
@@ -508,14 +496,14 @@ static void test_files(void **state)
 {
     (void)state;
     char glb[512];
-    snprintf(glb, sizeof glb, "%s", temp_path("room.glb"));
+    snprintf(glb, sizeof glb, "%s", test_path("room.glb"));
     size_t atlases;
     bake_files(glb, &atlases);
     rad_lightmap *lm = bake(100.0, 128, RAD_LIGHTMAP_RADIOSITY);
     assert_int_equal(lm->atlas_count, atlases);
 
     size_t size;
-    unsigned char *bytes = support_read_bytes(glb, &size);
+    unsigned char *bytes = (unsigned char *)test_read_file(glb, &size);
     uint32_t json_length = support_le_u32(bytes + 12);
     cJSON *json = cJSON_ParseWithLength((const char *)bytes + 20, json_length);
     assert_non_null(json);
@@ -607,11 +595,11 @@ static void test_files(void **state)
         char name[64];
         int w = 0, h = 0, n = 0;
         snprintf(name, sizeof name, "room_lightmap%zu.hdr", a);
-        float *hdr = stbi_loadf(temp_path(name), &w, &h, &n, 3);
+        float *hdr = stbi_loadf(test_path(name), &w, &h, &n, 3);
         assert_non_null(hdr);
         assert_true(w == atlas->width && h == atlas->height);
         snprintf(name, sizeof name, "room_lightmap%zu.png", a);
-        unsigned char *png = stbi_load(temp_path(name), &w, &h, &n, 4);
+        unsigned char *png = stbi_load(test_path(name), &w, &h, &n, 4);
         assert_non_null(png);
         assert_true(w == atlas->width && h == atlas->height && n == 4);
         for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
@@ -644,15 +632,15 @@ static void test_validator(void **state)
 {
     (void)state;
     char glb[512], gltf[512];
-    snprintf(glb, sizeof glb, "%s", temp_path("valid.glb"));
-    snprintf(gltf, sizeof gltf, "%s", temp_path("valid room.gltf"));
+    snprintf(glb, sizeof glb, "%s", test_path("valid.glb"));
+    snprintf(gltf, sizeof gltf, "%s", test_path("valid room.gltf"));
     size_t atlases;
     bake_files(glb, &atlases);
     bake_files(gltf, &atlases);
     /* Its one warning: unlit and MOZ_lightmap on one material, as meant. */
     const char *paths[2] = {glb, gltf};
     support_validate_gltf(RAD_TEST_SOURCE, RAD_NPM_MODULES, paths, 2, "MULTIPLE_EXTENSIONS ",
-                          temp_path("report.txt"));
+                          test_path("report.txt"));
 }
 
 int main(void)

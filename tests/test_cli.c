@@ -11,6 +11,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cli_support.h"
+
 #include <dirent.h>
 #include <math.h>
 #include <stdbool.h>
@@ -22,62 +24,10 @@
 #include <time.h>
 #include <unistd.h>
 
-static const char *radiosity_bin;
-static char workdir[256];
-static char err_text[8192], out_text[8192];
-
-static void write_file(const char *name, const char *text)
-{
-    char path[600];
-    snprintf(path, sizeof path, "%s/%s", workdir, name);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static void slurp(const char *path, char *buf, size_t size)
-{
-    buf[0] = '\0';
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return;
-    size_t n = fread(buf, 1, size - 1, f);
-    buf[n] = '\0';
-    fclose(f);
-}
-
-/* Run `radiosity ARGS` in the work dir; capture stdout and stderr. */
-static int run(const char *fmt, ...)
-{
-    char args[2048], cmd[4096];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args, sizeof args, fmt, ap);
-    va_end(ap);
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >stdout.txt 2>stderr.txt </dev/null", workdir,
-             radiosity_bin, args);
-    int status = system(cmd);
-    char p[600];
-    snprintf(p, sizeof p, "%s/stderr.txt", workdir);
-    slurp(p, err_text, sizeof err_text);
-    snprintf(p, sizeof p, "%s/stdout.txt", workdir);
-    slurp(p, out_text, sizeof out_text);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-static bool exists(const char *name)
-{
-    char path[600];
-    struct stat st;
-    snprintf(path, sizeof path, "%s/%s", workdir, name);
-    return stat(path, &st) == 0;
-}
-
 /* No file whose name starts with `prefix` (the output or its temporary). */
 static void assert_no_output(const char *prefix)
 {
-    DIR *d = opendir(workdir);
+    DIR *d = opendir(test_workdir());
     assert_non_null(d);
     struct dirent *e;
     while ((e = readdir(d)))
@@ -86,37 +36,16 @@ static void assert_no_output(const char *prefix)
     closedir(d);
 }
 
-/* One line on stderr containing every needle. */
-static void assert_one_line_error(const char *needle1, const char *needle2)
-{
-    size_t len = strlen(err_text);
-    if (len == 0 || err_text[len - 1] != '\n' || strchr(err_text, '\n') != err_text + len - 1)
-        fail_msg("expected exactly one line on stderr, got: <%s>", err_text);
-    if (needle1 && !strstr(err_text, needle1))
-        fail_msg("stderr lacks '%s': %s", needle1, err_text);
-    if (needle2 && !strstr(err_text, needle2))
-        fail_msg("stderr lacks '%s': %s", needle2, err_text);
-}
-
-static const char *good_mtl = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
-
-/* A small closed-enough scene: floor and a lamp above it. */
-static const char *good_obj = "mtllib good.mtl\n"
-                              "o floor\nusemtl white\n"
-                              "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
-                              "o lamp\nusemtl lamp\n"
-                              "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n";
-
 /* ---- bad input: the scene ---- */
 
 static void bad_scene(const char *obj_name, const char *obj, const char *mtl_name, const char *mtl,
                       const char *needle1, const char *needle2)
 {
-    write_file(obj_name, obj);
+    test_write_file(obj_name, obj);
     if (mtl_name)
-        write_file(mtl_name, mtl);
-    assert_int_equal(run("render %s -o bad_out.png --stats bad_stats.json", obj_name), 1);
-    assert_one_line_error(needle1, needle2);
+        test_write_file(mtl_name, mtl);
+    assert_int_equal(cli_run_here("render %s -o bad_out.png --stats bad_stats.json", obj_name), 1);
+    cli_assert_one_line_error(needle1, needle2);
     assert_no_output("bad_out");
     assert_no_output("bad_stats");
 }
@@ -124,8 +53,8 @@ static void bad_scene(const char *obj_name, const char *obj, const char *mtl_nam
 static void test_missing_file(void **state)
 {
     (void)state;
-    assert_int_equal(run("render no_such_scene.obj -o bad_out.png"), 1);
-    assert_one_line_error("no_such_scene.obj", "No such file");
+    assert_int_equal(cli_run_here("render no_such_scene.obj -o bad_out.png"), 1);
+    cli_assert_one_line_error("no_such_scene.obj", "No such file");
     assert_no_output("bad_out");
 }
 
@@ -162,16 +91,16 @@ static void test_huge_coordinates(void **state)
     (void)state;
     bad_scene("huge.obj", "v 0 0 0\nv 1 0 0\nv 0 3e31 0\nf 1 2 3\n", NULL, NULL,
               "huge.obj:3: vertex coordinate '3e31' is beyond the 1e+30 m", NULL);
-    write_file("good.mtl", good_mtl);
-    write_file("far.obj", "mtllib good.mtl\n"
+    test_write_file("good.mtl", cli_good_mtl);
+    test_write_file("far.obj", "mtllib good.mtl\n"
                           "o floor\nusemtl white\n"
                           "v 0 0 0\nv 1e18 0 0\nv 1e18 0 1e18\nv 0 0 1e18\nf 1 4 3 2\n"
                           "o lamp\nusemtl lamp\n"
                           "v 0 1e18 0\nv 1e18 1e18 0\nv 1e18 1e18 1e18\nv 0 1e18 1e18\nf 5 6 7 8\n");
-    write_file("near.obj", good_obj);
-    assert_int_equal(run("render far.obj -q --elements 50 --width 32 --height 32 --exposure 1 -o far.png "
+    test_write_file("near.obj", cli_good_obj);
+    assert_int_equal(cli_run_here("render far.obj -q --elements 50 --width 32 --height 32 --exposure 1 -o far.png "
                          "--camera 0.5e18,0.5e18,-2e18,0.5e18,0,0.5e18"), 0);
-    assert_int_equal(run("render near.obj -q --elements 50 --width 32 --height 32 --exposure 1 -o near.png "
+    assert_int_equal(cli_run_here("render near.obj -q --elements 50 --width 32 --height 32 --exposure 1 -o near.png "
                          "--camera 0.5,0.5,-2,0.5,0,0.5"), 0);
     /* The same picture, byte for byte. */
     unsigned char bytes[2][16384];
@@ -179,7 +108,7 @@ static void test_huge_coordinates(void **state)
     const char *names[2] = {"far.png", "near.png"};
     for (int k = 0; k < 2; k++) {
         char path[600];
-        snprintf(path, sizeof path, "%s/%s", workdir, names[k]);
+        snprintf(path, sizeof path, "%s/%s", test_workdir(), names[k]);
         FILE *f = fopen(path, "rb");
         assert_non_null(f);
         size[k] = fread(bytes[k], 1, sizeof bytes[k], f);
@@ -189,8 +118,8 @@ static void test_huge_coordinates(void **state)
     assert_int_equal(size[0], size[1]);
     assert_memory_equal(bytes[0], bytes[1], size[0]);
     /* A camera 10^7 scene sizes away is refused before the work: exit 2. */
-    assert_int_equal(run("render near.obj -o cam.png --stats cam.json --camera 0.5,2e7,0.5,0.5,0,0.5,0,0,1"), 2);
-    assert_one_line_error("--camera: the position is", "at most 1e+06 times");
+    assert_int_equal(cli_run_here("render near.obj -o cam.png --stats cam.json --camera 0.5,2e7,0.5,0.5,0,0.5,0,0,1"), 2);
+    cli_assert_one_line_error("--camera: the position is", "at most 1e+06 times");
     assert_no_output("cam.");
 }
 
@@ -198,7 +127,7 @@ static void test_huge_coordinates(void **state)
 static size_t read_bytes(const char *name, unsigned char *buf, size_t size)
 {
     char p[600];
-    snprintf(p, sizeof p, "%s/%s", workdir, name);
+    snprintf(p, sizeof p, "%s/%s", test_workdir(), name);
     FILE *f = fopen(p, "rb");
     if (!f)
         return 0;
@@ -213,19 +142,19 @@ static size_t read_bytes(const char *name, unsigned char *buf, size_t size)
 static void test_solution_file(void **state)
 {
     (void)state;
-    assert_int_equal(run("solve --elements 200 -q -o box.radsol --stats solve.json"), 0);
-    assert_true(exists("box.radsol") && exists("solve.json"));
+    assert_int_equal(cli_run_here("solve --elements 200 -q -o box.radsol --stats solve.json"), 0);
+    assert_true(test_file_exists(test_path("box.radsol")) && test_file_exists(test_path("solve.json")));
     const char *camera = "--camera 0.1,0.3,-0.5,0.3,0.25,0.3";
-    assert_int_equal(run("render box.radsol -q --width 64 --height 48 %s -o from_file.png", camera), 0);
-    assert_int_equal(run("render --elements 200 -q --width 64 --height 48 %s -o solved.png", camera), 0);
+    assert_int_equal(cli_run_here("render box.radsol -q --width 64 --height 48 %s -o from_file.png", camera), 0);
+    assert_int_equal(cli_run_here("render --elements 200 -q --width 64 --height 48 %s -o solved.png", camera), 0);
     static unsigned char a[65536], b[65536];
     size_t na = read_bytes("from_file.png", a, sizeof a), nb = read_bytes("solved.png", b, sizeof b);
     assert_true(na > 100 && na < sizeof a);
     assert_int_equal(na, nb);
     assert_memory_equal(a, b, na);
     /* export draws its lit mesh from the file as from the solve, to the byte. */
-    assert_int_equal(run("export box.radsol -q -o from_file.glb"), 0);
-    assert_int_equal(run("export --elements 200 -q -o solved.glb"), 0);
+    assert_int_equal(cli_run_here("export box.radsol -q -o from_file.glb"), 0);
+    assert_int_equal(cli_run_here("export --elements 200 -q -o solved.glb"), 0);
     na = read_bytes("from_file.glb", a, sizeof a);
     nb = read_bytes("solved.glb", b, sizeof b);
     assert_true(na > 1000 && na < sizeof a);
@@ -233,25 +162,25 @@ static void test_solution_file(void **state)
     assert_memory_equal(a, b, na);
     /* Refused before any work: another extension, a solution where a
      * scene is needed, a solve to follow. */
-    assert_int_equal(run("solve --elements 50 -o box.png"), 2);
-    assert_one_line_error("box.png: a solution file is named .radsol", NULL);
+    assert_int_equal(cli_run_here("solve --elements 50 -o box.png"), 2);
+    cli_assert_one_line_error("box.png: a solution file is named .radsol", NULL);
     assert_no_output("box.png");
-    assert_int_equal(run("viewfactors box.radsol -o vf.json"), 2);
-    assert_one_line_error("box.radsol is a solution file", "needs the scene");
-    assert_int_equal(run("render box.radsol --history h.csv -o x.png"), 2);
-    assert_one_line_error("--history: box.radsol is a solution file", NULL);
+    assert_int_equal(cli_run_here("viewfactors box.radsol -o vf.json"), 2);
+    cli_assert_one_line_error("box.radsol is a solution file", "needs the scene");
+    assert_int_equal(cli_run_here("render box.radsol --history h.csv -o x.png"), 2);
+    cli_assert_one_line_error("--history: box.radsol is a solution file", NULL);
     assert_no_output("h.csv");
     /* Damaged: cut short. */
     size_t n = read_bytes("box.radsol", a, sizeof a);
     assert_true(n > 1000);
     char p[600];
-    snprintf(p, sizeof p, "%s/cut.radsol", workdir);
+    snprintf(p, sizeof p, "%s/cut.radsol", test_workdir());
     FILE *f = fopen(p, "wb");
     assert_non_null(f);
     fwrite(a, 1, n / 2, f);
     fclose(f);
-    assert_int_equal(run("render cut.radsol -o cut.png"), 1);
-    assert_one_line_error("cut.radsol: the payload should hold", "truncated or damaged");
+    assert_int_equal(cli_run_here("render cut.radsol -o cut.png"), 1);
+    cli_assert_one_line_error("cut.radsol: the payload should hold", "truncated or damaged");
     assert_no_output("cut.png");
 }
 
@@ -259,7 +188,7 @@ static void test_zero_area_polygon(void **state)
 {
     (void)state;
     bad_scene("flat.obj", "mtllib good.mtl\no sliver\nusemtl lamp\nv 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
-              "good.mtl", good_mtl, "flat.obj", "sliver");
+              "good.mtl", cli_good_mtl, "flat.obj", "sliver");
 }
 
 static void test_reflectance_too_high(void **state)
@@ -280,7 +209,7 @@ static void test_no_emitter(void **state)
 {
     (void)state;
     bad_scene("dark.obj", "mtllib good.mtl\no a\nusemtl white\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
-              "good.mtl", good_mtl, "dark.obj", "emitter");
+              "good.mtl", cli_good_mtl, "dark.obj", "emitter");
 }
 
 static void test_empty_scene(void **state)
@@ -328,7 +257,7 @@ static void write_gltf(const char *name, const char *extra_nodes, const char *ex
              "   {\"bufferView\": 1, \"componentType\": 5123, \"count\": 6, "
              "\"type\": \"SCALAR\"}]%s}\n",
              extra_nodes[0] ? ", 2" : "", extra_nodes, extra);
-    write_file(name, text);
+    test_write_file(name, text);
     free(text);
 }
 
@@ -341,11 +270,11 @@ static void test_gltf_orthographic_camera(void **state)
                ",\n   {\"name\": \"top\", \"camera\": 0, \"translation\": [0.5, 0.5, 3]}",
                ", \"cameras\": [{\"type\": \"orthographic\", \"orthographic\": "
                "{\"xmag\": 1, \"ymag\": 1, \"znear\": 0.1, \"zfar\": 10}}]");
-    assert_int_equal(run("render ortho.gltf -o ortho.png --elements 50 --width 32 --height 32"), 0);
-    assert_one_line_error("radiosity: warning: ortho.gltf: camera 0 of node 'top' (2) is "
+    assert_int_equal(cli_run_here("render ortho.gltf -o ortho.png --elements 50 --width 32 --height 32"), 0);
+    cli_assert_one_line_error("radiosity: warning: ortho.gltf: camera 0 of node 'top' (2) is "
                           "orthographic, which the renderer does not draw",
                           "the view is framed automatically");
-    assert_true(exists("ortho.png"));
+    assert_true(test_file_exists(test_path("ortho.png")));
 }
 
 /* What a material says that the engine does not use (a highlight, a
@@ -354,18 +283,18 @@ static void test_gltf_orthographic_camera(void **state)
 static void test_unused_material_properties(void **state)
 {
     (void)state;
-    write_file("shiny.mtl", "newmtl white\nKd 0.5 0.5 0.5\nKs 0.8 0.8 0.8\nNs 100\nillum 2\n"
+    test_write_file("shiny.mtl", "newmtl white\nKd 0.5 0.5 0.5\nKs 0.8 0.8 0.8\nNs 100\nillum 2\n"
                             "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\nKs 0 0 0\nd 1\nillum 1\n");
-    write_file("shiny.obj", "mtllib shiny.mtl\n"
+    test_write_file("shiny.obj", "mtllib shiny.mtl\n"
                             "o floor\nusemtl white\n"
                             "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
                             "o lamp\nusemtl lamp\n"
                             "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n");
-    assert_int_equal(run("render shiny.obj -o shiny.png --elements 50 --width 32 --height 32"), 0);
-    assert_one_line_error("radiosity: warning: shiny.mtl: material 'white' (surface 'floor'): Ks, "
+    assert_int_equal(cli_run_here("render shiny.obj -o shiny.png --elements 50 --width 32 --height 32"), 0);
+    cli_assert_one_line_error("radiosity: warning: shiny.mtl: material 'white' (surface 'floor'): Ks, "
                           "Ns and illum 2 are not used (the engine reads Kd and Ke, and the specular keys with illum 3 to 7)",
                           NULL);
-    assert_true(exists("shiny.png"));
+    assert_true(test_file_exists(test_path("shiny.png")));
 }
 
 /* glTF files refused before assimp reads them: a tree 2,000 nodes deep
@@ -383,15 +312,15 @@ static void test_gltf_refused(void **state)
     snprintf(nodes + length, size - length, ",\n   {\"name\": \"bottom\"}");
     write_gltf("deep.gltf", nodes, "");
     free(nodes);
-    assert_int_equal(run("render deep.gltf -o bad_out.png"), 1);
-    assert_one_line_error("deep.gltf: node 'bottom' (2001) is nested 2000 levels deep",
+    assert_int_equal(cli_run_here("render deep.gltf -o bad_out.png"), 1);
+    cli_assert_one_line_error("deep.gltf: node 'bottom' (2001) is nested 2000 levels deep",
                           "at most 1000 levels are read");
     assert_no_output("bad_out");
 
     write_gltf("range.gltf", "", "");
     char *text = NULL;
     char path[600];
-    snprintf(path, sizeof path, "%s/range.gltf", workdir);
+    snprintf(path, sizeof path, "%s/range.gltf", test_workdir());
     FILE *f = fopen(path, "r+b");
     assert_non_null(f);
     text = calloc(1, 8192);
@@ -406,8 +335,8 @@ static void test_gltf_refused(void **state)
     assert_int_equal(fwrite(text, 1, n, f), n);
     fclose(f);
     free(text);
-    assert_int_equal(run("render range.gltf -o bad_out.png"), 1);
-    assert_one_line_error("range.gltf: mesh 0 primitive 0: index 5 refers to vertex 9 of 4", NULL);
+    assert_int_equal(cli_run_here("render range.gltf -o bad_out.png"), 1);
+    cli_assert_one_line_error("range.gltf: mesh 0 primitive 0: index 5 refers to vertex 9 of 4", NULL);
     assert_no_output("bad_out");
 }
 
@@ -424,14 +353,14 @@ static void test_scene_format_by_content(void **state)
                  names[i]);
         bad_scene(names[i], "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n", NULL, NULL, needle, NULL);
     }
-    write_file("good.mtl", good_mtl);
-    write_file("room", good_obj);
-    assert_int_equal(run("render room -o room.png --width 16 --height 16 --elements 50 "
+    test_write_file("good.mtl", cli_good_mtl);
+    test_write_file("room", cli_good_obj);
+    assert_int_equal(cli_run_here("render room -o room.png --width 16 --height 16 --elements 50 "
                          "--stats room.json"),
                      0);
     char path[600], text[16384];
-    snprintf(path, sizeof path, "%s/room.json", workdir);
-    slurp(path, text, sizeof text);
+    snprintf(path, sizeof path, "%s/room.json", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_non_null(strstr(text, "\"name\":\t\"lamp\""));
     assert_non_null(strstr(text, "\"emission\":\t[3.14159265358979")); /* pi Ke, Ke = 1 */
 }
@@ -454,18 +383,18 @@ static void test_face_vertex_count(void **state)
 static void test_several_material_libraries(void **state)
 {
     (void)state;
-    const char *body = good_obj + strlen("mtllib good.mtl\n");
+    const char *body = cli_good_obj + strlen("mtllib good.mtl\n");
     char obj[1024];
-    write_file("walls.mtl", "newmtl white\nKd 0.5 0.5 0.5\n");
-    write_file("lamps.mtl", "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
+    test_write_file("walls.mtl", "newmtl white\nKd 0.5 0.5 0.5\n");
+    test_write_file("lamps.mtl", "newmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n");
     snprintf(obj, sizeof obj, "mtllib walls.mtl lamps.mtl\n%s", body);
-    write_file("libs.obj", obj);
-    assert_int_equal(run("render libs.obj -o libs.png --width 16 --height 16 --elements 50 "
+    test_write_file("libs.obj", obj);
+    assert_int_equal(cli_run_here("render libs.obj -o libs.png --width 16 --height 16 --elements 50 "
                          "--stats libs.json"),
                      0);
     char path[600], text[16384];
-    snprintf(path, sizeof path, "%s/libs.json", workdir);
-    slurp(path, text, sizeof text);
+    snprintf(path, sizeof path, "%s/libs.json", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_non_null(strstr(text, "\"emission\":\t[3.14159265358979"));
     snprintf(obj, sizeof obj, "mtllib walls.mtl missing.mtl\n%s", body);
     bad_scene("libs2.obj", obj, NULL, NULL,
@@ -480,60 +409,60 @@ static void test_several_material_libraries(void **state)
 static void test_unknown_method_names(void **state)
 {
     (void)state;
-    assert_int_equal(run("render -o bad_out.png --solver nosuch"), 2);
-    assert_one_line_error("--solver: expected one of", "gauss-seidel");
-    assert_int_equal(run("render -o bad_out.png --form-factors nosuch"), 2);
-    assert_one_line_error("nosuch", "analytic");
-    assert_int_equal(run("viewfactors -o bad_out.json --visibility nosuch"), 2);
-    assert_one_line_error("nosuch", "embree");
+    assert_int_equal(cli_run_here("render -o bad_out.png --solver nosuch"), 2);
+    cli_assert_one_line_error("--solver: expected one of", "gauss-seidel");
+    assert_int_equal(cli_run_here("render -o bad_out.png --form-factors nosuch"), 2);
+    cli_assert_one_line_error("nosuch", "analytic");
+    assert_int_equal(cli_run_here("viewfactors -o bad_out.json --visibility nosuch"), 2);
+    cli_assert_one_line_error("nosuch", "embree");
     assert_no_output("bad_out");
 }
 
 static void test_usage_errors(void **state)
 {
     (void)state;
-    assert_int_equal(run("render --width abc"), 2);
-    assert_one_line_error("--width", "abc");
-    assert_int_equal(run("render --mesh-size -1"), 2);
-    assert_one_line_error("--mesh-size", NULL);
-    assert_int_equal(run("render --tolerance nan"), 2);
-    assert_one_line_error("--tolerance", NULL);
-    assert_int_equal(run("render --bogus"), 2);
-    assert_one_line_error("--bogus", NULL);
-    assert_int_equal(run("frobnicate"), 2);
-    assert_one_line_error("frobnicate", NULL);
-    assert_int_equal(run("render --camera 1,2,3"), 2);
-    assert_one_line_error("--camera", NULL);
-    assert_int_equal(run("render a.obj b.obj"), 2);
-    assert_one_line_error("more than one scene", NULL);
-    assert_int_equal(run("render --solver"), 2);
-    assert_one_line_error("--solver", NULL);
-    assert_int_equal(run("render --oracle nosuch"), 2);
-    assert_one_line_error("--oracle", "nosuch");
-    assert_int_equal(run("render --tolerance 2"), 2);
-    assert_one_line_error("--tolerance: expected a number in (0, 1), got '2'", NULL);
-    assert_int_equal(run("render --rooms 3"), 2);
-    assert_one_line_error("--rooms does not apply to render", NULL);
-    assert_int_equal(run("render -o ''"), 2);
-    assert_one_line_error("--output needs a value", NULL);
+    assert_int_equal(cli_run_here("render --width abc"), 2);
+    cli_assert_one_line_error("--width", "abc");
+    assert_int_equal(cli_run_here("render --mesh-size -1"), 2);
+    cli_assert_one_line_error("--mesh-size", NULL);
+    assert_int_equal(cli_run_here("render --tolerance nan"), 2);
+    cli_assert_one_line_error("--tolerance", NULL);
+    assert_int_equal(cli_run_here("render --bogus"), 2);
+    cli_assert_one_line_error("--bogus", NULL);
+    assert_int_equal(cli_run_here("frobnicate"), 2);
+    cli_assert_one_line_error("frobnicate", NULL);
+    assert_int_equal(cli_run_here("render --camera 1,2,3"), 2);
+    cli_assert_one_line_error("--camera", NULL);
+    assert_int_equal(cli_run_here("render a.obj b.obj"), 2);
+    cli_assert_one_line_error("more than one scene", NULL);
+    assert_int_equal(cli_run_here("render --solver"), 2);
+    cli_assert_one_line_error("--solver", NULL);
+    assert_int_equal(cli_run_here("render --oracle nosuch"), 2);
+    cli_assert_one_line_error("--oracle", "nosuch");
+    assert_int_equal(cli_run_here("render --tolerance 2"), 2);
+    cli_assert_one_line_error("--tolerance: expected a number in (0, 1), got '2'", NULL);
+    assert_int_equal(cli_run_here("render --rooms 3"), 2);
+    cli_assert_one_line_error("--rooms does not apply to render", NULL);
+    assert_int_equal(cli_run_here("render -o ''"), 2);
+    cli_assert_one_line_error("--output needs a value", NULL);
     /* The library's refusal, its field written as our flag. */
-    assert_int_equal(run("render --solver shooting --closure-correction -o cc.png"), 1);
-    assert_one_line_error("--closure-correction rescales", "shooting");
+    assert_int_equal(cli_run_here("render --solver shooting --closure-correction -o cc.png"), 1);
+    cli_assert_one_line_error("--closure-correction rescales", "shooting");
     assert_no_output("cc.png");
-    assert_int_equal(run(""), 2);
+    assert_int_equal(cli_run_here("%s", ""), 2); /* no command at all */
     assert_no_output("radiosity.png");
 }
 
 static void test_unwritable_output(void **state)
 {
     (void)state;
-    write_file("good.obj", good_obj);
-    write_file("good.mtl", good_mtl);
-    assert_int_equal(run("render good.obj --elements 50 -o no_such_dir/out.png"), 1);
-    assert_one_line_error("no_such_dir/out.png", NULL);
+    test_write_file("good.obj", cli_good_obj);
+    test_write_file("good.mtl", cli_good_mtl);
+    assert_int_equal(cli_run_here("render good.obj --elements 50 -o no_such_dir/out.png"), 1);
+    cli_assert_one_line_error("no_such_dir/out.png", NULL);
     /* An unknown format is refused before any work, as a usage error. */
-    assert_int_equal(run("render good.obj --elements 50 -o out.xyz"), 2);
-    assert_one_line_error("out.xyz", ".png");
+    assert_int_equal(cli_run_here("render good.obj --elements 50 -o out.xyz"), 2);
+    cli_assert_one_line_error("out.xyz", ".png");
     assert_no_output("out.xyz");
 }
 
@@ -542,16 +471,16 @@ static void test_unwritable_output(void **state)
 static void test_render_reports_output(void **state)
 {
     (void)state;
-    write_file("good.obj", good_obj);
-    write_file("good.mtl", good_mtl);
-    assert_int_equal(run("render good.obj --elements 50 --width 16 --height 16 -o good.png --stats good.json"), 0);
-    assert_true(exists("good.png"));
-    assert_true(exists("good.json"));
-    assert_non_null(strstr(out_text, "good.png"));
-    assert_string_equal(err_text, ""); /* no progress bar without a terminal */
-    assert_int_equal(run("render good.obj --elements 50 --width 16 --height 16 -o good.pfm -q"), 0);
-    assert_true(exists("good.pfm"));
-    assert_string_equal(out_text, "");
+    test_write_file("good.obj", cli_good_obj);
+    test_write_file("good.mtl", cli_good_mtl);
+    assert_int_equal(cli_run_here("render good.obj --elements 50 --width 16 --height 16 -o good.png --stats good.json"), 0);
+    assert_true(test_file_exists(test_path("good.png")));
+    assert_true(test_file_exists(test_path("good.json")));
+    assert_non_null(strstr(cli_stdout(), "good.png"));
+    assert_string_equal(cli_stderr(), ""); /* no progress bar without a terminal */
+    assert_int_equal(cli_run_here("render good.obj --elements 50 --width 16 --height 16 -o good.pfm -q"), 0);
+    assert_true(test_file_exists(test_path("good.pfm")));
+    assert_string_equal(cli_stdout(), "");
 }
 
 /* export: an unknown mesh format is a usage error before the load (the
@@ -560,33 +489,33 @@ static void test_render_reports_output(void **state)
 static void test_export(void **state)
 {
     (void)state;
-    assert_int_equal(run("export no_such_scene.obj -o x.obj --stats x.json"), 2);
-    assert_one_line_error("x.obj: unknown mesh format", ".glb, .gltf or .ply");
+    assert_int_equal(cli_run_here("export no_such_scene.obj -o x.obj --stats x.json"), 2);
+    cli_assert_one_line_error("x.obj: unknown mesh format", ".glb, .gltf or .ply");
     assert_no_output("x.");
-    write_file("good.obj", good_obj);
-    write_file("good.mtl", good_mtl);
-    assert_int_equal(run("export good.obj -o x.obj"), 2);
-    assert_one_line_error("x.obj: unknown mesh format", NULL);
+    test_write_file("good.obj", cli_good_obj);
+    test_write_file("good.mtl", cli_good_mtl);
+    assert_int_equal(cli_run_here("export good.obj -o x.obj"), 2);
+    cli_assert_one_line_error("x.obj: unknown mesh format", NULL);
     assert_no_output("x.");
     /* Flags of render only are refused. */
-    assert_int_equal(run("export good.obj --width 16 -o lit.glb"), 2);
-    assert_one_line_error("--width does not apply to export", NULL);
+    assert_int_equal(cli_run_here("export good.obj --width 16 -o lit.glb"), 2);
+    cli_assert_one_line_error("--width does not apply to export", NULL);
     assert_no_output("lit.");
-    assert_int_equal(run("export good.obj --elements 50 --solver southwell --exposure 2 -o lit.glb --stats lit.json"),
+    assert_int_equal(cli_run_here("export good.obj --elements 50 --solver southwell --exposure 2 -o lit.glb --stats lit.json"),
                      0);
-    assert_true(exists("lit.glb"));
-    assert_true(exists("lit.json"));
-    assert_non_null(strstr(out_text, "lit.glb ("));
-    assert_non_null(strstr(out_text, " vertices, "));
-    assert_string_equal(err_text, "");
-    assert_int_equal(run("export good.obj --elements 50 -o lit.ply -q"), 0);
-    assert_true(exists("lit.ply"));
-    assert_string_equal(out_text, "");
-    assert_int_equal(run("export --help"), 0);
-    assert_non_null(strstr(out_text, "usage: radiosity export"));
-    assert_non_null(strstr(out_text, "--exposure X"));
-    assert_non_null(strstr(out_text, "--solver NAME"));
-    assert_null(strstr(out_text, "--camera"));
+    assert_true(test_file_exists(test_path("lit.glb")));
+    assert_true(test_file_exists(test_path("lit.json")));
+    assert_non_null(strstr(cli_stdout(), "lit.glb ("));
+    assert_non_null(strstr(cli_stdout(), " vertices, "));
+    assert_string_equal(cli_stderr(), "");
+    assert_int_equal(cli_run_here("export good.obj --elements 50 -o lit.ply -q"), 0);
+    assert_true(test_file_exists(test_path("lit.ply")));
+    assert_string_equal(cli_stdout(), "");
+    assert_int_equal(cli_run_here("export --help"), 0);
+    assert_non_null(strstr(cli_stdout(), "usage: radiosity export"));
+    assert_non_null(strstr(cli_stdout(), "--exposure X"));
+    assert_non_null(strstr(cli_stdout(), "--solver NAME"));
+    assert_null(strstr(cli_stdout(), "--camera"));
 }
 
 /* bake: an unknown mesh format or a bad atlas size is a usage error before
@@ -595,73 +524,73 @@ static void test_export(void **state)
 static void test_bake(void **state)
 {
     (void)state;
-    assert_int_equal(run("bake no_such_scene.obj -o baked.obj --stats baked.json"), 2);
-    assert_one_line_error("baked.obj: unknown lightmapped mesh format", ".glb or .gltf");
+    assert_int_equal(cli_run_here("bake no_such_scene.obj -o baked.obj --stats baked.json"), 2);
+    cli_assert_one_line_error("baked.obj: unknown lightmapped mesh format", ".glb or .gltf");
     assert_no_output("baked");
-    assert_int_equal(run("bake no_such_scene.obj -o baked.ply"), 2);
-    assert_one_line_error("baked.ply: unknown lightmapped mesh format", NULL);
-    assert_int_equal(run("bake no_such_scene.obj -o baked.glb --atlas-size 1000"), 2);
-    assert_one_line_error("--atlas-size: expected a power of two", NULL);
+    assert_int_equal(cli_run_here("bake no_such_scene.obj -o baked.ply"), 2);
+    cli_assert_one_line_error("baked.ply: unknown lightmapped mesh format", NULL);
+    assert_int_equal(cli_run_here("bake no_such_scene.obj -o baked.glb --atlas-size 1000"), 2);
+    cli_assert_one_line_error("--atlas-size: expected a power of two", NULL);
     assert_no_output("baked");
-    write_file("good.obj", good_obj);
-    write_file("good.mtl", good_mtl);
-    assert_int_equal(run("bake good.obj --elements 50 --texels-per-metre 20 -o baked.glb --stats baked.json"), 0);
-    assert_true(exists("baked.glb"));
-    assert_true(exists("baked_lightmap0.hdr"));
-    assert_true(exists("baked_lightmap0.png"));
-    assert_true(exists("baked.json"));
-    assert_non_null(strstr(out_text, "baked.glb and 1 lightmap (fill "));
-    assert_string_equal(err_text, "");
+    test_write_file("good.obj", cli_good_obj);
+    test_write_file("good.mtl", cli_good_mtl);
+    assert_int_equal(cli_run_here("bake good.obj --elements 50 --texels-per-metre 20 -o baked.glb --stats baked.json"), 0);
+    assert_true(test_file_exists(test_path("baked.glb")));
+    assert_true(test_file_exists(test_path("baked_lightmap0.hdr")));
+    assert_true(test_file_exists(test_path("baked_lightmap0.png")));
+    assert_true(test_file_exists(test_path("baked.json")));
+    assert_non_null(strstr(cli_stdout(), "baked.glb and 1 lightmap (fill "));
+    assert_string_equal(cli_stderr(), "");
     /* Too many texels for an atlas: one line, nothing written. */
-    assert_int_equal(run("bake good.obj --elements 50 --texels-per-metre 1e5 -o huge.glb -q"), 1);
-    assert_one_line_error("above the atlas limit", NULL);
+    assert_int_equal(cli_run_here("bake good.obj --elements 50 --texels-per-metre 1e5 -o huge.glb -q"), 1);
+    cli_assert_one_line_error("above the atlas limit", NULL);
     assert_no_output("huge.glb");
     assert_no_output("huge_");
-    assert_int_equal(run("solve good.obj --elements 50 -q -o baked.radsol"), 0);
-    assert_int_equal(run("bake baked.radsol --lightmap irradiance -q -o again.gltf"), 0);
-    assert_true(exists("again.gltf") && exists("again_lightmap0.png") && exists("again_lightmap0.hdr"));
-    assert_int_equal(run("bake --help"), 0);
-    assert_non_null(strstr(out_text, "--texels-per-metre N"));
-    assert_non_null(strstr(out_text, "--lightmap WHICH"));
+    assert_int_equal(cli_run_here("solve good.obj --elements 50 -q -o baked.radsol"), 0);
+    assert_int_equal(cli_run_here("bake baked.radsol --lightmap irradiance -q -o again.gltf"), 0);
+    assert_true(test_file_exists(test_path("again.gltf")) && test_file_exists(test_path("again_lightmap0.png")) && test_file_exists(test_path("again_lightmap0.hdr")));
+    assert_int_equal(cli_run_here("bake --help"), 0);
+    assert_non_null(strstr(cli_stdout(), "--texels-per-metre N"));
+    assert_non_null(strstr(cli_stdout(), "--lightmap WHICH"));
 }
 
 static void test_help_version_methods(void **state)
 {
     (void)state;
-    assert_int_equal(run("--help"), 0);
-    assert_non_null(strstr(out_text, "--mesh-size"));
-    assert_non_null(strstr(out_text, "viewfactors"));
-    assert_non_null(strstr(out_text, "--rooms"));
+    assert_int_equal(cli_run_here("--help"), 0);
+    assert_non_null(strstr(cli_stdout(), "--mesh-size"));
+    assert_non_null(strstr(cli_stdout(), "viewfactors"));
+    assert_non_null(strstr(cli_stdout(), "--rooms"));
     /* A command's help has its flags only. */
-    assert_int_equal(run("render --help"), 0);
-    assert_non_null(strstr(out_text, "usage: radiosity render"));
-    assert_non_null(strstr(out_text, "--samples N"));
-    assert_null(strstr(out_text, "--rooms"));
-    assert_int_equal(run("generate --help"), 0);
-    assert_non_null(strstr(out_text, "--rooms N"));
-    assert_null(strstr(out_text, "--solver"));
-    assert_int_equal(run("--man"), 0);
-    assert_true(strncmp(out_text, ".TH RADIOSITY 1", 15) == 0);
-    assert_int_equal(run("--version"), 0);
-    assert_non_null(strstr(out_text, "radiosity 0."));
-    assert_int_equal(run("--list-methods"), 0);
-    assert_non_null(strstr(out_text, "analytic"));
-    assert_non_null(strstr(out_text, "southwell"));
-    assert_non_null(strstr(out_text, "brute"));
+    assert_int_equal(cli_run_here("render --help"), 0);
+    assert_non_null(strstr(cli_stdout(), "usage: radiosity render"));
+    assert_non_null(strstr(cli_stdout(), "--samples N"));
+    assert_null(strstr(cli_stdout(), "--rooms"));
+    assert_int_equal(cli_run_here("generate --help"), 0);
+    assert_non_null(strstr(cli_stdout(), "--rooms N"));
+    assert_null(strstr(cli_stdout(), "--solver"));
+    assert_int_equal(cli_run_here("--man"), 0);
+    assert_true(strncmp(cli_stdout(), ".TH RADIOSITY 1", 15) == 0);
+    assert_int_equal(cli_run_here("--version"), 0);
+    assert_non_null(strstr(cli_stdout(), "radiosity 0."));
+    assert_int_equal(cli_run_here("--list-methods"), 0);
+    assert_non_null(strstr(cli_stdout(), "analytic"));
+    assert_non_null(strstr(cli_stdout(), "southwell"));
+    assert_non_null(strstr(cli_stdout(), "brute"));
     /* The registry's descriptions name fields; the listing names flags. */
-    assert_non_null(strstr(out_text, "(--relaxation)"));
-    assert_null(strstr(out_text, "rad_options."));
+    assert_non_null(strstr(cli_stdout(), "(--relaxation)"));
+    assert_null(strstr(cli_stdout(), "rad_options."));
 }
 
 static void test_viewfactors_csv(void **state)
 {
     (void)state;
-    write_file("good.obj", good_obj);
-    write_file("good.mtl", good_mtl);
-    assert_int_equal(run("viewfactors good.obj --elements 64 -o vf.csv"), 0);
+    test_write_file("good.obj", cli_good_obj);
+    test_write_file("good.mtl", cli_good_mtl);
+    assert_int_equal(cli_run_here("viewfactors good.obj --elements 64 -o vf.csv"), 0);
     char path[600], text[4096];
-    snprintf(path, sizeof path, "%s/vf.csv", workdir);
-    slurp(path, text, sizeof text);
+    snprintf(path, sizeof path, "%s/vf.csv", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_true(strncmp(text, "from,area_m2,floor,lamp\n", 24) == 0);
     /* Two unit squares 1 m apart, facing: F = 0.1998 both ways. */
     double area, f_ff, f_fl;
@@ -678,12 +607,12 @@ static void test_deterministic_across_threads(void **state)
     (void)state;
     char a[600], b[600], ta[8192], tb[8192];
     for (int threads = 1; threads <= 2; threads++)
-        assert_int_equal(run("render --elements 400 --width 48 --height 48 --threads %d -o det%d.pfm "
+        assert_int_equal(cli_run_here("render --elements 400 --width 48 --height 48 --threads %d -o det%d.pfm "
                              "--stats det%d.json",
                              threads, threads, threads),
                          0);
-    snprintf(a, sizeof a, "%s/det1.pfm", workdir);
-    snprintf(b, sizeof b, "%s/det2.pfm", workdir);
+    snprintf(a, sizeof a, "%s/det1.pfm", test_workdir());
+    snprintf(b, sizeof b, "%s/det2.pfm", test_workdir());
     FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
     assert_non_null(fa);
     assert_non_null(fb);
@@ -694,10 +623,10 @@ static void test_deterministic_across_threads(void **state)
     assert_int_equal(na, nb);
     assert_memory_equal(ta, tb, na);
     /* The per-surface radiosities in the stats agree to the last digit. */
-    snprintf(a, sizeof a, "%s/det1.json", workdir);
-    snprintf(b, sizeof b, "%s/det2.json", workdir);
-    slurp(a, ta, sizeof ta);
-    slurp(b, tb, sizeof tb);
+    snprintf(a, sizeof a, "%s/det1.json", test_workdir());
+    snprintf(b, sizeof b, "%s/det2.json", test_workdir());
+    test_read_into(a, ta, sizeof ta);
+    test_read_into(b, tb, sizeof tb);
     const char *sa = strstr(ta, "\"surfaces\""), *sb = strstr(tb, "\"surfaces\"");
     assert_non_null(sa);
     assert_non_null(sb);
@@ -719,21 +648,21 @@ static void interrupt_with(int sig, int expected_status, const char *tag)
              "cd '%s' && ('%s' render --solver shooting --elements 20000 --unshot-tolerance 1e-12 "
              "--ff-samples 64 --width 32 --height 32 -o int_%s.png --stats int_%s.json "
              ">int_out.txt 2>int_err.txt & pid=$!; sleep 2; kill -%d $pid; wait $pid; echo $? > int_status.txt)",
-             workdir, radiosity_bin, tag, tag, sig);
+             test_workdir(), cli_binary(), tag, tag, sig);
     assert_int_equal(system(cmd), 0);
     char path[600], text[8192];
-    snprintf(path, sizeof path, "%s/int_status.txt", workdir);
-    slurp(path, text, sizeof text);
+    snprintf(path, sizeof path, "%s/int_status.txt", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_int_equal(atoi(text), expected_status);
     char name[64];
     snprintf(name, sizeof name, "int_%s.png", tag);
-    assert_true(exists(name));
-    snprintf(path, sizeof path, "%s/int_%s.json", workdir, tag);
-    slurp(path, text, sizeof text);
+    assert_true(test_file_exists(test_path(name)));
+    snprintf(path, sizeof path, "%s/int_%s.json", test_workdir(), tag);
+    test_read_into(path, text, sizeof text);
     assert_non_null(strstr(text, "\"partial\":\ttrue"));
     assert_non_null(strstr(text, "\"converged\":\tfalse"));
-    snprintf(path, sizeof path, "%s/int_err.txt", workdir);
-    slurp(path, text, sizeof text);
+    snprintf(path, sizeof path, "%s/int_err.txt", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_non_null(strstr(text, "interrupted"));
 }
 
@@ -749,8 +678,8 @@ static void test_interrupt_writes_partial(void **state)
 
 static void too_big(const char *args, const char *needle1, const char *needle2)
 {
-    assert_int_equal(run("render %s -o big.png --stats big.json", args), 1);
-    assert_one_line_error(needle1, needle2);
+    assert_int_equal(cli_run_here("render %s -o big.png --stats big.json", args), 1);
+    cli_assert_one_line_error(needle1, needle2);
     assert_no_output("big");
 }
 
@@ -775,9 +704,9 @@ static void test_limits(void **state)
     /* Element-to-element view factors: 3000^2 doubles (69 MiB) beside F's
      * as many do not fit in 100 MB, so they are made in row blocks
      * (docs/formats.md, "Streamed view factors") and written. */
-    assert_int_equal(run("viewfactors --elements 3000 --level element --max-memory 100M -o big.csv"), 0);
+    assert_int_equal(cli_run_here("viewfactors --elements 3000 --level element --max-memory 100M -o big.csv"), 0);
     char big[600];
-    snprintf(big, sizeof big, "%s/big.csv", workdir);
+    snprintf(big, sizeof big, "%s/big.csv", test_workdir());
     assert_int_equal(access(big, F_OK), 0);
     remove(big);
 }
@@ -793,33 +722,33 @@ static void test_loading_limits(void **state)
     /* /dev/zero under an OBJ name, with and without a limit: a NUL byte
      * in the first piece read, at once (before: with no --max-memory it
      * grew to 24 GB until the kernel killed it). */
-    snprintf(path, sizeof path, "%s/zero.obj", workdir);
+    snprintf(path, sizeof path, "%s/zero.obj", test_workdir());
     remove(path);
     assert_int_equal(symlink("/dev/zero", path), 0);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    assert_int_equal(run("render zero.obj -o zout.png --max-memory 64M"), 1);
-    assert_one_line_error("zero.obj:1: NUL byte in the text", NULL);
-    assert_int_equal(run("render zero.obj -o zout.png"), 1);
-    assert_one_line_error("zero.obj:1: NUL byte in the text", NULL);
+    assert_int_equal(cli_run_here("render zero.obj -o zout.png --max-memory 64M"), 1);
+    cli_assert_one_line_error("zero.obj:1: NUL byte in the text", NULL);
+    assert_int_equal(cli_run_here("render zero.obj -o zout.png"), 1);
+    cli_assert_one_line_error("zero.obj:1: NUL byte in the text", NULL);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     assert_true((double)(t1.tv_sec - t0.tv_sec) < 20.0);
     assert_no_output("zout");
     remove(path);
-    assert_int_equal(run("render /dev/zero -o zout.png"), 1);
-    assert_one_line_error("/dev/zero:1: NUL byte in the text", NULL);
-    assert_int_equal(run("render /dev/urandom -o zout.png"), 1);
-    assert_one_line_error("/dev/urandom:", "NUL byte in the text");
+    assert_int_equal(cli_run_here("render /dev/zero -o zout.png"), 1);
+    cli_assert_one_line_error("/dev/zero:1: NUL byte in the text", NULL);
+    assert_int_equal(cli_run_here("render /dev/urandom -o zout.png"), 1);
+    cli_assert_one_line_error("/dev/urandom:", "NUL byte in the text");
 
     /* A FIFO that never ends: read up to what the import could take
      * within the limit (1/20 of it), then refused.  With no --max-memory
      * the limit is half of what the process may use: here ulimit -v 2 GiB
      * (where the program can run so: not under AddressSanitizer, which
      * reserves terabytes of address space). */
-    snprintf(path, sizeof path, "%s/endless.obj", workdir);
+    snprintf(path, sizeof path, "%s/endless.obj", test_workdir());
     remove(path);
     assert_int_equal(mkfifo(path, 0600), 0);
-    snprintf(cmd, sizeof cmd, "(ulimit -v 2097152; '%s' --version) >/dev/null 2>&1", radiosity_bin);
+    snprintf(cmd, sizeof cmd, "(ulimit -v 2097152; '%s' --version) >/dev/null 2>&1", cli_binary());
     int runs = system(cmd) == 0 ? 2 : 1;
     const char *limits[2] = {"--max-memory 64M", ""};
     const char *ulimits[2] = {"", "ulimit -v 2097152; "};
@@ -834,35 +763,34 @@ static void test_loading_limits(void **state)
                  "cd '%s' && (timeout 60 sh -c \"yes 'v 0 0 0' > endless.obj\" >/dev/null 2>&1 &) "
                  "&& (%s'%s' render endless.obj -o zout.png %s >stdout.txt 2>stderr.txt "
                  "</dev/null)",
-                 workdir, ulimits[k], radiosity_bin, limits[k]);
+                 test_workdir(), ulimits[k], cli_binary(), limits[k]);
         int status = system(cmd);
-        snprintf(path, sizeof path, "%s/stderr.txt", workdir);
-        slurp(path, err_text, sizeof err_text);
+        cli_stderr_from(test_path("stderr.txt"));
         assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 1);
-        assert_one_line_error(expected[k], NULL);
+        cli_assert_one_line_error(expected[k], NULL);
         assert_no_output("zout");
     }
-    snprintf(path, sizeof path, "%s/endless.obj", workdir);
+    snprintf(path, sizeof path, "%s/endless.obj", test_workdir());
     remove(path);
 
     /* Sparse files: refused by their size, unread; or, with room for them,
      * stopped by the NUL byte at their start. */
-    snprintf(path, sizeof path, "%s/sparse.obj", workdir);
+    snprintf(path, sizeof path, "%s/sparse.obj", test_workdir());
     FILE *f = fopen(path, "wb");
     assert_non_null(f);
     fclose(f);
     assert_int_equal(truncate(path, (off_t)100 << 30), 0); /* 100 GiB, no blocks */
-    assert_int_equal(run("render sparse.obj -o zout.png --max-memory 64M"), 1);
-    assert_one_line_error("sparse.obj: a file of 100.00 GiB may need 2000.00 GiB to import (20x "
+    assert_int_equal(cli_run_here("render sparse.obj -o zout.png --max-memory 64M"), 1);
+    cli_assert_one_line_error("sparse.obj: a file of 100.00 GiB may need 2000.00 GiB to import (20x "
                           "its size), above the memory limit of 64.0 MiB (--max-memory)",
                           NULL);
     assert_int_equal(truncate(path, (off_t)2 << 30), 0); /* 2 GiB */
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    assert_int_equal(run("render sparse.obj -o zout.png"), 1);
+    assert_int_equal(cli_run_here("render sparse.obj -o zout.png"), 1);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     assert_true((double)(t1.tv_sec - t0.tv_sec) < 20.0);
-    if (!strstr(err_text, "sparse.obj:1: NUL byte in the text"))
-        assert_one_line_error("sparse.obj: a file of 2.00 GiB may need 40.00 GiB to import", NULL);
+    if (!strstr(cli_stderr(), "sparse.obj:1: NUL byte in the text"))
+        cli_assert_one_line_error("sparse.obj: a file of 2.00 GiB may need 40.00 GiB to import", NULL);
     assert_no_output("zout");
     remove(path);
 }
@@ -879,23 +807,23 @@ static void test_interrupt_during_form_factors(void **state)
              "cd '%s' && ('%s' render --elements 12000 --width 32 --height 32 -o ffint.png "
              "--stats ffint.json >ffint_out.txt 2>ffint_err.txt & pid=$!; sleep 2; kill -15 $pid; "
              "wait $pid; echo $? > ffint_status.txt)",
-             workdir, radiosity_bin);
+             test_workdir(), cli_binary());
     assert_int_equal(system(cmd), 0);
     char path[600], text[8192];
-    snprintf(path, sizeof path, "%s/ffint_status.txt", workdir);
-    slurp(path, text, sizeof text);
+    snprintf(path, sizeof path, "%s/ffint_status.txt", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_int_equal(atoi(text), 143);
-    assert_false(exists("ffint.png"));
-    snprintf(path, sizeof path, "%s/ffint.json", workdir);
-    slurp(path, text, sizeof text);
+    assert_false(test_file_exists(test_path("ffint.png")));
+    snprintf(path, sizeof path, "%s/ffint.json", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_non_null(strstr(text, "\"partial\":\ttrue"));
     assert_non_null(strstr(text, "\"interrupted\":\t\"form factors\""));
     assert_non_null(strstr(text, "\"scene\":\t\"cornell-box\""));
     assert_non_null(strstr(text, "\"surfaces\":\t8"));
     assert_no_output("ffint.png");
     assert_no_output("ffint.json.tmp");
-    snprintf(path, sizeof path, "%s/ffint_err.txt", workdir);
-    slurp(path, text, sizeof text);
+    snprintf(path, sizeof path, "%s/ffint_err.txt", test_workdir());
+    test_read_into(path, text, sizeof text);
     assert_non_null(strstr(text, "interrupted while computing form factors; wrote partial stats"));
 }
 
@@ -909,12 +837,12 @@ static void test_seed(void **state)
     (void)state;
     const char *good[] = {"0", "9007199254740993", "18446744073709551615"};
     for (size_t k = 0; k < 3; k++) {
-        assert_int_equal(run("render --elements 24 --width 4 --height 4 -o seed.png --stats seed.json --seed %s",
+        assert_int_equal(cli_run_here("render --elements 24 --width 4 --height 4 -o seed.png --stats seed.json --seed %s",
                              good[k]),
                          0);
         char path[600], text[16384], want[64];
-        snprintf(path, sizeof path, "%s/seed.json", workdir);
-        slurp(path, text, sizeof text);
+        snprintf(path, sizeof path, "%s/seed.json", test_workdir());
+        test_read_into(path, text, sizeof text);
         snprintf(want, sizeof want, "\"seed\":\t%s,", good[k]);
         if (!strstr(text, want))
             fail_msg("the stats lack %s", want);
@@ -923,27 +851,24 @@ static void test_seed(void **state)
     const char *commands[] = {"render -o seed.png", "viewfactors -o seed.json", "generate office -o seed.obj"};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++)
         for (size_t c = 0; c < 3; c++) {
-            assert_int_equal(run("%s --seed %s", commands[c], bad[k]), 2);
+            assert_int_equal(cli_run_here("%s --seed %s", commands[c], bad[k]), 2);
             if (strcmp(bad[k], "''") == 0)
-                assert_one_line_error("--seed needs a value", NULL);
+                cli_assert_one_line_error("--seed needs a value", NULL);
             else
-                assert_one_line_error("--seed: expected an integer in [0, 18446744073709551615], got '", NULL);
+                cli_assert_one_line_error("--seed: expected an integer in [0, 18446744073709551615], got '", NULL);
         }
 }
 
 static int setup(void **state)
 {
     (void)state;
-    snprintf(workdir, sizeof workdir, "/tmp/radiosity-cli-XXXXXX");
-    return mkdtemp(workdir) ? 0 : -1;
+    return test_workdir_make("cli");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    char cmd[400];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", workdir);
-    return system(cmd) == 0 ? 0 : -1;
+    return test_workdir_remove();
 }
 
 int main(int argc, char **argv)
@@ -952,7 +877,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: test_cli PATH_TO_RADIOSITY\n");
         return 2;
     }
-    radiosity_bin = argv[1];
+    cli_set_binary(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_malformed_obj),

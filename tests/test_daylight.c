@@ -54,28 +54,17 @@ static double rel(double a, double b) { return fabs(a - b) / (b != 0.0 ? fabs(b)
 enum { ROOF = 1, FACADE = 2, PLATE = 4, OPENING_MATERIAL = 8 };
 
 typedef struct obj_text {
-    char buf[16384];
-    size_t len;
+    test_text text;
     int vertices;
 } obj_text;
-
-static void put(obj_text *t, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(t->buf + t->len, sizeof t->buf - t->len, fmt, ap);
-    va_end(ap);
-    assert_true(n > 0 && (size_t)n < sizeof t->buf - t->len);
-    t->len += (size_t)n;
-}
 
 /* A quad a, b, c, d as OBJ object `name` of material `mtl`. */
 static void quad(obj_text *t, const char *name, const char *mtl, double q[4][3])
 {
-    put(t, "o %s\nusemtl %s\n", name, mtl);
+    test_put(&t->text, "o %s\nusemtl %s\n", name, mtl);
     for (int k = 0; k < 4; k++)
-        put(t, "v %.17g %.17g %.17g\n", q[k][0], q[k][1], q[k][2]);
-    put(t, "f %d %d %d %d\n", t->vertices + 1, t->vertices + 2, t->vertices + 3, t->vertices + 4);
+        test_put(&t->text, "v %.17g %.17g %.17g\n", q[k][0], q[k][1], q[k][2]);
+    test_put(&t->text, "f %d %d %d %d\n", t->vertices + 1, t->vertices + 2, t->vertices + 3, t->vertices + 4);
     t->vertices += 4;
 }
 
@@ -115,10 +104,9 @@ static const char room_mtl[] = "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl floor\nKd 0.
  * the material "opening" instead of being named. */
 static rad_scene *room(rad_context *ctx, int flags)
 {
-    static obj_text t;
-    memset(&t, 0, sizeof t);
+    obj_text t = {0};
     const char *om = flags & OPENING_MATERIAL ? "opening" : "dark";
-    put(&t, "mtllib room.mtl\n");
+    test_put(&t.text, "mtllib room.mtl\n");
     rect_y(&t, "floor", "floor", 0.0, 0, 4, 0, 4, true);
     if (flags & ROOF) {
         rect_y(&t, "ceiling", "wall", 3.0, 0, 4, 0, 1.5, false);
@@ -144,8 +132,10 @@ static rad_scene *room(rad_context *ctx, int flags)
     if (flags & PLATE)
         rect_y(&t, "plate", "dark", 3.5, -50, 2, -50, 50, false);
     rad_scene *scene = NULL;
-    assert_int_equal(rad_scene_load_memory(ctx, "room.obj", t.buf, t.len, room_mtl, strlen(room_mtl), &scene),
-                     RAD_OK);
+    assert_int_equal(
+        rad_scene_load_memory(ctx, "room.obj", t.text.data, t.text.length, room_mtl, strlen(room_mtl), &scene),
+        RAD_OK);
+    free(t.text.data);
     return scene;
 }
 
@@ -258,20 +248,12 @@ static double facade_reference(const world *w, vec3 p, vec3 n)
     return sky_over_rectangle(w->scene->daylight, p, n, v3(1.5, 1, 0), v3(1, 0, 0), v3(0, 1, 0));
 }
 
-static rad_context *context(void)
-{
-    rad_context_options co = {.threads = 1};
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
-    return ctx;
-}
-
 /* ---- skies ---- */
 
 static void test_overcast_horizontal(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = room(ctx, ROOF);
     const char *json = "{\"sky\": {\"type\": \"cie-overcast\", \"zenith_luminance\": 9000}}";
     assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "o.json", json, strlen(json)), RAD_OK);
@@ -409,7 +391,7 @@ static const char clear_json[] = "{\"sky\": {\"type\": 12, \"diffuse_illuminance
 
 static void check_sky_component(const char *json, int flags, vec3 p, vec3 n, bool roof)
 {
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     world w = make_world(ctx, flags, json);
     double got = daylight_at(&w, p, n);
     double want = roof ? roof_reference(&w, p, n) : facade_reference(&w, p, n);
@@ -447,7 +429,7 @@ static void test_obstruction_halves(void **state)
     const char *skies[2] = {"{\"sky\": {\"type\": 5}, \"openings\": {\"surfaces\": [\"skylight\"]}}",
                             overcast_json};
     for (int k = 0; k < 2; k++) {
-        rad_context *ctx = context();
+        rad_context *ctx = test_context(1);
         world open = make_world(ctx, ROOF, skies[k]), shaded = make_world(ctx, ROOF | PLATE, skies[k]);
         vec3 p = v3(2, 0, 1.3), n = v3(0, 1, 0);
         double full = daylight_at(&open, p, n), half = daylight_at(&shaded, p, n);
@@ -468,7 +450,7 @@ static void test_obstruction_halves(void **state)
 static void test_sun_patch(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     const char *with = "{\"sky\": {\"type\": \"cie-overcast\"}, \"sun\": {\"altitude\": 70, \"azimuth\": 180, "
                        "\"normal_illuminance\": 70000}, \"openings\": {\"surfaces\": [\"skylight\"]}}";
     const char *without = "{\"sky\": {\"type\": \"cie-overcast\"}, \"sun\": {\"altitude\": 70, \"azimuth\": 180}, "
@@ -509,7 +491,7 @@ static void test_sun_patch(void **state)
 static void test_outdoors(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     const char *json = "{\"sky\": {\"type\": \"cie-overcast\", \"zenith_luminance\": 8000}, "
                        "\"sun\": {\"altitude\": 70, \"azimuth\": 180, \"normal_illuminance\": 50000}, "
                        "\"ground\": {\"reflectance\": 0.2}, \"openings\": {\"surfaces\": [\"skylight\"]}}";
@@ -545,7 +527,7 @@ static void test_outdoors(void **state)
 static void test_daylight_factor(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     world w = make_world(ctx, ROOF, overcast_json);
     vec3 p = {2.6, 0.85, 2.3}, n = {0, 1, 0};
     double eh[3];
@@ -562,7 +544,7 @@ static void test_daylight_factor(void **state)
 static void test_flux_through_roof(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     world w = make_world(ctx, ROOF, clear_json);
     double x[8], wt[8];
     gauss01(8, x, wt);
@@ -597,7 +579,7 @@ static void test_flux_through_roof(void **state)
 static void test_daylight_only_solve(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = room(ctx, ROOF);
     rad_solution *sol = NULL;
     assert_int_equal(rad_solution_create(ctx, scene, &(rad_options){.target_elements = 200}, &sol), RAD_OK);
@@ -619,7 +601,7 @@ static void test_daylight_only_solve(void **state)
 static void test_sky_seen_through_opening(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = room(ctx, ROOF);
     const char *json = "{\"sky\": {\"type\": \"cie-overcast\", \"zenith_luminance\": 1000}, "
                        "\"openings\": {\"surfaces\": [\"skylight\"]}}";
@@ -660,7 +642,7 @@ static void test_sky_seen_through_opening(void **state)
 static void test_daylight_room_energy(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = room(ctx, ROOF);
     const char *json = "{\"sky\": {\"type\": \"cie-overcast\"}, \"openings\": {\"surfaces\": [\"skylight\"]}}";
     assert_int_equal(rad_scene_daylight_load_memory(ctx, scene, "sky.json", json, strlen(json)), RAD_OK);
@@ -723,7 +705,7 @@ static void test_daylight_room_energy(void **state)
 static void test_openings_leave_the_scene(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = room(ctx, ROOF | FACADE);
     size_t surfaces = rad_scene_surface_count(scene), polygons = rad_scene_polygon_count(scene);
     double ceiling = 0;
@@ -775,7 +757,7 @@ static void test_openings_leave_the_scene(void **state)
 static void test_opening_in_the_open(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     static const char obj[] = "o floor\nv 0 0 0\nv 0 0 4\nv 4 0 4\nv 4 0 0\nf 1 2 3 4\n"
                               "o skylight\nv 1.5 3 1.5\nv 2.5 3 1.5\nv 2.5 3 2\nv 2 3 2\nv 2 3 2.5\nv 1.5 3 2.5\n"
                               "f 5 6 7 8 9 10\n";
@@ -864,7 +846,7 @@ static void test_bad_files(void **state)
         {"{\"sky\": {\"type\": 5}, \"openings\": {\"materials\": [\"wall\", \"floor\", \"dark\"]}}",
          "bad.json: openings: every polygon of the scene room.obj is an opening"},
     };
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         rad_scene *scene = room(ctx, ROOF);
         size_t before = rad_scene_polygon_count(scene);
@@ -892,7 +874,7 @@ static void test_bad_files(void **state)
 static void test_allocation_failures(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     /* Two openings, a sky that needs the sun. */
     const char *json = "{\"sky\": {\"type\": 12}, \"sun\": {\"altitude\": 30, \"azimuth\": 10}, "
                        "\"openings\": {\"surfaces\": [\"skylight\", \"window\"]}}";
@@ -921,7 +903,7 @@ static void test_allocation_failures(void **state)
 static void test_example_file(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = room(ctx, ROOF | FACADE);
     assert_int_equal(rad_scene_daylight_load_file(ctx, scene, RAD_TEST_DATA "/daylight/room.json"), RAD_OK);
     assert_int_equal(rad_scene_daylight_opening_count(scene), 2);
@@ -939,9 +921,9 @@ static void test_command(void **state)
 {
     (void)state;
     char out[1024], errors[1024], bad[1024];
-    snprintf(out, sizeof out, "%s/vf.json", cli_workdir());
-    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
-    snprintf(bad, sizeof bad, "%s/bad.json", cli_workdir());
+    snprintf(out, sizeof out, "%s/vf.json", test_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", test_workdir());
+    snprintf(bad, sizeof bad, "%s/bad.json", test_workdir());
     assert_int_equal(cli_run("viewfactors %s/daylight/room.obj --daylight %s/daylight/room.json -o %s",
                              RAD_TEST_DATA, RAD_TEST_DATA, out), 0);
     cJSON *vf = cli_read_json(out);
@@ -952,7 +934,7 @@ static void test_command(void **state)
     /* F(floor -> skylight) = 0.0306 (a 1 x 1 m square 3 m over the 4 x 4 m
      * floor's centre), F(floor -> window) is smaller. */
     assert_true(row < 1.0 - 0.03 && row > 0.9);
-    char *written = cli_read_text(out);
+    char *written = test_read_file(out, NULL);
     assert_null(strstr(written, "\"skylight\""));
     free(written);
     cJSON_Delete(vf);
@@ -961,8 +943,8 @@ static void test_command(void **state)
     fputs("{\"sky\": {\"type\": 3}, \"ground\": {\"reflectance\": \"grey\"}}", f);
     fclose(f);
     assert_int_equal(cli_run_capture(errors, "solve %s/daylight/room.obj --daylight %s -o %s/x.radsol", RAD_TEST_DATA,
-                                     bad, cli_workdir()), 1);
-    char *text = cli_read_text(errors);
+                                     bad, test_workdir()), 1);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(strstr(text, "bad.json: ground.reflectance: must be a number"));
     free(text);
 }
@@ -988,7 +970,7 @@ static void *run_job(void *arg)
 static void test_threads_agree(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     world w = make_world(ctx, ROOF | FACADE, clear_json);
     double serial[100], parallel[100];
     job one = {&w, 0, 100, serial};
@@ -1028,7 +1010,7 @@ static const char *cie171_sky(int type)
 
 static void cie171_case(int flags, int type)
 {
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     world w = make_world(ctx, flags, cie171_sky(type));
     static const double pts[][2] = {{0.5, 0.5}, {2.0, 2.0}, {3.5, 1.0}, {1.0, 3.5}};
     double worst = 0;

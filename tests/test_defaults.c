@@ -39,8 +39,8 @@
 static double worst_error(const char *args, char *where, size_t where_size)
 {
     char stats_path[600], png[600], ref_path[600];
-    snprintf(stats_path, sizeof stats_path, "%s/stats.json", cli_workdir());
-    snprintf(png, sizeof png, "%s/box.png", cli_workdir());
+    snprintf(stats_path, sizeof stats_path, "%s/stats.json", test_workdir());
+    snprintf(png, sizeof png, "%s/box.png", test_workdir());
     snprintf(ref_path, sizeof ref_path, "%s/cornell_converged.json", RAD_TEST_DATA);
     assert_int_equal(cli_run("render -o '%s' --stats '%s' --width 32 --height 32 %s", png, stats_path, args), 0);
     cJSON *stats = cli_read_json(stats_path), *ref = cli_read_json(ref_path);

@@ -17,6 +17,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "radiosity.h"
 #include "gltf_support.h"
 
@@ -36,26 +38,11 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-static char temp_dir[] = "/tmp/rad_test_export_XXXXXX";
 static rad_context *ctx;
 static rad_scene *scene;
 static rad_solution *solution;
 static double *vertex_B;   /* rad_solution_vertex_radiosity: 3 per vertex, W/m^2 */
 static size_t vertex_count;
-
-static const char *temp_path(const char *name)
-{
-    static char path[4][512];
-    static int next;
-    char *p = path[next++ % 4];
-    snprintf(p, sizeof path[0], "%s/%s", temp_dir, name);
-    return p;
-}
-
-static bool file_exists(const char *path) { return access(path, F_OK) == 0; }
-
-
-
 
 /* What the writer promises for display: min(1, B/pi x exposure), B/pi
  * rounded to float first as the file's radiance is. */
@@ -94,7 +81,7 @@ static void assert_automatic_exposure(double exposure)
 static int setup(void **state)
 {
     (void)state;
-    if (!mkdtemp(temp_dir))
+    if (test_workdir_make("export") != 0)
         return -1;
     if (rad_context_create(NULL, &ctx) != RAD_OK || rad_scene_create_cornell_box(ctx, &scene) != RAD_OK)
         return -1;
@@ -114,9 +101,7 @@ static int teardown(void **state)
     rad_solution_destroy(solution);
     rad_scene_destroy(scene);
     rad_context_destroy(ctx);
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", temp_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return test_workdir_remove();
 }
 
 /* The solution's vertices of `surface`'s elements, ascending: the vertices
@@ -175,7 +160,7 @@ static void gltf_open(const char *path, bool binary, gltf_file *g)
 {
     size_t size;
     memset(g, 0, sizeof *g);
-    g->bytes = support_read_bytes(path, &size);
+    g->bytes = (unsigned char *)test_read_file(path, &size);
     cJSON *buffer;
     if (binary) {
         /* header (magic, version 2, length), JSON chunk, BIN chunk */
@@ -399,7 +384,7 @@ static void check_gltf(const char *path, bool binary, double exposure_given)
 static void test_glb(void **state)
 {
     (void)state;
-    const char *path = temp_path("lit.glb");
+    const char *path = test_path("lit.glb");
     assert_int_equal(rad_solution_write_mesh(ctx, solution, path, 0.0), RAD_OK);
     check_gltf(path, true, 0.0);
 }
@@ -407,11 +392,11 @@ static void test_glb(void **state)
 static void test_gltf(void **state)
 {
     (void)state;
-    const char *path = temp_path("lit.gltf");
+    const char *path = test_path("lit.gltf");
     assert_int_equal(rad_solution_write_mesh(ctx, solution, path, 10.0), RAD_OK);
     check_gltf(path, false, 10.0);
     /* Upper-case extensions are the same formats. */
-    path = temp_path("LIT.GLTF");
+    path = test_path("LIT.GLTF");
     assert_int_equal(rad_solution_write_mesh(ctx, solution, path, 0.0), RAD_OK);
     check_gltf(path, false, 0.0);
 }
@@ -426,7 +411,7 @@ static double srgb(double linear)
 static void check_ply(const char *path, double exposure_given)
 {
     size_t size;
-    unsigned char *bytes = support_read_bytes(path, &size);
+    unsigned char *bytes = (unsigned char *)test_read_file(path, &size);
     const char *end = strstr((const char *)bytes, "end_header\n");
     assert_non_null(end);
     size_t header_length = (size_t)(end - (const char *)bytes) + strlen("end_header\n");
@@ -497,7 +482,7 @@ static void check_ply(const char *path, double exposure_given)
 static void test_ply(void **state)
 {
     (void)state;
-    const char *path = temp_path("lit.ply");
+    const char *path = test_path("lit.ply");
     assert_int_equal(rad_solution_write_mesh(ctx, solution, path, 0.0), RAD_OK);
     check_ply(path, 0.0);
     assert_int_equal(rad_solution_write_mesh(ctx, solution, path, 2.5), RAD_OK);
@@ -509,20 +494,20 @@ static void test_ply(void **state)
 static void test_refused(void **state)
 {
     (void)state;
-    const char *obj = temp_path("lit.obj"), *glb = temp_path("bad.glb");
+    const char *obj = test_path("lit.obj"), *glb = test_path("bad.glb");
     assert_int_equal(rad_solution_write_mesh(ctx, solution, obj, 0.0), RAD_ERROR_INVALID_ARGUMENT);
     assert_non_null(strstr(rad_context_error(ctx), "unknown mesh format (use .glb, .gltf or .ply)"));
-    assert_false(file_exists(obj));
+    assert_false(test_file_exists(obj));
     assert_int_equal(rad_solution_write_mesh(ctx, solution, glb, -1.0), RAD_ERROR_INVALID_ARGUMENT);
     assert_int_equal(rad_solution_write_mesh(ctx, solution, glb, NAN), RAD_ERROR_INVALID_ARGUMENT);
     assert_int_equal(rad_solution_write_mesh(ctx, solution, glb, INFINITY), RAD_ERROR_INVALID_ARGUMENT);
-    assert_false(file_exists(glb));
+    assert_false(test_file_exists(glb));
     /* An output set refuses the extension before any work. */
     rad_output_set *set;
     const char *temp;
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
     assert_int_equal(rad_output_set_add(ctx, set, obj, RAD_OUTPUT_MESH, &temp), RAD_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(rad_output_set_add(ctx, set, temp_path("set.ply"), RAD_OUTPUT_MESH, &temp), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("set.ply"), RAD_OUTPUT_MESH, &temp), RAD_OK);
     rad_output_set_destroy(set);
 }
 
@@ -531,11 +516,11 @@ static void test_refused(void **state)
 static void test_validator(void **state)
 {
     (void)state;
-    const char *glb = temp_path("valid.glb"), *gltf = temp_path("valid.gltf");
+    const char *glb = test_path("valid.glb"), *gltf = test_path("valid.gltf");
     assert_int_equal(rad_solution_write_mesh(ctx, solution, glb, 0.0), RAD_OK);
     assert_int_equal(rad_solution_write_mesh(ctx, solution, gltf, 10.0), RAD_OK);
     const char *paths[2] = {glb, gltf};
-    support_validate_gltf(RAD_TEST_SOURCE, RAD_NPM_MODULES, paths, 2, NULL, temp_path("report.txt"));
+    support_validate_gltf(RAD_TEST_SOURCE, RAD_NPM_MODULES, paths, 2, NULL, test_path("report.txt"));
 }
 
 int main(void)

@@ -75,18 +75,6 @@ enum { MESH_SETTINGS = 3 };
 
 /* ---- the scenes ---- */
 
-static void write_two_surface_case(cli_scene_writer *w, const char *id)
-{
-    const cJSON *g = cJSON_GetObjectItem(cli_find_case(id), "geometry");
-    cli_scene_begin(w, id);
-    cli_scene_material(w, "grey", 0.5, 0.0);
-    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
-    cli_scene_case_surface(w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
-    if (cJSON_GetObjectItem(g, "blocker"))
-        cli_scene_case_surface(w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
-    cli_scene_end(w);
-}
-
 /* The perpendicular squares, each cut into four triangles about an
  * off-centre apex: the same surfaces, so the same exact factor, but the
  * elements' edges are skew to each other and meet at shared vertices. */
@@ -198,7 +186,7 @@ static void test_contour_parallel_squares(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "par_rect_1x1_d1");
+    cli_scene_two_surfaces(&w, "par_rect_1x1_d1", NULL);
     double exact = cli_exact_value(cli_find_case("par_rect_1x1_d1"));
     for (int m = 0; m < MESH_SETTINGS; m++)
         check_pair(&w, "contour", mesh_settings[m], exact, 1e-9, "parallel squares");
@@ -208,7 +196,7 @@ static void test_contour_perpendicular_shared_edge(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "perp_rect_1_1_1_cube");
+    cli_scene_two_surfaces(&w, "perp_rect_1_1_1_cube", NULL);
     double exact = cli_exact_value(cli_find_case("perp_rect_1_1_1_cube"));
     for (int m = 0; m < MESH_SETTINGS; m++)
         check_pair(&w, "contour", mesh_settings[m], exact, 1e-9, "perpendicular squares");
@@ -279,7 +267,7 @@ static void test_analytic_defaults(void **state)
     cli_scene_writer w;
     const char *ids[2] = {"par_rect_1x1_d1", "perp_rect_1_1_1_cube"};
     for (int k = 0; k < 2; k++) {
-        write_two_surface_case(&w, ids[k]);
+        cli_scene_two_surfaces(&w, ids[k], NULL);
         check_pair(&w, "analytic", "", cli_exact_value(cli_find_case(ids[k])), 1e-4, ids[k]);
     }
     check_cube("analytic", "", 1e-4);
@@ -297,7 +285,7 @@ static void test_hybrid_documented_error(void **state)
     cli_scene_writer w;
     const char *ids[2] = {"par_rect_1x1_d1", "perp_rect_1_1_1_cube"};
     for (int k = 0; k < 2; k++) {
-        write_two_surface_case(&w, ids[k]);
+        cli_scene_two_surfaces(&w, ids[k], NULL);
         check_pair(&w, "hybrid", "--elements 2000", cli_exact_value(cli_find_case(ids[k])), 2e-3, ids[k]);
     }
     check_cube("hybrid", "--elements 2000", 2e-3);
@@ -314,13 +302,13 @@ static void test_hybrid_switch(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "perp_rect_1_1_1_cube");
+    cli_scene_two_surfaces(&w, "perp_rect_1_1_1_cube", NULL);
     double exact = cli_exact_value(cli_find_case("perp_rect_1_1_1_cube"));
     check_pair(&w, "hybrid", "--mesh-size 0.125 --near-field 1000", exact, 1e-6, "all near");
 
     char stats[600], out[600];
-    snprintf(stats, sizeof stats, "%s/hybrid_stats.json", cli_workdir());
-    snprintf(out, sizeof out, "%s/hybrid_F.json", cli_workdir());
+    snprintf(stats, sizeof stats, "%s/hybrid_stats.json", test_workdir());
+    snprintf(out, sizeof out, "%s/hybrid_F.json", test_workdir());
     assert_int_equal(cli_run("viewfactors '%s' -o '%s' --stats '%s' --form-factors hybrid --mesh-size 0.125",
                              w.obj_path, out, stats),
                      0);
@@ -344,7 +332,7 @@ static void test_occluded_squares(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "occluded_squares_blocker0.5");
+    cli_scene_two_surfaces(&w, "occluded_squares_blocker0.5", NULL);
     double exact = cli_exact_value(cli_find_case("occluded_squares_blocker0.5"));
     const char *methods[3] = {"contour", "hybrid", "analytic"};
     for (int k = 0; k < 3; k++)
@@ -460,7 +448,7 @@ static int run_closure(const cli_scene_writer *w, const char *command, const cha
     snprintf(out, sizeof out, "%s.closure.%s", w->obj_path, strcmp(command, "render") == 0 ? "png" : "json");
     unlink(out);
     int status = cli_run_capture(errors, "%s '%s' -o '%s' --closure-correction %s", command, w->obj_path, out, extra);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     snprintf(line, size, "%s", text);
     free(text);
@@ -495,7 +483,7 @@ static void test_closure_open_scene(void **state)
     (void)state;
     char line[2048];
     cli_scene_writer squares;
-    write_two_surface_case(&squares, "par_rect_1x1_d1");
+    cli_scene_two_surfaces(&squares, "par_rect_1x1_d1", NULL);
     assert_int_equal(run_closure(&squares, "viewfactors", "--mesh-size 2", line, sizeof line), 1);
     assert_refused(line, &squares, 80.0, 1.0);
 
@@ -559,11 +547,11 @@ static void test_closure_open_scene(void **state)
     cJSON_Delete(vf);
 
     char help[600];
-    snprintf(help, sizeof help, "%s/help.txt", cli_workdir());
+    snprintf(help, sizeof help, "%s/help.txt", test_workdir());
     char cmd[1400];
     snprintf(cmd, sizeof cmd, "'%s' --help > '%s' 2>&1", cli_binary(), help);
     assert_int_equal(system(cmd), 0);
-    char *text = cli_read_text(help);
+    char *text = test_read_file(help, NULL);
     assert_non_null(text);
     const char *opt = strstr(text, "--closure-correction");
     assert_non_null(opt);
@@ -579,10 +567,10 @@ static void test_matrix_market_export(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "occluded_squares_blocker0.5");
+    cli_scene_two_surfaces(&w, "occluded_squares_blocker0.5", NULL);
     char mtx[600], json[600];
-    snprintf(mtx, sizeof mtx, "%s/F.mtx", cli_workdir());
-    snprintf(json, sizeof json, "%s/F_elements.json", cli_workdir());
+    snprintf(mtx, sizeof mtx, "%s/F.mtx", test_workdir());
+    snprintf(json, sizeof json, "%s/F_elements.json", test_workdir());
     const char *opts = "--form-factors contour --mesh-size 0.25 --level element";
     assert_int_equal(cli_run("viewfactors '%s' -o '%s' %s", w.obj_path, mtx, opts), 0);
     assert_int_equal(cli_run("viewfactors '%s' -o '%s' %s", w.obj_path, json, opts), 0);
@@ -635,12 +623,12 @@ static void test_thread_count_independent(void **state)
 {
     (void)state;
     cli_scene_writer w;
-    write_two_surface_case(&w, "occluded_squares_blocker0.5");
+    cli_scene_two_surfaces(&w, "occluded_squares_blocker0.5", NULL);
     const char *methods[2] = {"contour", "hybrid"};
     for (int k = 0; k < 2; k++) {
         char a[600], b[600];
-        snprintf(a, sizeof a, "%s/t1.json", cli_workdir());
-        snprintf(b, sizeof b, "%s/t3.json", cli_workdir());
+        snprintf(a, sizeof a, "%s/t1.json", test_workdir());
+        snprintf(b, sizeof b, "%s/t3.json", test_workdir());
         assert_int_equal(cli_run("viewfactors '%s' -o '%s' --form-factors %s --elements 500 --level element "
                                  "--threads 1",
                                  w.obj_path, a, methods[k]),
@@ -649,7 +637,7 @@ static void test_thread_count_independent(void **state)
                                  "--threads 3",
                                  w.obj_path, b, methods[k]),
                          0);
-        char *ta = cli_read_text(a), *tb = cli_read_text(b);
+        char *ta = test_read_file(a, NULL), *tb = test_read_file(b, NULL);
         assert_non_null(ta);
         assert_non_null(tb);
         assert_string_equal(ta, tb);
@@ -663,8 +651,8 @@ static void test_thread_count_independent(void **state)
 static cJSON *cornell_stats(const char *method)
 {
     char stats[600], png[600];
-    snprintf(stats, sizeof stats, "%s/cornell_%s.json", cli_workdir(), method);
-    snprintf(png, sizeof png, "%s/cornell_%s.png", cli_workdir(), method);
+    snprintf(stats, sizeof stats, "%s/cornell_%s.json", test_workdir(), method);
+    snprintf(png, sizeof png, "%s/cornell_%s.png", test_workdir(), method);
     assert_int_equal(cli_run("render -o '%s' --stats '%s' --form-factors %s --elements 1000 --width 16 "
                              "--height 16",
                              png, stats, method),

@@ -75,17 +75,10 @@ static void check_factor(const judge *jd, const cJSON *vf, const char *from, con
 static void two_surface_case(const judge *jd, const char *id, bool shared_edge)
 {
     const cJSON *c = cli_find_case(id);
-    const cJSON *g = cJSON_GetObjectItem(c, "geometry");
     char name[128], options[256];
     snprintf(name, sizeof name, "%s_%s", id, jd->method);
     cli_scene_writer w;
-    cli_scene_begin(&w, name);
-    cli_scene_material(&w, "grey", 0.5, 0.0);
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
-    if (cJSON_GetObjectItem(g, "blocker"))
-        cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "blocker"), "blocker", "grey");
-    cli_scene_end(&w);
+    cli_scene_two_surfaces(&w, id, name);
     snprintf(options, sizeof options, "--form-factors %s %s", jd->method, jd->options);
     cJSON *vf = cli_view_factors(&w, options);
     /* Equal areas: F_21 = F_12. */
@@ -381,8 +374,8 @@ static void test_trapezoids(void **state)
 static cJSON *cornell_stats(const char *method, const char *extra)
 {
     char stats[600], png[600];
-    snprintf(stats, sizeof stats, "%s/cornell_%s.json", cli_workdir(), method);
-    snprintf(png, sizeof png, "%s/cornell_%s.png", cli_workdir(), method);
+    snprintf(stats, sizeof stats, "%s/cornell_%s.json", test_workdir(), method);
+    snprintf(png, sizeof png, "%s/cornell_%s.png", test_workdir(), method);
     assert_int_equal(cli_run("render -o '%s' --stats '%s' --width 16 --height 16 --elements 1000 "
                              "--form-factors %s %s",
                              png, stats, method, extra),

@@ -45,15 +45,9 @@ static const char *cube_faces[6] = {"x0", "x1", "y0", "y1", "z0", "z1"};
  * and standard deviation. */
 static void z_scores(const char *id, const char *mesh, int seeds, double *mean, double *std)
 {
-    const cJSON *c = cli_find_case(id);
-    const cJSON *g = cJSON_GetObjectItem(c, "geometry");
-    double exact = cli_exact_value(c);
+    double exact = cli_exact_value(cli_find_case(id));
     cli_scene_writer w;
-    cli_scene_begin(&w, id);
-    cli_scene_material(&w, "grey", 0.5, 0.0);
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A1"), "A1", "grey");
-    cli_scene_case_surface(&w, cJSON_GetObjectItem(g, "A2"), "A2", "grey");
-    cli_scene_end(&w);
+    cli_scene_two_surfaces(&w, id, NULL); /* the unoccluded cases */
     double sum = 0.0, sum2 = 0.0;
     for (int seed = 0; seed < seeds; seed++) {
         char options[256];

@@ -16,6 +16,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cli_support.h"
 #include "scene/scene.h"
 
 #include <dirent.h>
@@ -25,9 +26,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-static char temp_dir[] = "/tmp/rad_test_generate_XXXXXX";
 static rad_context *ctx;
-static const char *radiosity_bin; /* argv[1], or NULL: CLI tests skipped */
 
 /* ---- helpers ---- */
 
@@ -382,7 +381,7 @@ static void test_interior_walls_are_back_to_back(void **state)
 
 static int count_temp_files(void)
 {
-    DIR *d = opendir(temp_dir);
+    DIR *d = opendir(test_workdir());
     assert_non_null(d);
     int n = 0;
     struct dirent *e;
@@ -398,8 +397,8 @@ static void test_obj_round_trip(void **state)
     (void)state;
     rad_scene *s = office(5, 99);
     char path[256], mtl[256];
-    snprintf(path, sizeof path, "%s/office.obj", temp_dir);
-    snprintf(mtl, sizeof mtl, "%s/office.mtl", temp_dir);
+    snprintf(path, sizeof path, "%s/office.obj", test_workdir());
+    snprintf(mtl, sizeof mtl, "%s/office.mtl", test_workdir());
     assert_int_equal(rad_scene_write_obj(ctx, s, path), RAD_OK);
     assert_int_equal(access(mtl, R_OK), 0);
     assert_int_equal(count_temp_files(), 0);
@@ -485,8 +484,8 @@ static void test_obj_write_failure_leaves_nothing(void **state)
     /* The MTL cannot be renamed into place (a folder is in the way): no OBJ
      * either, and no temporary file. */
     char path[256], blocker[256];
-    snprintf(path, sizeof path, "%s/blocked.obj", temp_dir);
-    snprintf(blocker, sizeof blocker, "%s/blocked.mtl", temp_dir);
+    snprintf(path, sizeof path, "%s/blocked.obj", test_workdir());
+    snprintf(blocker, sizeof blocker, "%s/blocked.mtl", test_workdir());
     assert_int_equal(mkdir(blocker, 0700), 0);
     assert_int_equal(rad_scene_write_obj(ctx, s, path), RAD_ERROR_IO);
     assert_int_equal(access(path, F_OK), -1);
@@ -538,23 +537,6 @@ static void test_power_balance_four_rooms(void **state)
 
 /* ---- the command ---- */
 
-static int run(const char *args, char *err, size_t err_size)
-{
-    char cmd[1024], err_path[300];
-    snprintf(err_path, sizeof err_path, "%s/stderr.txt", temp_dir);
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >/dev/null 2>stderr.txt </dev/null", temp_dir,
-             radiosity_bin, args);
-    int status = system(cmd);
-    err[0] = '\0';
-    FILE *f = fopen(err_path, "r");
-    if (f) {
-        size_t n = fread(err, 1, err_size - 1, f);
-        err[n] = '\0';
-        fclose(f);
-    }
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 static int lines(const char *text)
 {
     int n = 0;
@@ -566,11 +548,11 @@ static int lines(const char *text)
 static void test_cli_generate(void **state)
 {
     (void)state;
-    if (!radiosity_bin)
+    if (!cli_binary()) /* argv[1], or NULL: skipped */
         skip();
-    char err[4096], path[300];
-    assert_int_equal(run("generate office --rooms 3 --seed 11 -o cli.obj", err, sizeof err), 0);
-    snprintf(path, sizeof path, "%s/cli.obj", temp_dir);
+    char path[300];
+    assert_int_equal(cli_run_here("generate office --rooms 3 --seed 11 -o cli.obj"), 0);
+    snprintf(path, sizeof path, "%s/cli.obj", test_workdir());
     rad_scene *back = NULL;
     assert_int_equal(rad_scene_load_file(ctx, path, &back), RAD_OK);
     rad_scene *s = office(3, 11);
@@ -586,14 +568,14 @@ static void test_cli_generate(void **state)
                          "generate office --colour red -o bad.obj",
                          "generate"};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        assert_int_equal(run(bad[i], err, sizeof err), 2);
-        if (lines(err) != 1)
-            fail_msg("'%s': expected one line on stderr, got \"%s\"", bad[i], err);
+        assert_int_equal(cli_run_here("%s", bad[i]), 2);
+        if (lines(cli_stderr()) != 1)
+            fail_msg("'%s': expected one line on stderr, got \"%s\"", bad[i], cli_stderr());
     }
-    assert_int_equal(run("generate office -o /nonexistent-rad-dir/x.obj", err, sizeof err), 1);
-    assert_int_equal(lines(err), 1);
-    assert_non_null(strstr(err, "/nonexistent-rad-dir/x.obj"));
-    snprintf(path, sizeof path, "%s/bad.obj", temp_dir);
+    assert_int_equal(cli_run_here("generate office -o /nonexistent-rad-dir/x.obj"), 1);
+    assert_int_equal(lines(cli_stderr()), 1);
+    assert_non_null(strstr(cli_stderr(), "/nonexistent-rad-dir/x.obj"));
+    snprintf(path, sizeof path, "%s/bad.obj", test_workdir());
     assert_int_equal(access(path, F_OK), -1);
     assert_int_equal(count_temp_files(), 0);
 }
@@ -603,7 +585,7 @@ static void test_cli_generate(void **state)
 static int setup(void **state)
 {
     (void)state;
-    if (!mkdtemp(temp_dir))
+    if (test_workdir_make("generate") != 0)
         return -1;
     rad_context_options o = {0};
     return rad_context_create(&o, &ctx) == RAD_OK ? 0 : -1;
@@ -613,14 +595,12 @@ static int teardown(void **state)
 {
     (void)state;
     rad_context_destroy(ctx);
-    char cmd[300];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", temp_dir);
-    return system(cmd) == 0 ? 0 : -1;
+    return test_workdir_remove();
 }
 
 int main(int argc, char **argv)
 {
-    radiosity_bin = argc > 1 ? argv[1] : NULL;
+    cli_set_binary(argc > 1 ? argv[1] : NULL);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_seed_same_scene),
         cmocka_unit_test(test_different_seed_different_scene),

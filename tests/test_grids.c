@@ -33,6 +33,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "grid/grid.h"
 #include "radiosity.h"
 
@@ -801,20 +803,6 @@ static void test_progress_cancel(void **state)
 
 /* ---- outputs ---- */
 
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long size = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *text = malloc((size_t)size + 1);
-    assert_int_equal(fread(text, 1, (size_t)size, f), (size_t)size);
-    text[size] = '\0';
-    fclose(f);
-    return text;
-}
-
 static void test_outputs(void **state)
 {
     (void)state;
@@ -833,7 +821,7 @@ static void test_outputs(void **state)
     assert_int_equal(rad_illuminance_write(fx.ctx, il, "/tmp/E.txt"), RAD_ERROR_INVALID_ARGUMENT);
     /* CSV: a header and 16 + 1 rows; the grid's name quoted (it holds a
      * comma); E = E_direct + E_indirect on each row. */
-    char *text = slurp(csv);
+    char *text = test_read_file(csv, NULL);
     int lines = 0;
     for (char *c = text; *c; c++)
         lines += *c == '\n';
@@ -844,7 +832,7 @@ static void test_outputs(void **state)
     assert_non_null(strstr(text, "\npoints,0,P1,"));
     free(text);
     /* JSON: the statistics as the struct has them. */
-    text = slurp(json);
+    text = test_read_file(json, NULL);
     cJSON *root = cJSON_Parse(text);
     free(text);
     assert_non_null(root);
@@ -904,12 +892,12 @@ static void test_command(void **state)
     assert_int_equal(run_program(dir, "illuminance scene.obj --grid g.json -o E.csv -o E.json --mesh-size 0.5 "
                                       "--solver direct"), 0);
     snprintf(path, sizeof path, "%s/out.txt", dir);
-    char *text = slurp(path);
+    char *text = test_read_file(path, NULL);
     assert_non_null(strstr(text, "Eavg lux"));
     assert_non_null(strstr(text, "room                           45"));
     free(text);
     snprintf(path, sizeof path, "%s/E.json", dir);
-    text = slurp(path);
+    text = test_read_file(path, NULL);
     cJSON *root = cJSON_Parse(text);
     free(text);
     const cJSON *g0 = cJSON_GetArrayItem(cJSON_GetObjectItem(root, "grids"), 0);
@@ -929,7 +917,7 @@ static void test_command(void **state)
     char row[128];
     snprintf(row, sizeof row, "room                           45 %12.1f", eavg);
     snprintf(path, sizeof path, "%s/out.txt", dir);
-    text = slurp(path);
+    text = test_read_file(path, NULL);
     assert_non_null(strstr(text, row));
     free(text);
     cJSON_Delete(root);
@@ -941,7 +929,7 @@ static void test_command(void **state)
     /* A bad grid file: exit 1 before the work, the file and key named, no output. */
     assert_int_equal(run_program(dir, "illuminance scene.obj --grid bad.json -o E.csv"), 1);
     snprintf(path, sizeof path, "%s/out.txt", dir);
-    text = slurp(path);
+    text = test_read_file(path, NULL);
     assert_non_null(strstr(text, "bad.json: grids[0].spacing: must be a number of metres > 0"));
     free(text);
     snprintf(path, sizeof path, "%s/E.csv", dir);

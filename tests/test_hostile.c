@@ -31,6 +31,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "api/solution.h"
 #include "core/core.h"
 
@@ -42,48 +44,23 @@
 static rad_context *ctx;
 static char warning[1024]; /* the last warning the context gave (note_warning) */
 
-/* ---- OBJ text, built up in a growing buffer ---- */
-
-typedef struct text {
-    char *data;
-    size_t length, capacity;
-} text;
-
-static void put(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-
-static void put(text *t, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    assert_true(n >= 0);
-    if (t->length + (size_t)n + 1 > t->capacity) {
-        t->capacity = 2 * (t->length + (size_t)n + 1);
-        t->data = realloc(t->data, t->capacity);
-        assert_non_null(t->data);
-    }
-    va_start(ap, fmt);
-    vsnprintf(t->data + t->length, (size_t)n + 1, fmt, ap);
-    va_end(ap);
-    t->length += (size_t)n;
-}
+/* ---- OBJ text, built up in a growing buffer (test_text) ---- */
 
 /* A quad named `name` with corners a b c d (counter-clockwise seen from the
  * side it faces), scaled by `scale`. */
-static void quad(text *t, const char *name, const char *material, const double a[3],
+static void quad(test_text *t, const char *name, const char *material, const double a[3],
                  const double b[3], const double c[3], const double d[3], double scale)
 {
-    put(t, "o %s\nusemtl %s\n", name, material);
+    test_put(t, "o %s\nusemtl %s\n", name, material);
     const double *v[4] = {a, b, c, d};
     for (int k = 0; k < 4; k++)
-        put(t, "v %.17g %.17g %.17g\n", scale * v[k][0], scale * v[k][1], scale * v[k][2]);
-    put(t, "f -4 -3 -2 -1\n");
+        test_put(t, "v %.17g %.17g %.17g\n", scale * v[k][0], scale * v[k][1], scale * v[k][2]);
+    test_put(t, "f -4 -3 -2 -1\n");
 }
 
 /* A horizontal rectangle [x0, x1] x [z0, z1] at height y facing up (+1) or
  * down (-1). */
-static void flat(text *t, const char *name, const char *material, double x0, double x1, double z0,
+static void flat(test_text *t, const char *name, const char *material, double x0, double x1, double z0,
                  double z1, double y, int facing, double scale)
 {
     double a[3] = {x0, y, z0}, b[3] = {x1, y, z0}, c[3] = {x1, y, z1}, d[3] = {x0, y, z1};
@@ -96,7 +73,7 @@ static void flat(text *t, const char *name, const char *material, double x0, dou
 /* An axis-aligned box with its faces pointing inward (a room) or outward
  * (a solid), surfaces "<prefix>_floor", "_ceiling", "_x0", "_x1", "_z0",
  * "_z1"; the ceiling gets `ceiling_material`. */
-static void box(text *t, const char *prefix, const char *material, const char *ceiling_material,
+static void box(test_text *t, const char *prefix, const char *material, const char *ceiling_material,
                 const double lo[3], const double hi[3], int inward, double scale)
 {
     static const char *names[6] = {"floor", "ceiling", "x0", "x1", "z0", "z1"};
@@ -137,10 +114,10 @@ typedef struct solved {
     rad_solution *solution;
 } solved;
 
-static rad_result load(const text *t, rad_scene **scene)
+static rad_result load(const test_text *t, rad_scene **scene)
 {
-    text obj = {0};
-    put(&obj, "mtllib hostile.mtl\n%s", t->data);
+    test_text obj = {0};
+    test_put(&obj, "mtllib hostile.mtl\n%s", t->data);
     rad_result r = rad_scene_load_memory(ctx, "hostile.obj", obj.data, obj.length, materials,
                                          strlen(materials), scene);
     free(obj.data);
@@ -150,7 +127,7 @@ static rad_result load(const text *t, rad_scene **scene)
 /* Load, mesh (elements no longer than mesh_size x scale, or about
  * `elements` in all when mesh_size is 0), compute the form factors and
  * solve to 1e-12 by gauss-seidel.  Fails the test on any error. */
-static solved solve(const text *t, double mesh_size, size_t elements)
+static solved solve(const test_text *t, double mesh_size, size_t elements)
 {
     solved s = {NULL, NULL};
     if (load(t, &s.scene) != RAD_OK)
@@ -226,7 +203,7 @@ static double escaped_power(const solved *s, double row_tolerance)
 }
 
 /* The lamp used by most scenes: 0.5 m square at y = 1 facing down. */
-static void lamp(text *t, double scale) { flat(t, "lamp", "lamp", 0.25, 0.75, 0.25, 0.75, 1.0, -1, scale); }
+static void lamp(test_text *t, double scale) { flat(t, "lamp", "lamp", 0.25, 0.75, 0.25, 0.75, 1.0, -1, scale); }
 
 /* ---- the tests ---- */
 
@@ -237,7 +214,7 @@ static void lamp(text *t, double scale) { flat(t, "lamp", "lamp", 0.25, 0.75, 0.
 static void test_coplanar_overlapping(void **state)
 {
     (void)state;
-    text t = {0};
+    test_text t = {0};
     lamp(&t, 1.0);
     flat(&t, "floor_a", "white", 0, 1, 0, 1, 0, 1, 1.0);
     flat(&t, "floor_b", "white", 0, 1, 0, 1, 0, 1, 1.0);
@@ -245,7 +222,7 @@ static void test_coplanar_overlapping(void **state)
     solved all = solve(&t, 0.125, 0);
     assert_physical(&all);
 
-    text alone_a = {0}, alone_c = {0};
+    test_text alone_a = {0}, alone_c = {0};
     lamp(&alone_a, 1.0);
     flat(&alone_a, "floor_a", "white", 0, 1, 0, 1, 0, 1, 1.0);
     lamp(&alone_c, 1.0);
@@ -273,7 +250,7 @@ static void test_coplanar_overlapping(void **state)
 static void test_interpenetrating_solids(void **state)
 {
     (void)state;
-    text t = {0};
+    test_text t = {0};
     const double room_lo[3] = {0, 0, 0}, room_hi[3] = {2, 2, 2};
     const double a_lo[3] = {0.4, 0.1, 0.4}, a_hi[3] = {1.2, 0.8, 1.2};
     const double b_lo[3] = {0.9, 0.3, 0.9}, b_hi[3] = {1.6, 1.0, 1.6};
@@ -304,9 +281,9 @@ static void test_interpenetrating_solids(void **state)
 static void test_t_junctions(void **state)
 {
     (void)state;
-    text split = {0}, whole = {0};
+    test_text split = {0}, whole = {0};
     lamp(&split, 1.0);
-    put(&split, "g floor\nusemtl white\n"
+    test_put(&split, "g floor\nusemtl white\n"
                 "v 0 0 0\nv 0 0 1\nv 0.5 0 1\nv 0.5 0 0\nf -4 -3 -2 -1\n"
                 "v 0.5 0 0\nv 0.5 0 0.5\nv 1 0 0.5\nv 1 0 0\nf -4 -3 -2 -1\n"
                 "v 0.5 0 0.5\nv 0.5 0 1\nv 1 0 1\nv 1 0 0.5\nf -4 -3 -2 -1\n");
@@ -334,7 +311,7 @@ static void test_t_junctions(void **state)
 static void test_back_facing_emitter(void **state)
 {
     (void)state;
-    text t = {0};
+    test_text t = {0};
     flat(&t, "lamp", "lamp", 0.25, 0.75, 0.25, 0.75, 1.0, 1, 1.0);
     flat(&t, "floor", "white", 0, 1, 0, 1, 0, 1, 1.0);
     solved s = solve(&t, 0.25, 0);
@@ -357,9 +334,9 @@ static void test_back_facing_emitter(void **state)
 static void test_repeated_and_collinear_vertices(void **state)
 {
     (void)state;
-    text messy = {0}, clean = {0};
+    test_text messy = {0}, clean = {0};
     lamp(&messy, 1.0);
-    put(&messy, "o floor\nusemtl white\n"
+    test_put(&messy, "o floor\nusemtl white\n"
                 "v 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\nv 0.5 0 1\nv 1 0 0.25\n"
                 /* 0,0,0  0,0,1 (twice)  0.5,0,1 (mid-edge)  1,0,1  1,0,0.25 (mid-edge)  1,0,0  back to start */
                 "f -6 -5 -5 -2 -4 -1 -3 -6\n");
@@ -380,8 +357,8 @@ static void test_repeated_and_collinear_vertices(void **state)
         "hostile.obj:4: face needs 3 or more distinct vertices, has 1",
         "hostile.obj: polygon in surface 'stick' has zero area"};
     for (int k = 0; k < 2; k++) {
-        text t = {0};
-        put(&t, "%s", bad[k]);
+        test_text t = {0};
+        test_put(&t, "%s", bad[k]);
         rad_scene *scene = NULL;
         assert_int_equal(load(&t, &scene), RAD_ERROR_INVALID_SCENE);
         assert_null(scene);
@@ -402,7 +379,7 @@ static void test_thin_sliver(void **state)
     double B[2];
     const double width[2] = {1e-6, 1e-3};
     for (int k = 0; k < 2; k++) {
-        text t = {0};
+        test_text t = {0};
         lamp(&t, 1.0);
         flat(&t, "strip", "white", 0, 1, 0.5 - 0.5 * width[k], 0.5 + 0.5 * width[k], 0, 1, 1.0);
         solved s = solve(&t, 0.0625, 0);
@@ -437,7 +414,7 @@ static void test_thin_sliver(void **state)
 static void room_at_scale(double scale, bool blocker, double B[4])
 {
     static const char *const names[4] = {"room_floor", "room_x0", "room_z1", "room_ceiling"};
-    text t = {0};
+    test_text t = {0};
     const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
     box(&t, "room", "white", "glowing_white", lo, hi, 1, scale);
     if (blocker)
@@ -587,7 +564,7 @@ static void test_coordinate_limits(void **state)
         {1e-35, "is 1.41e-35 m across"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        text t = {0};
+        test_text t = {0};
         flat(&t, "floor", "white", 0, 1, 0, 1, 0, 1, cases[i].scale);
         rad_scene *scene = NULL;
         rad_result r = load(&t, &scene);
@@ -614,7 +591,7 @@ static void test_coordinate_limits(void **state)
 static void test_camera_distance(void **state)
 {
     (void)state;
-    text t = {0};
+    test_text t = {0};
     lamp(&t, 1.0);
     flat(&t, "floor", "white", 0, 1, 0, 1, 0, 1, 1.0);
     solved s = solve(&t, 0.25, 0);
@@ -661,7 +638,7 @@ static void test_camera_distance(void **state)
 static void test_scale_ratio(void **state)
 {
     (void)state;
-    text t = {0};
+    test_text t = {0};
     flat(&t, "floor", "white", -1000, 1000, -1000, 1000, 0, 1, 1.0);
     flat(&t, "lamp", "lamp", -0.0005, 0.0005, -0.0005, 0.0005, 3, -1, 1.0);
     rad_scene *scene = NULL;
@@ -715,7 +692,7 @@ static void test_scale_ratio(void **state)
  * stay exactly dark, whatever the mesh and the strategy.  Elements that
  * straddled the partition carried light through it (0.012 - 0.053 of the
  * lit side before patches were cut along contact lines). */
-static void partition_room(text *t)
+static void partition_room(test_text *t)
 {
     const double lo[3] = {0, 0, 0}, hi[3] = {6, 3, 4};
     box(t, "room", "white", NULL, lo, hi, 1, 1.0);
@@ -728,7 +705,7 @@ static void partition_room(text *t)
 
 static void assert_dark_side(const char *solver, size_t elements)
 {
-    text t = {0};
+    test_text t = {0};
     partition_room(&t);
     rad_scene *scene;
     if (load(&t, &scene) != RAD_OK)
@@ -807,7 +784,7 @@ static void test_two_separate_rooms(void **state)
     (void)state;
     const double a_lo[3] = {0, 0, 0}, a_hi[3] = {1, 1, 1};
     const double b_lo[3] = {3, 0, 0}, b_hi[3] = {4, 1.5, 1};
-    text both = {0}, only_a = {0}, only_b = {0};
+    test_text both = {0}, only_a = {0}, only_b = {0};
     box(&both, "a", "white", "glowing_white", a_lo, a_hi, 1, 1.0);
     box(&both, "b", "grey", "glowing_white", b_lo, b_hi, 1, 1.0);
     box(&only_a, "a", "white", "glowing_white", a_lo, a_hi, 1, 1.0);
@@ -839,7 +816,7 @@ static void test_two_separate_rooms(void **state)
 static void test_open_scene(void **state)
 {
     (void)state;
-    text t = {0};
+    test_text t = {0};
     flat(&t, "lamp", "glowing_white", 0.25, 0.75, 0.25, 0.75, 1.0, -1, 1.0);
     flat(&t, "floor", "white", 0, 1, 0, 1, 0, 1, 1.0);
     solved s = solve(&t, 0.125, 0);
@@ -864,16 +841,16 @@ static void test_million_tiny_triangles(void **state)
 {
     (void)state;
     enum { NX = 1000, NZ = 500 };
-    text t = {0};
+    test_text t = {0};
     lamp(&t, 1.0);
-    put(&t, "o floor\nusemtl white\n");
+    test_put(&t, "o floor\nusemtl white\n");
     for (int j = 0; j <= NZ; j++)
         for (int i = 0; i <= NX; i++)
-            put(&t, "v %g 0 %g\n", i * 0.001, j * 0.001);
+            test_put(&t, "v %g 0 %g\n", i * 0.001, j * 0.001);
     for (int j = 0; j < NZ; j++)
         for (int i = 0; i < NX; i++) {
             int a = 5 + j * (NX + 1) + i, b = a + 1, c = a + NX + 1, d = c + 1;
-            put(&t, "f %d %d %d\nf %d %d %d\n", a, c, d, a, d, b);
+            test_put(&t, "f %d %d %d\nf %d %d %d\n", a, c, d, a, d, b);
         }
     double t0 = rad_seconds();
     rad_scene *scene = NULL;

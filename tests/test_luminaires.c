@@ -43,14 +43,6 @@
 static const double DEG = M_PI / 180.0;
 #define K 179.0 /* RAD_LUMINOUS_EFFICACY */
 
-static rad_context *new_context(int threads)
-{
-    rad_context_options o = {.threads = threads};
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
-    return ctx;
-}
-
 /* ---- distributions by name ---- */
 
 /* I0 cos^k(gamma) below the horizontal, 0 above; every degree. */
@@ -192,7 +184,7 @@ static void assert_close(double got, double want, double rel, const char *what)
  * compared with I(gamma) cos(alpha) / d^2. */
 static void check_planes(const char *file, double i0, double k)
 {
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = box(ctx, 1.0, 0.5); /* any scene: the luminaires are what is tested */
     char json[256];
     snprintf(json, sizeof json, "{\"luminaires\": [{\"file\": \"%s\", \"position\": [0.3, -0.2, 3]}]}", file);
@@ -255,7 +247,7 @@ static void point_cos_power_planes(void **state)
 static void point_shadow(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = floor_and_plate(ctx);
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"iso.ies\", \"position\": [0.5, 0.5, 3]}]}"),
                      RAD_OK);
@@ -316,7 +308,7 @@ static double rectangle_factor(double x1, double x2, double y1, double y2, doubl
 static void area_lambertian_rectangle(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = box(ctx, 1.0, 0.5);
     /* spin 30: the opening's length along (cos 30, sin 30, 0) */
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"lambert.ies\", \"position\": [0, 0, 2], "
@@ -356,7 +348,7 @@ static void area_lambertian_rectangle(void **state)
 static void area_lambertian_disk(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = box(ctx, 1.0, 0.5);
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"disk.ies\", \"position\": [0, 0, 2]}]}"),
                      RAD_OK);
@@ -375,7 +367,7 @@ static void area_lambertian_disk(void **state)
 static void flux_closed_black_box(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(2);
+    rad_context *ctx = test_context(2);
     rad_scene *scene = box(ctx, 2.0, 0.0);
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"cos3.ies\", \"position\": [1, 1, 1.9], "
                                         "\"multiplier\": 2.5, \"aim\": [0.2, 0.1, -1]},"
@@ -410,7 +402,7 @@ static void flux_closed_black_box(void **state)
 static void solve_energy_balance(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(2);
+    rad_context *ctx = test_context(2);
     rad_scene *scene = box(ctx, 2.0, 0.6);
     assert_false(rad_scene_has_emitter(scene));
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"cos3.ies\", \"position\": [1, 1, 1.8]}]}"),
@@ -493,7 +485,7 @@ static void direct_thread_determinism(void **state)
     double *first = NULL;
     size_t n0 = 0;
     for (int threads = 1; threads <= 3; threads++) {
-        rad_context *ctx = new_context(threads);
+        rad_context *ctx = test_context(threads);
         rad_scene *scene = floor_and_plate(ctx);
         assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"lambert.ies\", \"position\": [0.4, 0.6, "
                                             "1.3]}, {\"file\": \"cos3.ies\", \"position\": [-2, 1, 2.5]}]}"),
@@ -533,7 +525,7 @@ static double lobe_lux(const rad_scene *scene, size_t k, vec3 d)
 static void layout_placement(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = box(ctx, 1.0, 0.5);
     assert_int_equal(layout(ctx, scene,
                             "{\"luminaires\": ["
@@ -661,7 +653,7 @@ static void layout_errors(void **state)
         {"{\"luminaires\": [{\"file\": \"iso.ies\", \"position\": [0, 0, 1], \"file\": \"iso.ies\"}]}",
          "mem/layout.json: luminaires[0].file: given twice"},
     };
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = box(ctx, 1.0, 0.5);
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"iso.ies\", \"position\": [0, 0, 0.5], "
                                         "\"name\": \"kept\"}]}"),
@@ -693,7 +685,7 @@ static void layout_errors(void **state)
 static void layout_and_gltf_files(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(2);
+    rad_context *ctx = test_context(2);
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_file(ctx, RAD_TEST_DATA "/luminaires/room.obj", &scene), RAD_OK);
     assert_int_equal(rad_scene_load_luminaires(ctx, scene, RAD_TEST_DATA "/luminaires/layout.json"), RAD_OK);
@@ -754,7 +746,7 @@ static void layout_and_gltf_files(void **state)
 static void public_null_arguments(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = box(ctx, 1.0, 0.5);
     assert_int_equal(rad_scene_load_luminaires(ctx, NULL, "x.json"), RAD_ERROR_INVALID_ARGUMENT);
     assert_non_null(strstr(rad_context_error(ctx), "rad_scene_load_luminaires"));
@@ -787,7 +779,7 @@ static void public_null_arguments(void **state)
 static void cie171_point_source(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     const char *obj = "mtllib m.mtl\nusemtl black\n"
                       "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nv 0 0 3\nv 4 0 3\nv 4 4 3\nv 0 4 3\n"
                       "o floor\nf 1 2 3 4\no ceiling\nf 5 8 7 6\no west\nf 1 4 8 5\no east\nf 2 6 7 3\n"
@@ -832,7 +824,7 @@ static void cie171_point_source(void **state)
 static void cie171_area_source(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = box(ctx, 1.0, 0.5);
     assert_int_equal(layout(ctx, scene, "{\"luminaires\": [{\"file\": \"lambert.ies\", \"position\": [0, 0, 4]}]}"),
                      RAD_OK);
@@ -856,10 +848,10 @@ static void command_luminaires(void **state)
     (void)state;
     assert_int_equal(cli_setup("luminaires"), 0);
     char png[600], stats[600], errors[600], bad[600];
-    snprintf(png, sizeof png, "%s/room.png", cli_workdir());
-    snprintf(stats, sizeof stats, "%s/room.json", cli_workdir());
-    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
-    snprintf(bad, sizeof bad, "%s/bad.json", cli_workdir());
+    snprintf(png, sizeof png, "%s/room.png", test_workdir());
+    snprintf(stats, sizeof stats, "%s/room.json", test_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", test_workdir());
+    snprintf(bad, sizeof bad, "%s/bad.json", test_workdir());
     /* The room lit by its layout only: the stats count the luminaires and
      * the light they land; emitted = absorbed in the closed room. */
     assert_int_equal(cli_run("render %s/luminaires/room.obj --luminaires %s/luminaires/layout.json --elements 300 "
@@ -885,7 +877,7 @@ static void command_luminaires(void **state)
     assert_int_equal(cli_run_capture(errors, "render %s/luminaires/room.obj --luminaires %s -o %s", RAD_TEST_DATA,
                                      bad, png),
                      1);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     assert_non_null(strstr(text, "bad.json: luminaires[0].position: must be 3 finite numbers"));
     free(text);
@@ -894,19 +886,19 @@ static void command_luminaires(void **state)
      * with them; --luminaires again with the file is a usage error. */
     assert_int_equal(cli_run("solve %s/luminaires/room.obj --luminaires %s/luminaires/layout.json --elements 300 "
                              "-o %s/room.radsol",
-                             RAD_TEST_DATA, RAD_TEST_DATA, cli_workdir()),
+                             RAD_TEST_DATA, RAD_TEST_DATA, test_workdir()),
                      0);
-    assert_int_equal(cli_run("render %s/room.radsol -o %s --stats %s", cli_workdir(), png, stats), 0);
+    assert_int_equal(cli_run("render %s/room.radsol -o %s --stats %s", test_workdir(), png, stats), 0);
     json = cli_read_json(stats);
     assert_non_null(json);
     assert_true(cli_stats_number(json, "luminaires", "count") == 5.0);
     cli_assert_relative(cli_stats_number(json, "luminaires", "direct_lumens"), lumens, 1e-3, "loaded direct lumens");
     cJSON_Delete(json);
     assert_int_equal(cli_run_capture(errors, "render %s/room.radsol --luminaires %s/luminaires/layout.json -o %s",
-                                     cli_workdir(), RAD_TEST_DATA, png),
+                                     test_workdir(), RAD_TEST_DATA, png),
                      2);
     assert_int_equal(cli_run("solve %s/luminaires/lamp.gltf --elements 100 -o %s/lamp.radsol", RAD_TEST_DATA,
-                             cli_workdir()),
+                             test_workdir()),
                      0);
     assert_int_equal(cli_teardown(), 0);
 }

@@ -29,6 +29,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "cli_support.h"
 #include "core/core.h"
 
 #include <cjson/cJSON.h>
@@ -47,10 +48,6 @@
 #include <time.h>
 #include <unistd.h>
 
-static const char *radiosity_bin;
-static char workdir[256];
-static char err_text[8192], out_text[65536];
-
 /* The longest any watched run may take before the test gives up on it. */
 enum { WATCH_SECONDS = 300 };
 
@@ -63,46 +60,12 @@ static void pause_ms(long ms)
 
 /* ---- files in the work folder ---- */
 
-static const char *in_work(const char *name)
-{
-    static char paths[4][1024];
-    static int next;
-    char *p = paths[next++ % 4];
-    snprintf(p, sizeof paths[0], "%s/%s", workdir, name);
-    return p;
-}
-
-static void write_file(const char *name, const char *text)
-{
-    FILE *f = fopen(in_work(name), "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static void slurp(const char *path, char *buf, size_t size)
-{
-    buf[0] = '\0';
-    FILE *f = fopen(path, "r");
-    if (!f)
-        return;
-    size_t n = fread(buf, 1, size - 1, f);
-    buf[n] = '\0';
-    fclose(f);
-}
-
 /* The whole of a work file (static buffer), "" when missing. */
 static const char *text_of(const char *name)
 {
     static char text[65536];
-    slurp(in_work(name), text, sizeof text);
+    test_read_into(test_path(name), text, sizeof text);
     return text;
-}
-
-static bool exists(const char *name)
-{
-    struct stat st;
-    return lstat(in_work(name), &st) == 0;
 }
 
 /* No temporary of ours in a folder: no hidden file, no "*.tmp.*". */
@@ -118,42 +81,6 @@ static void assert_no_temporaries(const char *folder)
     closedir(d);
 }
 
-/* Run `radiosity ARGS` in the work folder; stdout and stderr captured. */
-static int run(const char *fmt, ...)
-{
-    char args[4096], cmd[8192];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args, sizeof args, fmt, ap);
-    va_end(ap);
-    snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >stdout.txt 2>stderr.txt </dev/null", workdir,
-             radiosity_bin, args);
-    int status = system(cmd);
-    slurp(in_work("stderr.txt"), err_text, sizeof err_text);
-    slurp(in_work("stdout.txt"), out_text, sizeof out_text);
-    unlink(in_work("stderr.txt"));
-    unlink(in_work("stdout.txt"));
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-static void assert_one_line_error(const char *needle1, const char *needle2)
-{
-    size_t len = strlen(err_text);
-    if (len == 0 || err_text[len - 1] != '\n' || strchr(err_text, '\n') != err_text + len - 1)
-        fail_msg("expected exactly one line on stderr, got: <%s>", err_text);
-    if (needle1 && !strstr(err_text, needle1))
-        fail_msg("stderr lacks '%s': %s", needle1, err_text);
-    if (needle2 && !strstr(err_text, needle2))
-        fail_msg("stderr lacks '%s': %s", needle2, err_text);
-}
-
-static const char *good_mtl = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
-static const char *good_obj = "mtllib good.mtl\n"
-                              "o floor\nusemtl white\n"
-                              "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n"
-                              "o lamp\nusemtl lamp\n"
-                              "v 0 1 0\nv 1 1 0\nv 1 1 1\nv 0 1 1\nf 5 6 7 8\n";
-
 /* A quad lamp over a quad floor as glTF whose geometry is the external
  * buffer quad.bin (the loader reads it). */
 /* A glTF `name` (in the work folder) whose buffer is at `uri`; the buffer
@@ -163,7 +90,7 @@ static void write_gltf_referring(const char *name, const char *uri)
     float positions[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1},
                              {0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}};
     uint16_t indices[12] = {0, 3, 2, 0, 2, 1, 4, 7, 6, 4, 6, 5};
-    FILE *f = fopen(in_work("quad.bin"), "wb");
+    FILE *f = fopen(test_path("quad.bin"), "wb");
     assert_non_null(f);
     fwrite(positions, sizeof positions, 1, f);
     fwrite(indices, sizeof indices, 1, f);
@@ -186,7 +113,7 @@ static void write_gltf_referring(const char *name, const char *uri)
                "{\"bufferView\": 1, \"byteOffset\": 0, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
                "{\"bufferView\": 1, \"byteOffset\": 12, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}",
              uri);
-    write_file(name, text);
+    test_write_file(name, text);
 }
 
 static void write_gltf_with_buffer(void) { write_gltf_referring("quad.gltf", "quad.bin"); }
@@ -206,8 +133,8 @@ static void test_temporary_names(void **state)
     umask(mask);
     char *a, *b;
     int fa, fb;
-    assert_int_equal(rad_temp_create(NULL, workdir, name, ".png", "t", &a, &fa), RAD_OK);
-    assert_int_equal(rad_temp_create(NULL, workdir, name, ".png", "t", &b, &fb), RAD_OK);
+    assert_int_equal(rad_temp_create(NULL, test_workdir(), name, ".png", "t", &a, &fa), RAD_OK);
+    assert_int_equal(rad_temp_create(NULL, test_workdir(), name, ".png", "t", &b, &fb), RAD_OK);
     assert_string_not_equal(a, b);
     struct stat st;
     assert_int_equal(lstat(a, &st), 0);
@@ -229,9 +156,9 @@ static void test_output_targets(void **state)
     (void)state;
     rad_output_target t;
     /* A link to a regular file resolves to the file. */
-    write_file("real.json", "old");
-    assert_int_equal(symlink("real.json", in_work("link.json")), 0);
-    assert_int_equal(rad_output_target_resolve(NULL, in_work("link.json"), &t), RAD_OK);
+    test_write_file("real.json", "old");
+    assert_int_equal(symlink("real.json", test_path("link.json")), 0);
+    assert_int_equal(rad_output_target_resolve(NULL, test_path("link.json"), &t), RAD_OK);
     assert_false(t.stream);
     assert_string_equal(t.name, "real.json");
     rad_output_target_free(&t);
@@ -240,14 +167,14 @@ static void test_output_targets(void **state)
     assert_true(t.stream);
     rad_output_target_free(&t);
     /* Refused: a dangling link, a folder, a missing folder. */
-    assert_int_equal(symlink("nowhere.json", in_work("dangling.json")), 0);
-    assert_int_equal(rad_output_target_resolve(NULL, in_work("dangling.json"), &t), RAD_ERROR_IO);
-    assert_int_equal(rad_output_target_resolve(NULL, workdir, &t), RAD_ERROR_IO);
-    assert_int_equal(rad_output_target_resolve(NULL, in_work("no/such.json"), &t), RAD_ERROR_IO);
+    assert_int_equal(symlink("nowhere.json", test_path("dangling.json")), 0);
+    assert_int_equal(rad_output_target_resolve(NULL, test_path("dangling.json"), &t), RAD_ERROR_IO);
+    assert_int_equal(rad_output_target_resolve(NULL, test_workdir(), &t), RAD_ERROR_IO);
+    assert_int_equal(rad_output_target_resolve(NULL, test_path("no/such.json"), &t), RAD_ERROR_IO);
     assert_null(t.path);
-    unlink(in_work("link.json"));
-    unlink(in_work("dangling.json"));
-    unlink(in_work("real.json"));
+    unlink(test_path("link.json"));
+    unlink(test_path("dangling.json"));
+    unlink(test_path("real.json"));
 }
 
 /* Write `text` to an output set's temporary as a writer would. */
@@ -264,15 +191,15 @@ static void test_output_set_all_or_none(void **state)
     (void)state;
     rad_context *ctx;
     assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
-    write_file("a.json", "old a");
-    write_file("b.json", "old b");
+    test_write_file("a.json", "old a");
+    test_write_file("b.json", "old b");
 
     /* Committed: both replaced, nothing else left. */
     rad_output_set *set;
     const char *ta, *tb;
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("b.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("b.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
     fill(ta, "new a");
     fill(tb, "new b");
     assert_string_equal(text_of("a.json"), "old a"); /* nothing visible before the commit */
@@ -280,31 +207,31 @@ static void test_output_set_all_or_none(void **state)
     rad_output_set_destroy(set);
     assert_string_equal(text_of("a.json"), "new a");
     assert_string_equal(text_of("b.json"), "new b");
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 
     /* Abandoned (a failure before the commit): the old files, no temporary. */
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
     fill(ta, "lost");
     rad_output_set_destroy(set);
     assert_string_equal(text_of("a.json"), "new a");
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 
     /* Dropped: that file stays, the others are replaced. */
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("b.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("b.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
     fill(tb, "b3");
-    rad_output_set_drop(set, in_work("a.json"));
+    rad_output_set_drop(set, test_path("a.json"));
     assert_int_equal(rad_output_set_commit(ctx, set), RAD_OK);
     rad_output_set_destroy(set);
     assert_string_equal(text_of("a.json"), "new a");
     assert_string_equal(text_of("b.json"), "b3");
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 
     /* A stream that fails at the commit (/dev/full) changes no file. */
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
     const char *tf;
     assert_int_equal(rad_output_set_add(ctx, set, "/dev/full", RAD_OUTPUT_FILE, &tf), RAD_OK);
     fill(ta, "a4");
@@ -313,24 +240,24 @@ static void test_output_set_all_or_none(void **state)
     assert_non_null(strstr(rad_context_error(ctx), "/dev/full"));
     rad_output_set_destroy(set);
     assert_string_equal(text_of("a.json"), "new a");
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 
     /* A rename that fails half-way (its target became a folder) puts back
      * the file already replaced. */
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("c.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("a.json"), RAD_OUTPUT_FILE, &ta), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("c.json"), RAD_OUTPUT_FILE, &tb), RAD_OK);
     fill(ta, "a5");
     fill(tb, "c5");
-    assert_int_equal(mkdir(in_work("c.json"), 0777), 0);
+    assert_int_equal(mkdir(test_path("c.json"), 0777), 0);
     assert_int_equal(rad_output_set_commit(ctx, set), RAD_ERROR_IO);
     rad_output_set_destroy(set);
     assert_string_equal(text_of("a.json"), "new a");
-    assert_int_equal(rmdir(in_work("c.json")), 0);
-    assert_no_temporaries(workdir);
+    assert_int_equal(rmdir(test_path("c.json")), 0);
+    assert_no_temporaries(test_workdir());
 
-    unlink(in_work("a.json"));
-    unlink(in_work("b.json"));
+    unlink(test_path("a.json"));
+    unlink(test_path("b.json"));
     rad_context_destroy(ctx);
 }
 
@@ -339,43 +266,43 @@ static void test_output_set_aliasing(void **state)
     (void)state;
     rad_context *ctx;
     assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
-    write_file("in.obj", "o x\n");
-    assert_int_equal(link(in_work("in.obj"), in_work("hard.json")), 0);
+    test_write_file("in.obj", "o x\n");
+    assert_int_equal(link(test_path("in.obj"), test_path("hard.json")), 0);
     char dotted[1024];
-    snprintf(dotted, sizeof dotted, "%s/./new.png", workdir);
+    snprintf(dotted, sizeof dotted, "%s/./new.png", test_workdir());
 
     rad_output_set *set;
     const char *t;
     assert_int_equal(rad_output_set_create(ctx, &set), RAD_OK);
-    assert_int_equal(rad_output_set_add_input(ctx, set, in_work("in.obj")), RAD_OK);
+    assert_int_equal(rad_output_set_add_input(ctx, set, test_path("in.obj")), RAD_OK);
     /* The input by a hard link. */
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("hard.json"), RAD_OUTPUT_FILE, &t),
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("hard.json"), RAD_OUTPUT_FILE, &t),
                      RAD_ERROR_INVALID_ARGUMENT);
     assert_null(t);
     assert_non_null(strstr(rad_context_error(ctx), "hard.json"));
     assert_non_null(strstr(rad_context_error(ctx), "in.obj"));
     /* A file not there yet, by two spellings. */
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("new.png"), RAD_OUTPUT_IMAGE, &t), RAD_OK);
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("new.png"), RAD_OUTPUT_IMAGE, &t), RAD_OK);
     assert_int_equal(rad_output_set_add(ctx, set, dotted, RAD_OUTPUT_FILE, &t),
                      RAD_ERROR_INVALID_ARGUMENT);
     /* An input named after the output: refused as well. */
-    write_file("late.mtl", "");
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("late.mtl"), RAD_OUTPUT_FILE, &t), RAD_OK);
-    assert_int_equal(rad_output_set_add_input(ctx, set, in_work("late.mtl")),
+    test_write_file("late.mtl", "");
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("late.mtl"), RAD_OUTPUT_FILE, &t), RAD_OK);
+    assert_int_equal(rad_output_set_add_input(ctx, set, test_path("late.mtl")),
                      RAD_ERROR_INVALID_ARGUMENT);
     /* /dev/null twice is harmless; formats are checked. */
     assert_int_equal(rad_output_set_add(ctx, set, "/dev/null", RAD_OUTPUT_FILE, &t), RAD_OK);
     assert_int_equal(rad_output_set_add(ctx, set, "/dev/null", RAD_OUTPUT_FILE, &t), RAD_OK);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("x.xyz"), RAD_OUTPUT_IMAGE, &t),
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("x.xyz"), RAD_OUTPUT_IMAGE, &t),
                      RAD_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(rad_output_set_add(ctx, set, in_work("x.png"), RAD_OUTPUT_VIEW_FACTORS, &t),
+    assert_int_equal(rad_output_set_add(ctx, set, test_path("x.png"), RAD_OUTPUT_VIEW_FACTORS, &t),
                      RAD_ERROR_INVALID_ARGUMENT);
     rad_output_set_destroy(set);
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
     assert_string_equal(text_of("late.mtl"), "");
-    unlink(in_work("in.obj"));
-    unlink(in_work("hard.json"));
-    unlink(in_work("late.mtl"));
+    unlink(test_path("in.obj"));
+    unlink(test_path("hard.json"));
+    unlink(test_path("late.mtl"));
     rad_context_destroy(ctx);
 }
 
@@ -384,18 +311,18 @@ static void test_scene_inputs(void **state)
     (void)state;
     rad_context *ctx;
     assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
-    write_file("good.obj", good_obj);
-    write_file("good.mtl", good_mtl);
+    test_write_file("good.obj", cli_good_obj);
+    test_write_file("good.mtl", cli_good_mtl);
     rad_scene *scene;
-    assert_int_equal(rad_scene_load_file(ctx, in_work("good.obj"), &scene), RAD_OK);
+    assert_int_equal(rad_scene_load_file(ctx, test_path("good.obj"), &scene), RAD_OK);
     assert_int_equal(rad_scene_input_count(scene), 2);
-    assert_string_equal(rad_scene_input_path(scene, 0), in_work("good.obj"));
+    assert_string_equal(rad_scene_input_path(scene, 0), test_path("good.obj"));
     assert_non_null(strstr(rad_scene_input_path(scene, 1), "good.mtl"));
     assert_null(rad_scene_input_path(scene, 2));
     rad_scene_destroy(scene);
 
     write_gltf_with_buffer();
-    assert_int_equal(rad_scene_load_file(ctx, in_work("quad.gltf"), &scene), RAD_OK);
+    assert_int_equal(rad_scene_load_file(ctx, test_path("quad.gltf"), &scene), RAD_OK);
     bool buffer = false;
     for (size_t i = 0; i < rad_scene_input_count(scene); i++)
         buffer |= strstr(rad_scene_input_path(scene, i), "quad.bin") != NULL;
@@ -419,16 +346,16 @@ static void test_scene_references_confined(void **state)
     (void)state;
     rad_context *ctx;
     assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
-    assert_int_equal(mkdir(in_work("scene"), 0777), 0);
+    assert_int_equal(mkdir(test_path("scene"), 0777), 0);
     write_gltf_with_buffer(); /* work/quad.bin, outside work/scene */
     char absolute[600], uri_line[700];
-    snprintf(absolute, sizeof absolute, "%s", in_work("quad.bin"));
-    assert_int_equal(symlink("../quad.bin", in_work("scene/link.bin")), 0);
+    snprintf(absolute, sizeof absolute, "%s", test_path("quad.bin"));
+    assert_int_equal(symlink("../quad.bin", test_path("scene/link.bin")), 0);
     const char *uris[] = {"../quad.bin", absolute, "link.bin", "./../scene/../quad.bin"};
     for (size_t k = 0; k < sizeof uris / sizeof uris[0]; k++) {
         write_gltf_referring("scene/out.gltf", uris[k]);
         rad_scene *scene = (rad_scene *)(void *)ctx; /* must come back NULL */
-        rad_result r = rad_scene_load_file(ctx, in_work("scene/out.gltf"), &scene);
+        rad_result r = rad_scene_load_file(ctx, test_path("scene/out.gltf"), &scene);
         assert_null(scene);
         if (uris[k] == absolute) {
             /* assimp 5.2 joins even an absolute URI to the folder: nothing
@@ -443,32 +370,32 @@ static void test_scene_references_confined(void **state)
             fail_msg("uri %s: %s: '%s'", uris[k], rad_result_string(r), rad_context_error(ctx));
     }
     /* Inside, also through a link that stays inside: loads. */
-    assert_int_equal(symlink("../quad.bin", in_work("scene/ignored")), 0);
-    write_file("scene/copy.bin", "");
+    assert_int_equal(symlink("../quad.bin", test_path("scene/ignored")), 0);
+    test_write_file("scene/copy.bin", "");
     {
-        FILE *from = fopen(in_work("quad.bin"), "rb"), *to = fopen(in_work("scene/copy.bin"), "wb");
+        FILE *from = fopen(test_path("quad.bin"), "rb"), *to = fopen(test_path("scene/copy.bin"), "wb");
         char bytes[256];
         size_t n = fread(bytes, 1, sizeof bytes, from);
         fwrite(bytes, 1, n, to);
         fclose(from);
         fclose(to);
     }
-    assert_int_equal(symlink("copy.bin", in_work("scene/inner.bin")), 0);
+    assert_int_equal(symlink("copy.bin", test_path("scene/inner.bin")), 0);
     write_gltf_referring("scene/in.gltf", "inner.bin");
     rad_scene *scene = NULL;
-    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/in.gltf"), &scene), RAD_OK);
+    assert_int_equal(rad_scene_load_file(ctx, test_path("scene/in.gltf"), &scene), RAD_OK);
     rad_scene_destroy(scene);
 
     /* An OBJ's material library: relative and absolute, refused. */
-    write_file("good.mtl", good_mtl);
+    test_write_file("good.mtl", cli_good_mtl);
     char obj[8192];
-    snprintf(obj, sizeof obj, "mtllib ../good.mtl\n%s", strstr(good_obj, "\n") + 1);
-    write_file("scene/up.obj", obj);
-    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/up.obj"), &scene), RAD_ERROR_IO);
+    snprintf(obj, sizeof obj, "mtllib ../good.mtl\n%s", strstr(cli_good_obj, "\n") + 1);
+    test_write_file("scene/up.obj", obj);
+    assert_int_equal(rad_scene_load_file(ctx, test_path("scene/up.obj"), &scene), RAD_ERROR_IO);
     assert_non_null(strstr(rad_context_error(ctx), "/../good.mtl'"));
-    snprintf(obj, sizeof obj, "mtllib %s\n%s", in_work("good.mtl"), strstr(good_obj, "\n") + 1);
-    write_file("scene/abs.obj", obj);
-    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/abs.obj"), &scene), RAD_ERROR_IO);
+    snprintf(obj, sizeof obj, "mtllib %s\n%s", test_path("good.mtl"), strstr(cli_good_obj, "\n") + 1);
+    test_write_file("scene/abs.obj", obj);
+    assert_int_equal(rad_scene_load_file(ctx, test_path("scene/abs.obj"), &scene), RAD_ERROR_IO);
     assert_non_null(strstr(rad_context_error(ctx), "outside the scene's folder"));
     rad_context_destroy(ctx);
 
@@ -477,25 +404,25 @@ static void test_scene_references_confined(void **state)
     co.read_outside_scene_folder = true;
     assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
     write_gltf_referring("scene/out.gltf", "../quad.bin");
-    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/out.gltf"), &scene), RAD_OK);
+    assert_int_equal(rad_scene_load_file(ctx, test_path("scene/out.gltf"), &scene), RAD_OK);
     rad_scene_destroy(scene);
-    assert_int_equal(rad_scene_load_file(ctx, in_work("scene/up.obj"), &scene), RAD_OK);
+    assert_int_equal(rad_scene_load_file(ctx, test_path("scene/up.obj"), &scene), RAD_OK);
     rad_scene_destroy(scene);
     rad_context_destroy(ctx);
 
     /* The program: one line naming the reference, exit 1, no output;
      * --read-outside-scene-folder lets it through. */
-    int status = run("render scene/out.gltf --elements 50 --width 16 --height 16 --quiet -o out.png");
+    int status = cli_run_here("render scene/out.gltf --elements 50 --width 16 --height 16 --quiet -o out.png");
     if (status != 1)
         fail_msg("status %d: %s", status, text_of("stderr.txt"));
-    assert_one_line_error("/../quad.bin'", "outside the scene's folder");
+    cli_assert_one_line_error("/../quad.bin'", "outside the scene's folder");
     /* The message names the flag, not the library's field. */
-    assert_non_null(strstr(err_text, "(--read-outside-scene-folder allows it)"));
-    assert_false(exists("out.png"));
-    assert_int_equal(run("render scene/out.gltf --read-outside-scene-folder --elements 50 --width 16 "
+    assert_non_null(strstr(cli_stderr(), "(--read-outside-scene-folder allows it)"));
+    assert_false(test_file_exists(test_path("out.png")));
+    assert_int_equal(cli_run_here("render scene/out.gltf --read-outside-scene-folder --elements 50 --width 16 "
                          "--height 16 --quiet -o out.png"),
                      0);
-    assert_true(exists("out.png"));
+    assert_true(test_file_exists(test_path("out.png")));
 }
 
 /* ======================================================================
@@ -509,7 +436,7 @@ static void test_scene_references_confined(void **state)
 static void test_link_at_old_temporary_name(void **state)
 {
     (void)state;
-    write_file("victim.txt", "precious");
+    test_write_file("victim.txt", "precious");
     int go[2];
     assert_int_equal(pipe(go), 0);
     pid_t pid = fork();
@@ -517,12 +444,12 @@ static void test_link_at_old_temporary_name(void **state)
     if (pid == 0) {
         char byte;
         close(go[1]);
-        if (read(go[0], &byte, 1) != 1 || chdir(workdir) != 0)
+        if (read(go[0], &byte, 1) != 1 || chdir(test_workdir()) != 0)
             _exit(127);
         int null = open("/dev/null", O_WRONLY);
         dup2(null, 1);
         dup2(null, 2);
-        execl(radiosity_bin, radiosity_bin, "render", "--elements", "50", "--width", "16",
+        execl(cli_binary(), cli_binary(), "render", "--elements", "50", "--width", "16",
               "--height", "16", "--quiet", "-o", "planted.png", "--stats", "planted.json",
               (char *)NULL);
         _exit(127);
@@ -530,9 +457,9 @@ static void test_link_at_old_temporary_name(void **state)
     close(go[0]);
     char link_name[64];
     snprintf(link_name, sizeof link_name, "planted.png.tmp.%ld", (long)pid);
-    assert_int_equal(symlink(in_work("victim.txt"), in_work(link_name)), 0);
+    assert_int_equal(symlink(test_path("victim.txt"), test_path(link_name)), 0);
     snprintf(link_name, sizeof link_name, "planted.json.tmp.%ld", (long)pid);
-    assert_int_equal(symlink(in_work("victim.txt"), in_work(link_name)), 0);
+    assert_int_equal(symlink(test_path("victim.txt"), test_path(link_name)), 0);
     assert_int_equal(write(go[1], "x", 1), 1);
     close(go[1]);
     int status;
@@ -546,25 +473,25 @@ static void test_links_and_folders(void **state)
 {
     (void)state;
     /* A link to a regular file: the file is replaced, the link stays. */
-    write_file("target.json", "old");
-    assert_int_equal(symlink("target.json", in_work("via_link.json")), 0);
-    assert_int_equal(run("render " QUICK " -o l.png --stats via_link.json"), 0);
+    test_write_file("target.json", "old");
+    assert_int_equal(symlink("target.json", test_path("via_link.json")), 0);
+    assert_int_equal(cli_run_here("render " QUICK " -o l.png --stats via_link.json"), 0);
     struct stat st;
-    assert_int_equal(lstat(in_work("via_link.json"), &st), 0);
+    assert_int_equal(lstat(test_path("via_link.json"), &st), 0);
     assert_true(S_ISLNK(st.st_mode));
     assert_non_null(strstr(text_of("target.json"), "\"version\""));
     /* A dangling link: refused before any work, nothing created. */
-    assert_int_equal(symlink("ghost.json", in_work("dangling.json")), 0);
-    assert_int_equal(run("render " QUICK " -o l.png --stats dangling.json"), 1);
-    assert_one_line_error("dangling.json", "dangling symbolic link");
-    assert_false(exists("ghost.json"));
+    assert_int_equal(symlink("ghost.json", test_path("dangling.json")), 0);
+    assert_int_equal(cli_run_here("render " QUICK " -o l.png --stats dangling.json"), 1);
+    cli_assert_one_line_error("dangling.json", "dangling symbolic link");
+    assert_false(test_file_exists(test_path("ghost.json")));
     /* A folder as the output, a missing folder. */
-    assert_int_equal(mkdir(in_work("folder.png"), 0777), 0);
-    assert_int_equal(run("render " QUICK " -o folder.png"), 1);
-    assert_one_line_error("folder.png", "is a directory");
-    assert_int_equal(run("render " QUICK " -o l.png --history missing/h.csv"), 1);
-    assert_one_line_error("missing/h.csv", "No such file or directory");
-    assert_no_temporaries(workdir);
+    assert_int_equal(mkdir(test_path("folder.png"), 0777), 0);
+    assert_int_equal(cli_run_here("render " QUICK " -o folder.png"), 1);
+    cli_assert_one_line_error("folder.png", "is a directory");
+    assert_int_equal(cli_run_here("render " QUICK " -o l.png --history missing/h.csv"), 1);
+    cli_assert_one_line_error("missing/h.csv", "No such file or directory");
+    assert_no_temporaries(test_workdir());
 }
 
 static void test_read_only_folder(void **state)
@@ -572,11 +499,11 @@ static void test_read_only_folder(void **state)
     (void)state;
     if (geteuid() == 0)
         skip(); /* root writes anywhere */
-    assert_int_equal(mkdir(in_work("ro"), 0555), 0);
-    assert_int_equal(run("render " QUICK " -o ro/out.png"), 1);
-    assert_one_line_error("ro/out.png", "Permission denied");
-    chmod(in_work("ro"), 0755);
-    rmdir(in_work("ro"));
+    assert_int_equal(mkdir(test_path("ro"), 0555), 0);
+    assert_int_equal(cli_run_here("render " QUICK " -o ro/out.png"), 1);
+    cli_assert_one_line_error("ro/out.png", "Permission denied");
+    chmod(test_path("ro"), 0755);
+    rmdir(test_path("ro"));
 }
 
 static void test_long_names(void **state)
@@ -588,52 +515,52 @@ static void test_long_names(void **state)
         memset(name, 'x', length - 4);
         strcpy(name + length - 4, ".png");
         snprintf(args, sizeof args, "render " QUICK " -o %s", name);
-        int status = run("%s", args);
+        int status = cli_run_here("%s", args);
         if (length <= 255) {
             assert_int_equal(status, 0);
-            assert_true(exists(name));
-            unlink(in_work(name));
+            assert_true(test_file_exists(test_path(name)));
+            unlink(test_path(name));
         } else {
             assert_int_equal(status, 1);
-            assert_one_line_error("File name too long", NULL);
+            cli_assert_one_line_error("File name too long", NULL);
         }
     }
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 }
 
 static void test_devices_fifos_stdout(void **state)
 {
     (void)state;
     /* /dev/null stays the device. */
-    assert_int_equal(run("render " QUICK " -o d.png --stats /dev/null --history /dev/null"), 0);
+    assert_int_equal(cli_run_here("render " QUICK " -o d.png --stats /dev/null --history /dev/null"), 0);
     struct stat st;
     assert_int_equal(stat("/dev/null", &st), 0);
     assert_true(S_ISCHR(st.st_mode));
     /* /dev/stdout, a regular file here: written through stdout, after it. */
-    assert_int_equal(run("render --elements 50 --width 16 --height 16 -o d.png --stats /dev/stdout"),
+    assert_int_equal(cli_run_here("render --elements 50 --width 16 --height 16 -o d.png --stats /dev/stdout"),
                      0);
-    assert_non_null(strstr(out_text, "\"version\""));
-    assert_non_null(strstr(out_text, "wrote "));
+    assert_non_null(strstr(cli_stdout(), "\"version\""));
+    assert_non_null(strstr(cli_stdout(), "wrote "));
     /* A full device fails at the commit: the old image stays. */
-    write_file("keep.png", "old image");
-    assert_int_equal(run("render " QUICK " -o keep.png --stats /dev/full"), 1);
-    assert_one_line_error("/dev/full", NULL);
+    test_write_file("keep.png", "old image");
+    assert_int_equal(cli_run_here("render " QUICK " -o keep.png --stats /dev/full"), 1);
+    cli_assert_one_line_error("/dev/full", NULL);
     assert_string_equal(text_of("keep.png"), "old image");
     /* A FIFO with a reader: the stats go through it, it stays a FIFO. */
-    assert_int_equal(mkfifo(in_work("pipe.json"), 0666), 0);
+    assert_int_equal(mkfifo(test_path("pipe.json"), 0666), 0);
     char cmd[2048];
     snprintf(cmd, sizeof cmd, "cd '%s' && (cat pipe.json > from_pipe.json &) && '%s' render " QUICK
              " -o f.png --stats pipe.json; echo $? > fifo_status.txt; wait",
-             workdir, radiosity_bin);
+             test_workdir(), cli_binary());
     assert_int_equal(system(cmd), 0);
     assert_int_equal(atoi(text_of("fifo_status.txt")), 0);
     /* The reader may still be finishing: wait for its file to be whole. */
     for (int i = 0; i < 100 * WATCH_SECONDS && !strstr(text_of("from_pipe.json"), "}\n"); i++)
         pause_ms(10);
     assert_non_null(strstr(text_of("from_pipe.json"), "\"version\""));
-    assert_int_equal(lstat(in_work("pipe.json"), &st), 0);
+    assert_int_equal(lstat(test_path("pipe.json"), &st), 0);
     assert_true(S_ISFIFO(st.st_mode));
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 }
 
 /* ======================================================================
@@ -643,61 +570,61 @@ static void test_devices_fifos_stdout(void **state)
 static void test_outputs_aliasing_inputs(void **state)
 {
     (void)state;
-    write_file("good.obj", good_obj);
-    write_file("good.mtl", good_mtl);
-    assert_int_equal(run("render good.obj " QUICK " -o a.png --stats good.obj"), 2);
-    assert_one_line_error("good.obj: is the same file as the input good.obj", NULL);
-    assert_int_equal(run("render good.obj " QUICK " -o a.png --history good.mtl"), 2);
-    assert_one_line_error("good.mtl", "input");
-    assert_int_equal(run("render good.obj " QUICK " -o a.png --history ./good.mtl"), 2);
-    assert_int_equal(link(in_work("good.mtl"), in_work("mtl_link.csv")), 0);
-    assert_int_equal(run("render good.obj " QUICK " -o a.png --history mtl_link.csv"), 2);
-    assert_string_equal(text_of("good.obj"), good_obj);
-    assert_string_equal(text_of("good.mtl"), good_mtl);
+    test_write_file("good.obj", cli_good_obj);
+    test_write_file("good.mtl", cli_good_mtl);
+    assert_int_equal(cli_run_here("render good.obj " QUICK " -o a.png --stats good.obj"), 2);
+    cli_assert_one_line_error("good.obj: is the same file as the input good.obj", NULL);
+    assert_int_equal(cli_run_here("render good.obj " QUICK " -o a.png --history good.mtl"), 2);
+    cli_assert_one_line_error("good.mtl", "input");
+    assert_int_equal(cli_run_here("render good.obj " QUICK " -o a.png --history ./good.mtl"), 2);
+    assert_int_equal(link(test_path("good.mtl"), test_path("mtl_link.csv")), 0);
+    assert_int_equal(cli_run_here("render good.obj " QUICK " -o a.png --history mtl_link.csv"), 2);
+    assert_string_equal(text_of("good.obj"), cli_good_obj);
+    assert_string_equal(text_of("good.mtl"), cli_good_mtl);
     /* A glTF's buffer, by a hard link with a view-factor name. */
     write_gltf_with_buffer();
-    assert_int_equal(link(in_work("quad.bin"), in_work("buffer.json")), 0);
-    assert_int_equal(run("viewfactors quad.gltf --elements 20 --quiet -o buffer.json"), 2);
-    assert_one_line_error("buffer.json", "quad.bin");
-    assert_int_equal(run("viewfactors quad.gltf --elements 20 --quiet -o vf.json"), 0);
-    assert_false(exists("a.png"));
-    assert_no_temporaries(workdir);
+    assert_int_equal(link(test_path("quad.bin"), test_path("buffer.json")), 0);
+    assert_int_equal(cli_run_here("viewfactors quad.gltf --elements 20 --quiet -o buffer.json"), 2);
+    cli_assert_one_line_error("buffer.json", "quad.bin");
+    assert_int_equal(cli_run_here("viewfactors quad.gltf --elements 20 --quiet -o vf.json"), 0);
+    assert_false(test_file_exists(test_path("a.png")));
+    assert_no_temporaries(test_workdir());
 }
 
 static void test_outputs_aliasing_each_other(void **state)
 {
     (void)state;
-    assert_int_equal(run("render " QUICK " -o same.png --stats same.png"), 2);
-    assert_one_line_error("same.png: is the same file as the output same.png", NULL);
-    assert_int_equal(run("render " QUICK " -o same.png --stats ./same.png"), 2);
-    assert_int_equal(run("viewfactors --elements 50 --quiet -o vf.json --stats vf.json"), 2);
-    write_file("one.csv", "old");
-    assert_int_equal(link(in_work("one.csv"), in_work("two.json")), 0);
-    assert_int_equal(run("render " QUICK " -o o.png --history one.csv --stats two.json"), 2);
+    assert_int_equal(cli_run_here("render " QUICK " -o same.png --stats same.png"), 2);
+    cli_assert_one_line_error("same.png: is the same file as the output same.png", NULL);
+    assert_int_equal(cli_run_here("render " QUICK " -o same.png --stats ./same.png"), 2);
+    assert_int_equal(cli_run_here("viewfactors --elements 50 --quiet -o vf.json --stats vf.json"), 2);
+    test_write_file("one.csv", "old");
+    assert_int_equal(link(test_path("one.csv"), test_path("two.json")), 0);
+    assert_int_equal(cli_run_here("render " QUICK " -o o.png --history one.csv --stats two.json"), 2);
     assert_string_equal(text_of("one.csv"), "old");
-    assert_false(exists("same.png") || exists("o.png"));
-    assert_no_temporaries(workdir);
+    assert_false(test_file_exists(test_path("same.png")) || test_file_exists(test_path("o.png")));
+    assert_no_temporaries(test_workdir());
 }
 
 static void test_all_or_none(void **state)
 {
     (void)state;
-    write_file("old.png", "old image");
-    write_file("old.json", "old stats");
+    test_write_file("old.png", "old image");
+    test_write_file("old.json", "old stats");
     /* Stats into a missing folder: refused before any work; nothing replaced. */
-    assert_int_equal(run("render " QUICK " -o old.png --stats nowhere/s.json"), 1);
-    assert_one_line_error("nowhere/s.json", NULL);
+    assert_int_equal(cli_run_here("render " QUICK " -o old.png --stats nowhere/s.json"), 1);
+    cli_assert_one_line_error("nowhere/s.json", NULL);
     assert_string_equal(text_of("old.png"), "old image");
     /* A view-factor run with a bad stats path, likewise. */
-    write_file("old_vf.json", "old vf");
-    assert_int_equal(run("viewfactors --elements 50 --quiet -o old_vf.json --stats nowhere/s.json"), 1);
+    test_write_file("old_vf.json", "old vf");
+    assert_int_equal(cli_run_here("viewfactors --elements 50 --quiet -o old_vf.json --stats nowhere/s.json"), 1);
     assert_string_equal(text_of("old_vf.json"), "old vf");
     /* A failure after the work (the solve refuses the scene): nothing replaced. */
-    write_file("dark.obj", "o floor\nv 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 3 2\n");
-    assert_int_equal(run("render dark.obj " QUICK " -o old.png --stats old.json"), 1);
+    test_write_file("dark.obj", "o floor\nv 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 3 2\n");
+    assert_int_equal(cli_run_here("render dark.obj " QUICK " -o old.png --stats old.json"), 1);
     assert_string_equal(text_of("old.png"), "old image");
     assert_string_equal(text_of("old.json"), "old stats");
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 }
 
 /* ======================================================================
@@ -751,7 +678,7 @@ static void write_odd_scene(void)
              "{\"bufferView\": 1, \"byteOffset\": 24, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
              "{\"bufferView\": 1, \"byteOffset\": 36, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}",
              odd_names[0][0], odd_names[1][0], odd_names[2][0], odd_names[3][0], quads_base64);
-    write_file(ODD_SCENE, text);
+    test_write_file(ODD_SCENE, text);
 }
 
 /* Well-formed UTF-8 (RFC 3629), decoded by code point. */
@@ -790,7 +717,7 @@ static bool valid_utf8(const char *text, size_t size)
 /* A whole work file (caller frees), its size in *size. */
 static char *read_work(const char *name, size_t *size)
 {
-    FILE *f = fopen(in_work(name), "rb");
+    FILE *f = fopen(test_path(name), "rb");
     assert_non_null(f);
     char *text = malloc(1 << 20);
     assert_non_null(text);
@@ -864,7 +791,7 @@ static void test_names_in_every_output(void **state)
         for (int f = 0; f < 3; f++) {
             char out[64];
             snprintf(out, sizeof out, "vf%d.%s", level, formats[f]);
-            assert_int_equal(run("viewfactors '%s' %s -o %s --stats vf%d_stats.json", ODD_SCENE, flag, out, level), 0);
+            assert_int_equal(cli_run_here("viewfactors '%s' %s -o %s --stats vf%d_stats.json", ODD_SCENE, flag, out, level), 0);
             size_t size;
             char *text = read_work(out, &size);
             if (!valid_utf8(text, size))
@@ -957,18 +884,18 @@ static void test_names_in_every_output(void **state)
     rad_context *ctx = NULL;
     assert_int_equal(rad_context_create(NULL, &ctx), RAD_OK);
     rad_scene *scene = NULL, *back = NULL;
-    write_file("odd\nv 9 9 9\nf 1 2 3.gltf", text_of(ODD_SCENE));
-    assert_int_equal(rad_scene_load_file(ctx, in_work("odd\nv 9 9 9\nf 1 2 3.gltf"), &scene), RAD_OK);
+    test_write_file("odd\nv 9 9 9\nf 1 2 3.gltf", text_of(ODD_SCENE));
+    assert_int_equal(rad_scene_load_file(ctx, test_path("odd\nv 9 9 9\nf 1 2 3.gltf"), &scene), RAD_OK);
     const char *refused[] = {"odd\nv 9 9 9.obj", "two words.obj", "hash#.obj", "tab\t.obj"};
     for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
         char path[600];
-        snprintf(path, sizeof path, "%s", in_work(refused[k]));
+        snprintf(path, sizeof path, "%s", test_path(refused[k]));
         assert_int_equal(rad_scene_write_obj(ctx, scene, path), RAD_ERROR_INVALID_ARGUMENT);
         assert_non_null(strstr(rad_context_error(ctx), "an OBJ cannot name its MTL"));
-        assert_false(exists(refused[k]));
+        assert_false(test_file_exists(test_path(refused[k])));
     }
     char obj[600];
-    snprintf(obj, sizeof obj, "%s", in_work("odd_written.obj"));
+    snprintf(obj, sizeof obj, "%s", test_path("odd_written.obj"));
     if (rad_scene_write_obj(ctx, scene, obj) != RAD_OK)
         fail_msg("%s", rad_context_error(ctx));
     const char *written = text_of("odd_written.obj");
@@ -1007,7 +934,7 @@ static void watch_start(watched *w, const char *args)
     assert_non_null(slave);
     static char copy[2048], program[1024];
     snprintf(copy, sizeof copy, "%s", args);
-    snprintf(program, sizeof program, "%s", radiosity_bin);
+    snprintf(program, sizeof program, "%s", cli_binary());
     char *argv[64] = {program};
     int argc = 1;
     for (char *t = strtok(copy, " "); t && argc < 63; t = strtok(NULL, " "))
@@ -1017,14 +944,14 @@ static void watch_start(watched *w, const char *args)
     assert_true(w->pid >= 0);
     if (w->pid == 0) {
         int err = open(slave, O_RDWR | O_NOCTTY);
-        int out = open(in_work("watched_out.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0666);
+        int out = open(test_path("watched_out.txt"), O_WRONLY | O_CREAT | O_TRUNC, 0666);
         int in = open("/dev/null", O_RDONLY);
-        if (err < 0 || out < 0 || in < 0 || chdir(workdir) != 0)
+        if (err < 0 || out < 0 || in < 0 || chdir(test_workdir()) != 0)
             _exit(127);
         dup2(in, 0);
         dup2(out, 1);
         dup2(err, 2);
-        execv(radiosity_bin, argv);
+        execv(cli_binary(), argv);
         _exit(127);
     }
 }
@@ -1064,7 +991,7 @@ static void watch_for_text(watched *w, const char *text)
 static void watch_for_file(watched *w, const char *name)
 {
     time_t end = time(NULL) + WATCH_SECONDS;
-    while (!exists(name))
+    while (!test_file_exists(test_path(name)))
         if (!watch_read(w, 10) || time(NULL) > end)
             fail_msg("the run never wrote %s; it printed: %s", name, w->seen);
 }
@@ -1097,12 +1024,12 @@ static void test_signal_during_form_factors(void **state)
     watch_for_text(&w, "form factors");
     kill(w.pid, SIGTERM);
     assert_int_equal(watch_end(&w), 143);
-    assert_false(exists("ff.png") || exists("ff.csv"));
+    assert_false(test_file_exists(test_path("ff.png")) || test_file_exists(test_path("ff.csv")));
     const char *stats = text_of("ff.json");
     assert_non_null(strstr(stats, "\"partial\":\ttrue"));
     assert_non_null(strstr(stats, "\"interrupted\":\t\"form factors\""));
     assert_non_null(strstr(w.seen, "interrupted while computing form factors; wrote partial stats"));
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 }
 
 static void test_signal_during_solve_with_progress_images(void **state)
@@ -1114,12 +1041,12 @@ static void test_signal_during_solve_with_progress_images(void **state)
     watch_for_file(&w, "frames/step_00000002.png");
     kill(w.pid, SIGINT);
     assert_int_equal(watch_end(&w), 130);
-    assert_true(exists("solve.png"));
+    assert_true(test_file_exists(test_path("solve.png")));
     const char *stats = text_of("solve.json");
     assert_non_null(strstr(stats, "\"partial\":\ttrue"));
     assert_non_null(strstr(stats, "\"converged\":\tfalse"));
-    assert_no_temporaries(workdir);
-    assert_no_temporaries(in_work("frames"));
+    assert_no_temporaries(test_workdir());
+    assert_no_temporaries(test_path("frames"));
 }
 
 /* The first signal stops the solve; a second one, while the partial
@@ -1134,9 +1061,9 @@ static void test_second_signal_while_saving(void **state)
     watch_for_text(&w, "render");
     kill(w.pid, SIGINT);
     assert_int_equal(watch_end(&w), 130);
-    assert_true(exists("twice.png"));
+    assert_true(test_file_exists(test_path("twice.png")));
     assert_non_null(strstr(text_of("twice.json"), "\"partial\":\ttrue"));
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 }
 
 /* Signals during the final render of a converged solution: the render and
@@ -1156,10 +1083,10 @@ static void test_signal_during_final_render(void **state)
     nanosleep(&(struct timespec){0, 200000000}, NULL);
     kill(w.pid, SIGINT);
     assert_int_equal(watch_end(&w), 143);
-    assert_true(exists("final.png") && exists("final.csv"));
+    assert_true(test_file_exists(test_path("final.png")) && test_file_exists(test_path("final.csv")));
     assert_non_null(strstr(text_of("final.json"), "\"partial\":\tfalse"));
     assert_non_null(strstr(w.seen, "interrupted while writing the outputs"));
-    assert_no_temporaries(workdir);
+    assert_no_temporaries(test_workdir());
 }
 
 /* A closed box of reflectance 0.999999 lit from its floor: no solver
@@ -1167,9 +1094,9 @@ static void test_signal_during_final_render(void **state)
  * bounces), so each is in its solve when the signal comes. */
 static void write_bright_box(void)
 {
-    write_file("bright.mtl", "newmtl wall\nKd 0.999999 0.999999 0.999999\n"
+    test_write_file("bright.mtl", "newmtl wall\nKd 0.999999 0.999999 0.999999\n"
                              "newmtl lamp\nKd 0.999999 0.999999 0.999999\nKe 1 1 1\n");
-    write_file("bright.obj", "mtllib bright.mtl\n"
+    test_write_file("bright.obj", "mtllib bright.mtl\n"
                              "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
                              "usemtl lamp\no floor\nf 1 2 3 4\nusemtl wall\no ceiling\nf 5 8 7 6\n"
                              "o front\nf 1 5 6 2\no back\nf 4 3 7 8\no left\nf 1 4 8 5\no right\nf 2 6 7 3\n");
@@ -1215,12 +1142,12 @@ static void test_signal_during_each_solver(void **state)
         int status = watch_end(&w);
         if (status != 143)
             fail_msg("%s: exit %d after SIGTERM while solving; it printed: %s", solver, status, w.seen);
-        assert_true(exists(png));
+        assert_true(test_file_exists(test_path(png)));
         const char *stats = text_of(stats_name);
         if (!strstr(stats, "\"partial\":\ttrue") || !strstr(stats, "\"converged\":\tfalse"))
             fail_msg("%s: the stats are not marked partial: %s", solver, stats);
         assert_non_null(strstr(w.seen, "interrupted while solving; writing the partial solution"));
-        assert_no_temporaries(workdir);
+        assert_no_temporaries(test_workdir());
     }
 }
 
@@ -1253,12 +1180,12 @@ static void test_signal_during_generate(void **state)
     }
     kill(w.pid, SIGINT);
     assert_int_equal(watch_end(&w), 130);
-    assert_int_equal(exists("gen.obj"), exists("gen.mtl"));
-    if (exists("gen.obj"))
+    assert_int_equal(test_file_exists(test_path("gen.obj")), test_file_exists(test_path("gen.mtl")));
+    if (test_file_exists(test_path("gen.obj")))
         assert_non_null(strstr(text_of("gen.mtl"), "newmtl"));
-    assert_no_temporaries(workdir);
-    unlink(in_work("gen.obj"));
-    unlink(in_work("gen.mtl"));
+    assert_no_temporaries(test_workdir());
+    unlink(test_path("gen.obj"));
+    unlink(test_path("gen.mtl"));
 }
 
 /* A scene that never comes (a FIFO nobody writes): the load blocks in
@@ -1267,7 +1194,7 @@ static void test_signal_during_generate(void **state)
 static void test_signal_during_load(void **state)
 {
     (void)state;
-    assert_int_equal(mkfifo(in_work("never.obj"), 0600), 0);
+    assert_int_equal(mkfifo(test_path("never.obj"), 0600), 0);
     watched w;
     watch_start(&w, "render never.obj -o never.png");
     time_t end = time(NULL) + WATCH_SECONDS;
@@ -1279,31 +1206,23 @@ static void test_signal_during_load(void **state)
     pause_ms(100);
     kill(w.pid, SIGTERM);
     assert_int_equal(watch_end(&w), 143);
-    assert_false(exists("never.png"));
-    assert_no_temporaries(workdir);
-    unlink(in_work("never.obj"));
+    assert_false(test_file_exists(test_path("never.png")));
+    assert_no_temporaries(test_workdir());
+    unlink(test_path("never.obj"));
 }
 
 /* ---- the work folder ---- */
 
-static int remove_tree(const char *path)
-{
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", path);
-    return system(cmd);
-}
-
 static int setup(void **state)
 {
     (void)state;
-    snprintf(workdir, sizeof workdir, "/tmp/radiosity-outputs-XXXXXX");
-    return mkdtemp(workdir) ? 0 : -1;
+    return test_workdir_make("outputs");
 }
 
 static int teardown(void **state)
 {
     (void)state;
-    return remove_tree(workdir) == 0 ? 0 : -1;
+    return test_workdir_remove();
 }
 
 int main(int argc, char **argv)
@@ -1312,7 +1231,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s PATH-TO-radiosity\n", argv[0]);
         return 2;
     }
-    radiosity_bin = argv[1];
+    cli_set_binary(argv[1]);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_temporary_names, setup, teardown),
         cmocka_unit_test_setup_teardown(test_output_targets, setup, teardown),

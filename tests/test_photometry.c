@@ -30,6 +30,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "radiosity.h"
 #include "photometry/photometry.h"
 
@@ -63,29 +65,7 @@ static rad_context *context(void)
     return ctx;
 }
 
-/* ---- writing files ---- */
-
-typedef struct text {
-    char *s;
-    size_t n, cap;
-} text;
-
-static void put(text *t, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int need = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    if (t->n + (size_t)need + 1 > t->cap) {
-        t->cap = 2 * (t->n + (size_t)need + 1);
-        t->s = realloc(t->s, t->cap);
-        assert_non_null(t->s);
-    }
-    va_start(ap, fmt);
-    vsnprintf(t->s + t->n, (size_t)need + 1, fmt, ap);
-    va_end(ap);
-    t->n += (size_t)need;
-}
+/* ---- writing files (test_text) ---- */
 
 static const char *path_of(const char *name)
 {
@@ -94,14 +74,14 @@ static const char *path_of(const char *name)
     return path;
 }
 
-static const char *save(const char *name, text *t)
+static const char *save(const char *name, test_text *t)
 {
     const char *path = path_of(name);
     FILE *f = fopen(path, "wb");
     assert_non_null(f);
-    fwrite(t->s, 1, t->n, f);
+    fwrite(t->data, 1, t->length, f);
     fclose(f);
-    free(t->s);
+    free(t->data);
     memset(t, 0, sizeof *t);
     return path;
 }
@@ -122,22 +102,22 @@ typedef struct ies_spec {
 
 static const char *write_ies(const char *name, const ies_spec *s)
 {
-    text t = {0};
+    test_text t = {0};
     if (s->first)
-        put(&t, "%s\n[TEST] test_photometry\n[LUMINAIRE] %s\n", s->first, name);
+        test_put(&t, "%s\n[TEST] test_photometry\n[LUMINAIRE] %s\n", s->first, name);
     else
-        put(&t, "test_photometry 1986 %s\n", name);
-    put(&t, "TILT=%s\n", s->tilt ? s->tilt : "NONE");
-    put(&t, "%g %.17g %.17g %zu %zu %d %d %.17g %.17g %.17g\n", s->lamps, s->lumens, s->multiplier, s->nv, s->nh,
+        test_put(&t, "test_photometry 1986 %s\n", name);
+    test_put(&t, "TILT=%s\n", s->tilt ? s->tilt : "NONE");
+    test_put(&t, "%g %.17g %.17g %zu %zu %d %d %.17g %.17g %.17g\n", s->lamps, s->lumens, s->multiplier, s->nv, s->nh,
         s->type, s->units, s->width, s->length, s->height);
-    put(&t, "%.17g %.17g %.17g\n", s->ballast, s->second, s->watts);
+    test_put(&t, "%.17g %.17g %.17g\n", s->ballast, s->second, s->watts);
     for (size_t i = 0; i < s->nv; i++)
-        put(&t, "%.17g%s", s->v[i], i % 10 == 9 || i + 1 == s->nv ? "\n" : " ");
+        test_put(&t, "%.17g%s", s->v[i], i % 10 == 9 || i + 1 == s->nv ? "\n" : " ");
     for (size_t i = 0; i < s->nh; i++)
-        put(&t, "%.17g%s", s->h[i], i % 10 == 9 || i + 1 == s->nh ? "\n" : ", ");
+        test_put(&t, "%.17g%s", s->h[i], i % 10 == 9 || i + 1 == s->nh ? "\n" : ", ");
     for (size_t j = 0; j < s->nh; j++)
         for (size_t i = 0; i < s->nv; i++)
-            put(&t, "%.17g%s", s->f(s->h[j], s->v[i]), i % 7 == 6 || i + 1 == s->nv ? "\n" : " ");
+            test_put(&t, "%.17g%s", s->f(s->h[j], s->v[i]), i % 7 == 6 || i + 1 == s->nv ? "\n" : " ");
     return save(name, &t);
 }
 
@@ -152,17 +132,17 @@ static ies_spec ies_default(size_t nv, const double *v, size_t nh, const double 
 static const char *write_ldt(const char *name, int isym, size_t mc, const double *c, size_t ng, const double *g,
                              distribution f, double lumens, double lorl, int lamps)
 {
-    text t = {0};
-    put(&t, "radiosity tests\n1\n%d\n%zu\n%g\n%zu\n%g\nreport\n%s\n1\nx.ldt\n2026\n", isym, mc, mc > 1 ? c[1] : 0.0,
+    test_text t = {0};
+    test_put(&t, "radiosity tests\n1\n%d\n%zu\n%g\n%zu\n%g\nreport\n%s\n1\nx.ldt\n2026\n", isym, mc, mc > 1 ? c[1] : 0.0,
         ng, g[1] - g[0], name);
-    put(&t, "600\n600\n80\n500\n400\n0\n0\n0\n0\n100\n%g\n1\n0\n1\n%d\nLED\n%.17g\n3000K\n80\n20\n", lorl, lamps,
+    test_put(&t, "600\n600\n80\n500\n400\n0\n0\n0\n0\n100\n%g\n1\n0\n1\n%d\nLED\n%.17g\n3000K\n80\n20\n", lorl, lamps,
         lumens);
     for (int i = 0; i < 10; i++)
-        put(&t, "0.5\n");
+        test_put(&t, "0.5\n");
     for (size_t i = 0; i < mc; i++)
-        put(&t, "%.17g\n", c[i]);
+        test_put(&t, "%.17g\n", c[i]);
     for (size_t i = 0; i < ng; i++)
-        put(&t, "%.17g\n", g[i]);
+        test_put(&t, "%.17g\n", g[i]);
     size_t first = 0, planes = mc;
     switch (isym) {
     case 1: planes = 1; break;
@@ -173,7 +153,7 @@ static const char *write_ldt(const char *name, int isym, size_t mc, const double
     }
     for (size_t j = 0; j < planes; j++)
         for (size_t i = 0; i < ng; i++)
-            put(&t, "%.17g\n", f(c[(first + j) % mc], g[i]) * 1000.0 / fabs(lumens));
+            test_put(&t, "%.17g\n", f(c[(first + j) % mc], g[i]) * 1000.0 / fabs(lumens));
     return save(name, &t);
 }
 
@@ -590,8 +570,8 @@ static void test_tilt(void **state)
     assert_true(fabs(rad_photometry_intensity(p, v3(0, 0, -1)) - 100.0) < 1e-12);
     rad_photometry_free(p);
 
-    text t = {0};
-    put(&t, "2\n4\n0, 30, 60, 90\n1.0 0.8\n 0.6 0.4\n");
+    test_text t = {0};
+    test_put(&t, "2\n4\n0, 30, 60, 90\n1.0 0.8\n 0.6 0.4\n");
     save("lamp.tlt", &t);
     s.tilt = "lamp.tlt";
     p = load(ctx, write_ies("tilt_file.ies", &s));
@@ -607,7 +587,7 @@ static void test_tilt(void **state)
     assert_int_equal(rad_photometry_load(ctx, write_ies("tilt_absent.ies", &s), &q), RAD_ERROR_IO);
     assert_null(q);
     assert_non_null(strstr(rad_context_error(ctx), "tilt_absent.ies:4: TILT=absent.tlt: cannot open"));
-    put(&t, "1\n3\n0 45\n");
+    test_put(&t, "1\n3\n0 45\n");
     save("short.tlt", &t);
     s.tilt = "short.tlt";
     rad_api_enter(ctx);
@@ -872,8 +852,8 @@ static void test_allocation_failures(void **state)
         v[i] = 10.0 * i;
     for (int i = 0; i < 25; i++)
         h[i] = 15.0 * i;
-    text t = {0};
-    put(&t, "1\n2\n0 90\n1 0.5\n");
+    test_text t = {0};
+    test_put(&t, "1\n2\n0 90\n1 0.5\n");
     save("alloc.tlt", &t);
     ies_spec s = ies_default(19, v, 7, h, quad);
     s.tilt = "alloc.tlt";

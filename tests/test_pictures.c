@@ -46,28 +46,12 @@
 #pragma GCC diagnostic pop
 #endif
 
-#define assert_near(a, b, tol)                                                              \
-    do {                                                                                    \
-        double a_ = (a), b_ = (b), tol_ = (tol);                                            \
-        if (!(fabs(a_ - b_) <= tol_))                                                       \
-            fail_msg("%s = %.17g, %s = %.17g, differ by more than %g", #a, a_, #b, b_, tol_); \
-    } while (0)
-
-static rad_context *make_context(void)
-{
-    rad_context_options o = {0};
-    o.threads = 2;
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
-    return ctx;
-}
-
 static char *work_path(const char *name)
 {
     static char path[4][512];
     static int next;
     char *p = path[next++ % 4];
-    snprintf(p, sizeof path[0], "%s/%s", cli_workdir(), name);
+    snprintf(p, sizeof path[0], "%s/%s", test_workdir(), name);
     return p;
 }
 
@@ -222,7 +206,7 @@ static void test_ticks_and_labels(void **state)
     }
 
     /* Automatic: the 99th percentile (nearest rank) rounded up nicely. */
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     float values[200];
     for (int i = 0; i < 200; i++)
         values[i] = (float)i; /* rank 198 of 200: 197 -> 200 */
@@ -249,7 +233,7 @@ static void test_ticks_and_labels(void **state)
 static void test_legend_and_contours(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     enum { W = 120, H = 300 };
     float *values = malloc(sizeof(float) * W * H);
     for (int y = 0; y < H; y++)
@@ -419,7 +403,7 @@ static void test_luminance_box(void **state)
 {
     (void)state;
     const double rho = 0.5, E = 1.0;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     rad_scene *scene = NULL;
     rad_solution *sol = solve_scene(ctx, write_uniform_box(rho, E), "direct", 0.25, &scene);
     /* B = E / (1 - rho) on every element, grey: Y(B) = B. */
@@ -473,7 +457,7 @@ static const char *write_floor_scene(double rho_floor, double E, double s, doubl
 static void check_floor(const char *solver, double rho_floor, double tolerance_levels)
 {
     const double E = 100.0, s = 0.25, h = 1.0, eye = 0.5;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     rad_scene *scene = NULL;
     rad_solution *sol = solve_scene(ctx, write_floor_scene(rho_floor, E, s, h), solver, 0.05, &scene);
     enum { N = 101 };
@@ -519,7 +503,7 @@ static void test_illuminance_floor(void **state)
 static void test_grid_plot(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     /* 3 x 2 cells of 1 m: the point iu + 3 iv at (0.5 + iu, 0.5 + iv). */
     const double u[6] = {0.5, 1.5, 2.5, 0.5, 1.5, 2.5}, v[6] = {0.5, 0.5, 0.5, 1.5, 1.5, 1.5};
     const double value[6] = {100.0, 250.0, 400.0, 12.345, 300.0, 0.5};
@@ -623,7 +607,7 @@ static void expect_refused(rad_context *ctx, const rad_false_colour_options *o, 
 static void test_bad_options(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     assert_int_equal(rad_false_colour_check(ctx, NULL), RAD_OK);
     assert_int_equal(rad_false_colour_check(ctx, &(rad_false_colour_options){0}), RAD_OK);
     expect_refused(ctx, &(rad_false_colour_options){RAD_FALSE_COLOUR_LUMINANCE, 0, 5.0, 2.0, 0},
@@ -640,7 +624,7 @@ static void test_bad_options(void **state)
     const double u[2] = {0, 1}, v[2] = {0, 0}, good[2] = {1, 2}, bad[2] = {1, NAN};
     const double u3[3] = {0, 1, 2}, v3[3] = {0, 0, 0}, good3[3] = {1, 2, 3};
     const char *path = work_path("bad_grid.png");
-    size_t before = count_files(cli_workdir());
+    size_t before = count_files(test_workdir());
     rad_api_enter(ctx); /* the internal calls below keep the first error otherwise */
     rad_plot_grid g = {"g", 3, u3, v3, good3, "lx", 2, 1, 0.0, 0.0};
     assert_int_equal(rad_plot_grid_write(ctx, &g, NULL, path), RAD_ERROR_INVALID_ARGUMENT);
@@ -663,7 +647,7 @@ static void test_bad_options(void **state)
     rad_api_enter(ctx);
     assert_int_equal(rad_plot_grid_write(ctx, &g, &(rad_plot_options){0, 10.0, 1.0, 0}, path),
                      RAD_ERROR_INVALID_ARGUMENT);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     rad_context_destroy(ctx);
 
     /* The program: usage errors (exit 2) before any work, no output. */
@@ -677,7 +661,7 @@ static void test_bad_options(void **state)
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         int status = cli_run_capture(errors, "render %s -o %s", cases[i].flags, out);
-        char *text = cli_read_text(errors);
+        char *text = test_read_file(errors, NULL);
         assert_non_null(text);
         if (status != 2 || !strstr(text, cases[i].message))
             fail_msg("'%s': exit %d, message '%s' (want 2 and '%s')", cases[i].flags, status, text,
@@ -693,7 +677,7 @@ static void test_bad_options(void **state)
 static void test_atomic(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context();
+    rad_context *ctx = test_context(2);
     rad_scene *scene = NULL;
     rad_solution *sol = solve_scene(ctx, write_uniform_box(0.5, 1.0), "direct", 0.5, &scene);
     rad_render_options ro = {0};
@@ -706,24 +690,24 @@ static void test_atomic(void **state)
     assert_non_null(f);
     fputs("old", f);
     fclose(f);
-    size_t before = count_files(cli_workdir());
+    size_t before = count_files(test_workdir());
     rad_context_cancel(ctx, true);
     assert_int_equal(rad_solution_write_false_colour(ctx, sol, &ro, &fo, path), RAD_ERROR_INTERRUPTED);
     rad_context_cancel(ctx, false);
-    char *text = cli_read_text(path);
+    char *text = test_read_file(path, NULL);
     assert_string_equal(text, "old");
     free(text);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     /* ...or unwritable (a folder under a file). */
     const char *under = work_path("kept.png/x.png");
     assert_int_not_equal(rad_solution_write_false_colour(ctx, sol, &ro, &fo, under), RAD_OK);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     /* And it succeeds in place of the old file. */
     assert_int_equal(rad_solution_write_false_colour(ctx, sol, &ro, &fo, path), RAD_OK);
     picture p = read_png(path);
     assert_true(p.width > 32);
     stbi_image_free(p.rgb);
-    assert_int_equal(count_files(cli_workdir()), before);
+    assert_int_equal(count_files(test_workdir()), before);
     rad_solution_destroy(sol);
     rad_scene_destroy(scene);
     rad_context_destroy(ctx);
@@ -796,7 +780,7 @@ static void test_cli_grid_plots(void **state)
     assert_int_equal(cli_run_capture(errors, "illuminance %s --grid %s --scale log --range 0:5 -o %s", scene, grid,
                                      plan),
                      2);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(strstr(text, "log scale needs range min > 0"));
     free(text);
 }

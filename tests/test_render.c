@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "output/output.h"
 
 #include <dirent.h>
@@ -35,22 +37,6 @@
 #if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
-
-#define assert_near(a, b, tol)                                                              \
-    do {                                                                                    \
-        double a_ = (a), b_ = (b), tol_ = (tol);                                            \
-        if (!(fabs(a_ - b_) <= tol_))                                                       \
-            fail_msg("%s = %.17g, %s = %.17g, differ by more than %g", #a, a_, #b, b_, tol_); \
-    } while (0)
-
-static rad_context *make_context(int threads)
-{
-    rad_context_options o = {0};
-    o.threads = threads;
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
-    return ctx;
-}
 
 /* ---- meshes built by hand: structured patches, welded by position ---- */
 
@@ -192,7 +178,7 @@ static double *element_values(const test_mesh *m, field_fn field)
 static double *vertex_values(const test_mesh *m, const double *element)
 {
     double *values = calloc(3 * m->mesh.vertex_count, sizeof *values);
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     assert_int_equal(rad_vertex_values(ctx, &m->mesh, element, values), RAD_OK);
     rad_context_destroy(ctx);
     return values;
@@ -437,20 +423,6 @@ static rad_image *constant_image(int width, int height, float r, float g, float 
     return image;
 }
 
-static unsigned char *read_file(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *data = malloc((size_t)n + 1);
-    assert_int_equal(fread(data, 1, (size_t)n, f), (size_t)n);
-    fclose(f);
-    *size = (size_t)n;
-    return data;
-}
-
 static void test_pfm_round_trip(void **unused)
 {
     (void)unused;
@@ -461,10 +433,10 @@ static void test_pfm_round_trip(void **unused)
     rad_image *image = rad_image_create(NULL, 3, 2);
     for (int i = 0; i < 18; i++)
         image->pixels[i] = (float)(i * 0.37 - 1.1) * (i % 2 ? 1e-3f : 7.5f);
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     assert_int_equal(rad_image_write(ctx, image, path), RAD_OK);
     size_t size;
-    unsigned char *data = read_file(path, &size);
+    unsigned char *data = (unsigned char *)test_read_file(path, &size);
     const char header[] = "PF\n3 2\n-1.0\n";
     assert_int_equal(size, strlen(header) + 18 * 4);
     assert_memory_equal(data, header, strlen(header));
@@ -494,7 +466,7 @@ static void test_png_srgb(void **unused)
     temp_dir_make(&d);
     char path[512];
     temp_dir_file(&d, "image.png", path, sizeof path);
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     const struct {
         float radiance;
         double exposure;
@@ -542,7 +514,7 @@ static void test_hdr(void **unused)
     rad_image *image = rad_image_create(NULL, 4, 3);
     for (int i = 0; i < 36; i++)
         image->pixels[i] = (float)(0.01 + 13.0 * (i % 7) + (i % 3));
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     assert_int_equal(rad_image_write(ctx, image, path), RAD_OK);
     rad_context_destroy(ctx);
     int w, h, n;
@@ -565,7 +537,7 @@ static void test_write_failures(void **unused)
     (void)unused;
     temp_dir d;
     temp_dir_make(&d);
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     rad_image *image = constant_image(2, 2, 1, 1, 1);
     char path[512];
 
@@ -591,7 +563,7 @@ static void test_write_failures(void **unused)
     rad_image empty = {NULL, 0, 0, NULL};
     assert_int_equal(rad_image_write(ctx, &empty, path), RAD_ERROR_INVALID_ARGUMENT);
     size_t size;
-    unsigned char *data = read_file(path, &size);
+    unsigned char *data = (unsigned char *)test_read_file(path, &size);
     assert_int_equal(size, 3);
     free(data);
     assert_int_equal(temp_dir_entries(&d), 1);
@@ -630,7 +602,7 @@ static void test_auto_exposure(void **unused)
 static void test_camera_parse(void **unused)
 {
     (void)unused;
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     rad_camera c;
     assert_int_equal(rad_camera_parse(ctx, "1,2,3,4,5,6", &c), RAD_OK);
     assert_true(c.position[0] == 1 && c.position[2] == 3 && c.look_at[0] == 4 && c.look_at[2] == 6);
@@ -752,7 +724,7 @@ static vec3 pixel_point(int x, int y, int width, int height)
 static void test_render_shading(void **unused)
 {
     (void)unused;
-    rad_context *ctx = make_context(2);
+    rad_context *ctx = test_context(2);
     render_fixture f;
     fixture_make(&f, ctx);
     rad_render_options o = {0};
@@ -816,7 +788,7 @@ static void test_render_deterministic(void **unused)
     rad_image *images[2] = {NULL, NULL};
     const int threads[2] = {1, 3};
     for (int k = 0; k < 2; k++) {
-        rad_context *ctx = make_context(threads[k]);
+        rad_context *ctx = test_context(threads[k]);
         render_fixture f;
         fixture_make(&f, ctx);
         assert_int_equal(rad_camera_parse(ctx, "0.3,-0.2,3,0,0,0,0.1,1,0,50", &f.input.camera), RAD_OK);
@@ -841,7 +813,7 @@ static void test_render_deterministic(void **unused)
 static void test_render_adaptive(void **unused)
 {
     (void)unused;
-    rad_context *ctx = make_context(2);
+    rad_context *ctx = test_context(2);
     render_fixture f;
     fixture_make(&f, ctx);
     assert_int_equal(rad_camera_parse(ctx, "0.7,-0.5,3,0,0,0,0.3,1,0,60", &f.input.camera), RAD_OK);

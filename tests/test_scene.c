@@ -11,6 +11,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "formfactor/formfactor.h"
 #include "import/import_internal.h"
 #include "scene/scene.h"
@@ -437,43 +439,17 @@ static void test_gltf(void **state)
     rad_scene_destroy(scene);
 }
 
-/* ---- glTF built in memory: hostile and awkward files ---- */
-
-/* Text that grows: printf into it. */
-typedef struct text {
-    char *data;
-    size_t length, capacity;
-} text;
-
-static void put(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-
-static void put(text *t, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    assert_true(n >= 0);
-    if (t->length + (size_t)n + 1 > t->capacity) {
-        t->capacity = 2 * (t->length + (size_t)n + 1);
-        t->data = realloc(t->data, t->capacity);
-        assert_non_null(t->data);
-    }
-    va_start(ap, fmt);
-    vsnprintf(t->data + t->length, (size_t)n + 1, fmt, ap);
-    va_end(ap);
-    t->length += (size_t)n;
-}
+/* ---- glTF built in memory: hostile and awkward files (test_text) ---- */
 
 /* Replace the first `old` in t by `new_text`; fails the test if absent. */
-static void patch(text *t, const char *old, const char *new_text)
+static void patch(test_text *t, const char *old, const char *new_text)
 {
     char *at = strstr(t->data, old);
     if (!at)
         fail_msg("patch: '%s' not in the glTF", old);
     size_t before = (size_t)(at - t->data), old_length = strlen(old);
-    text patched = {0};
-    put(&patched, "%.*s%s%s", (int)before, t->data, new_text, at + old_length);
+    test_text patched = {0};
+    test_put(&patched, "%.*s%s%s", (int)before, t->data, new_text, at + old_length);
     free(t->data);
     *t = patched;
 }
@@ -490,14 +466,14 @@ typedef struct gltf_mesh {
     int material;
 } gltf_mesh;
 
-static void put_base64(text *t, const unsigned char *bytes, size_t n)
+static void put_base64(test_text *t, const unsigned char *bytes, size_t n)
 {
     static const char alphabet[] =
         "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     for (size_t i = 0; i < n; i += 3) {
         unsigned v = (unsigned)bytes[i] << 16 | (i + 1 < n ? (unsigned)bytes[i + 1] << 8 : 0) |
                      (i + 2 < n ? bytes[i + 2] : 0);
-        put(t, "%c%c%c%c", alphabet[v >> 18], alphabet[v >> 12 & 63],
+        test_put(t, "%c%c%c%c", alphabet[v >> 18], alphabet[v >> 12 & 63],
             i + 1 < n ? alphabet[v >> 6 & 63] : '=', i + 2 < n ? alphabet[v & 63] : '=');
     }
 }
@@ -506,7 +482,7 @@ static void put_base64(text *t, const unsigned char *bytes, size_t n)
  * arrays, mesh i made of meshes[i] with accessors 2i (POSITION, VEC3
  * float) and 2i + 1 (indices, SCALAR uint32), all in one base64 buffer;
  * `extra` is more top-level JSON (", \"cameras\": [...]") or "". */
-static text gltf_text(const char *nodes, const char *roots, const gltf_mesh *meshes, size_t count,
+static test_text gltf_text(const char *nodes, const char *roots, const gltf_mesh *meshes, size_t count,
                       const char *extra)
 {
     size_t bytes = 0;
@@ -514,46 +490,46 @@ static text gltf_text(const char *nodes, const char *roots, const gltf_mesh *mes
         bytes += 12 * meshes[m].vertices + 4 * meshes[m].index_count;
     unsigned char *buffer = calloc(bytes + 1, 1);
     assert_non_null(buffer);
-    text t = {0}, views = {0}, accessors = {0};
-    put(&t, "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": %s}],\n"
+    test_text t = {0}, views = {0}, accessors = {0};
+    test_put(&t, "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": %s}],\n"
             " \"nodes\": %s,\n \"meshes\": [",
         roots, nodes);
     size_t offset = 0;
     for (size_t m = 0; m < count; m++) {
         const gltf_mesh *mesh = &meshes[m];
-        put(&t, "%s{\"name\": \"m%zu\", \"primitives\": [{\"attributes\": {\"POSITION\": %zu}, "
+        test_put(&t, "%s{\"name\": \"m%zu\", \"primitives\": [{\"attributes\": {\"POSITION\": %zu}, "
                 "\"mode\": %d, \"material\": %d",
             m ? ",\n  " : "", m, 2 * m, mesh->mode, mesh->material);
         if (mesh->indices)
-            put(&t, ", \"indices\": %zu", 2 * m + 1);
-        put(&t, "}]}");
+            test_put(&t, ", \"indices\": %zu", 2 * m + 1);
+        test_put(&t, "}]}");
         for (int pass = 0; pass < 2; pass++) {
             size_t length = pass ? 4 * mesh->index_count : 12 * mesh->vertices;
             const void *data = pass ? (const void *)mesh->indices : (const void *)mesh->positions;
             if (length)
                 memcpy(buffer + offset, data, length); /* little-endian, as glTF */
             /* no indices: a dummy view of the first 4 bytes, never read */
-            put(&views, "%s{\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": %zu}",
+            test_put(&views, "%s{\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": %zu}",
                 views.length ? ", " : "", length ? offset : 0, length ? length : 4);
             if (pass == 0)
-                put(&accessors, "%s{\"bufferView\": %zu, \"componentType\": 5126, \"count\": %zu, "
+                test_put(&accessors, "%s{\"bufferView\": %zu, \"componentType\": 5126, \"count\": %zu, "
                                 "\"type\": \"VEC3\"}",
                     accessors.length ? ",\n  " : "", 2 * m, mesh->vertices);
             else
-                put(&accessors, ",\n  {\"bufferView\": %zu, \"componentType\": 5125, "
+                test_put(&accessors, ",\n  {\"bufferView\": %zu, \"componentType\": 5125, "
                                 "\"count\": %zu, \"type\": \"SCALAR\"}",
                     2 * m + 1, mesh->index_count ? mesh->index_count : 1);
             offset += length;
         }
     }
-    put(&t, "],\n \"materials\": [{\"name\": \"white\", \"pbrMetallicRoughness\": "
+    test_put(&t, "],\n \"materials\": [{\"name\": \"white\", \"pbrMetallicRoughness\": "
             "{\"baseColorFactor\": [0.5, 0.5, 0.5, 1]}},\n"
             "  {\"name\": \"lamp\", \"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]},"
             " \"emissiveFactor\": [1, 1, 1]}],\n"
             " \"buffers\": [{\"byteLength\": %zu, \"uri\": \"data:application/octet-stream;base64,",
         offset ? offset : 4);
     put_base64(&t, buffer, offset ? offset : 4);
-    put(&t, "\"}],\n \"bufferViews\": [%s],\n \"accessors\": [%s]%s}\n", views.data,
+    test_put(&t, "\"}],\n \"bufferViews\": [%s],\n \"accessors\": [%s]%s}\n", views.data,
         accessors.data, extra);
     free(buffer);
     free(views.data);
@@ -565,7 +541,7 @@ static text gltf_text(const char *nodes, const char *roots, const gltf_mesh *mes
 static const float unit_quad[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
 static const uint32_t unit_quad_indices[] = {0, 1, 2, 0, 2, 3};
 
-static rad_result load_gltf(const text *t, rad_scene **scene)
+static rad_result load_gltf(const test_text *t, rad_scene **scene)
 {
     *scene = NULL;
     rad_api_enter(ctx);
@@ -574,7 +550,7 @@ static rad_result load_gltf(const text *t, rad_scene **scene)
 
 /* Load `t`; it must fail with `expected` and a one-line message naming
  * x.gltf and holding every part given. */
-static void assert_gltf_refused(text *t, rad_result expected, const char *part1,
+static void assert_gltf_refused(test_text *t, rad_result expected, const char *part1,
                                 const char *part2)
 {
     rad_scene sentinel, *scene = &sentinel;
@@ -595,15 +571,15 @@ static void assert_gltf_refused(text *t, rad_result expected, const char *part1,
 
 /* A chain of `depth` nested nodes, each moved 1 mm up in y, the last
  * holding the unit quad. */
-static text nested(size_t depth)
+static test_text nested(size_t depth)
 {
-    text nodes = {0};
-    put(&nodes, "[");
+    test_text nodes = {0};
+    test_put(&nodes, "[");
     for (size_t i = 0; i + 1 < depth; i++)
-        put(&nodes, "{\"translation\": [0, 0.001, 0], \"children\": [%zu]},", i + 1);
-    put(&nodes, "{\"translation\": [0, 0.001, 0], \"mesh\": 0}]");
+        test_put(&nodes, "{\"translation\": [0, 0.001, 0], \"children\": [%zu]},", i + 1);
+    test_put(&nodes, "{\"translation\": [0, 0.001, 0], \"mesh\": 0}]");
     gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
-    text t = gltf_text(nodes.data, "[0]", &quad, 1, "");
+    test_text t = gltf_text(nodes.data, "[0]", &quad, 1, "");
     free(nodes.data);
     return t;
 }
@@ -615,7 +591,7 @@ static text nested(size_t depth)
 static void test_gltf_nesting(void **state)
 {
     (void)state;
-    text t = nested(1000);
+    test_text t = nested(1000);
     rad_scene *scene = NULL;
     assert_int_equal(load_gltf(&t, &scene), RAD_OK);
     assert_int_equal(rad_scene_polygon_count(scene), 2);
@@ -677,29 +653,29 @@ static void test_gltf_node_graphs(void **state)
     };
     gltf_mesh quad = {unit_quad, 4, unit_quad_indices, 6, 4, 0};
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, "");
+        test_text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, "");
         rad_api_enter(ctx);
         assert_gltf_refused(&t, RAD_ERROR_PARSE, cases[k].message[0], cases[k].message[1]);
     }
 
     /* The instance bomb (1.8 KB of nodes in the original). */
-    text nodes = {0}, roots = {0};
-    put(&nodes, "[");
+    test_text nodes = {0}, roots = {0};
+    test_put(&nodes, "[");
     for (int level = 0; level < 9; level++)
         for (int i = 0; i < 10; i++) {
-            put(&nodes, "%s{\"name\": \"n%d_%d\"", level + i ? ", " : "", level, i);
+            test_put(&nodes, "%s{\"name\": \"n%d_%d\"", level + i ? ", " : "", level, i);
             if (level == 8)
-                put(&nodes, ", \"mesh\": 0}");
+                test_put(&nodes, ", \"mesh\": 0}");
             else {
-                put(&nodes, ", \"children\": [");
+                test_put(&nodes, ", \"children\": [");
                 for (int k = 0; k < 10; k++)
-                    put(&nodes, "%s%d", k ? ", " : "", 10 * (level + 1) + k);
-                put(&nodes, "]}");
+                    test_put(&nodes, "%s%d", k ? ", " : "", 10 * (level + 1) + k);
+                test_put(&nodes, "]}");
             }
         }
-    put(&nodes, "]");
-    put(&roots, "[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]");
-    text t = gltf_text(nodes.data, roots.data, &quad, 1, "");
+    test_put(&nodes, "]");
+    test_put(&roots, "[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]");
+    test_text t = gltf_text(nodes.data, roots.data, &quad, 1, "");
     rad_api_enter(ctx);
     assert_gltf_refused(&t, RAD_ERROR_PARSE,
                         "node 'n1_0' (10) is a child of both node 'n0_0' (0) and node 'n0_1' (1)",
@@ -737,16 +713,16 @@ static void test_gltf_instances_memory(void **state)
     float *strip = zigzag(10000, &vertices);
     gltf_mesh mesh = {strip, vertices, NULL, 0, 5, 0};
     for (int instances = 10; instances <= 100; instances *= 10) {
-        text nodes = {0}, roots = {0};
-        put(&nodes, "[");
-        put(&roots, "[");
+        test_text nodes = {0}, roots = {0};
+        test_put(&nodes, "[");
+        test_put(&roots, "[");
         for (int i = 0; i < instances; i++) {
-            put(&nodes, "%s{\"mesh\": 0, \"translation\": [%d, 0, 0]}", i ? ", " : "", 2 * i);
-            put(&roots, "%s%d", i ? ", " : "", i);
+            test_put(&nodes, "%s{\"mesh\": 0, \"translation\": [%d, 0, 0]}", i ? ", " : "", 2 * i);
+            test_put(&roots, "%s%d", i ? ", " : "", i);
         }
-        put(&nodes, "]");
-        put(&roots, "]");
-        text t = gltf_text(nodes.data, roots.data, &mesh, 1, "");
+        test_put(&nodes, "]");
+        test_put(&roots, "]");
+        test_text t = gltf_text(nodes.data, roots.data, &mesh, 1, "");
         rad_scene *scene = NULL;
         rad_api_enter(limited);
         rad_result r = rad_scene_load_memory(limited, "x.gltf", t.data, t.length, NULL, 0, &scene);
@@ -815,11 +791,11 @@ static double floor_radiosity(const char *lamp_nodes, const float *lamp_position
 {
     gltf_mesh meshes[2] = {{unit_quad, 4, unit_quad_indices, 6, 4, 0},
                            {lamp_positions, 4, lamp_indices, 6, 4, 1}};
-    text nodes = {0};
-    put(&nodes, "[{\"name\": \"floor\", \"mesh\": 0, \"translation\": [-1, -1, 0], "
+    test_text nodes = {0};
+    test_put(&nodes, "[{\"name\": \"floor\", \"mesh\": 0, \"translation\": [-1, -1, 0], "
                 "\"scale\": [2, 2, 1]}, %s]",
         lamp_nodes);
-    text t = gltf_text(nodes.data, "[0, 1]", meshes, 2, "");
+    test_text t = gltf_text(nodes.data, "[0, 1]", meshes, 2, "");
     rad_scene *scene = NULL;
     if (load_gltf(&t, &scene) != RAD_OK)
         fail_msg("%s", rad_context_error(ctx));
@@ -912,12 +888,12 @@ static void test_gltf_mirrored(void **state)
 /* The unit quad file with `old` patched to `new_text` (NULL: as it is),
  * topology `mode`, indices `indices` (NULL: the quad's), positions
  * `positions` (NULL: the quad's). */
-static text quad_patched(const float *positions, const uint32_t *indices, size_t index_count,
+static test_text quad_patched(const float *positions, const uint32_t *indices, size_t index_count,
                          int mode, const char *old, const char *new_text)
 {
     gltf_mesh mesh = {positions ? positions : unit_quad, 4,
                       indices ? indices : unit_quad_indices, indices ? index_count : 6, mode, 0};
-    text t = gltf_text("[{\"mesh\": 0}]", "[0]", &mesh, 1, "");
+    test_text t = gltf_text("[{\"mesh\": 0}]", "[0]", &mesh, 1, "");
     if (old)
         patch(&t, old, new_text);
     return t;
@@ -941,7 +917,7 @@ static void test_gltf_bad_primitives(void **state)
         "\"type\": \"VEC3\", \"sparse\": {\"count\": 4, \"indices\": {\"bufferView\": 1, "
         "\"componentType\": 5125}, \"values\": {\"bufferView\": 0}}}";
     const struct {
-        text t;
+        test_text t;
         rad_result expected;
         const char *message[2];
     } cases[] = {
@@ -1004,7 +980,7 @@ static void test_gltf_bad_primitives(void **state)
          RAD_ERROR_PARSE, {"glTF version '1.0' is not read (2.0 is)", NULL}},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
-        text t = cases[k].t;
+        test_text t = cases[k].t;
         rad_api_enter(ctx);
         assert_gltf_refused(&t, cases[k].expected, cases[k].message[0], cases[k].message[1]);
     }
@@ -1033,7 +1009,7 @@ static void test_gltf_strips_and_fans(void **state)
                                        3, 0, 0, 4, 0, 0, 3, 1, 0, 4, 1, 0};
     static const uint32_t stitched[] = {0, 1, 2, 3, 3, 4, 4, 5, 6, 7};
     gltf_mesh strips = {two_strips, 8, stitched, 10, 5, 0};
-    text t = gltf_text("[{\"mesh\": 0}]", "[0]", &strips, 1, "");
+    test_text t = gltf_text("[{\"mesh\": 0}]", "[0]", &strips, 1, "");
     rad_scene *scene = NULL;
     assert_int_equal(load_gltf(&t, &scene), RAD_OK);
     check_faces_up(scene, 4, 2.0);
@@ -1146,7 +1122,7 @@ static void test_gltf_orthographic_camera(void **state)
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         seen.count = 0;
-        text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, cameras);
+        test_text t = gltf_text(cases[k].nodes, cases[k].roots, &quad, 1, cameras);
         rad_scene *scene = NULL;
         rad_api_enter(warned);
         if (rad_scene_load_memory(warned, "x.gltf", t.data, t.length, NULL, 0, &scene) != RAD_OK)

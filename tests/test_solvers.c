@@ -42,8 +42,8 @@ static int solver_count;
 static cJSON *render_stats(const char *scene, const char *tag, const char *extra)
 {
     char stats[600], png[600];
-    snprintf(stats, sizeof stats, "%s/%s.stats.json", cli_workdir(), tag);
-    snprintf(png, sizeof png, "%s/%s.png", cli_workdir(), tag);
+    snprintf(stats, sizeof stats, "%s/%s.stats.json", test_workdir(), tag);
+    snprintf(png, sizeof png, "%s/%s.png", test_workdir(), tag);
     int status = cli_run_capture(NULL, "render %s%s%s -o '%s' --stats '%s' --width 8 --height 8 %s",
                                  scene[0] ? "'" : "", scene, scene[0] ? "'" : "", png, stats, extra);
     if (status != 0)
@@ -340,11 +340,11 @@ static void test_relaxation(void **state)
 static void check_history(const char *scene, const char *solver, const char *tag, bool split)
 {
     char extra[1024], csv[600];
-    snprintf(csv, sizeof csv, "%s/%s.csv", cli_workdir(), tag);
+    snprintf(csv, sizeof csv, "%s/%s.csv", test_workdir(), tag);
     snprintf(extra, sizeof extra, "%s --solver %s --tolerance 1e-6 --history '%s'",
              split ? "--mesh-size 0.25" : "--elements 300", solver, csv);
     cJSON *stats = render_stats(scene, tag, extra);
-    char *text = cli_read_text(csv);
+    char *text = test_read_file(csv, NULL);
     assert_non_null(text);
     char *save = NULL, *line = strtok_r(text, "\n", &save);
     assert_non_null(line);
@@ -419,15 +419,15 @@ static void test_direct_memory_limit(void **state)
     cli_scene_writer w;
     write_case_cube(&w, "big_cube", "furnace_cube_rho0.5");
     char errors[600], png[600];
-    snprintf(errors, sizeof errors, "%s/direct_memory.err", cli_workdir());
-    snprintf(png, sizeof png, "%s/direct_memory.png", cli_workdir());
+    snprintf(errors, sizeof errors, "%s/direct_memory.err", test_workdir());
+    snprintf(png, sizeof png, "%s/direct_memory.png", test_workdir());
     /* 384 elements: F (8 n^2 = 1.1 MiB) fits in 2 MiB, LU beside it (16 n^2 = 2.3 MiB) does not. */
     int status = cli_run_capture(errors,
                                  "render '%s' -o '%s' --width 8 --height 8 --mesh-size 0.125 "
                                  "--solver direct --max-memory 2M",
                                  w.obj_path, png);
     assert_int_equal(status, 1);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     char *newline = strchr(text, '\n');
     assert_non_null(newline);
@@ -451,8 +451,8 @@ static void test_direct_memory_limit(void **state)
 static char *render_image(const char *tag, const char *env, const char *extra, size_t *size, cJSON **stats)
 {
     char pfm[600], json[600], cmd[4096];
-    snprintf(pfm, sizeof pfm, "%s/%s.pfm", cli_workdir(), tag);
-    snprintf(json, sizeof json, "%s/%s.json", cli_workdir(), tag);
+    snprintf(pfm, sizeof pfm, "%s/%s.pfm", test_workdir(), tag);
+    snprintf(json, sizeof json, "%s/%s.json", test_workdir(), tag);
     snprintf(cmd, sizeof cmd, "%s '%s' render -o '%s' --stats '%s' --width 24 --height 24 --elements 600 %s -q",
              env, cli_binary(), pfm, json, extra);
     int status = system(cmd);
@@ -544,15 +544,15 @@ static void write_bright_cube(cli_scene_writer *w, const char *name, double rho)
 static cJSON *render_loud(const char *scene, const char *tag, const char *extra, char *errors, size_t size)
 {
     char stats[600], png[600], err[600], cmd[4096];
-    snprintf(stats, sizeof stats, "%s/%s.stats.json", cli_workdir(), tag);
-    snprintf(png, sizeof png, "%s/%s.png", cli_workdir(), tag);
-    snprintf(err, sizeof err, "%s/%s.err", cli_workdir(), tag);
+    snprintf(stats, sizeof stats, "%s/%s.stats.json", test_workdir(), tag);
+    snprintf(png, sizeof png, "%s/%s.png", test_workdir(), tag);
+    snprintf(err, sizeof err, "%s/%s.err", test_workdir(), tag);
     snprintf(cmd, sizeof cmd, "'%s' render '%s' -o '%s' --stats '%s' --width 8 --height 8 %s >/dev/null 2>'%s'",
              cli_binary(), scene, png, stats, extra, err);
     int status = system(cmd);
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
         fail_msg("%s: radiosity render %s exited with %d", tag, extra, status);
-    char *text = cli_read_text(err);
+    char *text = test_read_file(err, NULL);
     assert_non_null(text);
     snprintf(errors, size, "%s", text);
     free(text);

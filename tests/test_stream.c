@@ -28,6 +28,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include <dirent.h>
 #include <math.h>
 #include <pthread.h>
@@ -83,27 +85,10 @@ static const char *in_folder(const char *name)
     return path[next];
 }
 
-/* The whole file, NUL-terminated; *size its bytes. */
-static char *slurp(const char *path, size_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *text = malloc((size_t)len + 1);
-    assert_non_null(text);
-    assert_int_equal(fread(text, 1, (size_t)len, f), (size_t)len);
-    text[len] = '\0';
-    fclose(f);
-    *size = (size_t)len;
-    return text;
-}
-
 static void assert_same_file(const char *a, const char *b)
 {
     size_t na, nb;
-    char *ta = slurp(a, &na), *tb = slurp(b, &nb);
+    char *ta = test_read_file(a, &na), *tb = test_read_file(b, &nb);
     if (na != nb || memcmp(ta, tb, na) != 0) {
         size_t k = 0;
         while (k < na && k < nb && ta[k] == tb[k])
@@ -182,7 +167,7 @@ static dense_ff dense_stats(rad_solution *sol)
 {
     assert_int_equal(rad_solution_write_stats(ctx, sol, in_folder("dense.stats.json"), false), RAD_OK);
     size_t size;
-    char *text = slurp(in_folder("dense.stats.json"), &size);
+    char *text = test_read_file(in_folder("dense.stats.json"), &size);
     cJSON *root = cJSON_Parse(text);
     free(text);
     cJSON *ff = cJSON_GetObjectItem(root, "form_factors");

@@ -59,14 +59,6 @@ static rad_result solve_with(rad_context *ctx, problem *pb, const char *solver, 
     return rad_thermal_solve_system(ctx, &sys, rad_solver_find(solver), &p, &out, &pb->balance, &st);
 }
 
-static rad_context *context(void)
-{
-    rad_context *ctx = NULL;
-    rad_context_options o = {.threads = 1};
-    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
-    return ctx;
-}
-
 /* The floor (A1 = 1) of a closed unit cube against the other five faces
  * as one surface (A2 = 5): F_12 = 1, F_21 = 1/5, F_22 = 4/5. */
 static void two_surface(problem *pb, double eps1, double eps2)
@@ -82,7 +74,7 @@ static void two_surface(problem *pb, double eps1, double eps2)
 static void test_two_surface_enclosure(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     two_surface(&pb, 0.8, 0.5);
     pb.known_t[0] = pb.known_t[1] = 1;
@@ -126,7 +118,7 @@ static void duct_345(problem *pb)
 static void test_reradiating_wall(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     duct_345(&pb);
     double e1 = 0.6, e2 = 0.8, T1 = 800.0, T2 = 400.0;
@@ -162,7 +154,7 @@ static void test_reradiating_wall(void **state)
 static void test_open_plate(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     memset(&pb, 0, sizeof pb);
     pb.n = 1;
@@ -222,7 +214,7 @@ static void mixed_conditions(problem *pb)
 static void test_energy_balance(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb, ref;
     cube(&pb, 6);
     mixed_conditions(&pb);
@@ -272,7 +264,7 @@ static void test_energy_balance(void **state)
 static void test_gebhart(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     cube(&pb, 6);
     mixed_conditions(&pb);
@@ -327,7 +319,7 @@ static void test_gebhart(void **state)
 static void test_undetermined(void **state)
 {
     (void)state;
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     problem pb;
     cube(&pb, 6);
     for (size_t i = 0; i < 6; i++)
@@ -355,9 +347,9 @@ static void test_undetermined(void **state)
 static void write_box(const char *name, double rho_floor, double ke_floor, double rho_walls, double ke_walls,
                       char *path, size_t size)
 {
-    snprintf(path, size, "%s/%s.obj", cli_workdir(), name);
+    snprintf(path, size, "%s/%s.obj", test_workdir(), name);
     char mtl[600];
-    snprintf(mtl, sizeof mtl, "%s/%s.mtl", cli_workdir(), name);
+    snprintf(mtl, sizeof mtl, "%s/%s.mtl", test_workdir(), name);
     FILE *m = fopen(mtl, "w");
     assert_non_null(m);
     fprintf(m, "newmtl f\nKd %.17g %.17g %.17g\nKe %.17g %.17g %.17g\n", rho_floor, rho_floor, rho_floor, ke_floor,
@@ -383,7 +375,7 @@ typedef struct box_run {
 
 static void box_open(box_run *b, const char *path, double mesh_size, int closure)
 {
-    b->ctx = context();
+    b->ctx = test_context(1);
     assert_int_equal(rad_scene_load_file(b->ctx, path, &b->scene), RAD_OK);
     rad_options o = {.solver = "direct", .mesh_size = mesh_size, .closure_correction = closure};
     assert_int_equal(rad_solution_create(b->ctx, b->scene, &o, &b->sol), RAD_OK);
@@ -542,7 +534,7 @@ static void test_long_duct(void **state)
              "o bottom\nf 1 2 3 4\no top\nf 5 6 7 8\no side0\nf 1 5 8 2\no side1\nf 4 3 7 6\n"
              "o cap0\nf 1 4 6 5\no cap1\nf 2 8 7 3\n",
              L, L, L, L);
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_memory(ctx, "duct.obj", obj, strlen(obj), NULL, 0, &scene), RAD_OK);
     rad_options o = {.solver = "direct", .mesh_size = 1.0};
@@ -604,7 +596,7 @@ static void test_obstruction_surfaces(void **state)
                               "V 1 0 0 0\nV 2 1 0 0\nV 3 1 1 0\nV 4 0 1 0\n"
                               "V 5 -.5 -.5 .2\nV 6 -.5 1.5 .2\nV 7 1.5 1.5 .2\nV 8 1.5 -.5 .2\n"
                               "S 1 1 2 3 4 0 0 0.7 plate\nO 2 5 6 7 8 0 0 0.5 lid\nE\n";
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_memory(ctx, "lid.vs3", vs3, strlen(vs3), NULL, 0, &scene), RAD_OK);
     rad_thermal_conditions *c = NULL;
@@ -649,7 +641,7 @@ static void test_bad_conditions(void **state)
     (void)state;
     char path[600];
     write_box("box_bad", 0.5, 0.0, 0.5, 0.0, path, sizeof path);
-    rad_context *ctx = context();
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_load_file(ctx, path, &scene), RAD_OK);
     static const struct {
@@ -748,7 +740,7 @@ static double csv_value(const char *text, const char *name, int column)
 static void test_command(void **state)
 {
     (void)state;
-    const char *dir = cli_workdir();
+    const char *dir = test_workdir();
     char cmd_args[2048];
     /* The furnace of docs/thermal.md: the roof gives 30 kW/m^2 x 2 m^2 to
      * the hearth at 700 K through adiabatic walls. */
@@ -759,7 +751,7 @@ static void test_command(void **state)
     assert_int_equal(cli_run("%s", cmd_args), 0);
     char path[600];
     snprintf(path, sizeof path, "%s/heat.csv", dir);
-    char *csv = cli_read_text(path);
+    char *csv = test_read_file(path, NULL);
     assert_non_null(csv);
     assert_true(strncmp(csv, "surface,condition,area_m2,emissivity,temperature_K,radiosity_W_m2,irradiation_W_m2,"
                              "heat_flux_W_m2,heat_W\n", 105) == 0);
@@ -823,7 +815,7 @@ static void test_command(void **state)
     fclose(f);
     snprintf(errors, sizeof errors, "%s/errors.txt", dir);
     assert_int_equal(cli_run_capture(errors, "thermal %s/furnace.obj --bc %s -o %s", RAD_TEST_DATA, bc, path), 1);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     assert_non_null(strstr(text, "bad_bc.json: surfaces.hearth.emissivity: must be in (0, 1], got 2"));
     free(text);
@@ -841,7 +833,7 @@ static void test_command(void **state)
 static void test_solvers_without_f(void **state)
 {
     (void)state;
-    const char *dir = cli_workdir();
+    const char *dir = test_workdir();
     char path[600], errors[600];
     snprintf(path, sizeof path, "%s/refused.csv", dir);
     snprintf(errors, sizeof errors, "%s/refused.txt", dir);
@@ -863,7 +855,7 @@ static void test_solvers_without_f(void **state)
                  "radiosity: --solver %s keeps no form-factor matrix: thermal takes direct, gauss-seidel, jacobi, "
                  "southwell or conjugate-gradient (see radiosity thermal --help)\n",
                  name);
-        char *text = cli_read_text(errors);
+        char *text = test_read_file(errors, NULL);
         assert_non_null(text);
         assert_string_equal(text, expected);
         free(text);

@@ -11,6 +11,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "radiosity.h"
 #include "output/output.h"
 #include "scene/scene.h"
@@ -19,14 +21,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static rad_context *make_context(int threads)
-{
-    rad_context_options co = {.threads = threads};
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
-    return ctx;
-}
 
 static void keep_warning(void *user, const char *message)
 {
@@ -65,7 +59,7 @@ static const char *four_quads = "mtllib two.mtl\n"
 static void test_mtl_specular_read(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     const char *mtl = "newmtl mirror\nKd 0.1 0.1 0.1\nKs 0.8 0.7 0.6\nillum 3\n"
                       "newmtl glossy\nKd 0.2 0.2 0.2\nKs 0.5\nNs 40\nillum 5\n"
                       "newmtl glass\nKd 0 0 0\nNi 1.45\nd 0.25\nillum 7\n"
@@ -106,7 +100,7 @@ static void test_mtl_specular_read(void **state)
 static void test_mtl_specular_energy(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     const char *mtl = "newmtl mirror\nKd 0.1 0.1 0.1\nKs 0.8 0.8 0.8\nillum 3\n"
                       "newmtl glossy\nKd 0.5 0.5 0.5\nillum 3\nKs 0.4 0.6 0.4\n"
                       "newmtl glass\nKd 0 0 0\nillum 7\n"
@@ -139,7 +133,7 @@ static void test_mtl_specular_energy(void **state)
 static void test_gltf_specular_read(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     const char *gltf =
         "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0,\n"
         " \"extensionsUsed\": [\"KHR_materials_transmission\", \"KHR_lights_punctual\", "
@@ -220,7 +214,7 @@ static double parallel_rectangle(double a1, double a2, double b1, double b2, dou
 static void test_mirror_image_irradiance(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(2);
+    rad_context *ctx = test_context(2);
     const char *obj = "mtllib two.mtl\n"
                       "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
                       "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 0 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
@@ -344,7 +338,7 @@ static void test_mirror_solvers(void **state)
 static void test_mirror_power_balance(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(2);
+    rad_context *ctx = test_context(2);
     const char *obj = "mtllib two.mtl\n"
                       "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
                       "o floor\nusemtl mirror\nf 1 5 6 2\n"
@@ -409,7 +403,7 @@ static double render_mean(rad_context *ctx, const rad_scene *scene, const char *
 static void test_render_mirror(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     const char *obj = "mtllib two.mtl\n"
                       "o mirror\nusemtl mirror\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n"
                       "o lamp\nusemtl lamp\nv -50 -50 5\nv -50 50 5\nv 50 50 5\nv 50 -50 5\nf 5 6 7 8\n";
@@ -433,7 +427,7 @@ static void test_render_mirror(void **state)
 static void test_render_glass_pane(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     const char *obj = "mtllib two.mtl\n"
                       "o front\nusemtl glass\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n"
                       "o back\nusemtl glass\nv -1 -1 -0.1\nv -1 1 -0.1\nv 1 1 -0.1\nv 1 -1 -0.1\nf 5 6 7 8\n"
@@ -460,7 +454,7 @@ static void test_render_glass_pane(void **state)
 static void test_render_glossy(void **state)
 {
     (void)state;
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     const char *obj = "mtllib two.mtl\n"
                       "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n"
                       "o floor\nusemtl glossy\nf 1 5 6 2\n"
@@ -477,7 +471,7 @@ static void test_render_glossy(void **state)
     double seen = render_mean(ctx, scene, camera, 8, 0, 64, &one);
     print_message("glossy floor: %.6f, closed form 0.7\n", seen);
     assert_true(fabs(seen - 0.7) < 2e-3 * 0.7);
-    rad_context *ctx3 = make_context(3);
+    rad_context *ctx3 = test_context(3);
     render_mean(ctx3, scene, camera, 8, 0, 64, &three);
     assert_memory_equal(one, three, 8 * 8 * 3 * sizeof(float));
     free(one);

@@ -83,7 +83,7 @@ static void read_vf(const char *path, vf_file *v)
 static void run_vs3(const char *name, const char *extra, vf_file *v)
 {
     char out[512];
-    snprintf(out, sizeof out, "%s/%s.vf", cli_workdir(), name);
+    snprintf(out, sizeof out, "%s/%s.vf", test_workdir(), name);
     assert_int_equal(cli_run("viewfactors %s%s.vs3 -o %s --elements 400 %s", DATA, name, out, extra), 0);
     read_vf(out, v);
 }
@@ -116,7 +116,7 @@ static void test_binary(void **state)
 {
     (void)state;
     char out[512];
-    snprintf(out, sizeof out, "%s/binary.vf", cli_workdir());
+    snprintf(out, sizeof out, "%s/binary.vf", test_workdir());
     assert_int_equal(cli_run("viewfactors %sparallel_binary.vs3 -o %s --elements 400", DATA, out), 0);
     /* out=1: a 32-byte header ending in CR LF, then float32 areas, rows
      * and emissivities, nothing more (View3D's SaveF1). */
@@ -185,7 +185,7 @@ static void test_blocker(void **state)
 {
     (void)state;
     char out[512];
-    snprintf(out, sizeof out, "%s/blocker.vf", cli_workdir());
+    snprintf(out, sizeof out, "%s/blocker.vf", test_workdir());
     assert_int_equal(cli_run("viewfactors %sblocker.vs3 -o %s", DATA, out), 0);
     vf_file v;
     read_vf(out, &v);
@@ -449,8 +449,8 @@ static void test_sparse_threshold(void **state)
 {
     (void)state;
     char out[512], errors[512];
-    snprintf(out, sizeof out, "%s/cube.mtx", cli_workdir());
-    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
+    snprintf(out, sizeof out, "%s/cube.mtx", test_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", test_workdir());
     /* 0.2 drops the opposite faces (0.19982): 24 factors kept, rows still 1. */
     assert_int_equal(cli_run("viewfactors %scube.vs3 -o %s --elements 400 --smooth enclosure "
                              "--sparse-threshold 0.2", DATA, out), 0);
@@ -476,7 +476,7 @@ static void test_sparse_threshold(void **state)
     for (int i = 0; i < 6; i++)
         assert_float_equal(F[i * 6 + (i + 1) % 6], 0.25, 1e-12);
     /* Options that cannot apply: usage errors before any work. */
-    snprintf(line, sizeof line, "%s/cube.json", cli_workdir());
+    snprintf(line, sizeof line, "%s/cube.json", test_workdir());
     assert_int_equal(cli_run_capture(errors, "viewfactors %scube.vs3 -o %s --sparse-threshold 0.1", DATA, line), 2);
     assert_int_equal(cli_run_capture(errors, "viewfactors %scube.vs3 -o %s --level element --smooth open", DATA,
                                      out), 2);
@@ -532,16 +532,16 @@ static void test_bad_files(void **state)
     expect_error(HEAD "V 5 2 2 0\nS 1 1 2 3 4 0 0 0.5 a\nS 2 1 2 5 0 1 0 0.5 b\n", 9, "not inside");
     /* The program: a line-numbered error, exit 1, nothing written. */
     char bad[512], out[512], errors[512];
-    snprintf(bad, sizeof bad, "%s/bad.vs3", cli_workdir());
-    snprintf(out, sizeof out, "%s/bad.vf", cli_workdir());
-    snprintf(errors, sizeof errors, "%s/errors.txt", cli_workdir());
+    snprintf(bad, sizeof bad, "%s/bad.vs3", test_workdir());
+    snprintf(out, sizeof out, "%s/bad.vf", test_workdir());
+    snprintf(errors, sizeof errors, "%s/errors.txt", test_workdir());
     FILE *f = fopen(bad, "w");
     assert_non_null(f);
     fputs(HEAD "S 1 1 2 3 4 0 0 0.5 a\nS 2 1 2 3 0 0 0 zero b\n", f);
     fclose(f);
     assert_int_equal(cli_run_capture(errors, "viewfactors %s -o %s", bad, out), 1);
     assert_int_not_equal(access(out, F_OK), 0);
-    char *text = cli_read_text(errors);
+    char *text = test_read_file(errors, NULL);
     assert_non_null(text);
     assert_non_null(strstr(text, "bad.vs3:8: surface 2: emissivity"));
     free(text);
@@ -599,10 +599,10 @@ static rad_result sweep_once(uint64_t fail_at, const char *folder)
 static void test_allocation_sweep(void **state)
 {
     (void)state;
-    assert_int_equal(sweep_once(0, cli_workdir()), RAD_OK);
+    assert_int_equal(sweep_once(0, test_workdir()), RAD_OK);
     uint64_t k = 1;
     for (; k < 100000; k++)
-        if (sweep_once(k, cli_workdir()) == RAD_OK)
+        if (sweep_once(k, test_workdir()) == RAD_OK)
             break;
     assert_true(k > 20); /* the path does allocate, and every failure was reported */
 }

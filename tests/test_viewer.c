@@ -39,6 +39,8 @@
 
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "output/output.h"
 #include "viewer.h"
 
@@ -51,14 +53,6 @@
 #include <unistd.h>
 
 static rv_offscreen *offscreen;
-
-static rad_context *new_context(int threads)
-{
-    rad_context_options co = {.threads = threads};
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
-    return ctx;
-}
 
 /* The Cornell box solved (or only made, solve = false) with `solver`. */
 static rad_solution *cornell(rad_context *ctx, rad_scene **scene, const char *solver, size_t elements,
@@ -120,7 +114,7 @@ static frame_difference compare(const float *a, const float *b, double exposure)
 
 static void frame_against_render(rad_shading shading)
 {
-    rad_context *ctx = new_context(0);
+    rad_context *ctx = test_context(0);
     rad_scene *scene = NULL;
     rad_solution *solution = cornell(ctx, &scene, "gauss-seidel", 1000, NULL, true);
     rad_camera camera;
@@ -278,7 +272,7 @@ static void run_free(run *r)
 static void progressive_moves_toward_solution(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     run r;
     rad_solution *solution = progressive_run(ctx, &scene, false, &r);
@@ -389,7 +383,7 @@ static double power(const double *area, const double *rgb, size_t n)
 static void progressive_hierarchical_meshes(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     rv_step_slot slot = {NULL, NULL};
     rad_solution *solution = cornell(ctx, &scene, "hierarchical", 0, &slot, false);
@@ -534,7 +528,7 @@ static rv_status wait_for(rv_progress *p, uint64_t *generation, uint64_t at_leas
 static void pause_and_stop_keep_a_solution(void **state)
 {
     (void)state;
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_scene *scene = NULL;
     rv_step_slot slot = {NULL, NULL};
     rad_solution *solution = cornell(ctx, &scene, "shooting", 600, &slot, false);
@@ -608,7 +602,7 @@ static void camera_orbit_and_text(void **state)
     assert_true(c.position[1] > 1.0); /* pitched up: the eye rises */
     char text[512];
     rv_camera_text(&c, text, sizeof text);
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_camera parsed;
     assert_int_equal(rad_camera_from_string(ctx, text, &parsed), RAD_OK);
     rad_camera back = rv_camera_to(&c);
@@ -697,7 +691,7 @@ static void cli_window_script(void **state)
     assert_non_null(line);
     char text[512];
     assert_int_equal(sscanf(line + 9, "%511s", text), 1);
-    rad_context *ctx = new_context(1);
+    rad_context *ctx = test_context(1);
     rad_camera printed, expected;
     assert_int_equal(rad_camera_from_string(ctx, text, &printed), RAD_OK);
     rad_scene *box = NULL;

@@ -9,6 +9,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "test_support.h"
+
 #include "vis/vis.h"
 
 #include <stdlib.h>
@@ -17,13 +19,6 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
-
-#define assert_near(a, b, tol)                                                              \
-    do {                                                                                    \
-        double a_ = (a), b_ = (b), tol_ = (tol);                                            \
-        if (!(fabs(a_ - b_) <= tol_))                                                       \
-            fail_msg("%s = %.17g, %s = %.17g, differ by more than %g", #a, a_, #b, b_, tol_); \
-    } while (0)
 
 /* ---- scenes, built by hand (patches only: that is all vis reads) ---- */
 
@@ -94,15 +89,6 @@ static void make_scene(test_scene *s, vec3 offset)
     }
 }
 
-static rad_context *make_context(int threads)
-{
-    rad_context_options o = {0};
-    o.threads = threads;
-    rad_context *ctx = NULL;
-    assert_int_equal(rad_context_create(&o, &ctx), RAD_OK);
-    return ctx;
-}
-
 static rad_vis *make_vis(rad_context *ctx, const char *name, const rad_mesh *mesh)
 {
     rad_vis *vis = NULL;
@@ -123,7 +109,7 @@ static void test_embree_matches_brute(void **unused)
     (void)unused;
     test_scene *s = calloc(1, sizeof *s);
     make_scene(s, v3(0, 0, 0));
-    rad_context *ctx = make_context(2);
+    rad_context *ctx = test_context(2);
     rad_vis *embree = make_vis(ctx, "embree", &s->mesh);
     rad_vis *brute = make_vis(ctx, "brute", &s->mesh);
 
@@ -192,7 +178,7 @@ static void test_thread_safety(void **unused)
     (void)unused;
     test_scene *s = calloc(1, sizeof *s);
     make_scene(s, v3(0, 0, 0));
-    rad_context *ctx = make_context(4);
+    rad_context *ctx = test_context(4);
     rad_vis *embree = make_vis(ctx, "embree", &s->mesh);
     enum { N = 40000, CHUNK = 64 };
     rad_ray *rays = calloc(N, sizeof *rays);
@@ -236,7 +222,7 @@ static void check_epsilon(vec3 offset)
 {
     test_scene *s = calloc(1, sizeof *s);
     make_scene(s, offset);
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     double eps = rad_vis_epsilon(&s->mesh);
     for (const rad_vis_backend *const *b = rad_vis_backends; *b; b++) {
         rad_vis *vis = make_vis(ctx, (*b)->name, &s->mesh);
@@ -309,7 +295,7 @@ static void test_segment_limits(void **unused)
     vec3 tri[3] = {{-1, -1, 2}, {1, -1, 2}, {-1, 1, 2}};
     add_patch(s, quad, 4);
     add_patch(s, tri, 3);
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     for (const rad_vis_backend *const *b = rad_vis_backends; *b; b++) {
         rad_vis *vis = make_vis(ctx, (*b)->name, &s->mesh);
         const vec3 o = {-0.1, -0.2, -1.0}, up = {0, 0, 1};
@@ -354,7 +340,7 @@ static void test_empty_scene(void **unused)
 {
     (void)unused;
     rad_mesh mesh = {0};
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     for (const rad_vis_backend *const *b = rad_vis_backends; *b; b++) {
         rad_vis *vis = make_vis(ctx, (*b)->name, &mesh);
         rad_ray ray = {v3(0, 0, 0), v3(1, 0, 0), 0.0, INFINITY};
@@ -382,7 +368,7 @@ static void test_registry(void **unused)
     assert_null(rad_vis_find(NULL));
 
     rad_mesh mesh = {0};
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     rad_vis *vis = (rad_vis *)&mesh; /* must be reset to NULL */
     assert_int_equal(rad_vis_create(ctx, "optix", &mesh, &vis), RAD_ERROR_INVALID_ARGUMENT);
     assert_null(vis);
@@ -399,7 +385,7 @@ static void test_speed(void **unused)
     (void)unused;
     test_scene *s = calloc(1, sizeof *s);
     make_scene(s, v3(0, 0, 0));
-    rad_context *ctx = make_context(1);
+    rad_context *ctx = test_context(1);
     enum { N = 200000 };
     rad_ray *rays = calloc(N, sizeof *rays);
     uint8_t *occluded = calloc(N, 1);

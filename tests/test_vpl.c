@@ -39,8 +39,8 @@ static const char *cube_faces[6] = {"x0", "x1", "y0", "y1", "z0", "z1"};
 static cJSON *render_stats(const char *scene, const char *extra)
 {
     char stats[700], png[700];
-    snprintf(stats, sizeof stats, "%s/stats.json", cli_workdir());
-    snprintf(png, sizeof png, "%s/out.png", cli_workdir());
+    snprintf(stats, sizeof stats, "%s/stats.json", test_workdir());
+    snprintf(png, sizeof png, "%s/out.png", test_workdir());
     assert_int_equal(cli_run("render %s -o '%s' --stats '%s' --width 16 --height 16 %s", scene, png, stats, extra), 0);
     cJSON *j = cli_read_json(stats);
     assert_non_null(j);
@@ -252,7 +252,7 @@ static float *read_pfm(const char *path, int *w, int *h)
 static float *render_pfm(const char *scene, const char *extra, int *w, int *h)
 {
     char out[700];
-    snprintf(out, sizeof out, "%s/pixels.pfm", cli_workdir());
+    snprintf(out, sizeof out, "%s/pixels.pfm", test_workdir());
     assert_int_equal(cli_run("render %s -o '%s' --quiet %s", scene, out, extra), 0);
     float *px = read_pfm(out, w, h);
     assert_non_null(px);

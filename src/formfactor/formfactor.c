@@ -245,27 +245,13 @@ rad_result rad_ff_escape_rays(rad_context *ctx, const rad_mesh *mesh, const rad_
         if (e->vertex_count == 4)
             for (int k = 1; k < 4; k++)
                 lift += fabs(v3_dot(e->normal, v3_sub(mesh->vertices[e->vertex[k]], mesh->vertices[e->vertex[0]])));
-        vec3 nrm = e->normal;
-        vec3 t = v3_normalize(fabs(nrm.x) > 0.9 ? v3_cross(nrm, v3(0, 1, 0)) : v3_cross(nrm, v3(1, 0, 0)));
-        vec3 b = v3_cross(nrm, t);
         rad_rng rng = rad_rng_keyed(seed ^ 0x436c6f736564ULL, i, 0); /* "Closed" */
         rad_ray ray[BLOCK];
         rad_hit hit[BLOCK];
         int missed = 0;
         for (int first = 0; first < rays; first += BLOCK) {
             int count = rays - first < BLOCK ? rays - first : BLOCK;
-            for (int k = 0; k < count; k++) {
-                /* Directions stratified over the disk (Malley), points uniform. */
-                int cell = (first + k) % (side * side);
-                double u = ((cell % side) + rad_rng_uniform(&rng)) / side;
-                double v = ((cell / side) + rad_rng_uniform(&rng)) / side;
-                double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
-                double r = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
-                ray[k].origin = v3_mad(rad_element_sample(mesh, e, pu, pv), nrm, lift);
-                ray[k].direction = v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(nrm, z));
-                ray[k].tnear = 0.0;
-                ray[k].tfar = INFINITY;
-            }
+            rad_element_cosine_rays(mesh, e, lift, side, first, count, &rng, ray);
             vis->backend->intersect(vis->state, ray, (size_t)count, hit);
             for (int k = 0; k < count; k++)
                 missed += !isfinite(hit[k].t);

@@ -227,6 +227,15 @@ double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, dou
  * the hemicube's faces and of the hemisphere's directions.  Cannot fail. */
 void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v);
 
+/* Rays first .. first + count - 1 of a bundle leaving element e by the
+ * cosine law (Malley): ray k's direction in cell k mod side^2 of a side x
+ * side stratification of the unit disk, lifted to the hemisphere about
+ * e's normal; its origin uniform on e (rad_element_sample), independent of
+ * the direction, lifted by `lift` (m) along the normal; tnear 0, tfar
+ * infinite.  Four draws from rng per ray.  Cannot fail. */
+void rad_element_cosine_rays(const rad_mesh *mesh, const rad_element *e, double lift, int side, int first,
+                             int count, rad_rng *rng, rad_ray *ray);
+
 /* The four children of a quad (bilinear midpoints) or a triangle (midpoint
  * subdivision, the middle child last), same orientation as the parent:
  * the adaptive quadratures' refinement step (analytic, hemicube).  A

@@ -2,7 +2,8 @@
  * polygon.c -- the unoccluded point-to-polygon form factor; and the small
  * helpers the sampling methods share: the bend of a quad (how far ray end
  * points must be lifted), the density of rad_element_sample, the tangent
- * frame of an element and the split of a region into four.
+ * frame of an element, its bundles of cosine-distributed rays and the
+ * split of a region into four.
  *
  * Lambert's contour formula (Lambert 1760; in radiosity: Baum, Rushmeier &
  * Winget, SIGGRAPH 1989; Cohen & Wallace 1993, sec. 4.6):
@@ -113,6 +114,25 @@ void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v)
     vec3 a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
     *u = v3_normalize(v3_sub(a, v3_scale(n, v3_dot(a, n))));
     *v = v3_cross(n, *u);
+}
+
+void rad_element_cosine_rays(const rad_mesh *mesh, const rad_element *e, double lift, int side, int first,
+                             int count, rad_rng *rng, rad_ray *ray)
+{
+    vec3 n = e->normal;
+    vec3 t = v3_normalize(fabs(n.x) > 0.9 ? v3_cross(n, v3(0, 1, 0)) : v3_cross(n, v3(1, 0, 0)));
+    vec3 b = v3_cross(n, t);
+    for (int k = 0; k < count; k++) {
+        int cell = (first + k) % (side * side);
+        double u = ((cell % side) + rad_rng_uniform(rng)) / side;
+        double v = ((cell / side) + rad_rng_uniform(rng)) / side;
+        double pu = rad_rng_uniform(rng), pv = rad_rng_uniform(rng);
+        double r = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
+        ray[k].origin = v3_mad(rad_element_sample(mesh, e, pu, pv), n, lift);
+        ray[k].direction = v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(n, z));
+        ray[k].tnear = 0.0;
+        ray[k].tfar = INFINITY;
+    }
 }
 
 void rad_ff_split4(const vec3 *region, uint32_t corners, vec3 sub[4][4])

@@ -71,27 +71,12 @@ static rad_result closure_rays(rad_context *ctx, const rad_ff_request *req, doub
             continue;
         const rad_element *e = &mesh->elements[i];
         double lift = eps + rad_element_bend(mesh, e);
-        vec3 nrm = e->normal;
-        vec3 t = v3_normalize(fabs(nrm.x) > 0.9 ? v3_cross(nrm, v3(0, 1, 0)) : v3_cross(nrm, v3(1, 0, 0)));
-        vec3 b = v3_cross(nrm, t);
         rad_rng rng = rad_rng_keyed(req->seed ^ 0x436c6f73757265ULL, i, 1); /* "Closure" */
         rad_ray ray[BLOCK];
         rad_hit hit[BLOCK];
         int met = 0;
         for (int first = 0; first < CLOSURE_RAYS; first += BLOCK) {
-            for (int k = 0; k < BLOCK; k++) {
-                /* Directions stratified over the disk (Malley), points uniform. */
-                int cell = first + k;
-                double u = ((cell % side) + rad_rng_uniform(&rng)) / side;
-                double v = ((cell / side) + rad_rng_uniform(&rng)) / side;
-                double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
-                double r = sqrt(u), phi = 2.0 * M_PI * v, z = sqrt(fmax(0.0, 1.0 - u));
-                ray[k].origin = v3_mad(rad_element_sample(mesh, e, pu, pv), nrm, lift);
-                ray[k].direction =
-                    v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(nrm, z));
-                ray[k].tnear = 0.0;
-                ray[k].tfar = INFINITY;
-            }
+            rad_element_cosine_rays(mesh, e, lift, side, first, BLOCK, &rng, ray);
             req->vis->backend->intersect(req->vis->state, ray, BLOCK, hit);
             for (int k = 0; k < BLOCK; k++)
                 met += isfinite(hit[k].t) && v3_dot(ray[k].direction, mesh->patches[hit[k].patch].normal) < 0.0;

@@ -53,6 +53,41 @@ static void element_geometry(rad_element *e, const vec3 corner[4])
                                 : c1;
 }
 
+/* Each element's corners from the grid points or leaf corners it was made
+ * of (raw), its vertex indices then made the welded ones; returns the
+ * elements' total area, m^2.  Cannot fail. */
+static double weld_elements(rad_mesh *mesh, const raw_vertex *raw, const uint32_t *weld_of)
+{
+    double area = 0.0;
+    for (size_t i = 0; i < mesh->element_count; i++) {
+        rad_element *e = &mesh->elements[i];
+        vec3 corner[4] = {{0}}; /* 3 or 4 set: the vertex counts are 3 or 4 */
+        for (uint32_t c = 0; c < e->vertex_count; c++) {
+            corner[c] = raw[e->vertex[c]].position;
+            e->vertex[c] = weld_of[e->vertex[c]];
+        }
+        element_geometry(e, corner);
+        area += e->area;
+    }
+    return area;
+}
+
+/* The end of a build that got as far as welding: the scratch freed, and
+ * the mesh measured (rad_mesh_measure) into *out, or destroyed when r is a
+ * failure. */
+static rad_result build_done(rad_result r, rad_mesh *mesh, raw_vertex *raw, uint32_t *weld_of, rad_mesh **out)
+{
+    rad_free(raw);
+    rad_free(weld_of);
+    if (r != RAD_OK) {
+        rad_mesh_destroy(mesh);
+        return r;
+    }
+    rad_mesh_measure(mesh);
+    *out = mesh;
+    return RAD_OK;
+}
+
 rad_result rad_mesh_build(rad_context *ctx, const rad_scene *scene, const rad_mesh_options *opt,
                           rad_mesh **out)
 {
@@ -143,15 +178,7 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
     r = mesh_weld(ctx, mesh, raw, nraw, tol, cos(o.crease_angle_degrees * M_PI / 180.0), weld_of,
                   &mesh->vertices, &mesh->vertex_count);
     if (r == RAD_OK) {
-        for (size_t i = 0; i < mesh->element_count; i++) {
-            rad_element *e = &mesh->elements[i];
-            vec3 corner[4];
-            for (uint32_t c = 0; c < e->vertex_count; c++) {
-                corner[c] = raw[e->vertex[c]].position;
-                e->vertex[c] = weld_of[e->vertex[c]];
-            }
-            element_geometry(e, corner);
-        }
+        weld_elements(mesh, raw, weld_of);
         /* The search grid: the edge length, or the typical element size
          * where that is smaller (a hierarchical base mesh asks for one
          * element per patch with an infinite edge length; one cell would
@@ -160,15 +187,7 @@ rad_result rad_mesh_build_within(rad_context *ctx, const rad_scene *scene,
         double hg = fmax(fmin(h, typical), 10.0 * tol);
         r = mesh_find_tvertices(ctx, mesh, tol, hg, cos(o.crease_angle_degrees * M_PI / 180.0));
     }
-    rad_free(raw);
-    rad_free(weld_of);
-    if (r != RAD_OK) {
-        rad_mesh_destroy(mesh);
-        return r;
-    }
-    rad_mesh_measure(mesh);
-    *out = mesh;
-    return RAD_OK;
+    return build_done(r, mesh, raw, weld_of, out);
 }
 
 rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const rad_mesh *base,
@@ -223,7 +242,6 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
         mesh->patches[p].first_element = 0;
     }
     size_t k = 0;
-    double area = 0.0;
     for (size_t i = 0; i < leaf_count; i++) {
         const rad_mesh_leaf *l = &leaves[i];
         rad_patch *p = &mesh->patches[l->patch];
@@ -255,30 +273,13 @@ rad_result rad_mesh_from_leaves(rad_context *ctx, const rad_scene *scene, const 
     rad_result r = mesh_weld(ctx, mesh, raw, nraw, tol, cos(crease * M_PI / 180.0), weld_of,
                              &mesh->vertices, &mesh->vertex_count);
     if (r == RAD_OK) {
-        for (size_t i = 0; i < leaf_count; i++) {
-            rad_element *e = &mesh->elements[i];
-            vec3 corner[4];
-            for (uint32_t c = 0; c < e->vertex_count; c++) {
-                corner[c] = raw[e->vertex[c]].position;
-                e->vertex[c] = weld_of[e->vertex[c]];
-            }
-            element_geometry(e, corner);
-            area += e->area;
-        }
+        double area = weld_elements(mesh, raw, weld_of);
         /* The T-vertex search grid: about the typical leaf size. */
         double h = leaf_count ? sqrt(area / (double)leaf_count) : 1.0;
         mesh->mesh_size = h;
         r = mesh_find_tvertices(ctx, mesh, tol, h > tol ? h : tol, cos(crease * M_PI / 180.0));
     }
-    rad_free(raw);
-    rad_free(weld_of);
-    if (r != RAD_OK) {
-        rad_mesh_destroy(mesh);
-        return r;
-    }
-    rad_mesh_measure(mesh);
-    *out = mesh;
-    return RAD_OK;
+    return build_done(r, mesh, raw, weld_of, out);
 }
 
 void rad_mesh_measure(rad_mesh *mesh)

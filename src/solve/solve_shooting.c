@@ -35,6 +35,7 @@
 #include "solve/solve.h"
 #include "mesh/mesh.h"
 #include "vis/vis.h"
+#include "formfactor/formfactor.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -106,9 +107,6 @@ static void shoot_rays(const rad_context *ctx, const rad_system *sys, uint32_t i
     if (e->vertex_count == 4)
         for (int k = 1; k < 4; k++)
             lift += fabs(v3_dot(e->normal, v3_sub(mesh->vertices[e->vertex[k]], mesh->vertices[e->vertex[0]])));
-    vec3 n = e->normal;
-    vec3 t = v3_normalize(fabs(n.x) > 0.9 ? v3_cross(n, v3(0, 1, 0)) : v3_cross(n, v3(1, 0, 0)));
-    vec3 b = v3_cross(n, t);
     rad_rng rng = rad_rng_keyed(sys->seed, key, i);
     int side = (int)sqrt((double)N);
     if (side < 1)
@@ -117,23 +115,9 @@ static void shoot_rays(const rad_context *ctx, const rad_system *sys, uint32_t i
         if (rad_cancelled(ctx))
             return; /* the caller discards the batch */
         int count = N - first < RAY_BLOCK ? N - first : RAY_BLOCK;
-        for (int k = 0; k < count; k++) {
-            int s = first + k;
-            /* Directions stratified over the disk (Malley); origins uniform
-             * and independent of the direction (tying the two strata by a
-             * fixed rule would bias the estimate). */
-            int cell = s % (side * side);
-            double u = ((cell % side) + rad_rng_uniform(&rng)) / side;
-            double v = ((cell / side) + rad_rng_uniform(&rng)) / side;
-            double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
-            double r = sqrt(u), phi = 2.0 * M_PI * v;
-            double z = sqrt(fmax(0.0, 1.0 - u));
-            vec3 dir = v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(n, z));
-            rays[k].origin = v3_mad(rad_element_sample(mesh, e, pu, pv), n, lift);
-            rays[k].direction = dir;
-            rays[k].tnear = 0.0;
-            rays[k].tfar = INFINITY;
-        }
+        /* Origins independent of the directions: tying the two strata by a
+         * fixed rule would bias the estimate. */
+        rad_element_cosine_rays(mesh, e, lift, side, first, count, &rng, rays);
         sys->vis->backend->intersect(sys->vis->state, rays, (size_t)count, hits);
         for (int k = 0; k < count; k++) {
             out[first + k].element = UINT32_MAX;

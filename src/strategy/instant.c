@@ -171,18 +171,11 @@ static void compensate_element(const rad_meshed *m, double radius, uint32_t i, d
     const rad_mesh *mesh = m->mesh;
     const rad_element *e = &mesh->elements[i];
     double lift = eps + rad_element_bend(mesh, e);
-    vec3 n = e->normal;
-    vec3 t = v3_normalize(fabs(n.x) > 0.9 ? v3_cross(n, v3(0, 1, 0)) : v3_cross(n, v3(1, 0, 0)));
-    vec3 b = v3_cross(n, t);
     rad_rng rng = rad_rng_keyed(m->options->seed, 0x49525f43u, i); /* "IR_C" */
     enum { SIDE = 4 }; /* SIDE^2 = COMPENSATION_RAYS strata of the disk */
-    for (int k = 0; k < COMPENSATION_RAYS; k++) {
-        double u = ((k % SIDE) + rad_rng_uniform(&rng)) / SIDE, v = ((k / SIDE) + rad_rng_uniform(&rng)) / SIDE;
-        double pu = rad_rng_uniform(&rng), pv = rad_rng_uniform(&rng);
-        double r = sqrt(u), phi = 2.0 * M_PI * v;
-        vec3 dir = v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(n, sqrt(fmax(0.0, 1.0 - u))));
-        rays[k] = (rad_ray){v3_mad(rad_element_sample(mesh, e, pu, pv), n, lift), dir, 0.0, radius};
-    }
+    rad_element_cosine_rays(mesh, e, lift, SIDE, 0, COMPENSATION_RAYS, &rng, rays);
+    for (int k = 0; k < COMPENSATION_RAYS; k++)
+        rays[k].tfar = radius;
     m->vis->backend->intersect(m->vis->state, rays, COMPENSATION_RAYS, hits);
     H[0] = H[1] = H[2] = 0.0;
     for (int k = 0; k < COMPENSATION_RAYS; k++) {
