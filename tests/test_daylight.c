@@ -43,6 +43,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1057,7 +1058,7 @@ static void cie171_5_10_facade_overcast(void **state) { (void)state; cie171_case
 
 int main(int argc, char **argv)
 {
-    const struct CMUnitTest tests[] = {
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_overcast_horizontal),
         cmocka_unit_test(test_general_sky_quadrature),
         cmocka_unit_test(test_general_sky_values),
@@ -1077,7 +1078,6 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_allocation_failures),
         cmocka_unit_test(test_example_file),
-        cmocka_unit_test(test_command),
         cmocka_unit_test(test_threads_agree),
         cmocka_unit_test(cie171_5_9_roof_type1),
         cmocka_unit_test(cie171_5_9_roof_type3),
@@ -1088,14 +1088,23 @@ int main(int argc, char **argv)
         cmocka_unit_test(cie171_5_10_facade_type12),
         cmocka_unit_test(cie171_5_10_facade_overcast),
     };
-    if (argc < 2)
+    /* The command on the daylit room's view factors: with --slow alone
+     * (CTest: test_daylight_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_command),
+    };
+    if (argc < 2 || argc > 3) {
+        fprintf(stderr, "usage: test_daylight PATH_TO_RADIOSITY [--slow | FILTER]\n");
         return 2;
+    }
     cli_set_binary(argv[1]);
-    if (argc > 2)
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc == 3 && !slow)
         cmocka_set_test_filter(argv[2]); /* "cie171_*": the CIE 171 cases alone */
     if (cli_setup("daylight") != 0)
         return 1;
-    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = slow ? cmocka_run_group_tests_name("daylight_slow", slow_tests, NULL, NULL)
+                      : cmocka_run_group_tests_name("daylight", fast_tests, NULL, NULL);
     cli_teardown();
     return failed;
 }
