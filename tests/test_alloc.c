@@ -11,9 +11,10 @@
  * writers that had finished, and give all its memory back (the accounting
  * returns to 0; the sanitizer build checks for leaks and bad frees).
  *
- *   test_alloc           every 97th k of each sweep (the quick run: a sample
- *                        of each scenario's failure paths, for the sanitizers)
- *   test_alloc --full    every k (CTest test_alloc_full, label slow)
+ *   test_alloc             the allocator's cases, no sweep (the quick run)
+ *   test_alloc --every N   and every N-th k of each sweep (the quick run of
+ *                          the sanitizer build: --every 97)
+ *   test_alloc --full      and every k (CTest test_alloc_full, label slow)
  */
 #include "api/solution.h"
 
@@ -33,7 +34,7 @@
 
 #include <cmocka.h>
 
-static int stride = 97; /* --full: 1 */
+static int stride = 1; /* --every N */
 
 /* ---- the scene: a closed unit box, normals inward, a glowing ceiling ---- */
 
@@ -859,14 +860,29 @@ static void test_messages_one_line(void **state)
 
 int main(int argc, char **argv)
 {
-    bool full = argc == 2 && strcmp(argv[1], "--full") == 0;
-    if (argc > 2 || (argc == 2 && !full)) {
-        fprintf(stderr, "usage: test_alloc [--full]\n");
+    bool sweep = false;
+    if (argc == 2 && strcmp(argv[1], "--full") == 0) {
+        sweep = true;
+    } else if (argc == 3 && strcmp(argv[1], "--every") == 0) {
+        char *end = NULL;
+        long every = strtol(argv[2], &end, 10);
+        sweep = *argv[2] && !*end && every >= 1 && every <= 1000000;
+        stride = (int)every;
+    }
+    if (argc > 1 && !sweep) {
+        fprintf(stderr, "usage: test_alloc [--full | --every N]\n");
         return 2;
     }
-    if (full)
-        stride = 1;
-    const struct CMUnitTest tests[] = {
+    const struct CMUnitTest fast_tests[] = {
+        cmocka_unit_test(test_limit),
+        cmocka_unit_test(test_context_outlived),
+        cmocka_unit_test(test_loading_limit),
+        cmocka_unit_test(test_default_limit),
+        cmocka_unit_test(test_stats_by_category),
+        cmocka_unit_test(test_messages_one_line),
+    };
+    /* The same, and the sweep: every allocation (--full) or every N-th failing. */
+    const struct CMUnitTest sweep_tests[] = {
         cmocka_unit_test(test_limit),
         cmocka_unit_test(test_context_outlived),
         cmocka_unit_test(test_loading_limit),
@@ -875,5 +891,6 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_messages_one_line),
         cmocka_unit_test(test_fail_each_allocation),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return sweep ? cmocka_run_group_tests_name("alloc_sweep", sweep_tests, setup, teardown)
+                 : cmocka_run_group_tests_name("alloc", fast_tests, setup, teardown);
 }

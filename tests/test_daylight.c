@@ -1072,7 +1072,6 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_flux_through_roof),
         cmocka_unit_test(test_daylight_only_solve),
         cmocka_unit_test(test_sky_seen_through_opening),
-        cmocka_unit_test(test_daylight_room_energy),
         cmocka_unit_test(test_openings_leave_the_scene),
         cmocka_unit_test(test_opening_in_the_open),
         cmocka_unit_test(test_bad_files),
@@ -1088,9 +1087,10 @@ int main(int argc, char **argv)
         cmocka_unit_test(cie171_5_10_facade_type12),
         cmocka_unit_test(cie171_5_10_facade_overcast),
     };
-    /* The command on the daylit room's view factors: with --slow alone
-     * (CTest: test_daylight_slow, label slow). */
+    /* The daylit room solved on the engine's mesh, and the command on its
+     * view factors: with --slow alone (CTest: test_daylight_slow, label slow). */
     const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_daylight_room_energy),
         cmocka_unit_test(test_command),
     };
     if (argc < 2 || argc > 3) {

@@ -952,8 +952,9 @@ static int teardown(void **state)
 
 int main(int argc, char **argv)
 {
-    /* "--slow": the 10^6-triangle test and the ten generated rooms instead
-     * of the quick ones (CTest: test_hostile_slow, label slow). */
+    /* "--slow": the sealed partition (up to 3,000 elements), the ten
+     * generated rooms and the 10^6-triangle test instead of the quick ones
+     * (CTest: test_hostile_slow, label slow). */
     bool slow = argc == 2 && strcmp(argv[1], "--slow") == 0;
     if (argc > 2 || (argc == 2 && !slow)) {
         fprintf(stderr, "usage: test_hostile [--slow]\n");
@@ -972,11 +973,11 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_camera_distance),
         cmocka_unit_test(test_scale_ratio),
         cmocka_unit_test(test_two_separate_rooms),
-        cmocka_unit_test(test_sealed_partition),
         cmocka_unit_test(test_open_scene),
         cmocka_unit_test(test_allocation_overflow),
     };
     const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_sealed_partition),
         cmocka_unit_test(test_closed_rooms_are_components),
         cmocka_unit_test(test_million_tiny_triangles),
     };

@@ -1335,7 +1335,6 @@ int main(int argc, char **argv)
         cmocka_unit_test_setup_teardown(test_outputs_aliasing_each_other, setup, teardown),
         cmocka_unit_test_setup_teardown(test_all_or_none, setup, teardown),
         cmocka_unit_test_setup_teardown(test_names_in_every_output, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_signal_during_form_factors, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_solve_with_progress_images, setup, teardown),
         cmocka_unit_test_setup_teardown(test_second_signal_while_saving, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_final_render, setup, teardown),
@@ -1344,6 +1343,7 @@ int main(int argc, char **argv)
     };
     /* At scale: with --slow alone (CTest: test_outputs_slow, label slow). */
     const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test_setup_teardown(test_signal_during_form_factors, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_each_solver, setup, teardown),
     };
     return slow ? cmocka_run_group_tests_name("outputs_slow", slow_tests, NULL, NULL)
