@@ -11,10 +11,12 @@
  * writers that had finished, and give all its memory back (the accounting
  * returns to 0; the sanitizer build checks for leaks and bad frees).
  *
- *   test_alloc             the allocator's cases, no sweep (the quick run)
- *   test_alloc --every N   and every N-th k of each sweep (the quick run of
- *                          the sanitizer build: --every 97)
- *   test_alloc --full      and every k (CTest test_alloc_full, label slow)
+ *   test_alloc                        the allocator's cases, no sweep (the quick run)
+ *   test_alloc --every N [--offset R] and the k = R+1, R+1+N, R+1+2N, ... of each
+ *                                     sweep (the sanitizer build's quick run:
+ *                                     --every 97; CTest test_alloc_full_1 and _2,
+ *                                     label slow: --every 2 --offset 0 and 1)
+ *   test_alloc --full                 and every k (= --every 1)
  */
 #include "api/solution.h"
 
@@ -34,7 +36,7 @@
 
 #include <cmocka.h>
 
-static int stride = 1; /* --every N */
+static int stride = 1, offset = 0; /* --every N --offset R */
 
 /* ---- the scene: a closed unit box, normals inward, a glowing ceiling ---- */
 
@@ -460,7 +462,7 @@ static void sweep(const scenario *sc)
     assert_int_equal(again, n);
     clear_outputs();
     printf("    %s: %llu allocations\n", sc->name, (unsigned long long)n);
-    for (uint64_t k = 1; k <= n; k += (uint64_t)stride) {
+    for (uint64_t k = 1 + (uint64_t)offset; k <= n; k += (uint64_t)stride) {
         uint64_t count;
         rad_result r = run_once(sc, k, &out, error, sizeof error, &count);
         if (r != RAD_ERROR_OUT_OF_MEMORY || !strstr(error, "(test hook: allocation") || strchr(error, '\n'))
@@ -858,19 +860,28 @@ static void test_messages_one_line(void **state)
     rad_context_destroy(ctx);
 }
 
+/* A count on the command line: decimal digits, at most 10^6; -1 otherwise. */
+static long count_argument(const char *text)
+{
+    char *end = NULL;
+    long value = strtol(text, &end, 10);
+    return *text >= '0' && *text <= '9' && !*end && value <= 1000000 ? value : -1;
+}
+
 int main(int argc, char **argv)
 {
     bool sweep = false;
     if (argc == 2 && strcmp(argv[1], "--full") == 0) {
         sweep = true;
-    } else if (argc == 3 && strcmp(argv[1], "--every") == 0) {
-        char *end = NULL;
-        long every = strtol(argv[2], &end, 10);
-        sweep = *argv[2] && !*end && every >= 1 && every <= 1000000;
+    } else if (strcmp(argc > 1 ? argv[1] : "", "--every") == 0 &&
+               (argc == 3 || (argc == 5 && strcmp(argv[3], "--offset") == 0))) {
+        long every = count_argument(argv[2]), from = argc == 5 ? count_argument(argv[4]) : 0;
+        sweep = every >= 1 && from >= 0 && from < every;
         stride = (int)every;
+        offset = (int)from;
     }
     if (argc > 1 && !sweep) {
-        fprintf(stderr, "usage: test_alloc [--full | --every N]\n");
+        fprintf(stderr, "usage: test_alloc [--full | --every N [--offset R]] (0 <= R < N)\n");
         return 2;
     }
     const struct CMUnitTest fast_tests[] = {
