@@ -17,6 +17,7 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -346,7 +347,13 @@ int main(int argc, char **argv)
         return 2;
     }
     cli_set_binary(argv[1]);
-    const struct CMUnitTest tests[] = {
+    /* "--slow" after the program's path: the cases at scale instead of the quick ones. */
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc > 3 || (argc == 3 && !slow)) {
+        fprintf(stderr, "usage: test_accuracy PATH_TO_RADIOSITY [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_parallel_squares),
         cmocka_unit_test(test_perpendicular_shared_edge),
         cmocka_unit_test(test_coaxial_disks),
@@ -356,9 +363,13 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_furnace_southwell),
         cmocka_unit_test(test_six_patch_gauss_seidel),
         cmocka_unit_test(test_six_patch_southwell),
-        cmocka_unit_test(test_shooting_exact_cases),
         cmocka_unit_test(test_embree_matches_brute_force),
         cmocka_unit_test(test_cornell_box_closure_and_energy),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    /* At scale: with --slow alone (CTest: test_accuracy_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_shooting_exact_cases),
+    };
+    return slow ? cmocka_run_group_tests_name("accuracy_slow", slow_tests, setup, teardown)
+                : cmocka_run_group_tests_name("accuracy", fast_tests, setup, teardown);
 }

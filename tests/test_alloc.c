@@ -11,8 +11,12 @@
  * writers that had finished, and give all its memory back (the accounting
  * returns to 0; the sanitizer build checks for leaks and bad frees).
  *
- *   test_alloc           every 7th k of each sweep (the unit run)
- *   test_alloc --full    every k (label slow)
+ *   test_alloc                        the allocator's cases, no sweep (the quick run)
+ *   test_alloc --every N [--offset R] and the k = R+1, R+1+N, R+1+2N, ... of each
+ *                                     sweep (the sanitizer build's quick run:
+ *                                     --every 97; CTest test_alloc_full_1 and _2,
+ *                                     label slow: --every 2 --offset 0 and 1)
+ *   test_alloc --full                 and every k (= --every 1)
  */
 #include "api/solution.h"
 
@@ -32,7 +36,7 @@
 
 #include <cmocka.h>
 
-static int stride = 7;
+static int stride = 1, offset = 0; /* --every N --offset R */
 
 /* ---- the scene: a closed unit box, normals inward, a glowing ceiling ---- */
 
@@ -458,7 +462,7 @@ static void sweep(const scenario *sc)
     assert_int_equal(again, n);
     clear_outputs();
     printf("    %s: %llu allocations\n", sc->name, (unsigned long long)n);
-    for (uint64_t k = 1; k <= n; k += (uint64_t)stride) {
+    for (uint64_t k = 1 + (uint64_t)offset; k <= n; k += (uint64_t)stride) {
         uint64_t count;
         rad_result r = run_once(sc, k, &out, error, sizeof error, &count);
         if (r != RAD_ERROR_OUT_OF_MEMORY || !strstr(error, "(test hook: allocation") || strchr(error, '\n'))
@@ -856,11 +860,40 @@ static void test_messages_one_line(void **state)
     rad_context_destroy(ctx);
 }
 
+/* A count on the command line: decimal digits, at most 10^6; -1 otherwise. */
+static long count_argument(const char *text)
+{
+    char *end = NULL;
+    long value = strtol(text, &end, 10);
+    return *text >= '0' && *text <= '9' && !*end && value <= 1000000 ? value : -1;
+}
+
 int main(int argc, char **argv)
 {
-    if (argc > 1 && strcmp(argv[1], "--full") == 0)
-        stride = 1;
-    const struct CMUnitTest tests[] = {
+    bool sweep = false;
+    if (argc == 2 && strcmp(argv[1], "--full") == 0) {
+        sweep = true;
+    } else if (strcmp(argc > 1 ? argv[1] : "", "--every") == 0 &&
+               (argc == 3 || (argc == 5 && strcmp(argv[3], "--offset") == 0))) {
+        long every = count_argument(argv[2]), from = argc == 5 ? count_argument(argv[4]) : 0;
+        sweep = every >= 1 && from >= 0 && from < every;
+        stride = (int)every;
+        offset = (int)from;
+    }
+    if (argc > 1 && !sweep) {
+        fprintf(stderr, "usage: test_alloc [--full | --every N [--offset R]] (0 <= R < N)\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
+        cmocka_unit_test(test_limit),
+        cmocka_unit_test(test_context_outlived),
+        cmocka_unit_test(test_loading_limit),
+        cmocka_unit_test(test_default_limit),
+        cmocka_unit_test(test_stats_by_category),
+        cmocka_unit_test(test_messages_one_line),
+    };
+    /* The same, and the sweep: every allocation (--full) or every N-th failing. */
+    const struct CMUnitTest sweep_tests[] = {
         cmocka_unit_test(test_limit),
         cmocka_unit_test(test_context_outlived),
         cmocka_unit_test(test_loading_limit),
@@ -869,5 +902,6 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_messages_one_line),
         cmocka_unit_test(test_fail_each_allocation),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return sweep ? cmocka_run_group_tests_name("alloc_sweep", sweep_tests, setup, teardown)
+                 : cmocka_run_group_tests_name("alloc", fast_tests, setup, teardown);
 }

@@ -878,7 +878,13 @@ int main(int argc, char **argv)
         return 2;
     }
     cli_set_binary(argv[1]);
-    const struct CMUnitTest tests[] = {
+    /* "--slow" after the program's path: the cases at scale instead of the quick ones. */
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc > 3 || (argc == 3 && !slow)) {
+        fprintf(stderr, "usage: test_cli PATH_TO_RADIOSITY [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_malformed_obj),
         cmocka_unit_test(test_face_index_out_of_range),
@@ -909,9 +915,13 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_viewfactors_csv),
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_interrupt_writes_partial),
-        cmocka_unit_test(test_interrupt_during_form_factors),
-        cmocka_unit_test(test_limits),
         cmocka_unit_test(test_loading_limits),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    /* At scale: with --slow alone (CTest: test_cli_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_interrupt_during_form_factors),
+        cmocka_unit_test(test_limits),
+    };
+    return slow ? cmocka_run_group_tests_name("cli_slow", slow_tests, setup, teardown)
+                : cmocka_run_group_tests_name("cli", fast_tests, setup, teardown);
 }

@@ -43,6 +43,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -1039,7 +1040,7 @@ static void cie171_5_10_facade_overcast(void **state) { (void)state; cie171_case
 
 int main(int argc, char **argv)
 {
-    const struct CMUnitTest tests[] = {
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_overcast_horizontal),
         cmocka_unit_test(test_general_sky_quadrature),
         cmocka_unit_test(test_general_sky_values),
@@ -1053,13 +1054,11 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_flux_through_roof),
         cmocka_unit_test(test_daylight_only_solve),
         cmocka_unit_test(test_sky_seen_through_opening),
-        cmocka_unit_test(test_daylight_room_energy),
         cmocka_unit_test(test_openings_leave_the_scene),
         cmocka_unit_test(test_opening_in_the_open),
         cmocka_unit_test(test_bad_files),
         cmocka_unit_test(test_allocation_failures),
         cmocka_unit_test(test_example_file),
-        cmocka_unit_test(test_command),
         cmocka_unit_test(test_threads_agree),
         cmocka_unit_test(cie171_5_9_roof_type1),
         cmocka_unit_test(cie171_5_9_roof_type3),
@@ -1070,14 +1069,24 @@ int main(int argc, char **argv)
         cmocka_unit_test(cie171_5_10_facade_type12),
         cmocka_unit_test(cie171_5_10_facade_overcast),
     };
-    if (argc < 2)
+    /* The daylit room solved on the engine's mesh, and the command on its
+     * view factors: with --slow alone (CTest: test_daylight_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_daylight_room_energy),
+        cmocka_unit_test(test_command),
+    };
+    if (argc < 2 || argc > 3) {
+        fprintf(stderr, "usage: test_daylight PATH_TO_RADIOSITY [--slow | FILTER]\n");
         return 2;
+    }
     cli_set_binary(argv[1]);
-    if (argc > 2)
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc == 3 && !slow)
         cmocka_set_test_filter(argv[2]); /* "cie171_*": the CIE 171 cases alone */
     if (cli_setup("daylight") != 0)
         return 1;
-    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    int failed = slow ? cmocka_run_group_tests_name("daylight_slow", slow_tests, NULL, NULL)
+                      : cmocka_run_group_tests_name("daylight", fast_tests, NULL, NULL);
     cli_teardown();
     return failed;
 }

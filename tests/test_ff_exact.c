@@ -717,7 +717,13 @@ int main(int argc, char **argv)
         return 2;
     }
     cli_set_binary(argv[1]);
-    const struct CMUnitTest tests[] = {
+    /* "--slow" after the program's path: the cases at scale instead of the quick ones. */
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc > 3 || (argc == 3 && !slow)) {
+        fprintf(stderr, "usage: test_ff_exact PATH_TO_RADIOSITY [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_contour_parallel_squares),
         cmocka_unit_test(test_contour_perpendicular_shared_edge),
         cmocka_unit_test(test_contour_skew_fans),
@@ -725,15 +731,19 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_contour_cube),
         cmocka_unit_test(test_contour_disks),
         cmocka_unit_test(test_analytic_defaults),
-        cmocka_unit_test(test_hybrid_documented_error),
         cmocka_unit_test(test_hybrid_switch),
-        cmocka_unit_test(test_occluded_squares),
         cmocka_unit_test(test_closure_closed_cube),
-        cmocka_unit_test(test_closure_open_scene),
         cmocka_unit_test(test_matrix_market_export),
         cmocka_unit_test(test_thread_count_independent),
+    };
+    /* At scale: with --slow alone (CTest: test_ff_exact_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_hybrid_documented_error),
+        cmocka_unit_test(test_occluded_squares),
+        cmocka_unit_test(test_closure_open_scene),
         cmocka_unit_test(test_cornell_contour),
         cmocka_unit_test(test_cornell_hybrid),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return slow ? cmocka_run_group_tests_name("ff_exact_slow", slow_tests, setup, teardown)
+                : cmocka_run_group_tests_name("ff_exact", fast_tests, setup, teardown);
 }

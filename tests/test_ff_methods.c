@@ -27,6 +27,7 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -473,7 +474,13 @@ int main(int argc, char **argv)
         return 2;
     }
     cli_set_binary(argv[1]);
-    const struct CMUnitTest tests[] = {
+    /* "--slow" after the program's path: the cases at scale instead of the quick ones. */
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc > 3 || (argc == 3 && !slow)) {
+        fprintf(stderr, "usage: test_ff_methods PATH_TO_RADIOSITY [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_hemicube_delta_factors),
         cmocka_unit_test(test_hemicube_parallel_squares),
         cmocka_unit_test(test_hemicube_perpendicular_shared_edge),
@@ -491,11 +498,15 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_montecarlo_cube),
         cmocka_unit_test(test_montecarlo_occluded),
         cmocka_unit_test(test_trapezoids),
+    };
+    /* At scale: with --slow alone (CTest: test_ff_methods_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
         cmocka_unit_test(test_cornell_contour),
         cmocka_unit_test(test_cornell_hybrid),
         cmocka_unit_test(test_cornell_hemicube),
         cmocka_unit_test(test_cornell_hemisphere),
         cmocka_unit_test(test_cornell_montecarlo),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return slow ? cmocka_run_group_tests_name("ff_methods_slow", slow_tests, setup, teardown)
+                : cmocka_run_group_tests_name("ff_methods", fast_tests, setup, teardown);
 }

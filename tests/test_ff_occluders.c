@@ -28,6 +28,8 @@
 #include "formfactor/formfactor.h"
 #include "scene/scene.h"
 
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -274,15 +276,25 @@ static void test_box_without_cube(void **state)
     check_box(20, false, 2e-5);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    const struct CMUnitTest tests[] = {
+    /* "--slow": the cases at scale instead of the quick ones. */
+    bool slow = argc == 2 && strcmp(argv[1], "--slow") == 0;
+    if (argc > 2 || (argc == 2 && !slow)) {
+        fprintf(stderr, "usage: test_ff_occluders [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_verdicts_against_rays),
         cmocka_unit_test(test_verdicts_cornell),
         cmocka_unit_test(test_visible_point_factor),
         cmocka_unit_test(test_box_8),
-        cmocka_unit_test(test_box_20),
         cmocka_unit_test(test_box_without_cube),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    /* At scale: with --slow alone (CTest: test_ff_occluders_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_box_20),
+    };
+    return slow ? cmocka_run_group_tests_name("ff_occluders_slow", slow_tests, NULL, NULL)
+                : cmocka_run_group_tests_name("ff_occluders", fast_tests, NULL, NULL);
 }

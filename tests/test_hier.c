@@ -22,6 +22,8 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <stdbool.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -756,9 +758,15 @@ static void test_diverging_links_refused(void **state)
     rad_scene_destroy(scene);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    const struct CMUnitTest tests[] = {
+    /* "--slow": the cases at scale instead of the quick ones. */
+    bool slow = argc == 2 && strcmp(argv[1], "--slow") == 0;
+    if (argc > 2 || (argc == 2 && !slow)) {
+        fprintf(stderr, "usage: test_hier [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_closed_box_energy),
         cmocka_unit_test(test_contact_line_energy),
@@ -766,12 +774,16 @@ int main(void)
         cmocka_unit_test(test_classic_oracle),
         cmocka_unit_test(test_leaves_locate),
         cmocka_unit_test(test_thread_count_independent),
-        cmocka_unit_test(test_clusters_office),
         cmocka_unit_test(test_furnace_clusters),
         cmocka_unit_test(test_cluster_sampling),
-        cmocka_unit_test(test_office_energy),
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_diverging_links_refused),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    /* At scale: with --slow alone (CTest: test_hier_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_clusters_office),
+        cmocka_unit_test(test_office_energy),
+    };
+    return slow ? cmocka_run_group_tests_name("hier_slow", slow_tests, setup, teardown)
+                : cmocka_run_group_tests_name("hier", fast_tests, setup, teardown);
 }

@@ -929,8 +929,14 @@ static int teardown(void **state)
 
 int main(int argc, char **argv)
 {
-    /* "--slow" adds the 10^6-triangle test (CTest: test_hostile_slow). */
-    bool slow = argc > 1 && strcmp(argv[1], "--slow") == 0;
+    /* "--slow": the sealed partition (up to 3,000 elements), the ten
+     * generated rooms and the 10^6-triangle test instead of the quick ones
+     * (CTest: test_hostile_slow, label slow). */
+    bool slow = argc == 2 && strcmp(argv[1], "--slow") == 0;
+    if (argc > 2 || (argc == 2 && !slow)) {
+        fprintf(stderr, "usage: test_hostile [--slow]\n");
+        return 2;
+    }
     const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_coplanar_overlapping),
         cmocka_unit_test(test_interpenetrating_solids),
@@ -944,12 +950,12 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_camera_distance),
         cmocka_unit_test(test_scale_ratio),
         cmocka_unit_test(test_two_separate_rooms),
-        cmocka_unit_test(test_sealed_partition),
-        cmocka_unit_test(test_closed_rooms_are_components),
         cmocka_unit_test(test_open_scene),
         cmocka_unit_test(test_allocation_overflow),
     };
     const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_sealed_partition),
+        cmocka_unit_test(test_closed_rooms_are_components),
         cmocka_unit_test(test_million_tiny_triangles),
     };
     return slow ? cmocka_run_group_tests_name("hostile_slow", slow_tests, setup, teardown)

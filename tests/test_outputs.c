@@ -1232,7 +1232,13 @@ int main(int argc, char **argv)
         return 2;
     }
     cli_set_binary(argv[1]);
-    const struct CMUnitTest tests[] = {
+    /* "--slow" after the program's path: the cases at scale instead of the quick ones. */
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc > 3 || (argc == 3 && !slow)) {
+        fprintf(stderr, "usage: test_outputs PATH_TO_RADIOSITY [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test_setup_teardown(test_temporary_names, setup, teardown),
         cmocka_unit_test_setup_teardown(test_output_targets, setup, teardown),
         cmocka_unit_test_setup_teardown(test_output_set_all_or_none, setup, teardown),
@@ -1248,13 +1254,17 @@ int main(int argc, char **argv)
         cmocka_unit_test_setup_teardown(test_outputs_aliasing_each_other, setup, teardown),
         cmocka_unit_test_setup_teardown(test_all_or_none, setup, teardown),
         cmocka_unit_test_setup_teardown(test_names_in_every_output, setup, teardown),
-        cmocka_unit_test_setup_teardown(test_signal_during_form_factors, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_solve_with_progress_images, setup, teardown),
         cmocka_unit_test_setup_teardown(test_second_signal_while_saving, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_final_render, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_generate, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_load, setup, teardown),
+    };
+    /* At scale: with --slow alone (CTest: test_outputs_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test_setup_teardown(test_signal_during_form_factors, setup, teardown),
         cmocka_unit_test_setup_teardown(test_signal_during_each_solver, setup, teardown),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    return slow ? cmocka_run_group_tests_name("outputs_slow", slow_tests, NULL, NULL)
+                : cmocka_run_group_tests_name("outputs", fast_tests, NULL, NULL);
 }

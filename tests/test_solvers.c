@@ -762,19 +762,29 @@ int main(int argc, char **argv)
         return 2;
     }
     cli_set_binary(argv[1]);
-    const struct CMUnitTest tests[] = {
+    /* "--slow" after the program's path: the cases at scale instead of the quick ones. */
+    bool slow = argc == 3 && strcmp(argv[2], "--slow") == 0;
+    if (argc > 3 || (argc == 3 && !slow)) {
+        fprintf(stderr, "usage: test_solvers PATH_TO_RADIOSITY [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
         cmocka_unit_test(test_registry),
-        cmocka_unit_test(test_cornell_box_against_direct),
         cmocka_unit_test(test_six_patch_exact),
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_separate_rooms),
-        cmocka_unit_test(test_relaxation),
         cmocka_unit_test(test_history),
         cmocka_unit_test(test_conjugate_gradient_restarts),
         cmocka_unit_test(test_direct_memory_limit),
-        cmocka_unit_test(test_thread_count),
         cmocka_unit_test(test_bright_boxes_dense),
+    };
+    /* At scale: with --slow alone (CTest: test_solvers_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_cornell_box_against_direct),
+        cmocka_unit_test(test_relaxation),
+        cmocka_unit_test(test_thread_count),
         cmocka_unit_test(test_bright_boxes_matrix_free),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return slow ? cmocka_run_group_tests_name("solvers_slow", slow_tests, setup, teardown)
+                : cmocka_run_group_tests_name("solvers", fast_tests, setup, teardown);
 }

@@ -33,6 +33,7 @@
 #include <dirent.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -487,14 +488,28 @@ static void test_adjusted_surface_factors(void **state)
     assert_int_equal(temporaries(), 0);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_identity_analytic), cmocka_unit_test(test_identity_hybrid),
-        cmocka_unit_test(test_identity_hemicube_raw), cmocka_unit_test(test_memory_limit),
-        cmocka_unit_test(test_refusals), cmocka_unit_test(test_cancellation),
-        cmocka_unit_test(test_two_ranks), cmocka_unit_test(test_three_ranks),
+    /* "--slow": the cases at scale instead of the quick ones. */
+    bool slow = argc == 2 && strcmp(argv[1], "--slow") == 0;
+    if (argc > 2 || (argc == 2 && !slow)) {
+        fprintf(stderr, "usage: test_stream [--slow]\n");
+        return 2;
+    }
+    const struct CMUnitTest fast_tests[] = {
+        cmocka_unit_test(test_identity_hybrid),
+        cmocka_unit_test(test_memory_limit),
+        cmocka_unit_test(test_refusals),
+        cmocka_unit_test(test_cancellation),
+        cmocka_unit_test(test_two_ranks),
+        cmocka_unit_test(test_three_ranks),
         cmocka_unit_test(test_adjusted_surface_factors),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    /* At scale: with --slow alone (CTest: test_stream_slow, label slow). */
+    const struct CMUnitTest slow_tests[] = {
+        cmocka_unit_test(test_identity_analytic),
+        cmocka_unit_test(test_identity_hemicube_raw),
+    };
+    return slow ? cmocka_run_group_tests_name("stream_slow", slow_tests, setup, teardown)
+                : cmocka_run_group_tests_name("stream", fast_tests, setup, teardown);
 }
