@@ -678,6 +678,10 @@ static rad_result assemble_collocation(rad_context *ctx, galerkin_state *st)
     double eps = rad_vis_epsilon(mesh);
     uint64_t rays = 0, pairs = 0;
     volatile int cancelled = 0; /* raised by any thread (formfactor.c's pattern) */
+    /* The start reported from the calling thread: a cancellation asked at
+     * this stage is seen by the first row of every thread, whichever rows
+     * thread 0 (the one that reports within the loop) happens to get. */
+    rad_progress(ctx, "collocation kernel", 0, dofs);
 #pragma omp parallel for schedule(dynamic, 16) num_threads(st->base.threads) reduction(+ : rays, pairs)
     for (long k = 0; k < (long)dofs; k++) {
         if (cancelled)
