@@ -76,11 +76,13 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
         mirrors |= scene->materials[m].specular_kind == RAD_SPECULAR_MIRROR;
     unsigned can = rad_strategy_capabilities(s->options.solver);
     if (mirrors && (can & RAD_REFUSES_MIRRORS)) {
+        /* The message first: the solver's name lives in s. */
+        r = rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                     "%s: solver '%s' reads F_ji through reciprocity, which light through mirrors "
+                     "does not keep; use gauss-seidel, jacobi, direct or conjugate-gradient",
+                     scene->source, s->options.solver);
         rad_free(s);
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: solver '%s' reads F_ji through reciprocity, which light through mirrors "
-                        "does not keep; use gauss-seidel, jacobi, direct or conjugate-gradient",
-                        scene->source, s->options.solver);
+        return r;
     }
     if (mirrors && !(can & RAD_CAN_MIRRORS))
         rad_warn(ctx,
