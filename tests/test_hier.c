@@ -105,26 +105,25 @@ static void test_furnace(void **state)
     rad_solution_power(s, &emitted, &absorbed);
     assert_true(relative(absorbed, emitted) < 1e-5);
     rad_solution_destroy(s);
-    /* Refined: links at many levels; the answer stays within the oracle's
-     * bound and tightens with epsilon. */
-    double err[2];
-    const double eps[2] = {1e-3, 1e-5};
-    for (int i = 0; i < 2; i++) {
+    /* Refined: links at many levels, a leaf reading its ancestors' mean
+     * factors; the balance (hier.c) holds every leaf's row and column sum
+     * to 1, so every leaf, not only the means, is exact.  Unbalanced the
+     * leaves ran from -0.4% to +0.5% at 1e-3 and the box made 0.1%. */
+    const double eps[3] = {1e-3, 1e-4, 1e-5};
+    for (int i = 0; i < 3; i++) {
         s = solve(scene, eps[i], 0);
         assert_true(s->view.hier->leaves > 100);
-        err[i] = 0.0;
-        for (size_t k = 0; k < scene->surface_count; k++) {
-            double B[3];
-            rad_solution_surface_radiosity(s, k, B);
-            err[i] = fmax(err[i], relative(B[0], 2.0));
-        }
+        assert_true(s->view.hier->balanced_leaves == s->view.hier->leaves);
+        double worst = 0.0;
+        for (size_t e = 0; e < s->view.n; e++)
+            for (int c = 0; c < 3; c++)
+                worst = fmax(worst, relative(s->view.radiosity[3 * e + (size_t)c], 2.0));
+        if (!(worst < 1e-4))
+            fail_msg("epsilon %g: a leaf %.3g off B = 2", eps[i], worst);
         rad_solution_power(s, &emitted, &absorbed);
-        assert_true(relative(absorbed, emitted) < 1e-2);
+        assert_true(relative(absorbed, emitted) < 1e-5);
         rad_solution_destroy(s);
     }
-    assert_true(err[0] < 5e-3);
-    assert_true(err[1] < 2e-4);
-    assert_true(err[1] < err[0]);
     rad_scene_destroy(scene);
 }
 
@@ -175,9 +174,11 @@ static void test_closed_box_energy(void **state)
  * without the open-fraction correction (hier.c, measure_open) 0.32% of the
  * power vanished there, with it 0.06%.  Now the floor is cut along the
  * footprint: the piece under the block sends nothing, the rest is open.
- * What remains is the links' own error along the new 90-degree edges
+ * What remained was the links' own error along the new 90-degree edges
  * between floor pieces and block faces (leaf closures up to 1.27 there):
- * +0.27% measured, bounded here at 0.4%. */
+ * +0.27%.  The balance (hier.c) holds the leaves' sums to 1 until it
+ * stalls (the links' visibility is estimated, so not reciprocal):
+ * -0.06% measured, bounded here at 0.15%. */
 static void test_contact_line_energy(void **state)
 {
     (void)state;
@@ -203,7 +204,7 @@ static void test_contact_line_energy(void **state)
     rad_solution *s = solve(scene, 3e-5, 0);
     double emitted, absorbed;
     rad_solution_power(s, &emitted, &absorbed);
-    if (!(relative(absorbed, emitted) < 4e-3))
+    if (!(relative(absorbed, emitted) < 1.5e-3))
         fail_msg("absorbed %.9g W, emitted %.9g W", absorbed, emitted);
     rad_solution_destroy(s);
     rad_scene_destroy(scene);

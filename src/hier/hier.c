@@ -45,9 +45,12 @@ typedef struct hr_state {
     float *open;          /* per node: fraction of its area outside every solid; -1 for a
                              leaf not measured yet (see measure_open) */
     float *send;          /* per node: 1 / open (0 when closed): the gather's source scale */
-    float *corr;          /* per leaf: closure correction, 1 / closure (NULL when off) */
+    float *corr;          /* per leaf: the source scale y of the balance (balance()), or
+                             1 / closure (--closure-correction); 1 until then */
+    float *gain;          /* per leaf: the receiver scale x of the balance; 1 until then */
+    uint8_t *escape;      /* per leaf: how many of measure_open's rays left the scene */
     double *Bsend;        /* 3 per node: what sources send, B with the leaves' corr
-                             pulled up (= B when corr is NULL) */
+                             pulled up */
     double *bins_in;      /* 18 per cluster: [channel][signed axis] */
     double *bins_total;   /* 18 per cluster, pushed down */
     double *bins_exit;    /* 18 per cluster, pulled up: sum A B |n_a| */
@@ -105,16 +108,19 @@ static rad_result ensure_values(hr_state *st)
     float *se = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->send, n, sizeof *se, VALUES_WHAT);
     if (se)
         st->send = se;
-    bool correct = st->p->closure_correction;
-    double *Bs = correct ? rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->Bsend, 3 * n, sizeof *Bs, VALUES_WHAT) : st->B;
-    if (correct && Bs)
+    double *Bs = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->Bsend, 3 * n, sizeof *Bs, VALUES_WHAT);
+    if (Bs)
         st->Bsend = Bs;
-    float *co = correct ? rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->corr, n, sizeof *co, VALUES_WHAT) : NULL;
+    float *co = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->corr, n, sizeof *co, VALUES_WHAT);
     if (co)
         st->corr = co;
-    if (!correct)
-        st->Bsend = st->B;
-    if (!B || !H || !Ht || !sp || !op || !se || !Bs || (correct && !co))
+    float *ga = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->gain, n, sizeof *ga, VALUES_WHAT);
+    if (ga)
+        st->gain = ga;
+    uint8_t *es = rad_realloc(st->ctx, RAD_MEM_HIERARCHY, st->escape, n, 1, VALUES_WHAT);
+    if (es)
+        st->escape = es;
+    if (!B || !H || !Ht || !sp || !op || !se || !Bs || !co || !ga || !es)
         return RAD_ERROR_OUT_OF_MEMORY;
     for (size_t k = st->values; k < n; k++) {
         const hr_node *nd = &st->tree.nodes[k];
@@ -128,11 +134,11 @@ static rad_result ensure_values(hr_state *st)
         st->spread[k] = 0.0;
         st->open[k] = -1.0f;
         st->send[k] = 1.0f;
-        if (st->corr) {
-            st->corr[k] = 1.0f;
-            for (int c = 0; c < 3; c++)
-                st->Bsend[3 * k + (size_t)c] = st->B[3 * k + (size_t)c];
-        }
+        st->corr[k] = 1.0f;
+        st->gain[k] = 1.0f;
+        st->escape[k] = 0;
+        for (int c = 0; c < 3; c++)
+            st->Bsend[3 * k + (size_t)c] = st->B[3 * k + (size_t)c];
     }
     st->values = n;
     return RAD_OK;
@@ -226,12 +232,13 @@ static void gather(hr_state *st)
     }
 }
 
-/* Push down, update the leaves, pull up.  Returns the residual. */
-static double push_pull(hr_state *st)
+/* Push down: every surface node's total irradiance Ht is its own H plus
+ * its parent's (read from a parent cluster's bins with its normal); the
+ * clusters' bins_total likewise.  Parents come first in the node array. */
+static void push(hr_state *st)
 {
     const hr_tree *t = &st->tree;
     size_t n = t->count;
-    double change = 0.0, absorbed = 0.0, radiant = 0.0;
     for (size_t k = 0; k < n; k++) {
         const hr_node *nd = &t->nodes[k];
         uint32_t up = nd->parent;
@@ -252,60 +259,100 @@ static double push_pull(hr_state *st)
             }
             ht[c] = st->H[3 * k + (size_t)c] + from_parent;
         }
-        if (nd->child[0] == 0) {
-            const double *E = node_emission(st, nd), *rho = node_reflectance(st, nd);
-            for (int c = 0; c < 3; c++) {
-                double b = E[c] + rho[c] * ht[c];
-                change += nd->area * fabs(b - st->B[3 * k + (size_t)c]);
-                absorbed += nd->area * (1.0 - rho[c]) * ht[c];
-                radiant += nd->area * b;
-                st->B[3 * k + (size_t)c] = b;
-            }
-        }
     }
+}
+
+/* What the sources send, from the leaves' values V (3 per node): the area
+ * means of surface nodes, and the clusters' exitance bins (the root
+ * surfaces' A V / open by their normals, summed up the cluster tree).
+ * Children come after their parents, so one backward loop. */
+static void pull_send(hr_state *st, double *V)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
     memset(st->bins_exit, 0, 18 * t->clusters * sizeof *st->bins_exit);
     for (size_t k = n; k-- > 0;) {
         const hr_node *nd = &t->nodes[k];
         if (nd->kind == HR_SURFACE && nd->child[0]) {
-            double sum[3] = {0.0, 0.0, 0.0}, sent[3] = {0.0, 0.0, 0.0}, area = 0.0;
+            double sum[3] = {0.0, 0.0, 0.0}, area = 0.0;
             for (uint32_t c4 = 0; c4 < 4; c4++) {
                 uint32_t ch = nd->child[0] + c4;
                 double a = t->nodes[ch].area;
                 area += a;
                 for (int c = 0; c < 3; c++)
-                    sum[c] += a * st->B[3 * (size_t)ch + (size_t)c];
-                if (st->corr)
-                    for (int c = 0; c < 3; c++)
-                        sent[c] += a * st->Bsend[3 * (size_t)ch + (size_t)c];
+                    sum[c] += a * V[3 * (size_t)ch + (size_t)c];
             }
-            for (int c = 0; c < 3; c++) {
-                st->B[3 * k + (size_t)c] = area > 0.0 ? sum[c] / area : 0.0;
-                if (st->corr)
-                    st->Bsend[3 * k + (size_t)c] = area > 0.0 ? sent[c] / area : 0.0;
-            }
-        } else if (nd->kind == HR_SURFACE && st->corr) {
             for (int c = 0; c < 3; c++)
-                st->Bsend[3 * k + (size_t)c] = st->B[3 * k + (size_t)c] * st->corr[k];
+                V[3 * k + (size_t)c] = area > 0.0 ? sum[c] / area : 0.0;
         }
         if (nd->kind == HR_SURFACE && nd->parent != HR_NONE && t->nodes[nd->parent].kind == HR_CLUSTER) {
             double *bins = &st->bins_exit[18 * (size_t)nd->parent];
             for (int c = 0; c < 3; c++) /* from its open part, as for surface sources */
-                hr_bins_add(bins + 6 * c, nd->normal, nd->area * st->Bsend[3 * k + (size_t)c] * st->send[k]);
+                hr_bins_add(bins + 6 * c, nd->normal, nd->area * V[3 * k + (size_t)c] * st->send[k]);
         }
-        if (nd->kind == HR_CLUSTER) {
-            double sum[3] = {0.0, 0.0, 0.0};
-            for (int i = 0; i < 2; i++) {
-                uint32_t ch = nd->child[i];
+        if (nd->kind == HR_CLUSTER && nd->parent != HR_NONE)
+            for (int q = 0; q < 18; q++)
+                st->bins_exit[18 * (size_t)nd->parent + (size_t)q] += st->bins_exit[18 * k + (size_t)q];
+    }
+}
+
+/* Pull up: every surface node's B is the area mean of its children's, a
+ * cluster's of its members'; what the leaves send (Bsend: B times the
+ * balance's source scale, balance()) and the clusters' exitance bins
+ * follow (pull_send). */
+static void pull(hr_state *st)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    for (size_t k = n; k-- > 0;) {
+        const hr_node *nd = &t->nodes[k];
+        int m = nd->kind == HR_CLUSTER ? 2 : nd->child[0] ? 4 : 0;
+        if (m == 0) {
+            if (st->corr)
                 for (int c = 0; c < 3; c++)
-                    sum[c] += t->nodes[ch].area * st->B[3 * (size_t)ch + (size_t)c];
-            }
+                    st->Bsend[3 * k + (size_t)c] = st->B[3 * k + (size_t)c] * st->corr[k];
+            continue;
+        }
+        double sum[3] = {0.0, 0.0, 0.0}, area = 0.0;
+        for (int q = 0; q < m; q++) {
+            uint32_t ch = hr_child(t, (uint32_t)k, q);
+            double a = t->nodes[ch].area;
+            area += a;
             for (int c = 0; c < 3; c++)
-                st->B[3 * k + (size_t)c] = nd->area > 0.0 ? sum[c] / nd->area : 0.0;
-            if (nd->parent != HR_NONE)
-                for (int q = 0; q < 18; q++)
-                    st->bins_exit[18 * (size_t)nd->parent + (size_t)q] += st->bins_exit[18 * k + (size_t)q];
+                sum[c] += a * st->B[3 * (size_t)ch + (size_t)c];
+        }
+        if (nd->kind == HR_CLUSTER)
+            area = nd->area;
+        for (int c = 0; c < 3; c++)
+            st->B[3 * k + (size_t)c] = area > 0.0 ? sum[c] / area : 0.0;
+    }
+    pull_send(st, st->Bsend);
+}
+
+/* Push down, update the leaves (B = E + rho x Ht, x the balance's
+ * receiver scale), pull up.  Returns the residual. */
+static double push_pull(hr_state *st)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    double change = 0.0, absorbed = 0.0, radiant = 0.0;
+    push(st);
+    for (size_t k = 0; k < n; k++) {
+        const hr_node *nd = &t->nodes[k];
+        if (nd->kind != HR_SURFACE || nd->child[0] != 0)
+            continue;
+        const double *E = node_emission(st, nd), *rho = node_reflectance(st, nd);
+        double x = st->gain ? st->gain[k] : 1.0;
+        for (int c = 0; c < 3; c++) {
+            double h = x * st->Ht[3 * k + (size_t)c];
+            double b = E[c] + rho[c] * h;
+            change += nd->area * fabs(b - st->B[3 * k + (size_t)c]);
+            absorbed += nd->area * (1.0 - rho[c]) * h;
+            radiant += nd->area * b;
+            st->B[3 * k + (size_t)c] = b;
         }
     }
+    pull(st);
     st->absorbed = absorbed;
     st->radiant = radiant;
     return st->emitted > 0.0 ? change / st->emitted : 0.0;
@@ -440,11 +487,14 @@ static void measure_open(hr_state *st, const rad_vis *vis, uint64_t seed)
             ray[r].tfar = INFINITY;
         }
         vis->backend->intersect(vis->state, ray, RAYS, hit);
-        int open = 0;
-        for (int r = 0; r < RAYS; r++)
+        int open = 0, escape = 0;
+        for (int r = 0; r < RAYS; r++) {
             open += !(isfinite(hit[r].t) &&
                       v3_dot(ray[r].direction, t->base->patches[hit[r].patch].normal) > 0.0);
+            escape += !isfinite(hit[r].t);
+        }
         st->open[k] = (float)open / RAYS;
+        st->escape[k] = (uint8_t)escape;
     }
     /* Internal nodes: area means, bottom-up. */
     for (size_t k = n; k-- > 0;) {
@@ -534,7 +584,7 @@ static void bins_of(vec3 d, double *out)
  * has in the cluster's exitance bins.  acc: n values, the closure of each
  * surface node (its ancestors' links included); the leaves' are the ones
  * that count.  O(links + nodes). */
-static rad_result link_closure(const hr_state *st, double *acc)
+static rad_result link_closure(const hr_state *st, double *acc, const double *X, const double *xbins, double *cl)
 {
     const hr_tree *t = &st->tree;
     size_t n = t->count, C = t->clusters;
@@ -543,11 +593,15 @@ static rad_result link_closure(const hr_state *st, double *acc)
     if (!x)
         return RAD_ERROR_OUT_OF_MEMORY;
     memset(acc, 0, n * sizeof *acc);
+    if (cl)
+        memset(cl, 0, n * sizeof *cl);
     for (size_t i = 0; i < st->links.count; i++) {
         const hr_link *l = &st->links.items[i];
         const hr_node *nr = &t->nodes[l->r], *ns = &t->nodes[l->s];
         vec3 w = nr->kind == HR_SURFACE && ns->kind == HR_SURFACE ? v3(0.0, 0.0, 1.0) : hr_link_direction(l);
-        double share = nr->kind == HR_SURFACE ? nr->area : hr_projected(t, l->r, w);
+        double share = nr->kind == HR_SURFACE ? (X ? X[l->r] : nr->area)
+                       : xbins                ? hr_bins_eval(&xbins[6 * (size_t)l->r], w)
+                                              : hr_projected(t, l->r, w);
         share *= l->k;
         if (ns->kind == HR_SURFACE) {
             acc[l->s] += share * st->send[l->s] / ns->area;
@@ -576,23 +630,40 @@ static rad_result link_closure(const hr_state *st, double *acc)
             for (int q = 0; q < 6; q++)
                 f += nb[q] * x[6 * (size_t)up + (size_t)q];
             acc[k] += f * st->send[k];
+            if (cl)
+                cl[k] = f * st->send[k];
         } else {
             acc[k] += acc[up];
+            if (cl)
+                cl[k] = cl[up];
         }
     }
     rad_free(x);
     return RAD_OK;
 }
 
+static rad_result link_columns(hr_state *st, const float *x, double *X, double *xbins, double *acc, double *cl);
+
 /* The closure's area-weighted mean and range over leaves, and its
- * power-weighted mean (weights A B, channels summed), into the stats. */
+ * power-weighted mean (weights A B, channels summed), into the stats: of
+ * the operator the solve used, the balance's scales included. */
 static rad_result measure_closure(hr_state *st, rad_hier_stats *hs)
 {
     const hr_tree *t = &st->tree;
     double *acc = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, t->count, sizeof *acc, "hierarchical: closure");
-    if (!acc)
+    double *X = acc ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, t->count, sizeof *X, "hierarchical: closure") : NULL;
+    double *xb = X ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 6 * t->clusters + 1, sizeof *xb, "hierarchical: closure")
+                   : NULL;
+    if (!xb) {
+        rad_free(acc);
+        rad_free(X);
         return RAD_ERROR_OUT_OF_MEMORY;
-    rad_result r = link_closure(st, acc);
+    }
+    rad_result r = link_columns(st, st->gain, X, xb, acc, NULL);
+    for (size_t k = 0; r == RAD_OK && k < t->count; k++)
+        acc[k] *= st->corr[k];
+    rad_free(X);
+    rad_free(xb);
     double a_sum = 0.0, c_sum = 0.0, p_sum = 0.0, pc_sum = 0.0, lo = INFINITY, hi = -INFINITY;
     for (size_t k = 0; r == RAD_OK && k < t->count; k++) {
         const hr_node *nd = &t->nodes[k];
@@ -641,7 +712,7 @@ static rad_result correct_closure(hr_state *st, size_t *corrected)
         rad_free(sum);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    rad_result r = link_closure(st, acc);
+    rad_result r = link_closure(st, acc, NULL, NULL, NULL);
     *corrected = 0;
     /* Parents come before their children. */
     for (size_t k = 0; r == RAD_OK && k < n; k++) {
@@ -673,6 +744,208 @@ static rad_result correct_closure(hr_state *st, size_t *corrected)
     return r;
 }
 
+/* ---- the balance: a link operator that conserves power exactly ----
+ *
+ * The links are exact factors between nodes (refine.c), but a leaf
+ * receives through its ancestors' links too, with their area means: the
+ * effective leaf-to-leaf operator K (K(r, m) = k of the link that covers
+ * the pair, times m's share of its source) has the right sums over every
+ * node that holds links, not over each leaf.  On a closed 1 x 2 x 3 m box
+ * of 6 patches the leaves' row sums run from 0.87 to 1.15 around an area
+ * mean of 1 - 2e-8: corner leaves read their walls' mean factor, not their
+ * own.  Those errors are small per link (the oracle's epsilon) and add up
+ * with one sign, so B = E / (1 - rho) came out 0.7% high at rho 0.8, and
+ * the box absorbed 0.6% more than it emitted.
+ *
+ * Where the answer is known, the operator is made to hold it once the
+ * links are final: leaf r's irradiance is scaled by x_r and leaf m's
+ * sending by y_m (Bsend = y B),
+ *
+ *      K'(r, m) = x_r K(r, m) y_m,
+ *
+ * with x, y found by Sinkhorn's alternation (Sinkhorn & Knopp 1967) so
+ * that every row sum (what a leaf receives per unit of radiosity
+ * everywhere) and every column sum (the fraction of what it sends that
+ * arrives, sum_r A_r K'(r, m) / A_m) is 1.  The answer is known in a
+ * closed scene (no ray of measure_open left it), for the leaves wholly
+ * outside the solids (every ray met a front face).  Then a furnace gives
+ * B = E / (1 - rho) and a closed scene absorbs what it emits, to the
+ * scales' float precision; the box's scales run from 0.74 to 1.21 and
+ * settle in 11 iterations, each one gather and one adjoint pass over the
+ * links.
+ *
+ * Left at scale 1:
+ *   - open scenes: a leaf's true sum is 1 less what it sees of the
+ *     opening, which varies over a patch.  Targets made of the leaves' own
+ *     factors with their links' visibility (a link's visibility is its
+ *     receiver's mean) made the open Cornell box's surfaces worse, 1.0%
+ *     against 0.4% from the converged reference; a patch whose few rays
+ *     missed a small view of the opening, held to 1, put its floor 0.2%
+ *     high.
+ *   - leaves partly inside a solid: they receive on their open part.
+ *   - leaves whose row or column goes through a cluster: a cluster shares
+ *     its transfer among its members by their normals, not by how each
+ *     sees the other end, so a member's sums are not its own factor sums;
+ *     held to 1 they needed scales of 0.004 to 22 in an office, and rows
+ *     held to 1 without their columns made 2.6% of its power.  Clustered
+ *     scenes keep the links' own closure (the office: 99.7%). */
+
+/* Row sums of the operator with source scale y (per leaf): R[k] for every
+ * leaf, what it receives per unit of radiosity everywhere, before its
+ * receiver scale.  V: 3 per node, scratch. */
+static void link_rows(hr_state *st, const float *y, double *V, double *R)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    for (size_t k = 0; k < n; k++) {
+        bool leaf = t->nodes[k].kind == HR_SURFACE && !t->nodes[k].child[0];
+        for (int c = 0; c < 3; c++)
+            V[3 * k + (size_t)c] = leaf ? (double)y[k] : 0.0;
+    }
+    pull_send(st, V);
+    double *keep = st->Bsend;
+    st->Bsend = V;
+    gather(st);
+    st->Bsend = keep;
+    push(st);
+    for (size_t k = 0; k < n; k++)
+        R[k] = st->Ht[3 * k];
+}
+
+/* Column sums of the operator with receiver scale x: acc[m] for every
+ * leaf, the fraction of what it sends that arrives, before its source
+ * scale.  X: n values, xbins: 6 per cluster, scratch. */
+static rad_result link_columns(hr_state *st, const float *x, double *X, double *xbins, double *acc, double *cl)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    memset(xbins, 0, 6 * t->clusters * sizeof *xbins);
+    for (size_t k = n; k-- > 0;) {
+        const hr_node *nd = &t->nodes[k];
+        if (nd->kind == HR_CLUSTER) {
+            if (nd->parent != HR_NONE)
+                for (int q = 0; q < 6; q++)
+                    xbins[6 * (size_t)nd->parent + (size_t)q] += xbins[6 * k + (size_t)q];
+            continue;
+        }
+        if (!nd->child[0]) {
+            X[k] = nd->area * (double)x[k];
+        } else {
+            X[k] = 0.0;
+            for (uint32_t q = 0; q < 4; q++)
+                X[k] += X[nd->child[0] + q];
+        }
+        if (nd->parent != HR_NONE && t->nodes[nd->parent].kind == HR_CLUSTER)
+            hr_bins_add(&xbins[6 * (size_t)nd->parent], nd->normal, X[k]);
+    }
+    return link_closure(st, acc, X, xbins, cl);
+}
+
+/* Balance the operator (above): the leaves' gain (x) and corr (y).  The
+ * iterations, the last row error and the scales' range go to the stats. */
+static rad_result balance(hr_state *st, rad_hier_stats *hs)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    double *V = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 3 * n, sizeof *V, "hierarchical: balance");
+    double *R = V ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *R, "hierarchical: balance") : NULL;
+    double *X = R ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *X, "hierarchical: balance") : NULL;
+    double *xb = X ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 6 * t->clusters + 1, sizeof *xb, "hierarchical: balance")
+                   : NULL;
+    double *cl = xb ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *cl, "hierarchical: balance") : NULL;
+    uint8_t *role = cl ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, 1, "hierarchical: balance") : NULL;
+    rad_result r = role ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t k = 0; r == RAD_OK && k < n; k++)
+        st->corr[k] = st->gain[k] = 1.0f;
+    /* Who takes part (above): in a closed scene (no ray of measure_open
+     * left it), the leaves wholly outside the solids (every ray met a
+     * front face) whose rows and columns go through no cluster. */
+    enum { ROW = 1, COLUMN = 2 };
+    if (r == RAD_OK)
+        r = link_columns(st, st->gain, X, xb, R, cl);
+    size_t escaped = 0;
+    for (size_t k = 0; r == RAD_OK && k < n; k++)
+        if (t->nodes[k].kind == HR_SURFACE && !t->nodes[k].child[0])
+            escaped += st->escape[k];
+    /* Rows through a cluster: a link with a cluster end at the leaf, an
+     * ancestor or a cluster above it (flagged in role, pushed down). */
+    for (size_t k = 0; r == RAD_OK && k < n; k++)
+        role[k] = 0;
+    for (size_t i = 0; r == RAD_OK && i < st->links.count; i++) {
+        const hr_link *l = &st->links.items[i];
+        if (t->nodes[l->r].kind == HR_CLUSTER || t->nodes[l->s].kind == HR_CLUSTER)
+            role[l->r] = 1;
+    }
+    size_t rows = 0;
+    for (size_t k = 0; r == RAD_OK && k < n; k++) {
+        const hr_node *nd = &t->nodes[k];
+        bool via_cluster = role[k] || (nd->parent != HR_NONE && role[nd->parent]);
+        role[k] = via_cluster;
+        if (nd->kind != HR_SURFACE || nd->child[0])
+            continue;
+        role[k] = 0;
+        if (escaped > 0 || via_cluster || st->open[k] != 1.0f || !(R[k] > 0.0) || cl[k] > 1e-9 * R[k])
+            continue;
+        role[k] = ROW | COLUMN;
+        rows++;
+    }
+    /* Alternate: rows to 1 with y fixed, columns to 1 with x fixed, until
+     * the rows are off by under 1e-6 after a column step (the scales are
+     * floats).  Leaves that receive or send nothing keep scale 1. */
+    int it = 0;
+    double worst = 0.0;
+    const double tiny = 1e-12;
+    double last = INFINITY;
+    for (; r == RAD_OK && rows > 0 && it < 100; it++) {
+        link_rows(st, st->corr, V, R);
+        worst = 0.0;
+        for (size_t k = 0; k < n; k++)
+            if ((role[k] & ROW) && R[k] > tiny)
+                worst = fmax(worst, fabs((double)st->gain[k] * R[k] - 1.0));
+        /* Done; or stalled, left after a column step (the columns carry
+         * the power balance): where the links' visibility is estimated, a
+         * pair's two links are not reciprocal and sums of exactly 1 may
+         * not exist.  On a closed box with a block on its floor the error
+         * fell 0.31, 0.05, 0.008, 0.005, then 1.3% an iteration while the
+         * scales drifted and the power balance worsened (-0.05% after 1
+         * iteration, -0.2% after 40, +0.27% unbalanced). */
+        if (worst < 1e-6 || (it >= 2 && worst > 0.7 * last))
+            break;
+        last = worst;
+        for (size_t k = 0; k < n; k++)
+            if ((role[k] & ROW) && R[k] > tiny)
+                st->gain[k] = (float)(1.0 / R[k]);
+        if ((r = link_columns(st, st->gain, X, xb, R, NULL)) != RAD_OK)
+            break;
+        for (size_t k = 0; k < n; k++) {
+            if (!(role[k] & COLUMN) || !(R[k] > tiny))
+                continue;
+            st->corr[k] = (float)(1.0 / R[k]);
+        }
+    }
+    if (r == RAD_OK) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t k = 0; k < n; k++)
+            if (t->nodes[k].kind == HR_SURFACE && !t->nodes[k].child[0]) {
+                lo = fmin(lo, fmin(st->gain[k], st->corr[k]));
+                hi = fmax(hi, fmax(st->gain[k], st->corr[k]));
+            }
+        hs->balance_iterations = it;
+        hs->balanced_leaves = rows;
+        hs->balance_residual = worst;
+        hs->balance_scale_min = isfinite(lo) ? lo : 1.0;
+        hs->balance_scale_max = isfinite(hi) ? hi : 1.0;
+        pull(st);
+    }
+    rad_free(V);
+    rad_free(R);
+    rad_free(X);
+    rad_free(xb);
+    rad_free(cl);
+    rad_free(role);
+    return r;
+}
+
 /* q of the links (solve.h): rho_max times the largest closure of a leaf
  * (link_closure; its links may deliver more than it sends: 1.2 on a
  * uniform box), at least rho_max.  Fails only for memory. */
@@ -682,7 +955,7 @@ static rad_result links_contraction(hr_state *st, double rho_max, double *q)
     double *acc = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, t->count, sizeof *acc, "hierarchical: closure");
     if (!acc)
         return RAD_ERROR_OUT_OF_MEMORY;
-    rad_result r = link_closure(st, acc);
+    rad_result r = link_closure(st, acc, NULL, NULL, NULL);
     double most = 1.0;
     for (size_t k = 0; r == RAD_OK && k < t->count; k++)
         if (t->nodes[k].kind == HR_SURFACE && t->nodes[k].child[0] == 0)
@@ -906,7 +1179,8 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                 if ((r = sort_links(&st)) != RAD_OK)
                     goto done;
             }
-            if (p->closure_correction && (r = correct_closure(&st, &hs->closure_corrected)) != RAD_OK)
+            r = p->closure_correction ? correct_closure(&st, &hs->closure_corrected) : balance(&st, hs);
+            if (r != RAD_OK)
                 goto done;
         }
         double t2 = rad_seconds();
@@ -977,9 +1251,10 @@ done:
     rad_free(st.spread);
     rad_free(st.open);
     rad_free(st.send);
-    if (p->closure_correction)
-        rad_free(st.Bsend);
+    rad_free(st.Bsend);
     rad_free(st.corr);
+    rad_free(st.gain);
+    rad_free(st.escape);
     rad_free(st.bins_in);
     rad_free(st.bins_total);
     rad_free(st.bins_exit);

@@ -277,6 +277,10 @@ typedef struct rad_hier_stats {
     bool clustered;
     bool classic_oracle;
     size_t closure_corrected;  /* leaves whose sending was scaled by 1 / closure */
+    int balance_iterations;    /* Sinkhorn steps of the balance (hier.c); 0: not balanced */
+    size_t balanced_leaves;    /* leaves it held to sums of 1 (closed patches) */
+    double balance_residual;   /* its largest relative row error at the end */
+    double balance_scale_min, balance_scale_max; /* range of the leaves' scales */
 } rad_hier_stats;
 
 /* Solve; on success *leaf_mesh is the mesh of the leaves (patches as in

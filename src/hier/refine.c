@@ -248,6 +248,30 @@ static double plane_low(const hr_node *x, vec3 o, vec3 n)
     return least;
 }
 
+/* The unoccluded factor a surface <- surface link carries (k before its
+ * visibility): the Gauss mean of the exact point factor where it varies by
+ * less than 1% over r (far pairs: the rule's error is then far smaller);
+ * else the exact area-to-area factor by the double contour integral
+ * (ff_contour.c), which also holds for pairs sharing an edge: there a
+ * fixed rule falls short (by 0.7% on a unit-cube face pair, always low,
+ * and the shortfalls add up).  Pairs that straddle each other's planes
+ * take it too: their factor drops to 0 inside r, which no fixed rule sees.
+ * A pair seen from part of the receiver only whose mean comes out 0 gets
+ * 1e-30, so that it is kept and refined. */
+static double surface_factor(const hr_tree *t, uint32_t r, uint32_t s, double tol, double *spread)
+{
+    const hr_node *nr = &t->nodes[r], *ns = &t->nodes[s];
+    double k = gauss_factor(nr, ns, spread);
+    bool straddle = plane_low(nr, ns->center, ns->normal) < -tol || plane_low(ns, nr->center, nr->normal) < -tol;
+    if ((straddle || *spread > 0.01 * k) && nr->area > 0.0)
+        k = rad_polygon_coupling_to(nr->corner, nr->corners, nr->normal, ns->corner, ns->corners, ns->normal, tol,
+                                    HR_CONTOUR_REL) /
+            nr->area;
+    if (!(k > 0.0) && *spread > 0.0)
+        k = 1e-30;
+    return k;
+}
+
 typedef struct link_ctx {
     const hr_tree *tree;
     const hr_refine_params *p;
@@ -271,22 +295,7 @@ static bool make_link(const link_ctx *lc, uint32_t r, uint32_t s, uint32_t paren
     double k;
     double spread = 0.0;
     if (nr->kind == HR_SURFACE && ns->kind == HR_SURFACE) {
-        /* k: the Gauss mean of the exact point factor where it varies by
-         * less than 1% over r (far pairs: the rule's error is then far
-         * smaller); else the exact area-to-area factor by the double
-         * contour integral (ff_contour.c), which also holds for pairs
-         * sharing an edge: there a fixed rule falls short (by 0.7% on a
-         * unit-cube face pair, always low, and the shortfalls add up).
-         * Pairs that straddle each other's planes take it too: their
-         * factor drops to 0 inside r, which no fixed rule sees. */
-        k = gauss_factor(nr, ns, &spread);
-        bool straddle = plane_low(nr, ns->center, ns->normal) < -p->tol ||
-                        plane_low(ns, nr->center, nr->normal) < -p->tol;
-        if ((straddle || spread > 0.01 * k) && nr->area > 0.0)
-            k = rad_polygon_coupling_to(nr->corner, nr->corners, nr->normal, ns->corner, ns->corners, ns->normal,
-                                        p->tol, HR_CONTOUR_REL) / nr->area;
-        if (!(k > 0.0) && spread > 0.0)
-            k = 1e-30; /* seen from part of the receiver only: keep it, to be refined */
+        k = surface_factor(t, r, s, p->tol, &spread);
     } else {
         /* A cluster's self-link carries nothing: it is always split. */
         if (r == s) {

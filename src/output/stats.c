@@ -277,6 +277,12 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
         cJSON_AddNumberToObject(closure, "power_weighted", h->closure_power);
         cJSON_AddNumberToObject(closure, "min", h->closure_min);
         cJSON_AddNumberToObject(closure, "max", h->closure_max);
+        cJSON *balance = cJSON_AddObjectToObject(hi, "balance");
+        cJSON_AddNumberToObject(balance, "leaves", (double)h->balanced_leaves);
+        cJSON_AddNumberToObject(balance, "iterations", h->balance_iterations);
+        cJSON_AddNumberToObject(balance, "residual", h->balance_residual);
+        cJSON_AddNumberToObject(balance, "scale_min", h->balance_scale_min);
+        cJSON_AddNumberToObject(balance, "scale_max", h->balance_scale_max);
         cJSON_AddNumberToObject(hi, "refine_rounds", h->refine_rounds);
         cJSON_AddNumberToObject(hi, "refine_passes", h->refine_passes);
         cJSON_AddNumberToObject(hi, "rays", (double)h->rays);
