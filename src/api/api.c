@@ -48,15 +48,6 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->ctx = ctx;
     s->scene = scene;
     s->threads = rad_context_threads(ctx);
-    /* Luminaires and daylight light the elements of the uniform-mesh
-     * strategies, not hierarchical radiosity's nodes: without a solver
-     * named, one that takes them. */
-    rad_options lit;
-    if (rad_light_present(scene) && (!options || !options->solver)) {
-        lit = options ? *options : (rad_options){0};
-        lit.solver = rad_options_default_solver(&lit, RAD_CAN_LIGHTS);
-        options = &lit;
-    }
     rad_result r = rad_options_resolve(ctx, options, &s->options, &s->names);
     if (r != RAD_OK) {
         rad_free(s);
