@@ -552,14 +552,6 @@ rad_result rad_solution_save(rad_context *ctx, rad_solution *s, const char *path
                         "solution file: solver '%s' solves for vertex values, which a solution file "
                         "does not hold (it keeps element values): not saved",
                         s->options.solver);
-    /* The file holds the luminaires with the scene (saved.h), not daylight:
-     * loaded without it, the radiosity would answer to a scene without its
-     * light.  Refused rather than loaded wrong. */
-    if (s->scene->daylight)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "solution file: the scene %s is lit by daylight, which a solution file does not hold "
-                        "yet: not saved (solve and render, export or bake in one run)",
-                        s->scene->source);
     double *display = NULL;
     rad_result r = display_values(ctx, s, &display);
     if (r == RAD_OK)
