@@ -16,7 +16,9 @@
  *     is not meshed finely everywhere;
  *   - one and two threads give the same leaves, direct light and radiosity
  *     to the bit;
- *   - the solver named by no option is hierarchical for a lit scene.
+ *   - the solver named by no option is hierarchical for a lit scene;
+ *   - a daylit solution file keeps its daylight and direct light, and a sky
+ *     out of range in its header is refused in one line.
  *   - slow (test_hier_lights_slow): a daylit room (sky, sun, two openings)
  *     agrees with gauss-seidel per surface and per grid point, and its
  *     solution file gives the same grid to the bit.
@@ -321,6 +323,42 @@ static void test_daylight_agrees_and_saves(void **state)
     rad_scene_destroy(scene);
 }
 
+/* The solution file's daylight part: kept (a coarse daylit solution saved
+ * and loaded has the same daylight and direct light), and checked (a sky
+ * type out of range in the header is one line naming the file). */
+static void test_daylight_solution_file(void **state)
+{
+    (void)state;
+    rad_scene *scene = daylit_room();
+    rad_solution *sol = solve(ctx, scene, (rad_options){.solver = "gauss-seidel", .target_elements = 60});
+    assert_int_equal(rad_solution_save(ctx, sol, test_path("coarse.radsol")), RAD_OK);
+    rad_scene *loaded_scene = NULL;
+    rad_solution *loaded = NULL;
+    assert_int_equal(rad_solution_load_file(ctx, test_path("coarse.radsol"), &loaded_scene, &loaded), RAD_OK);
+    assert_non_null(loaded_scene->daylight);
+    assert_true(rad_scene_daylight_sky_illuminance(loaded_scene) == rad_scene_daylight_sky_illuminance(scene));
+    assert_int_equal(rad_scene_daylight_opening_count(loaded_scene), rad_scene_daylight_opening_count(scene));
+    assert_int_equal(loaded->view.n, sol->view.n);
+    assert_non_null(loaded->view.direct);
+    assert_memory_equal(loaded->view.direct, sol->view.direct, 3 * sol->view.n * sizeof(double));
+    assert_memory_equal(loaded->view.emission, sol->view.emission, 3 * sol->view.n * sizeof(double));
+    rad_solution_destroy(loaded);
+    rad_scene_destroy(loaded_scene);
+    /* Sky type 12 -> 99 in the header (same length; the header is not in
+     * the payload's checksum). */
+    size_t size = 0;
+    char *bytes = test_read_file(test_path("coarse.radsol"), &size);
+    char *type = strstr(bytes + 12, "\"type\":\t12"); /* after the signature and the header's length */
+    assert_non_null(type);
+    memcpy(type + strlen("\"type\":\t"), "99", 2);
+    assert_int_equal(rad_solution_load_memory(ctx, "bad.radsol", bytes, size, &loaded_scene, &loaded),
+                     RAD_ERROR_PARSE);
+    assert_non_null(strstr(rad_context_error(ctx), "bad.radsol: daylight: the sky, sun or ground is out of range"));
+    free(bytes);
+    rad_solution_destroy(sol);
+    rad_scene_destroy(scene);
+}
+
 int main(int argc, char **argv)
 {
     /* "--slow": the daylit case (a minute of sky integration) instead of
@@ -335,6 +373,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_luminaires_energy),
         cmocka_unit_test(test_shadow_edge_leaves),
         cmocka_unit_test(test_threads_identical),
+        cmocka_unit_test(test_daylight_solution_file),
     };
     const struct CMUnitTest slow_tests[] = {
         cmocka_unit_test(test_daylight_agrees_and_saves),
