@@ -580,16 +580,27 @@ cli_action cli_parse_args(int argc, char *const *argv, cli_settings *s, char *er
                        "(its elements change while it solves; use --history)", s->solve.solver);
         return CLI_USAGE_ERROR;
     }
-    /* The default solver is hierarchical, which meshes as it solves.  What
-     * needs a uniform mesh or a form-factor matrix takes gauss-seidel
-     * instead when no --solver is given: the view factors (a matrix's F),
-     * progress images (elements that stay put while solving), and the
-     * uniform mesh's and the matrix's own options, which hierarchical would
-     * ignore (adaptive subdivision among them). */
+    /* The default solver is hierarchical, which meshes as it solves, lit
+     * or not.  What needs a uniform mesh or a form-factor matrix takes
+     * gauss-seidel instead when no --solver is given: the view factors (a
+     * matrix's F), progress images (elements that stay put while solving),
+     * and the uniform mesh's and the matrix's own options, which
+     * hierarchical would ignore (adaptive subdivision among them).  Never
+     * silently: a solve that the uniform mesh's options sent to the O(n^2)
+     * solver says so in a note naming the flag (docs/hierarchical.md,
+     * "Which solver"). */
     /* The window shows progressive refinement: shooting, unless another
      * solver is asked for (an off-screen frame solves as render does). */
     if (!s->solve.solver && s->command == CLI_VIEW && !s->offscreen && s->solve.adaptive_levels == 0)
         s->solve.solver = "shooting";
+    if (!s->solve.solver && s->command != CLI_VIEWFACTORS && !s->progress_dir)
+        s->dense_for = s->solve.target_elements != 0 ? "--elements"
+                       : s->solve.mesh_size != 0.0   ? "--mesh-size"
+                       : s->solve.form_factors       ? "--form-factors"
+                       : s->solve.adaptive_levels != 0 || s->solve.adaptive_threshold != 0.0 ||
+                               s->solve.adaptive_max_elements != 0
+                           ? "--adaptive"
+                           : NULL;
     if (!s->solve.solver &&
         (s->command == CLI_VIEWFACTORS || s->progress_dir || s->solve.target_elements != 0 ||
          s->solve.mesh_size != 0.0 || s->solve.form_factors || s->solve.adaptive_levels != 0 ||

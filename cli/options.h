@@ -82,6 +82,8 @@ typedef struct cli_settings {
     int contours;             /* render --contours: isolines at the legend's ticks */
     const char *grid;         /* illuminance: the grid file (--grid) */
     const char *output2;      /* illuminance: a second -o (CSV and JSON both), or NULL */
+    const char *dense_for;    /* the flag that made gauss-seidel the solver, no --solver given
+                                 (said in a note before the solve), or NULL */
 } cli_settings;
 
 /* Where a flag's value goes. */

@@ -212,8 +212,16 @@ int cli_finish(cli_job *job, rad_result r, const char *detail, ...)
             snprintf(measure, sizeof measure, "unshot %.2g", h[steps - 1].unshot);
         else
             snprintf(measure, sizeof measure, "residual %.2g", residual);
-        printf("wrote %s%s%zu elements, %s, %.1f s)%s\n", cli_where(s->output, full), what,
-               rad_solution_element_count(job->sol), measure, cli_now() - job->t0,
+        /* The solver by name, and the flag that chose it when no --solver
+         * did (a uniform mesh's option takes gauss-seidel: cli/options.c),
+         * so that the O(n^2) path is never taken unsaid. */
+        char solver[96] = "";
+        const char *name = s->solve.solver ? s->solve.solver : "hierarchical"; /* the library's default */
+        if (!job->saved)
+            snprintf(solver, sizeof solver, "%s%s%s, ", name, s->dense_for ? " for " : "",
+                     s->dense_for ? s->dense_for : "");
+        printf("wrote %s%s%zu elements, %s%s, %.1f s)%s\n", cli_where(s->output, full), what,
+               rad_solution_element_count(job->sol), solver, measure, cli_now() - job->t0,
                job->partial ? " [partial]" : "");
         size_t lights = rad_scene_luminaire_count(job->scene);
         if (lights > 0) {

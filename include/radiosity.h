@@ -362,11 +362,10 @@ typedef struct rad_options {
                                      of each pair are combined (reciprocity) and rows held
                                      to their measured closure, so energy is conserved */
 
-    const char *solver;           /* NULL = "hierarchical", or "gauss-seidel" when mesh_size,
-                                     target_elements, form_factors or an adaptive_* field is
-                                     set (options of the uniform mesh and the matrix), or the
-                                     scene has luminaires or daylight (which hierarchical
-                                     refuses) */
+    const char *solver;           /* NULL = "hierarchical" (lit scenes too), or "gauss-seidel"
+                                     when mesh_size, target_elements, form_factors or an
+                                     adaptive_* field is set (options of the uniform mesh and
+                                     the matrix) */
     double tolerance;             /* stop when the residual falls below; 0 = 1e-6 */
     double unshot_tolerance;      /* also stop when the unshot power / emitted power falls
                                      below (shooting); 0 = not used */
@@ -631,11 +630,11 @@ RAD_API rad_result rad_solution_point_radiosity(rad_context *ctx, rad_solution *
  * mesh (patches, elements, welded vertices, T-vertices, quadtrees), each
  * element's and vertex's radiosity in W/m^2 as doubles, the options and the
  * solve's figures; atomically (a temporary, renamed).  The vertex values
- * are the renderer's, so they are computed here if no render did.  Fails
- * with RAD_ERROR_INVALID_ARGUMENT for a solution not solved, one whose
- * scene has daylight, which the file does not hold (luminaires it holds:
- * their distributions, placements and each element's direct light), or
- * NULL ctx, solution or path; RAD_ERROR_IO,
+ * are the renderer's, so they are computed here if no render did.  The
+ * scene's light goes with it: luminaires (distributions, placements),
+ * daylight (the sky as prepared, sun, ground, openings) and each element's
+ * direct light.  Fails with RAD_ERROR_INVALID_ARGUMENT for a solution not
+ * solved, or NULL ctx, solution or path; RAD_ERROR_IO,
  * RAD_ERROR_OUT_OF_MEMORY.  Not at the same time as other calls on the
  * same solution. */
 RAD_API rad_result rad_solution_save(rad_context *ctx, rad_solution *solution, const char *path);
@@ -1553,12 +1552,13 @@ RAD_API size_t rad_scene_daylight_opening_count(const rad_scene *scene);
  * shadow ray each) and its first reflection enters the solve as emission;
  * candela count as cd / 179 W/sr on each channel (docs/units.md
  * "Photometry").  A scene lit only by luminaires needs no emitting surface.
- * Hierarchical radiosity refuses luminaires (without a solver named, a lit
- * scene is solved by gauss-seidel); a solution file holds them.
+ * Every solver takes them: hierarchical radiosity (the default) gives each
+ * node of its hierarchy the direct irradiance where it makes it, and splits
+ * leaves where that light varies; a solution file holds them.
  *
  *     rad_scene_load_file(ctx, "office.obj", &scene);
  *     rad_scene_load_luminaires(ctx, scene, "layout.json");
- *     rad_solution_create(ctx, scene, NULL, &sol);      (gauss-seidel)
+ *     rad_solution_create(ctx, scene, NULL, &sol);      (hierarchical)
  *     rad_solution_solve(ctx, sol);
  * ---------------------------------------------------------------------- */
 

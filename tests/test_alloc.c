@@ -173,6 +173,7 @@ static const scenario scenarios[] = {
     {"instant-radiosity (virtual point lights)", "instant-radiosity", NULL, 0, 32, 0, false, 0, false, false, false},
     {"gauss-seidel (dense, mirror images, second pass)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, true, false, false},
     {"gauss-seidel (dense, a luminaire)", "gauss-seidel", "analytic", 0, 0, 0, true, 0, false, false, true},
+    {"hierarchical (a luminaire: the nodes' direct light)", "hierarchical", NULL, 0, 0, 0, false, 0, false, false, true},
 };
 
 /* Loading: the OBJ + MTL from a file and from memory, the glTF from

@@ -473,11 +473,19 @@ static void test_render_reports_output(void **state)
     (void)state;
     test_write_file("good.obj", cli_good_obj);
     test_write_file("good.mtl", cli_good_mtl);
-    assert_int_equal(cli_run_here("render good.obj --elements 50 --width 16 --height 16 -o good.png --stats good.json"), 0);
+    assert_int_equal(cli_run_here("render good.obj --solver gauss-seidel --elements 50 --width 16 --height 16 -o good.png "
+                                  "--stats good.json"), 0);
     assert_true(test_file_exists(test_path("good.png")));
     assert_true(test_file_exists(test_path("good.json")));
     assert_non_null(strstr(cli_stdout(), "good.png"));
     assert_string_equal(cli_stderr(), ""); /* no progress bar without a terminal */
+    assert_non_null(strstr(cli_stdout(), "50 elements, gauss-seidel, residual"));
+    /* --elements without --solver: gauss-seidel, and the line says why. */
+    assert_int_equal(cli_run_here("render good.obj --elements 50 --width 16 --height 16 -o good.png"), 0);
+    assert_non_null(strstr(cli_stdout(), "50 elements, gauss-seidel for --elements, residual"));
+    assert_string_equal(cli_stderr(), "");
+    assert_int_equal(cli_run_here("render good.obj --width 16 --height 16 -o good.png"), 0);
+    assert_non_null(strstr(cli_stdout(), " elements, hierarchical, residual"));
     assert_int_equal(cli_run_here("render good.obj --elements 50 --width 16 --height 16 -o good.pfm -q"), 0);
     assert_true(test_file_exists(test_path("good.pfm")));
     assert_string_equal(cli_stdout(), "");
@@ -534,7 +542,8 @@ static void test_bake(void **state)
     assert_no_output("baked");
     test_write_file("good.obj", cli_good_obj);
     test_write_file("good.mtl", cli_good_mtl);
-    assert_int_equal(cli_run_here("bake good.obj --elements 50 --texels-per-metre 20 -o baked.glb --stats baked.json"), 0);
+    assert_int_equal(cli_run_here("bake good.obj --solver gauss-seidel --elements 50 --texels-per-metre 20 -o baked.glb "
+                                  "--stats baked.json"), 0);
     assert_true(test_file_exists(test_path("baked.glb")));
     assert_true(test_file_exists(test_path("baked_lightmap0.hdr")));
     assert_true(test_file_exists(test_path("baked_lightmap0.png")));

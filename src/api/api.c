@@ -48,15 +48,6 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->ctx = ctx;
     s->scene = scene;
     s->threads = rad_context_threads(ctx);
-    /* Luminaires and daylight light the elements of the uniform-mesh
-     * strategies, not hierarchical radiosity's nodes: without a solver
-     * named, one that takes them. */
-    rad_options lit;
-    if (rad_light_present(scene) && (!options || !options->solver)) {
-        lit = options ? *options : (rad_options){0};
-        lit.solver = rad_options_default_solver(&lit, RAD_CAN_LIGHTS);
-        options = &lit;
-    }
     rad_result r = rad_options_resolve(ctx, options, &s->options, &s->names);
     if (r != RAD_OK) {
         rad_free(s);
@@ -561,14 +552,6 @@ rad_result rad_solution_save(rad_context *ctx, rad_solution *s, const char *path
                         "solution file: solver '%s' solves for vertex values, which a solution file "
                         "does not hold (it keeps element values): not saved",
                         s->options.solver);
-    /* The file holds the luminaires with the scene (saved.h), not daylight:
-     * loaded without it, the radiosity would answer to a scene without its
-     * light.  Refused rather than loaded wrong. */
-    if (s->scene->daylight)
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "solution file: the scene %s is lit by daylight, which a solution file does not hold "
-                        "yet: not saved (solve and render, export or bake in one run)",
-                        s->scene->source);
     double *display = NULL;
     rad_result r = display_values(ctx, s, &display);
     if (r == RAD_OK)

@@ -54,6 +54,7 @@ typedef struct hr_state {
     double *bins_in;      /* 18 per cluster: [channel][signed axis] */
     double *bins_total;   /* 18 per cluster, pushed down */
     double *bins_exit;    /* 18 per cluster, pulled up: sum A B |n_a| */
+    hr_direct direct;     /* luminaires' and daylight's H_d per node (direct.c) */
     size_t values;        /* nodes the arrays cover */
     double emitted;       /* sum_leaves A E, channels summed */
     double absorbed;      /* W, channels summed */
@@ -342,10 +343,11 @@ static double push_pull(hr_state *st)
         if (nd->kind != HR_SURFACE || nd->child[0] != 0)
             continue;
         const double *E = node_emission(st, nd), *rho = node_reflectance(st, nd);
+        const double *hd = st->direct.H ? &st->direct.H[3 * k] : NULL; /* direct.c */
         double x = st->gain ? st->gain[k] : 1.0;
         for (int c = 0; c < 3; c++) {
             double h = x * st->Ht[3 * k + (size_t)c];
-            double b = E[c] + rho[c] * h;
+            double b = E[c] + rho[c] * (hd ? h + hd[c] : h);
             change += nd->area * fabs(b - st->B[3 * k + (size_t)c]);
             absorbed += nd->area * (1.0 - rho[c]) * h;
             radiant += nd->area * b;
@@ -1042,14 +1044,16 @@ static double bytes_in_use(const hr_state *st)
            (double)st->values * (10.0 * sizeof(double) + 2.0 * sizeof(float)) +
            (double)st->tree.clusters * 54.0 * sizeof(double) +
            2.0 * (double)(st->tree.count + 1) * sizeof(size_t) +
-           (st->corr ? (double)st->values * (3.0 * sizeof(double) + sizeof(float)) : 0.0);
+           (st->corr ? (double)st->values * (3.0 * sizeof(double) + sizeof(float)) : 0.0) +
+           hr_direct_bytes(&st->direct);
 }
 
 rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **leaf_mesh, double **radiosity,
-                        rad_solve_stats *ss, rad_hier_stats *hs)
+                        double **direct, rad_solve_stats *ss, rad_hier_stats *hs)
 {
     *leaf_mesh = NULL;
     *radiosity = NULL;
+    *direct = NULL;
     memset(hs, 0, sizeof *hs);
     hr_state st = {0};
     st.ctx = ctx;
@@ -1102,6 +1106,23 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         for (int c = 0; c < 3; c++)
             st.emitted += st.tree.nodes[k].area * E[c];
     }
+    {
+        /* Luminaires and daylight (direct.c): every node's direct
+         * irradiance; its first reflection counts as emission for epsilon
+         * and the residual, as E += rho H_d does for the dense solvers. */
+        double reflected = 0.0;
+        size_t grown = 0;
+        r = hr_direct_start(ctx, &st.tree, p->vis, &st.direct, &reflected);
+        st.emitted += reflected;
+        epsilon_abs += (p->epsilon > 0.0 ? p->epsilon : 1e-4) * reflected / 3.0;
+        hs->epsilon_abs = epsilon_abs;
+        if (r == RAD_OK)
+            r = hr_direct_update(ctx, &st.tree, &st.direct, epsilon_abs, &grown);
+        if (r == RAD_OK)
+            r = ensure_values(&st);
+        if (r != RAD_OK)
+            goto done;
+    }
     memset(st.bins_in, 0, 18 * st.tree.clusters * sizeof(double));
     memset(st.H, 0, 3 * st.tree.count * sizeof(double));
     push_pull(&st);
@@ -1138,17 +1159,19 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     for (int round = 0; round < max_rounds; round++) {
         rad_progress(ctx, "hierarchical", (uint64_t)round, (uint64_t)max_rounds);
         double t1 = rad_seconds();
-        size_t split = 0;
+        size_t split = 0, grown = 0;
         r = measure_spread(&st);
         if (r == RAD_OK)
             hr_tree_set_power(&st.tree, st.B, st.send);
         if (r == RAD_OK)
             r = hr_refine(ctx, &st.tree, &rp, st.B, st.spread, &st.links, &split, &rs);
+        if (r == RAD_OK) /* the new leaves' direct light (direct.c) */
+            r = hr_direct_update(ctx, &st.tree, &st.direct, epsilon_abs, &grown);
         if (r == RAD_OK)
             r = ensure_values(&st);
         if (r == RAD_OK)
             measure_open(&st, p->vis, p->seed);
-        if (r == RAD_OK && split > 0)
+        if (r == RAD_OK && (split > 0 || grown > 0))
             r = sort_links(&st);
         if (r == RAD_OK && bytes_in_use(&st) > p->max_memory)
             r = rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
@@ -1237,6 +1260,8 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         hs->seconds_mesh = rad_seconds() - t3;
         if (rm == RAD_OK && r == RAD_OK)
             rm = measure_closure(&st, hs);
+        if (rm == RAD_OK)
+            rm = hr_direct_leaves(ctx, &st.tree, &st.direct, leaves, direct);
         if (rm != RAD_OK)
             r = rm;
     }
@@ -1259,5 +1284,10 @@ done:
     rad_free(st.bins_total);
     rad_free(st.bins_exit);
     rad_free(st.display_B);
+    hr_direct_free(&st.direct);
+    if (!*leaf_mesh) { /* the leaves' light goes with the leaves */
+        rad_free(*direct);
+        *direct = NULL;
+    }
     return r;
 }

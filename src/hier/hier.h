@@ -26,6 +26,9 @@
  *   hier.c    gather along links, push-pull, Jacobi sweeps; B F refinement
  *             rounds as the radiosity converges; the leaves as a mesh
  *   shaft.c   shaft culling (Haines & Wallace 1994)
+ *   direct.c  luminaires' and daylight's direct irradiance per node (the
+ *             light module's polygon mean), and leaves split where it
+ *             varies
  *
  * Clusters exchange energy through six-direction distributions (one value
  * per signed axis): a cluster's exitance toward direction w is
@@ -228,6 +231,38 @@ static inline void hr_bins_add(double *bins, vec3 d, double value)
     bins[d.z >= 0.0 ? 4 : 5] += fabs(d.z) * value;
 }
 
+/* ---- direct light (direct.c) ---- */
+
+/* Luminaires' and daylight's direct irradiance of every surface node (0
+ * for clusters), made when the node is: B_leaf = E + rho (H + H_d). */
+typedef struct hr_direct {
+    const rad_scene *scene;
+    const rad_mesh *base;     /* the rays' lift is the base mesh's */
+    const rad_vis *vis;
+    double *H;                /* 3 per node, W/m^2; NULL when the scene has no light */
+    float *deviation;         /* per node: max |H_d(x) - H_d| over the cubature's points, W/m^2 */
+    size_t count, capacity;   /* nodes computed; allocated */
+} hr_direct;
+
+/* Zero *d and, when the scene has luminaires or daylight, compute every
+ * node of the tree (its roots: call before any split); *reflected = the
+ * roots' first reflection sum A rho H_d, W with the channels summed (0
+ * without light).  Fails for memory or cancellation. */
+rad_result hr_direct_start(rad_context *ctx, const hr_tree *tree, const rad_vis *vis, hr_direct *d,
+                           double *reflected);
+/* Compute the nodes made since the last call, then split every new leaf
+ * where rho A max|H_d(x) - H_d| exceeds epsilon (W) and min_area allows,
+ * and their children alike until none is split; *split counts the leaves
+ * split.  Serial splits in node order: deterministic.  No-op without
+ * light.  Fails for memory or cancellation. */
+rad_result hr_direct_update(rad_context *ctx, hr_tree *tree, hr_direct *d, double epsilon, size_t *split);
+/* The leaves' H_d (3 per leaf) in the leaf mesh's order, allocated for the
+ * solution (RAD_MEM_SOLVER); *out NULL without light.  Fails for memory. */
+rad_result hr_direct_leaves(rad_context *ctx, const hr_tree *tree, const hr_direct *d, size_t leaves,
+                            double **out);
+double hr_direct_bytes(const hr_direct *d);
+void hr_direct_free(hr_direct *d);
+
 /* ---- the solver (hier.c) ---- */
 
 typedef struct rad_hier_params {
@@ -285,8 +320,11 @@ typedef struct rad_hier_stats {
 
 /* Solve; on success *leaf_mesh is the mesh of the leaves (patches as in
  * base, elements = leaves, located through the quadtree) and *radiosity
- * their B (3 per leaf).  stats->iterations etc. go into *solve_stats. */
+ * their B (3 per leaf), and with luminaires or daylight *direct their
+ * direct irradiance H_d (3 per leaf; NULL without light), B including
+ * rho H_d.  stats->iterations etc. go into *solve_stats. */
 rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **leaf_mesh,
-                        double **radiosity, rad_solve_stats *solve_stats, rad_hier_stats *stats);
+                        double **radiosity, double **direct, rad_solve_stats *solve_stats,
+                        rad_hier_stats *stats);
 
 #endif /* RAD_HIER_H */

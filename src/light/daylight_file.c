@@ -494,14 +494,16 @@ rad_result rad_scene_attach_daylight(rad_context *ctx, rad_scene *scene, rad_day
                      "nothing would be left", d->source, scene->source ? scene->source : "");
     rad_polygon *polygons = NULL;
     rad_surface *surfaces = NULL;
-    uint32_t *renumber = NULL;
+    uint32_t *renumber = NULL, *material_renumber = NULL;
     char **inputs = NULL;
     if (r == RAD_OK) {
         polygons = rad_alloc(ctx, RAD_MEM_SCENE, kept, sizeof *polygons, "scene: polygons");
         surfaces = rad_alloc(ctx, RAD_MEM_SCENE, scene->surface_count, sizeof *surfaces, "scene: surfaces");
         renumber = rad_alloc(ctx, RAD_MEM_SCENE, scene->surface_count, sizeof *renumber, "scene: surfaces");
         inputs = rad_alloc(ctx, RAD_MEM_SCENE, scene->input_count + 1, sizeof *inputs, "scene: inputs");
-        if (!polygons || !surfaces || !renumber || !inputs)
+        material_renumber = rad_alloc(ctx, RAD_MEM_SCENE, scene->material_count + 1, sizeof *material_renumber,
+                                      "scene: materials");
+        if (!polygons || !surfaces || !renumber || !inputs || !material_renumber)
             r = RAD_ERROR_OUT_OF_MEMORY;
     }
     char *input = NULL;
@@ -511,6 +513,7 @@ rad_result rad_scene_attach_daylight(rad_context *ctx, rad_scene *scene, rad_day
         rad_free(polygons);
         rad_free(surfaces);
         rad_free(renumber);
+        rad_free(material_renumber);
         rad_free(inputs);
         rad_daylight_free(d);
         return r;
@@ -553,6 +556,26 @@ rad_result rad_scene_attach_daylight(rad_context *ctx, rad_scene *scene, rad_day
         }
         polygons[m++] = poly;
     }
+    /* Materials only the openings used go too, as the scene builder drops
+     * unused ones: the scene is the one its file without the openings would
+     * make (a solution file rebuilds it so, and checks its checksum). */
+    for (size_t k = 0; k < scene->material_count; k++)
+        material_renumber[k] = 0;
+    for (size_t p = 0; p < m; p++)
+        material_renumber[polygons[p].material] = 1;
+    size_t material_count = 0;
+    for (size_t k = 0; k < scene->material_count; k++) {
+        if (!material_renumber[k]) {
+            rad_free(scene->materials[k].name);
+            continue;
+        }
+        scene->materials[material_count] = scene->materials[k];
+        material_renumber[k] = (uint32_t)material_count++;
+    }
+    for (size_t p = 0; p < m; p++)
+        polygons[p].material = material_renumber[polygons[p].material];
+    scene->material_count = material_count;
+    rad_free(material_renumber);
     rad_free(scene->polygons);
     rad_free(scene->surfaces);
     scene->polygons = polygons;

@@ -2,15 +2,18 @@
  * direct.c -- the scene's direct light (light.h): the sum over its kinds of
  * source at a point, and the mean over an element by adaptive cubature.
  *
- * The element mean: a region (the element's corners; triangle or planar
- * quad) is integrated with a fixed rule (quads: 2 x 2 Gauss-Legendre on
+ * The mean over a polygon (an element's corners, or a hierarchical node's:
+ * triangle or planar quad): the region is integrated with a fixed rule (quads: 2 x 2 Gauss-Legendre on
  * the bilinear map with its Jacobian; triangles: Strang and Fix's 3-point
  * rule of degree 2), then as its four children (rad_ff_split4); where the
  * two disagree by more than REL_TOL of the element's whole estimate the
  * children are integrated alike, down to MAX_DEPTH levels (4^MAX_DEPTH
  * regions at most, each of 3 or 4 points: bounded; shadow edges, where the
  * integrand jumps, are what reach the bottom).  The same order of regions
- * and points whatever the thread: deterministic.
+ * and points whatever the thread: deterministic.  The points' own values
+ * also tell how much the light varies over the polygon (their largest
+ * difference from the mean), which the hierarchical solver's oracle reads
+ * to split nodes along shadows (hier/direct.c).
  */
 #include "light/light.h"
 
@@ -54,15 +57,20 @@ typedef struct cubature {
     const rad_mesh *mesh;
     const rad_vis *vis;
     vec3 normal;
+    double lo[3], hi[3]; /* W/m^2: the range of the values at the points evaluated */
 } cubature;
 
-static void light_at(const cubature *c, vec3 x, double out[3])
+static void light_at(cubature *c, vec3 x, double out[3])
 {
     rad_light_irradiance(c->scene, c->mesh, c->vis, x, c->normal, out);
+    for (int ch = 0; ch < 3; ch++) {
+        c->lo[ch] = fmin(c->lo[ch], out[ch]);
+        c->hi[ch] = fmax(c->hi[ch], out[ch]);
+    }
 }
 
 /* The integral (W per channel) of the irradiance over one region. */
-static void region_integral(const cubature *c, const vec3 *q, uint32_t corners, double out[3])
+static void region_integral(cubature *c, const vec3 *q, uint32_t corners, double out[3])
 {
     double h[3];
     out[0] = out[1] = out[2] = 0.0;
@@ -94,7 +102,7 @@ static void region_integral(const cubature *c, const vec3 *q, uint32_t corners, 
 
 /* The children's integral where they agree with `coarse` (the region's
  * own) within `tol` W, else each child refined alike. */
-static void refine(const cubature *c, const vec3 *q, uint32_t corners, const double coarse[3], int depth,
+static void refine(cubature *c, const vec3 *q, uint32_t corners, const double coarse[3], int depth,
                    double tol, double out[3])
 {
     vec3 sub[4][4];
@@ -122,6 +130,39 @@ static void refine(const cubature *c, const vec3 *q, uint32_t corners, const dou
     }
 }
 
+void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                                  const vec3 *corner, uint32_t corners, vec3 normal, double out[3],
+                                  double *deviation)
+{
+    out[0] = out[1] = out[2] = 0.0;
+    if (deviation)
+        *deviation = 0.0;
+    if (!rad_light_present(scene) || (corners != 3 && corners != 4))
+        return;
+    cubature c = {scene, mesh, vis, normal, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    const vec3 *q = corner;
+    /* The region rules integrate over the corners' own area; the mean is
+     * over it. */
+    double area = 0.0;
+    if (corners == 3)
+        area = 0.5 * v3_length(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
+    else
+        area = 0.5 * v3_length(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[3], q[1])));
+    if (!(area > 0.0))
+        return;
+    double whole[3], total[3];
+    region_integral(&c, q, corners, whole);
+    double scale = fmax(fmax(whole[0], whole[1]), whole[2]);
+    refine(&c, q, corners, whole, 0, REL_TOL * scale, total);
+    double spread = 0.0;
+    for (int ch = 0; ch < 3; ch++) {
+        out[ch] = total[ch] / area;
+        spread = fmax(spread, fmax(c.hi[ch] - out[ch], out[ch] - c.lo[ch]));
+    }
+    if (deviation)
+        *deviation = spread;
+}
+
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   size_t element, double out[3])
 {
@@ -129,21 +170,8 @@ void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, 
     out[0] = out[1] = out[2] = 0.0;
     if (!rad_light_present(scene) || !(e->area > 0.0))
         return;
-    cubature c = {scene, mesh, vis, e->normal};
     vec3 q[4];
-    for (uint32_t k = 0; k < e->vertex_count; k++)
+    for (uint32_t k = 0; k < e->vertex_count && k < 4; k++)
         q[k] = mesh->vertices[e->vertex[k]];
-    double whole[3], total[3];
-    region_integral(&c, q, e->vertex_count, whole);
-    double scale = fmax(fmax(whole[0], whole[1]), whole[2]);
-    refine(&c, q, e->vertex_count, whole, 0, REL_TOL * scale, total);
-    /* The region rules integrate over the corners' own area; the mean is
-     * over the element's. */
-    double area = 0.0;
-    if (e->vertex_count == 3)
-        area = 0.5 * v3_length(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
-    else
-        area = 0.5 * v3_length(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[3], q[1])));
-    for (int ch = 0; ch < 3; ch++)
-        out[ch] = area > 0.0 ? total[ch] / area : 0.0;
+    rad_light_polygon_irradiance(scene, mesh, vis, q, e->vertex_count, e->normal, out, NULL);
 }

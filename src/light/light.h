@@ -42,6 +42,18 @@ void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const ra
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   size_t element, double out[3]);
 
+/* The same mean over a planar polygon: `corners` (3 or 4) points,
+ * counter-clockwise about the unit normal `normal` (a hierarchical node's,
+ * which is no element of `mesh`; mesh only scales the rays' lift).  When
+ * deviation is not NULL it gets the largest difference, over the channels
+ * and the points the cubature evaluated, between the irradiance there and
+ * the mean (W/m^2): how far the light varies across the polygon (a shadow
+ * edge crossing it gives about the step's size).  A degenerate polygon
+ * gives zeros.  Thread-safe, deterministic. */
+void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                                  const vec3 *corner, uint32_t corners, vec3 normal, double out[3],
+                                  double *deviation);
+
 /* The parts, one file each. */
 void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                                vec3 n, double out[3]);           /* light/luminaire.c */

@@ -168,6 +168,12 @@ rad_result rad_write_solution(rad_context *ctx, const rad_solution_view *v, cons
     cJSON *light = v->scene->luminaires.count > 0 ? rad_saved_put_light(&payload, v->scene, v->direct, v->n) : NULL;
     if (v->scene->luminaires.count > 0 && !light)
         payload.failed = true;
+    /* The daylight likewise (saved.h "daylight"), the direct irradiance
+     * with it when no luminaire part holds it. */
+    const struct rad_daylight *day = v->scene->daylight;
+    cJSON *daylight = day ? rad_saved_put_daylight(&payload, day, light ? NULL : v->direct, v->n) : NULL;
+    if (day && !daylight)
+        payload.failed = true;
     char hex[17];
     snprintf(hex, sizeof hex, "%016" PRIx64, rad_fnv1a(RAD_FNV_OFFSET, payload.data, payload.size));
     cJSON_AddStringToObject(header, "format", "radiosity solution");
@@ -182,6 +188,8 @@ rad_result rad_write_solution(rad_context *ctx, const rad_solution_view *v, cons
     cJSON_AddItemToObject(header, "solution", solution);
     if (light)
         cJSON_AddItemToObject(header, "light", light);
+    if (daylight)
+        cJSON_AddItemToObject(header, "daylight", daylight);
     char *text = cJSON_Print(header);
     cJSON_Delete(header);
     if (!text || payload.failed) {

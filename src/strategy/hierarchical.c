@@ -3,7 +3,9 @@
  * Salzman & Aupperle 1991, with clusters).  The patches are the roots of
  * the hierarchy and its first elements; solving refines the links and
  * splits nodes, and its leaves become the elements.  The ray structure is
- * built once, on the patches, and serves every level.
+ * built once, on the patches, and serves every level.  Luminaires and
+ * daylight light every node where it is made (hier/direct.c); the leaves
+ * carry their direct irradiance out as the dense strategies' elements do.
  */
 #include "strategy/strategy.h"
 
@@ -57,15 +59,6 @@ static rad_result hierarchical_create(rad_context *ctx, const rad_scene *scene, 
                                       void **out)
 {
     *out = NULL;
-    /* Its nodes take their emission from the materials (hier.c), and the
-     * direct light of luminaires and daylight would have to follow every
-     * refinement down to new leaves: refused rather than left dark. */
-    if (rad_light_present(scene))
-        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "%s: the hierarchical solver does not take luminaires or daylight; use a dense "
-                        "solver (e.g. gauss-seidel, with --adaptive for refinement), matrix-free, galerkin "
-                        "or instant-radiosity",
-                        scene->source);
     hierarchical_state *st = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *st, "solution: hierarchical state");
     if (!st)
         return RAD_ERROR_OUT_OF_MEMORY;
@@ -155,8 +148,8 @@ static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_st
     st->solve_stats.unshot = NAN;
     double t = rad_seconds();
     rad_mesh *leaves = NULL;
-    double *B = NULL;
-    rad_result r = rad_hier_run(ctx, &hp, &leaves, &B, &st->solve_stats, &st->hier_stats);
+    double *B = NULL, *direct = NULL;
+    rad_result r = rad_hier_run(ctx, &hp, &leaves, &B, &direct, &st->solve_stats, &st->hier_stats);
     st->hier_stats.patches = st->patches->patch_count;
     st->solve_stats.seconds = rad_seconds() - t;
     st->seconds.solve = st->solve_stats.seconds;
@@ -167,11 +160,25 @@ static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_st
         rad_elements e;
         if (rad_elements_create(ctx, st->scene, leaves, &e) != RAD_OK) {
             rad_free(B);
+            rad_free(direct);
             rad_mesh_destroy(leaves);
             return RAD_ERROR_OUT_OF_MEMORY;
         }
         rad_free(e.radiosity);
         e.radiosity = B;
+        /* Luminaires and daylight: each leaf's direct irradiance, its first
+         * reflection in the emission, as rad_elements_add_light leaves the
+         * dense strategies' elements (the power balance and the grids'
+         * gathering read them so).  The solver used the materials'
+         * reflectance, so it is the part added here too. */
+        if (direct) {
+            for (size_t i = 0; i < leaves->element_count; i++) {
+                const double *rho = st->scene->materials[leaves->elements[i].material].reflectance;
+                for (int c = 0; c < 3; c++)
+                    e.emission[3 * i + (size_t)c] += rho[c] * direct[3 * i + (size_t)c];
+            }
+            e.direct = direct;
+        }
         rad_mesh_destroy(st->leaves);
         rad_elements_free(&st->leaf_elements);
         st->leaves = leaves;
@@ -205,7 +212,7 @@ static void hierarchical_view(const void *state, rad_solution_view *v)
 const rad_strategy rad_strategy_hierarchical = {
     "hierarchical",
     "links between quadtree nodes and clusters, refined as the radiosity converges",
-    RAD_CAN_CLOSURE_CORRECTION,
+    RAD_CAN_CLOSURE_CORRECTION | RAD_CAN_LIGHTS,
     hierarchical_solver_info,
     hierarchical_create,
     hierarchical_solve,

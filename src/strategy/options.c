@@ -68,8 +68,9 @@ static const rad_option_info solution_rows[] = {
              "makes it reciprocal and holds its rows to their measured closure (energy conservation)"},
     {SOLUTION(solver), .type = RAD_OPTION_METHOD, .methods = RAD_METHOD_SOLVER, .default_value = NAN,
      .default_text = "hierarchical",
-     .help = "solver (without one: gauss-seidel where an element count, a mesh size, a form-factor "
-             "method or adaptive subdivision is given, and for view factors and progress images); "
+     .help = "solver (without one: hierarchical, lit scenes too; gauss-seidel where an element count, a "
+             "mesh size, a form-factor method or adaptive subdivision is given, and for view factors and "
+             "progress images); "
              "galerkin-linear, galerkin-constant and collocation: basis functions per vertex or element "
              "(docs/methods.md, \"Galerkin elements\")"},
     {SOLUTION(tolerance), .type = RAD_OPTION_DOUBLE, .min = 0.0, .min_open = true, .max = 1.0, .max_open = true,

@@ -16,6 +16,7 @@
 
 #include "strategy/options.h"
 #include "photometry/photometry.h"
+#include "scene/daylight.h"
 
 #include <cjson/cJSON.h>
 #include <inttypes.h>
@@ -595,6 +596,95 @@ static rad_result read_light(rad_context *ctx, const char *name, rad_scene *scen
     return RAD_OK;
 }
 
+static bool unit_vector(vec3 v) { return v3_finite(v) && fabs(v3_length(v) - 1.0) < 1e-9; }
+
+/* The daylight part (saved.h): the sky as prepared, the sun, the ground and
+ * the openings, each number finite and in its range, the directions unit
+ * vectors, attached to `scene`; *direct (when the header says it follows)
+ * the elements' direct irradiance, finite and >= 0 (the caller's to free). */
+static rad_result read_daylight(rad_context *ctx, const char *name, rad_scene *scene, const cJSON *day,
+                                cursor *c, size_t elements, double **direct)
+{
+    rad_daylight *d = rad_alloc(ctx, RAD_MEM_SCENE, 1, sizeof *d, "solution file: daylight");
+    if (!d)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    memset(d, 0, sizeof *d);
+    scene->daylight = d; /* the scene frees it from here on */
+    const cJSON *names = cJSON_GetObjectItemCaseSensitive(day, "opening_names");
+    size_t N = (size_t)cJSON_GetArraySize(names), O = (size_t)number_in(day, "openings");
+    d->source = rad_strdup(ctx, RAD_MEM_SCENE, cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(day, "source")),
+                           "solution file: daylight");
+    d->opening_names = rad_alloc(ctx, RAD_MEM_SCENE, N + 1, sizeof *d->opening_names, "solution file: daylight");
+    d->openings = rad_alloc(ctx, RAD_MEM_SCENE, O + 1, sizeof *d->openings, "solution file: daylight");
+    if (!d->source || !d->opening_names || !d->openings)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    for (const cJSON *o = names->child; o; o = o->next) {
+        d->opening_names[d->opening_name_count] = rad_strdup(ctx, RAD_MEM_SCENE, o->valuestring, "solution file: daylight");
+        if (!d->opening_names[d->opening_name_count])
+            return RAD_ERROR_OUT_OF_MEMORY;
+        d->opening_name_count++;
+    }
+    double model = number_in(day, "model"), type = number_in(day, "type");
+    rad_sky *k = &d->sky;
+    double *sky[10] = {&k->a, &k->b, &k->c, &k->d, &k->e, &k->sun_zenith, &k->sun_azimuth, &k->norm,
+                       &k->zenith_radiance, &k->horizontal};
+    bool ok = true;
+    for (int i = 0; i < 10; i++) {
+        *sky[i] = get_f64(c);
+        ok = ok && isfinite(*sky[i]);
+    }
+    k->up = get_vec3(c);
+    k->north = get_vec3(c);
+    k->east = get_vec3(c);
+    k->sun = get_vec3(c);
+    double *rest[6] = {&d->sun_normal, &d->ground_reflectance, &d->ground_radiance, &d->zenith_luminance,
+                       &d->diffuse_illuminance, &d->tolerance};
+    for (int i = 0; i < 6; i++) {
+        *rest[i] = get_f64(c);
+        ok = ok && isfinite(*rest[i]) && *rest[i] >= 0.0;
+    }
+    ok = ok && (model == RAD_SKY_CIE_GENERAL ? type >= 1 && type <= 15 && type == floor(type)
+                                             : model == RAD_SKY_CIE_OVERCAST && type == 0);
+    ok = ok && unit_vector(k->up) && unit_vector(k->north) && unit_vector(k->east) && unit_vector(k->sun) &&
+         k->sun_zenith >= 0.0 && k->sun_zenith < 0.5 * M_PI && k->norm >= 0.0 && k->zenith_radiance >= 0.0 &&
+         k->horizontal >= 0.0 && d->ground_reflectance <= 1.0 && d->tolerance > 0.0 && d->tolerance <= 0.1;
+    if (!ok)
+        return BAD("%s: daylight: the sky, sun or ground is out of range", name);
+    k->model = (rad_sky_model)model;
+    k->type = (int)type;
+    d->ground = cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(day, "ground"));
+    for (size_t i = 0; i < O; i++) {
+        rad_opening *o = &d->openings[i];
+        o->corner_count = get_u32(c);
+        o->surface = get_u32(c);
+        for (int q = 0; q < 4; q++)
+            o->corner[q] = get_vec3(c);
+        o->normal = get_vec3(c);
+        o->area = get_f64(c);
+        ok = (o->corner_count == 3 || o->corner_count == 4) && o->surface < N && unit_vector(o->normal) &&
+             isfinite(o->area) && o->area > 0.0;
+        for (int q = 0; q < 4 && ok; q++)
+            ok = v3_finite(o->corner[q]);
+        if (!ok)
+            return BAD("%s: daylight: opening %zu is malformed", name, i);
+        d->opening_count = i + 1;
+    }
+    if (!direct || !cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(day, "direct")))
+        return RAD_OK;
+    double *h = rad_alloc(ctx, RAD_MEM_SOLVER, 3 * elements + 1, sizeof *h, "solution: direct light");
+    if (!h)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < 3 * elements; i++) {
+        h[i] = get_f64(c);
+        if (!(isfinite(h[i]) && h[i] >= 0.0)) {
+            rad_free(h);
+            return BAD("%s: daylight: element %zu has direct irradiance %g W/m^2", name, i / 3, h[i]);
+        }
+    }
+    *direct = h;
+    return RAD_OK;
+}
+
 rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned char *data, size_t size,
                           rad_scene **scene_out, rad_options *options, rad_method_names *names,
                           void **state)
@@ -670,6 +760,25 @@ rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned cha
             goto done;
         }
     }
+    /* The daylight, when the header names it: its bytes follow the light's. */
+    const cJSON *day = cJSON_GetObjectItemCaseSensitive(header, "daylight");
+    size_t day_at = expected;
+    if (day) {
+        const cJSON *day_names = cJSON_GetObjectItemCaseSensitive(day, "opening_names");
+        size_t openings = 0;
+        bool ok = cJSON_IsObject(day) && cJSON_IsArray(day_names) &&
+                  cJSON_IsString(cJSON_GetObjectItemCaseSensitive(day, "source")) &&
+                  count_in(day, "openings", most, &openings) && cJSON_IsBool(cJSON_GetObjectItemCaseSensitive(day, "ground")) &&
+                  cJSON_IsBool(cJSON_GetObjectItemCaseSensitive(day, "direct")) &&
+                  cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(day, "direct")) == !light;
+        for (const cJSON *o = ok ? day_names->child : NULL; o && ok; o = o->next)
+            ok = cJSON_IsString(o) && o->valuestring[0];
+        expected += 8 * 28 + 136 * openings + (light ? 0 : 24 * elements);
+        if (!ok || expected > size) {
+            r = BAD("%s: the header's daylight is malformed", name);
+            goto done;
+        }
+    }
     double payload_bytes = number_in(payload, "bytes");
     const char *checksum = cJSON_GetStringValue(cJSON_GetObjectItemCaseSensitive(payload, "fnv1a64"));
     if (payload_at > size || payload_bytes != (double)expected || expected != size - payload_at || !checksum) {
@@ -700,6 +809,14 @@ rad_result rad_saved_read(rad_context *ctx, const char *name, const unsigned cha
         r = read_light(ctx, name, scene, light_ph, light_lu, &lc, elements, &direct);
         if (r != RAD_OK)
             goto done;
+    }
+    if (day) {
+        cursor dc = {data + payload_at + day_at, data + size};
+        r = read_daylight(ctx, name, scene, day, &dc, elements, light ? NULL : &direct);
+        if (r != RAD_OK) {
+            rad_free(direct);
+            goto done;
+        }
     }
     st = rad_alloc(ctx, RAD_MEM_SOLVER, 1, sizeof *st, "solution file: state");
     if (!st || rad_elements_create(ctx, scene, mesh, &st->elements) != RAD_OK) {

@@ -25,6 +25,17 @@
  *                length, height, C angles, gamma angles, candela (f64); per
  *                luminaire position, 3 axes, multiplier (13 f64); each
  *                element's direct irradiance 3 x f64 (W/m^2)
+ *     daylight   only with daylight (the header's "daylight": its file's
+ *                name, sky model and type, ground, opening count and the
+ *                openings' surface names, whether the direct irradiance
+ *                follows): the sky's a, b, c, d, e, sun zenith and azimuth,
+ *                norm, zenith radiance, horizontal irradiance, its up, north,
+ *                east and sun directions (22 f64); the sun's normal
+ *                irradiance, the ground's reflectance and radiance, the
+ *                zenith luminance, diffuse illuminance and tolerance (6 f64);
+ *                per opening its corner count and surface (2 u32), 4
+ *                corners, normal, area (16 f64); then, without luminaires,
+ *                each element's direct irradiance 3 x f64 (W/m^2)
  *
  * Loading trusts nothing: the scene is rebuilt through the scene builder
  * (which validates every polygon) and must hash to the stored checksum;
@@ -67,6 +78,13 @@ struct cJSON;
  * irradiance `direct`, 3n, NULL: zeros) and its header object; NULL when
  * out of memory. */
 struct cJSON *rad_saved_put_light(rad_bytes *b, const rad_scene *scene, const double *direct, size_t n);
+/* The daylight part of the payload (the sky as prepared, the sun, the
+ * ground, the openings; then the elements' direct irradiance `direct`, 3n,
+ * unless NULL: the light part holds it when there are luminaires too) and
+ * its header object; NULL when out of memory. */
+struct rad_daylight;
+struct cJSON *rad_saved_put_daylight(rad_bytes *b, const struct rad_daylight *daylight, const double *direct,
+                                     size_t n);
 
 /* The scene and mesh part of the payload, and the counts that go with it
  * into the header (a cJSON object, `counts`). */

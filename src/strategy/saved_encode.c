@@ -7,6 +7,7 @@
 #include "strategy/saved.h"
 
 #include "photometry/photometry.h"
+#include "scene/daylight.h"
 
 #include <cjson/cJSON.h>
 #include <stdlib.h>
@@ -242,3 +243,47 @@ cJSON *rad_saved_put_light(rad_bytes *b, const rad_scene *scene, const double *d
     return light;
 }
 
+
+cJSON *rad_saved_put_daylight(rad_bytes *b, const rad_daylight *d, const double *direct, size_t n)
+{
+    cJSON *day = cJSON_CreateObject(), *names = cJSON_AddArrayToObject(day, "opening_names");
+    bool ok = day && names && cJSON_AddStringToObject(day, "source", d->source ? d->source : "") &&
+              cJSON_AddNumberToObject(day, "model", (double)d->sky.model) &&
+              cJSON_AddNumberToObject(day, "type", (double)d->sky.type) &&
+              cJSON_AddBoolToObject(day, "ground", d->ground) &&
+              cJSON_AddNumberToObject(day, "openings", (double)d->opening_count) &&
+              cJSON_AddBoolToObject(day, "direct", direct != NULL);
+    for (size_t k = 0; ok && k < d->opening_name_count; k++)
+        ok = cJSON_AddItemToArray(names, cJSON_CreateString(d->opening_names[k]));
+    if (!ok) {
+        cJSON_Delete(day);
+        return NULL;
+    }
+    /* The sky as prepared (rad_sky_prepare's scale included): the loaded
+     * daylight gives the same numbers to the bit. */
+    const rad_sky *k = &d->sky;
+    const double sky[10] = {k->a, k->b, k->c, k->d, k->e, k->sun_zenith, k->sun_azimuth, k->norm,
+                            k->zenith_radiance, k->horizontal};
+    for (int i = 0; i < 10; i++)
+        rad_bytes_f64(b, sky[i]);
+    put_vec3(b, k->up);
+    put_vec3(b, k->north);
+    put_vec3(b, k->east);
+    put_vec3(b, k->sun);
+    const double rest[6] = {d->sun_normal, d->ground_reflectance, d->ground_radiance, d->zenith_luminance,
+                            d->diffuse_illuminance, d->tolerance};
+    for (int i = 0; i < 6; i++)
+        rad_bytes_f64(b, rest[i]);
+    for (size_t i = 0; i < d->opening_count; i++) {
+        const rad_opening *o = &d->openings[i];
+        rad_bytes_u32(b, o->corner_count);
+        rad_bytes_u32(b, o->surface);
+        for (int c = 0; c < 4; c++)
+            put_vec3(b, o->corner[c]);
+        put_vec3(b, o->normal);
+        rad_bytes_f64(b, o->area);
+    }
+    for (size_t i = 0; direct && i < 3 * n; i++)
+        rad_bytes_f64(b, direct[i]);
+    return day;
+}
