@@ -115,23 +115,7 @@ static void geom_init(elem_geom *g, const rad_mesh *mesh, const rad_element *e)
             g->diameter = fmax(g->diameter, v3_length(v3_sub(g->corner[a], g->corner[b])));
     }
     /* The 2x2 Gauss rule of integrate(), here over the whole element. */
-    const vec3 *r = g->corner;
-    for (int a = 0; a < 2; a++)
-        for (int b = 0; b < 2; b++) {
-            double s = gauss_x[2][a], t = gauss_x[2][b], w = gauss_w[2][a] * gauss_w[2][b];
-            if (g->corners == 4) {
-                vec3 e1 = v3_sub(r[1], r[0]), e3 = v3_sub(r[3], r[0]);
-                vec3 h = v3_add(v3_sub(r[2], r[1]), v3_sub(r[0], r[3]));
-                g->gauss_point[2 * a + b] =
-                    v3_add(r[0], v3_add(v3_scale(e1, s), v3_add(v3_scale(e3, t), v3_scale(h, s * t))));
-                vec3 ds = v3_add(e1, v3_scale(h, t)), dt = v3_add(e3, v3_scale(h, s));
-                g->gauss_weight[2 * a + b] = w * v3_length(v3_cross(ds, dt));
-            } else {
-                vec3 e1 = v3_sub(r[1], r[0]), e2 = v3_sub(r[2], r[0]);
-                g->gauss_point[2 * a + b] = v3_add(r[0], v3_add(v3_scale(e1, s), v3_scale(e2, (1.0 - s) * t)));
-                g->gauss_weight[2 * a + b] = w * v3_length(v3_cross(e1, e2)) * (1.0 - s);
-            }
-        }
+    rad_element_gauss(mesh, e, 2, g->gauss_point, g->gauss_weight);
 }
 
 /* Every corner of a strictly in front of b's plane. */

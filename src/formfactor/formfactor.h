@@ -236,6 +236,13 @@ void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v);
 void rad_element_cosine_rays(const rad_mesh *mesh, const rad_element *e, double lift, int side, int first,
                              int count, rad_rng *rng, rad_ray *ray);
 
+/* The order x order Gauss-Legendre product rule over element e (order 1
+ * to 4): points into point[], weights (m^2, the rule's weight times the
+ * Jacobian of the bilinear map, or of the square collapsed onto a
+ * triangle) into weight[], summing to the element's area for flat quads
+ * and triangles.  Returns order^2.  Cannot fail. */
+int rad_element_gauss(const rad_mesh *mesh, const rad_element *e, int order, vec3 *point, double *weight);
+
 /* The four children of a quad (bilinear midpoints) or a triangle (midpoint
  * subdivision, the middle child last), same orientation as the parent:
  * the adaptive quadratures' refinement step (analytic, hemicube).  A

@@ -1,9 +1,10 @@
 /*
  * polygon.c -- the unoccluded point-to-polygon form factor; and the small
- * helpers the sampling methods share: the bend of a quad (how far ray end
- * points must be lifted), the density of rad_element_sample, the tangent
- * frame of an element, its bundles of cosine-distributed rays and the
- * split of a region into four.
+ * helpers the sampling methods share: the Gauss-Legendre product rule over
+ * an element (analytic's and hybrid's far pairs), the bend of a quad (how
+ * far ray end points must be lifted), the density of rad_element_sample,
+ * the tangent frame of an element, its bundles of cosine-distributed rays
+ * and the split of a region into four.
  *
  * Lambert's contour formula (Lambert 1760; in radiosity: Baum, Rushmeier &
  * Winget, SIGGRAPH 1989; Cohen & Wallace 1993, sec. 4.6):
@@ -185,4 +186,45 @@ bool rad_ff_facing(const rad_mesh *mesh, uint32_t i, uint32_t j, double plane_to
             return false;
     }
     return true;
+}
+
+/* Gauss-Legendre nodes and weights on [0, 1], orders 1..4. */
+static const double gauss_node[5][4] = {
+    {0},
+    {0.5},
+    {0.21132486540518713, 0.78867513459481287},
+    {0.11270166537925831, 0.5, 0.88729833462074169},
+    {0.06943184420297371, 0.33000947820757187, 0.66999052179242813, 0.93056815579702629},
+};
+static const double gauss_weight[5][4] = {
+    {0},
+    {1.0},
+    {0.5, 0.5},
+    {0.27777777777777778, 0.44444444444444444, 0.27777777777777778},
+    {0.17392742256872693, 0.32607257743127307, 0.32607257743127307, 0.17392742256872693},
+};
+
+int rad_element_gauss(const rad_mesh *mesh, const rad_element *e, int order, vec3 *point, double *weight)
+{
+    const vec3 *v = mesh->vertices;
+    vec3 r0 = v[e->vertex[0]], r1 = v[e->vertex[1]], r2 = v[e->vertex[2]];
+    int q = 0;
+    for (int a = 0; a < order; a++)
+        for (int b = 0; b < order; b++, q++) {
+            double s = gauss_node[order][a], t = gauss_node[order][b];
+            double w = gauss_weight[order][a] * gauss_weight[order][b];
+            if (e->vertex_count == 4) {
+                vec3 r3 = v[e->vertex[3]];
+                vec3 e1 = v3_sub(r1, r0), e3 = v3_sub(r3, r0);
+                vec3 h = v3_add(v3_sub(r2, r1), v3_sub(r0, r3));
+                point[q] = v3_add(r0, v3_add(v3_scale(e1, s), v3_add(v3_scale(e3, t), v3_scale(h, s * t))));
+                vec3 ds = v3_add(e1, v3_scale(h, t)), dt = v3_add(e3, v3_scale(h, s));
+                weight[q] = w * v3_length(v3_cross(ds, dt));
+            } else { /* the square collapsed onto the triangle (Duffy) */
+                vec3 e1 = v3_sub(r1, r0), e2 = v3_sub(r2, r0);
+                point[q] = v3_add(r0, v3_add(v3_scale(e1, s), v3_scale(e2, (1.0 - s) * t)));
+                weight[q] = w * v3_length(v3_cross(e1, e2)) * (1.0 - s);
+            }
+        }
+    return q;
 }
