@@ -7,11 +7,11 @@
  * "Lightcuts").
  *
  *                 root
- *            /          \            the top levels split by normal bin
- *        +x ... -z bins               (the dominant axis of the normal,
- *        /    \                        six bins), below by the median of
- *      ...    ...                      the centroids along the longest side
- *     leaf = one element
+ *            /          \            the top levels split by bin (the
+ *        +x ... -z bins               dominant axis of the normal, six
+ *        /    \                        bins, emitters apart: twelve), below
+ *      ...    ...                      by the median of the centroids
+ *     leaf = one element               along the longest side
  *
  * A node keeps, per RGB channel, the vector sum of area x radiosity x
  * normal of its elements (the self-emission and the rest apart):
@@ -116,6 +116,7 @@ static uint32_t leaf(builder *bd, uint32_t j)
         node->power_rest[c] = v3_scale(e->normal, e->area * (B[c] - S[c]));
     }
     node->weight = e->area * (0.265 * B[0] + 0.670 * B[1] + 0.065 * B[2]);
+    node->emits = S[0] > 0.0 || S[1] > 0.0 || S[2] > 0.0;
     node->centre = e->centroid;
     element_moment(mesh, e, node->weight, node->moment);
     node->axis = e->normal;
@@ -141,6 +142,7 @@ static uint32_t join(builder *bd, uint32_t a, uint32_t b)
         node->power_rest[c] = v3_add(x->power_rest[c], y->power_rest[c]);
     }
     node->weight = x->weight + y->weight;
+    node->emits = x->emits || y->emits;
     /* The centre of power; halfway where neither child has any. */
     node->centre = node->weight > 0.0
                        ? v3_scale(v3_add(v3_scale(x->centre, x->weight), v3_scale(y->centre, y->weight)),
@@ -197,12 +199,17 @@ static uint32_t build(builder *bd, build_item *items, size_t count)
     return join(bd, left, right);
 }
 
-/* The normal bin of a unit normal: 2 x the dominant axis, +1 if negative. */
-static int normal_bin(vec3 n)
+enum { BINS = 12 };
+
+/* An element's bin: 2 x the dominant axis of its normal, +1 if negative;
+ * +6 for an emitter (some self-emission), so that emitters and the rest
+ * never share a node (gather.c never takes emitters as clusters). */
+static int element_bin(vec3 n, const double self[3])
 {
     double ax = fabs(n.x), ay = fabs(n.y), az = fabs(n.z);
     int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
-    return 2 * a + (axis_of(n, a) < 0.0);
+    bool emits = self[0] > 0.0 || self[1] > 0.0 || self[2] > 0.0;
+    return 2 * a + (axis_of(n, a) < 0.0) + 6 * emits;
 }
 
 rad_result rad_gather_tree_build(rad_context *ctx, const rad_solution_view *view, const double *self,
@@ -220,30 +227,30 @@ rad_result rad_gather_tree_build(rad_context *ctx, const rad_solution_view *view
         rad_gather_tree_destroy(t);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    /* The elements that send light, grouped by normal bin (a counting
-     * sort, element order kept within a bin). */
-    size_t start[7] = {0};
+    /* The elements that send light, grouped by bin (a counting sort,
+     * element order kept within a bin). */
+    size_t start[BINS + 1] = {0};
     for (size_t j = 0; j < n; j++) {
         const double *B = view->radiosity + 3 * j;
         if (B[0] > 0.0 || B[1] > 0.0 || B[2] > 0.0)
-            start[normal_bin(mesh->elements[j].normal) + 1]++;
+            start[element_bin(mesh->elements[j].normal, self + 3 * j) + 1]++;
     }
-    for (int b = 0; b < 6; b++)
+    for (int b = 0; b < BINS; b++)
         start[b + 1] += start[b];
-    size_t fill[6];
+    size_t fill[BINS];
     memcpy(fill, start, sizeof fill);
     for (size_t j = 0; j < n; j++) {
         const double *B = view->radiosity + 3 * j;
         if (!(B[0] > 0.0 || B[1] > 0.0 || B[2] > 0.0))
             continue;
         const rad_element *e = &mesh->elements[j];
-        items[fill[normal_bin(e->normal)]++] = (build_item){(uint32_t)j, e->centroid, 0.0};
+        items[fill[element_bin(e->normal, self + 3 * j)]++] = (build_item){(uint32_t)j, e->centroid, 0.0};
         lit++;
     }
     builder bd = {view, self, t};
-    uint32_t roots[6];
+    uint32_t roots[BINS];
     int bins = 0;
-    for (int b = 0; b < 6; b++)
+    for (int b = 0; b < BINS; b++)
         if (start[b + 1] > start[b])
             roots[bins++] = build(&bd, items + start[b], start[b + 1] - start[b]);
     /* The bins joined pairwise into one root. */

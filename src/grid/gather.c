@@ -30,6 +30,13 @@
  * first reflection included).  Parallel over points: each point's sum is
  * made in one thread in element order, and its rays are keyed on (seed,
  * point, element), so the numbers do not depend on the thread count.
+ *
+ * RAD_GRID_GATHER_TREE walks cluster.c's tree instead of the element list
+ * (gather_tree): far groups count as one source (Barnes & Hut 1986's
+ * opening criterion; the visibility of a group by rays to its
+ * representatives, as Walter et al. 2005's lightcuts), the elements it
+ * reaches go through the same exact path.  Not the default: on the
+ * generated offices it is no faster (docs/performance.md, bench_gather).
  */
 #include "grid/grid.h"
 
@@ -218,28 +225,69 @@ static void gather_element(const gather_shared *g, point_sums *ps, size_t j, ray
         }
 }
 
+/* The rays of one visibility test, handed down the walk: a child's
+ * representatives are among its parent's (cluster.c alternates them), and
+ * the same ray from the same origin has the same answer, so a child casts
+ * only those its parent did not. */
+typedef struct known_rays {
+    uint32_t element[RAD_GATHER_REPS];
+    uint8_t blocked[RAD_GATHER_REPS];
+    int count;
+} known_rays;
+
 /* A node's visibility from the point by rays to its representatives'
  * centroids (lifted as the element rays' ends): 1 all clear, 0 all
- * blocked, -1 mixed (the node is opened).  Without a ray structure, 1. */
-static int cluster_visible(const gather_shared *g, point_sums *ps, const rad_gather_node *node)
+ * blocked, -1 mixed (the node is opened).  `clear_counts` false: the node
+ * cannot count as clear (it is not one-sided or not far enough), so the
+ * first clear ray ends the test (-1).  The rays cast are added to `known`
+ * (those of `parent` reused).  Without a ray structure, 1. */
+static int cluster_visible(const gather_shared *g, point_sums *ps, const rad_gather_node *node,
+                           const known_rays *parent, bool clear_counts, known_rays *known)
 {
+    known->count = 0;
     const rad_vis *vis = g->view->vis;
     if (!vis)
         return 1;
     const rad_mesh *mesh = g->view->mesh;
+    int clear = 0, hidden = 0;
     rad_ray ray[RAD_GATHER_REPS];
-    uint8_t blocked[RAD_GATHER_REPS];
+    uint32_t pending[RAD_GATHER_REPS];
+    int count = 0;
     for (int k = 0; k < node->reps; k++) {
-        const rad_element *e = &mesh->elements[node->rep[k]];
+        uint32_t j = node->rep[k];
+        int at = -1;
+        for (int i = 0; parent && i < parent->count; i++)
+            if (parent->element[i] == j)
+                at = i;
+        if (at >= 0) {
+            known->element[known->count] = j;
+            known->blocked[known->count++] = parent->blocked[at];
+            parent->blocked[at] ? hidden++ : clear++;
+            continue;
+        }
+        const rad_element *e = &mesh->elements[j];
         vec3 y = v3_mad(e->centroid, e->normal, g->eps + rad_element_bend(mesh, e));
-        ray[k] = (rad_ray){ps->origin, v3_sub(y, ps->origin), 0.0, 1.0};
+        ray[count] = (rad_ray){ps->origin, v3_sub(y, ps->origin), 0.0, 1.0};
+        pending[count++] = j;
     }
-    vis->backend->occluded(vis->state, ray, (size_t)node->reps, blocked);
-    ps->cluster_rays += (uint64_t)node->reps;
-    int hits = 0;
-    for (int k = 0; k < node->reps; k++)
-        hits += blocked[k] != 0;
-    return hits == 0 ? 1 : hits == node->reps ? 0 : -1;
+    /* Two at a time: a disagreement (or a clear ray where clear does not
+     * count) ends the test without the others. */
+    for (int first = 0; first < count; first += 2) {
+        if ((clear > 0 && hidden > 0) || (clear > 0 && !clear_counts))
+            break;
+        int m = count - first < 2 ? count - first : 2;
+        uint8_t blocked[2];
+        vis->backend->occluded(vis->state, ray + first, (size_t)m, blocked);
+        ps->cluster_rays += (uint64_t)m;
+        for (int i = 0; i < m; i++) {
+            known->element[known->count] = pending[first + i];
+            known->blocked[known->count++] = blocked[i];
+            blocked[i] ? hidden++ : clear++;
+        }
+    }
+    if (clear > 0 && (hidden > 0 || !clear_counts))
+        return -1;
+    return hidden == 0 ? 1 : 0;
 }
 
 /* A far node as one source (cluster.c's header): per channel
@@ -300,12 +348,21 @@ static void gather_tree(const gather_shared *g, point_sums *ps, ray_batch *b)
     const rad_gather_tree *tree = g->tree;
     if (tree->root == RAD_GATHER_LEAF)
         return;
-    uint32_t stack[128];
+    /* Depth-first; each entry with the rays its parent cast.  The stack
+     * holds at most the tree's depth + 1 entries: median splits make it
+     * ceil(log2 n) + 3 (the bins joined), 36 for 2^32 elements. */
+    enum { DEPTH = 64 };
+    uint32_t stack[DEPTH];
+    known_rays rays[DEPTH];
     int top = 0;
-    stack[top++] = tree->root;
+    stack[top] = tree->root;
+    rays[top++].count = 0;
     vec3 p = ps->p, n = ps->n;
     while (top > 0) {
-        const rad_gather_node *node = &tree->nodes[stack[--top]];
+        --top;
+        const rad_gather_node *node = &tree->nodes[stack[top]];
+        known_rays parent = rays[top], mine;
+        mine.count = 0;
         vec3 centre = v3_scale(v3_add(node->lo, node->hi), 0.5), half = v3_scale(v3_sub(node->hi, node->lo), 0.5);
         double mid = v3_dot(n, v3_sub(centre, p));
         double ext = fabs(n.x) * half.x + fabs(n.y) * half.y + fabs(n.z) * half.z;
@@ -320,12 +377,28 @@ static void gather_tree(const gather_shared *g, point_sums *ps, ray_batch *b)
             if (gamma - node->spread - beta >= 0.5 * M_PI)
                 continue;
             if (!leaf && 2.0 * radius < g->theta * dist) {
-                int seen = cluster_visible(g, ps, node);
-                if (seen == 0) {
+                /* Counted as one source: not emitters (their self-emission
+                 * is the direct part: a cluster of them may be found
+                 * blocked, never summed), every element facing the point
+                 * and the point facing all the box, and small against the
+                 * distance times both cosines, since the expansion is in
+                 * size over distance divided by the cosines (a grazing
+                 * wall beside the point is opened). */
+                double facing = cos(fmin(gamma + node->spread, 0.5 * M_PI));
+                bool one_sided = !node->emits && mid - ext > 0.0 && gamma + node->spread + beta < 0.5 * M_PI &&
+                                 2.0 * radius < g->theta * fmin(mid, dist * facing);
+                int seen = cluster_visible(g, ps, node, &parent, one_sided, &mine);
+                /* Found blocked, it sends nothing, where its rays sampled
+                 * distinct elements: a node of fewer elements than rays
+                 * would stand for each element's visibility by its centre
+                 * alone, coarser than the stratified rays of the exact path
+                 * (bench_gather: counting those blocked lost up to 1.5% per
+                 * point, a desk's edge across a few ceiling elements). */
+                if (seen == 0 && node->reps == RAD_GATHER_REPS) {
                     ps->cluster_pairs++;
                     continue;
                 }
-                if (seen == 1 && mid - ext > 0.0 && gamma + node->spread + beta < 0.5 * M_PI) {
+                if (seen == 1) {
                     cluster_add(ps, node);
                     continue;
                 }
@@ -335,8 +408,10 @@ static void gather_tree(const gather_shared *g, point_sums *ps, ray_batch *b)
             gather_element(g, ps, node->child[0], b);
             continue;
         }
-        stack[top++] = node->child[1];
-        stack[top++] = node->child[0];
+        stack[top] = node->child[1];
+        rays[top++] = mine.count ? mine : parent;
+        stack[top] = node->child[0];
+        rays[top++] = mine.count ? mine : parent;
     }
 }
 

@@ -82,6 +82,7 @@ typedef struct rad_gather_node {
     uint32_t child[2];          /* nodes; a leaf: child[0] its element, child[1] RAD_GATHER_LEAF */
     uint32_t rep[RAD_GATHER_REPS]; /* elements whose centroids visibility rays aim at */
     int reps;
+    bool emits;                 /* some element has self-emission (the direct part: never one source) */
 } rad_gather_node;
 
 typedef struct rad_gather_tree {
