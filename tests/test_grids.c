@@ -1064,10 +1064,11 @@ static void cie171_interreflection_obstruction(void **state)
 
 /* Irradiance at the points of `json` by `method` (3 direct then 3
  * indirect per point, W/m^2) on fx's solved view, the tree's opening
- * criterion `theta` (0: the default), `threads` threads and the shadow
- * rays keyed on `seed`.  Returns the point count. */
-static size_t gather_with(fixture *fx, const char *json, rad_grid_gather_method method, double theta, int threads,
-                          uint64_t seed, double **H, rad_grid_gather_stats *st)
+ * criterion `theta` (0: the default), `strata` x `strata` rays for every
+ * element (0: by distance), `threads` threads and the shadow rays keyed
+ * on `seed`.  Returns the point count. */
+static size_t gather_with(fixture *fx, const char *json, rad_grid_gather_method method, double theta, int strata,
+                          int threads, uint64_t seed, double **H, rad_grid_gather_stats *st)
 {
     rad_grid_set *set = NULL;
     assert_int_equal(rad_grid_parse(fx->ctx, fx->sol->view.scene, "g.json", json, strlen(json), &set), RAD_OK);
@@ -1078,7 +1079,7 @@ static size_t gather_with(fixture *fx, const char *json, rad_grid_gather_method 
     o.seed = seed;
     view.options = &o;
     view.threads = threads;
-    assert_int_equal(rad_grid_gather_theta(fx->ctx, &view, set, method, theta, *H, *H + 3 * n, st), RAD_OK);
+    assert_int_equal(rad_grid_gather_tuned(fx->ctx, &view, set, method, theta, strata, *H, *H + 3 * n, st), RAD_OK);
     rad_grid_set_destroy(set);
     return n;
 }
@@ -1123,7 +1124,7 @@ static void tree_closed_box(void **state)
                        "\"v\": [0, 0.3, 1.4]}, \"spacing\": 0.35}]}";
     double *H;
     rad_grid_gather_stats st;
-    size_t points = gather_with(&fx, json, RAD_GRID_GATHER_TREE, 0.8, 0, 7, &H, &st);
+    size_t points = gather_with(&fx, json, RAD_GRID_GATHER_TREE, 0.8, 0, 0, 7, &H, &st);
     *view = saved;
     double worst = 0.0;
     for (size_t k = 0; k < points; k++)
@@ -1143,63 +1144,64 @@ static void tree_closed_box(void **state)
 }
 
 /* Tree against exact per point on a solved scene, on points lying on the
- * floor (visibility exact from the occluder classification where it can
- * list the blockers).  Where the exact gathering falls back on shadow
- * rays its value moves with the seed; that spread, measured per point
- * with another seed (s = |E_exact(seed 8) - E_exact(seed 7)|), is added to
- * the allowances.  The tree's own error has two parts: the far field's
- * truncation (third order in theta = 0.3: 4e-5 in the closed box) and the
- * clusters' binary visibility (eight representatives all clear or all
- * blocked: a cluster half hidden behind a block's edge can pass as
- * clear), which dominates next to occluders.  Hence, with Em the grid's
- * mean:
+ * floor.  The reference is the exact gathering with 8 x 8 shadow rays for
+ * every element that needs rays: the default's single ray to a far
+ * element, its hidden part clamped to [0, F], lets a little of a wholly
+ * blocked element through (a bias: on the generated office a point inside
+ * furniture gets 18.7 lux against the reference's 0.3, bench_gather).
+ * With Em the reference's mean over the grid:
  *
- *   every point:          |E_tree - E_exact| <= b E_exact + 1% Em + s
- *   a share q of points:  |E_tree - E_exact| <= 1% E_exact + s
- *   the mean:             within 0.5%
+ *   the grid:    mean |E_tree - E_ref| <= 1.25 mean |E_exact - E_ref| + 1e-3 Em
+ *                (the tree no worse than the default exact gathering), or
+ *                where the exact gathering is exact (points on a surface
+ *                whose occluders are listed: the Cornell box) <= g Em
+ *   the mean:    within 0.5%
+ *   each point:  |E_tree - E_ref| <= b E_ref + 2% Em, or no more than
+ *                1.25 |E_exact - E_ref| (a point inside furniture: both off)
  *
- * Measured (theta 0.3, 8 representatives, blocked verdicts only for
- * nodes of 8 elements or more): the office of three rooms, every point
- * within 1%, the worst 1.7e-4 (b = 0.01, q = 0.99); the Cornell box's
- * floor around its blocks at 2.5 cm, 89% within 1%, the worst 0.39 (a
- * point in a block's shadow: 7.7 lux against 13.1, the grid's mean 60)
- * (b = 0.5, q = 0.8): the binary visibility's limit next to occluders. */
-static void tree_against_exact(fixture *fx, const char *json, const char *what, double b, double q)
+ * Measured: the office's mean |difference| 4.40 lux against the exact
+ * gathering's 4.50 (Em 683); the Cornell box's 0.124 lux, 0.21% of Em,
+ * against the exact's 0.019, its worst point 0.40 of E beyond 2% Em (in
+ * a block's shadow), hence g = 0.4% and b = 0.5.
+ * The tree's own errors are the far
+ * field's truncation (third order in theta, 8e-4 in tree_closed_box) and
+ * the clusters' binary visibility (eight representatives all clear or
+ * all blocked), which dominates next to occluders. */
+static void tree_against_exact(fixture *fx, const char *json, const char *what, double b, double g)
 {
-    double *He, *He2, *Ht;
-    rad_grid_gather_stats se, se2, stt;
-    size_t n = gather_with(fx, json, RAD_GRID_GATHER_EXACT, 0.0, 0, 7, &He, &se);
-    gather_with(fx, json, RAD_GRID_GATHER_EXACT, 0.0, 0, 8, &He2, &se2);
-    gather_with(fx, json, RAD_GRID_GATHER_TREE, 0.0, 0, 7, &Ht, &stt);
-    double sum_e = 0.0, sum_t = 0.0;
+    double *He, *Hr, *Ht;
+    rad_grid_gather_stats se, sr, stt;
+    size_t n = gather_with(fx, json, RAD_GRID_GATHER_EXACT, 0.0, 0, 0, 7, &He, &se);
+    gather_with(fx, json, RAD_GRID_GATHER_EXACT, 0.0, 8, 0, 7, &Hr, &sr);
+    gather_with(fx, json, RAD_GRID_GATHER_TREE, 0.0, 0, 0, 7, &Ht, &stt);
+    double mean = 0.0, mean_t = 0.0, diff_e = 0.0, diff_t = 0.0, worst = 0.0;
     for (size_t k = 0; k < n; k++) {
-        sum_e += lux_at(He, n, k);
-        sum_t += lux_at(Ht, n, k);
+        mean += lux_at(Hr, n, k) / (double)n;
+        mean_t += lux_at(Ht, n, k) / (double)n;
     }
-    double mean = sum_e / (double)n, worst = 0.0;
-    size_t within = 0, failed = 0;
+    size_t failed = 0;
     for (size_t k = 0; k < n; k++) {
-        double e = lux_at(He, n, k), e2 = lux_at(He2, n, k), t = lux_at(Ht, n, k);
-        double err = fabs(t - e), spread = fabs(e2 - e);
-        worst = fmax(worst, fmax(0.0, err - spread) / (e + 0.01 * mean));
-        within += err <= 0.01 * e + spread;
-        if (err > b * e + 0.01 * mean + spread) {
-            printf("  point %zu: tree %.4f exact %.4f (seed 8: %.4f) lux\n", k, t, e, e2);
+        double r = lux_at(Hr, n, k), e = lux_at(He, n, k), t = lux_at(Ht, n, k);
+        diff_e += fabs(e - r) / (double)n;
+        diff_t += fabs(t - r) / (double)n;
+        worst = fmax(worst, fmax(0.0, fabs(t - r) - 0.02 * mean) / fmax(r, 1e-9 * mean));
+        if (fabs(t - r) > fmax(b * r + 0.02 * mean, 1.25 * fabs(e - r))) {
+            printf("  point %zu: tree %.4f exact %.4f reference %.4f lux\n", k, t, e, r);
             failed++;
         }
     }
-    printf("tree, %s: %zu points, %zu elements, %llu clusters, %llu exact elements (exact: %llu); %.1f%% of the "
-           "points within 1%% + the seeds' spread; worst (difference - spread) / (E + 1%% Em) %.3g; mean %.4f "
-           "against %.4f lux\n", what, n, fx->sol->view.n, (unsigned long long)stt.cluster_pairs,
+    printf("tree, %s: %zu points, %zu elements, %llu clusters, %llu exact elements (exact: %llu); mean |difference| "
+           "to the reference: tree %.4f, exact %.4f lux; means: tree %.4f, reference %.4f lux; worst (|difference| "
+           "- 2%% Em) / E %.3g\n", what, n, fx->sol->view.n, (unsigned long long)stt.cluster_pairs,
            (unsigned long long)(stt.exact_pairs + stt.ray_pairs), (unsigned long long)(se.exact_pairs + se.ray_pairs),
-           100.0 * (double)within / (double)n, worst, sum_t / (double)n, mean);
-    assert_true(stt.tree && !se.tree);
+           diff_t, diff_e, mean_t, mean, worst);
+    assert_true(stt.tree && !se.tree && !sr.tree);
     assert_true(stt.cluster_pairs > n);
+    assert_true(g > 0.0 ? diff_t <= g * mean : diff_t <= 1.25 * diff_e + 1e-3 * mean);
+    assert_true(fabs(mean_t - mean) <= 0.005 * mean);
     assert_int_equal(failed, 0);
-    assert_true(within >= q * (double)n);
-    assert_true(fabs(sum_t - sum_e) <= 0.005 * sum_e);
     free(He);
-    free(He2);
+    free(Hr);
     free(Ht);
 }
 
@@ -1232,7 +1234,7 @@ static void tree_office(void **state)
                        "{\"name\": \"r0\", \"surface\": \"room0/floor\", \"height\": 0, \"spacing\": 0.5},"
                        "{\"name\": \"r1\", \"surface\": \"room1/floor\", \"height\": 0, \"spacing\": 0.5},"
                        "{\"name\": \"r2\", \"surface\": \"room2/floor\", \"height\": 0, \"spacing\": 0.5}]}";
-    tree_against_exact(&fx, json, "office of 3 rooms", 0.01, 0.99);
+    tree_against_exact(&fx, json, "office of 3 rooms", 0.5, 0.0);
     release(&fx);
 }
 
@@ -1249,7 +1251,7 @@ static void tree_cornell(void **state)
      * them: points inside a block see nothing), at 2.5 cm. */
     const char *json = "{\"up\": \"y\", \"grids\": [{\"name\": \"floor\", \"surface\": \"floor\", \"height\": 0, "
                        "\"spacing\": 0.025, \"border\": 0.01}]}";
-    tree_against_exact(&fx, json, "Cornell box", 0.5, 0.8);
+    tree_against_exact(&fx, json, "Cornell box", 0.5, 0.004);
     release(&fx);
 }
 
@@ -1270,8 +1272,8 @@ static void tree_threads(void **state)
                        "\"spacing\": 0.4}]}";
     double *H1, *H2;
     rad_grid_gather_stats s1, s2;
-    size_t n = gather_with(&fx, json, RAD_GRID_GATHER_TREE, 0.0, 1, 7, &H1, &s1);
-    assert_int_equal(gather_with(&fx, json, RAD_GRID_GATHER_TREE, 0.0, 2, 7, &H2, &s2), n);
+    size_t n = gather_with(&fx, json, RAD_GRID_GATHER_TREE, 0.0, 0, 1, 7, &H1, &s1);
+    assert_int_equal(gather_with(&fx, json, RAD_GRID_GATHER_TREE, 0.0, 0, 2, 7, &H2, &s2), n);
     assert_true(s1.cluster_pairs > 0);
     assert_int_equal(s1.cluster_pairs, s2.cluster_pairs);
     assert_true(memcmp(H1, H2, 6 * n * sizeof *H1) == 0);

@@ -138,10 +138,13 @@ rad_result rad_grid_gather(rad_context *ctx, const rad_solution_view *view, cons
                            rad_grid_gather_method method, double *direct, double *indirect,
                            rad_grid_gather_stats *stats);
 /* The same with the tree's opening criterion `theta` (diameter over
- * distance; 0: RAD_GRID_GATHER_THETA), for the tests and bench_gather. */
-rad_result rad_grid_gather_theta(rad_context *ctx, const rad_solution_view *view, const rad_grid_set *set,
-                                 rad_grid_gather_method method, double theta, double *direct, double *indirect,
-                                 rad_grid_gather_stats *stats);
+ * distance; 0: RAD_GRID_GATHER_THETA) and, with `strata` > 0, strata x
+ * strata shadow rays for every element that needs rays (0: 1, 2 or 4 by
+ * its size over its distance): the references of the tests and
+ * bench_gather. */
+rad_result rad_grid_gather_tuned(rad_context *ctx, const rad_solution_view *view, const rad_grid_set *set,
+                                 rad_grid_gather_method method, double theta, int strata, double *direct,
+                                 double *indirect, rad_grid_gather_stats *stats);
 
 /* ---- the rad_illuminance handle (illuminance.c; radiosity.h) ---- */
 
