@@ -56,6 +56,11 @@ typedef struct cli_command cli_command;
 
 /* One run of a command.  main.c fills in the first five fields; the stages
  * the rest. */
+/* --progress-images writes at most this many frames in a run (a solve of
+ * thousands of steps, shooting's or hierarchical's sweeps at a tight
+ * tolerance, would fill a disk); later steps are not drawn, said once. */
+#define CLI_MAX_PROGRESS_IMAGES 1000
+
 typedef struct cli_job {
     cli_settings s;                /* the command line; render sets s.render.camera, cli_solve s.solve.on_step */
     const cli_command *command;    /* its row */
@@ -70,6 +75,7 @@ typedef struct cli_job {
     double t0;                     /* s, cli_now() when cli_load began */
     double frame_exposure;         /* --progress-images: the user's, else the first frame's automatic one */
     bool frame_failed;             /* a progress image could not be written: the message is in ctx */
+    int frames;                    /* progress images written (at most CLI_MAX_PROGRESS_IMAGES) */
 } cli_job;
 
 /* A row of the command table (main.c), looked up by the name the parser

@@ -214,7 +214,8 @@ static const cli_flag FLAGS[] = {
     {"history", 0, "FILE.csv", RS & ~CLI_VIEW, OWN(history, RAD_OPTION_STRING),
      .own.help = "write the convergence history: iteration, seconds, residual, unshot power"},
     {"progress-images", 0, "DIR", CLI_RENDER, OWN(progress_dir, RAD_OPTION_STRING),
-     .own.help = "write the image every --every iterations while solving (progressive display)"},
+     .own.help = "write the image every --every iterations while solving (progressive display; hierarchical: "
+                 "the current leaves after each sweep, refinement rounds included); at most 1000 frames"},
     {"every", 0, "K", CLI_RENDER, OWN(every, RAD_OPTION_INT), .own.min = 1.0, .own.max = INT_MAX,
      .own.default_text = "1", .own.help = "with --progress-images: every K iterations"},
     {"width", 0, "W", CLI_RENDER | CLI_VIEW, RENDER(width)},

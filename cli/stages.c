@@ -109,6 +109,12 @@ static int on_step(void *user, rad_solution *solution, const rad_solve_step *ste
     cli_job *job = user;
     if (step->iteration % (job->s.every ? job->s.every : 1) != 0)
         return 0;
+    if (job->frames >= CLI_MAX_PROGRESS_IMAGES) {
+        if (job->frames++ == CLI_MAX_PROGRESS_IMAGES && !job->s.quiet)
+            fprintf(stderr, "radiosity: --progress-images: %d frames written, the later steps are not drawn "
+                            "(--every K draws every K-th)\n", CLI_MAX_PROGRESS_IMAGES);
+        return 0;
+    }
     rad_image *image = NULL;
     char path[4096];
     snprintf(path, sizeof path, "%s/step_%08d.png", job->s.progress_dir, step->iteration);
@@ -121,6 +127,8 @@ static int on_step(void *user, rad_solution *solution, const rad_solve_step *ste
         job->frame_exposure = rad_image_auto_exposure(image); /* fixed from the first frame on */
     if (r == RAD_OK)
         r = rad_image_write_exposed(job->ctx, image, path, job->frame_exposure);
+    if (r == RAD_OK)
+        job->frames++;
     rad_image_destroy(image);
     if (r != RAD_OK) {
         job->frame_failed = true;

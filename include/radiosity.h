@@ -1268,9 +1268,10 @@ typedef enum rad_capability {
     /* takes rad_options.closure_correction (closed scenes); without it the
      * option is refused */
     RAD_CAN_CLOSURE_CORRECTION = 1 << 6,
-    /* its elements stay put while it solves, so the iterate can be drawn
-     * after every step (rad_options.on_step; `radiosity --progress-images`);
-     * hierarchical radiosity refines them as it goes */
+    /* the iterate can be drawn after every step (rad_options.on_step;
+     * `radiosity --progress-images`): its elements stay put while it
+     * solves, or (hierarchical) the view shows the current leaves, the
+     * mesh renewed after each refinement round */
     RAD_CAN_PROGRESS_IMAGES = 1 << 7
 } rad_capability;
 

@@ -184,6 +184,62 @@ static void test_solution_file(void **state)
     assert_no_output("cut.png");
 }
 
+/* The frames in folder `dir` of the work folder, step_*.png. */
+static int count_frames(const char *dir, char *last, size_t last_size)
+{
+    char p[600];
+    snprintf(p, sizeof p, "%s/%s", test_workdir(), dir);
+    DIR *d = opendir(p);
+    assert_non_null(d);
+    int n = 0;
+    struct dirent *e;
+    last[0] = '\0';
+    while ((e = readdir(d)))
+        if (strncmp(e->d_name, "step_", 5) == 0) {
+            n++;
+            if (strcmp(e->d_name, last) > 0)
+                snprintf(last, last_size, "%s", e->d_name);
+        }
+    closedir(d);
+    return n;
+}
+
+/* --progress-images with hierarchical radiosity: a frame per sweep (the
+ * current leaves, refinement rounds included), numbered by the sweep, as
+ * many as the stats' iterations; the last is the final picture to the
+ * byte (one exposure for all), the first darker (the first sweep has
+ * gathered one bounce); --every K keeps every K-th. */
+static void test_progress_images_hierarchical(void **state)
+{
+    (void)state;
+    const char *common = "--solver hierarchical --width 24 --height 24 --exposure 1 -q";
+    assert_int_equal(cli_run_here("render %s --progress-images hframes --stats h.json -o h.png", common), 0);
+    cJSON *stats = cli_read_json(test_path("h.json"));
+    assert_non_null(stats);
+    int sweeps = (int)cli_stats_number(stats, "solver", "iterations");
+    cJSON_Delete(stats);
+    char last[256], path[300];
+    int frames = count_frames("hframes", last, sizeof last);
+    printf("hierarchical: %d sweeps, %d frames, the last %s\n", sweeps, frames, last);
+    assert_true(sweeps >= 3);
+    assert_int_equal(frames, sweeps);
+    char want[64];
+    snprintf(want, sizeof want, "step_%08d.png", sweeps);
+    assert_string_equal(last, want);
+    static unsigned char a[65536], b[65536];
+    snprintf(path, sizeof path, "hframes/%s", last);
+    size_t na = read_bytes(path, a, sizeof a), nb = read_bytes("h.png", b, sizeof b);
+    assert_true(na > 100 && na < sizeof a);
+    assert_int_equal(na, nb);
+    assert_memory_equal(a, b, na);
+    size_t n1 = read_bytes("hframes/step_00000001.png", b, sizeof b);
+    assert_true(n1 > 100);
+    assert_true(n1 != na || memcmp(a, b, na) != 0);
+    /* Every 4th sweep. */
+    assert_int_equal(cli_run_here("render %s --progress-images hframes4 --every 4 -o h4.png", common), 0);
+    assert_int_equal(count_frames("hframes4", last, sizeof last), sweeps / 4);
+}
+
 static void test_zero_area_polygon(void **state)
 {
     (void)state;
@@ -901,6 +957,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_infinite_coordinates),
         cmocka_unit_test(test_huge_coordinates),
         cmocka_unit_test(test_solution_file),
+        cmocka_unit_test(test_progress_images_hierarchical),
         cmocka_unit_test(test_zero_area_polygon),
         cmocka_unit_test(test_reflectance_too_high),
         cmocka_unit_test(test_reflectance_negative),

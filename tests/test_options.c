@@ -389,7 +389,6 @@ static void test_words_and_methods(void **state)
         } else if (o->type == RAD_OPTION_METHOD) {
             const char *name, *description;
             for (size_t i = 0; rad_method_info(o->methods, i, &name, &description); i++) {
-                /* --progress-images is refused with hierarchical; no need here. */
                 assert_int_equal(parse_flag(f, name), CLI_RUN);
                 const char *base = f->target == CLI_TO_SOLVE ? (const char *)&settings.solve : (const char *)&settings;
                 assert_string_equal(*(const char *const *)(const void *)(base + o->offset), name);

@@ -64,6 +64,55 @@ rad_result rad_grid_parse(rad_context *ctx, const rad_scene *scene, const char *
                           size_t size, rad_grid_set **out);
 void rad_grid_set_destroy(rad_grid_set *set);
 
+/* ---- the gathering's hierarchy over the elements (cluster.c) ---- */
+
+enum { RAD_GATHER_REPS = 8 };                 /* representatives per node */
+#define RAD_GATHER_LEAF UINT32_MAX            /* child[1] of a leaf; the root of an empty tree */
+
+typedef struct rad_gather_node {
+    vec3 lo, hi;                /* m: the box of its elements' corners */
+    vec3 centre;                /* m: the centre of power (centroids weighted by A_j Y(B_j)) */
+    vec3 axis;                  /* unit: the axis of the cone of its elements' normals */
+    double spread;              /* rad: the cone's half-angle */
+    double weight;              /* W: sum A_j Y(B_j) (luminance weights 0.265, 0.670, 0.065) */
+    double moment[6];           /* W m^2: the weight's second moment about `centre`,
+                                   xx yy zz xy xz yz (the elements' own spread included) */
+    vec3 power_self[3];         /* W per channel: sum A_j E_j n_j (self-emission) */
+    vec3 power_rest[3];         /* W per channel: sum A_j (B_j - E_j) n_j */
+    uint32_t child[2];          /* nodes; a leaf: child[0] its element, child[1] RAD_GATHER_LEAF */
+    uint32_t rep[RAD_GATHER_REPS]; /* elements whose centroids visibility rays aim at */
+    int reps;
+    bool emits;                 /* some element has self-emission (the direct part: never one source) */
+} rad_gather_node;
+
+typedef struct rad_gather_tree {
+    rad_gather_node *nodes;
+    size_t node_count;
+    uint32_t root;              /* RAD_GATHER_LEAF: no element sends light */
+    size_t elements;            /* leaves: the elements with some radiosity */
+} rad_gather_tree;
+
+/* The tree over the elements of `view` whose radiosity is not zero, `self`
+ * (3n, W/m^2) their self-emission.  RAD_ERROR_OUT_OF_MEMORY (then *out is
+ * NULL).  Deterministic: the same view gives the same tree. */
+rad_result rad_gather_tree_build(rad_context *ctx, const rad_solution_view *view, const double *self,
+                                 rad_gather_tree **out);
+void rad_gather_tree_destroy(rad_gather_tree *tree);
+
+/* The tree's opening criterion: a node counts as one source where its
+ * bounding sphere's diameter is below THETA x its distance (bench_gather:
+ * at 0.3 its error stays within the exact gathering's own spread over
+ * seeds on the generated office). */
+#define RAD_GRID_GATHER_THETA 0.3
+
+/* How the elements' radiosity is gathered at a point. */
+typedef enum rad_grid_gather_method {
+    RAD_GRID_GATHER_AUTO = 0,   /* the default: exact, until the tree is measured faster on the
+                                   offices it is for (bench_gather, docs/performance.md) */
+    RAD_GRID_GATHER_EXACT,      /* every element, exactly (the reference) */
+    RAD_GRID_GATHER_TREE        /* far clusters as one source, near elements exactly */
+} rad_grid_gather_method;
+
 /* What the gathering counted. */
 typedef struct rad_grid_gather_stats {
     uint64_t rays;              /* shadow rays cast */
@@ -73,6 +122,9 @@ typedef struct rad_grid_gather_stats {
     double light_seconds;       /* thread-seconds in the direct light of luminaires and daylight
                                    (rad_light_irradiance), summed over threads */
     double thread_seconds;      /* thread-seconds of all the points' work, summed over threads */
+    uint64_t cluster_pairs;     /* point-cluster pairs taken as one source (the tree) */
+    uint64_t cluster_rays;      /* ... the visibility rays to clusters' representatives (in `rays`) */
+    bool tree;                  /* the tree gathered */
 } rad_grid_gather_stats;
 
 /* Irradiance (W/m^2 RGB, 3 per point) at every point of `set` from a
@@ -83,7 +135,16 @@ typedef struct rad_grid_gather_stats {
  * point and the element); progress "illuminance"; RAD_ERROR_INTERRUPTED
  * when cancelled (outputs then incomplete).  RAD_ERROR_OUT_OF_MEMORY. */
 rad_result rad_grid_gather(rad_context *ctx, const rad_solution_view *view, const rad_grid_set *set,
-                           double *direct, double *indirect, rad_grid_gather_stats *stats);
+                           rad_grid_gather_method method, double *direct, double *indirect,
+                           rad_grid_gather_stats *stats);
+/* The same with the tree's opening criterion `theta` (diameter over
+ * distance; 0: RAD_GRID_GATHER_THETA) and, with `strata` > 0, strata x
+ * strata shadow rays for every element that needs rays (0: 1, 2 or 4 by
+ * its size over its distance): the references of the tests and
+ * bench_gather. */
+rad_result rad_grid_gather_tuned(rad_context *ctx, const rad_solution_view *view, const rad_grid_set *set,
+                                 rad_grid_gather_method method, double theta, int strata, double *direct,
+                                 double *indirect, rad_grid_gather_stats *stats);
 
 /* ---- the rad_illuminance handle (illuminance.c; radiosity.h) ---- */
 

@@ -51,7 +51,7 @@ static rad_result evaluate(rad_context *ctx, const rad_solution_view *solved, co
     if (r == RAD_OK) {
         rad_solution_view view = *solved;
         view.threads = rad_context_threads(ctx);
-        r = rad_grid_gather(ctx, &view, il->set, H, H + 3 * n, &gs);
+        r = rad_grid_gather(ctx, &view, il->set, RAD_GRID_GATHER_AUTO, H, H + 3 * n, &gs);
     }
     if (r != RAD_OK) {
         rad_free(H);

@@ -212,7 +212,9 @@ static void hierarchical_view(const void *state, rad_solution_view *v)
 const rad_strategy rad_strategy_hierarchical = {
     "hierarchical",
     "links between quadtree nodes and clusters, refined as the radiosity converges",
-    RAD_CAN_CLOSURE_CORRECTION | RAD_CAN_LIGHTS,
+    /* Progress images: with a step hook that displays, the current leaves
+     * are the elements at every sweep (hierarchical_display). */
+    RAD_CAN_CLOSURE_CORRECTION | RAD_CAN_LIGHTS | RAD_CAN_PROGRESS_IMAGES,
     hierarchical_solver_info,
     hierarchical_create,
     hierarchical_solve,
