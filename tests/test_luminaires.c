@@ -278,6 +278,24 @@ static void point_shadow(void **state)
         rad_luminaires_irradiance(scene, mesh, vis, beside[k], up, c);
         assert_memory_equal(a, c, sizeof a);
     }
+    /* A subset of the luminaires (light.h, rad_light_among): the one
+     * luminaire reaches a lit point and not a shadowed one; asked among
+     * what reached, the same light; among none, none. */
+    {
+        uint64_t reached = 0, none = 0;
+        rad_light_among ask = {NULL, &reached};
+        double a[3], c[3];
+        rad_light_irradiance_among(scene, mesh, vis, behind[0], up, &ask, a);
+        assert_true(reached == 0 && a[0] == 0.0);
+        rad_light_irradiance_among(scene, mesh, vis, beside[0], up, &ask, a);
+        assert_true(reached == 1 && a[0] > 0.0);
+        rad_light_among among = {&reached, NULL}, nothing = {&none, NULL};
+        rad_light_irradiance_among(scene, mesh, vis, beside[1], up, &among, c);
+        rad_light_irradiance(scene, mesh, vis, beside[1], up, a);
+        assert_memory_equal(a, c, sizeof a);
+        rad_light_irradiance_among(scene, mesh, vis, beside[1], up, &nothing, c);
+        assert_true(c[0] == 0.0 && c[1] == 0.0 && c[2] == 0.0);
+    }
     /* The plate's top is lit (its own shadow rays start off it). */
     vec3 top = v3(0.5, 0.5, 1.0);
     assert_close(lux_at(scene, mesh, vis, top, up), 1000.0 / 4.0, 1e-12, "the plate's top");

@@ -242,6 +242,9 @@ typedef struct hr_direct {
     double *H;                /* 3 per node, W/m^2; NULL when the scene has no light */
     float *deviation;         /* per node: max |H_d(x) - H_d| over the cubature's points, W/m^2 */
     size_t count, capacity;   /* nodes computed; allocated */
+    uint64_t *reached;        /* per patch, `words` each: the luminaires that lit its root
+                                 (light.h's rad_light_among), the only ones its nodes ask */
+    size_t words;
 } hr_direct;
 
 /* Zero *d and, when the scene has luminaires or daylight, compute every

@@ -33,15 +33,26 @@ bool rad_light_present(const rad_scene *scene)
     return scene && (scene->luminaires.count > 0 || scene->daylight != NULL);
 }
 
+size_t rad_light_mask_words(const rad_scene *scene)
+{
+    return (scene->luminaires.count + 63) / 64;
+}
+
 void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                           vec3 n, double out[3])
+{
+    rad_light_irradiance_among(scene, mesh, vis, p, n, NULL, out);
+}
+
+void rad_light_irradiance_among(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                                vec3 n, const rad_light_among *set, double out[3])
 {
     out[0] = out[1] = out[2] = 0.0;
     if (!rad_light_present(scene))
         return;
     double part[3];
     if (scene->luminaires.count > 0) {
-        rad_luminaires_irradiance(scene, mesh, vis, p, n, part);
+        rad_luminaires_irradiance_among(scene, mesh, vis, p, n, set, part);
         for (int c = 0; c < 3; c++)
             out[c] += part[c];
     }
@@ -57,12 +68,13 @@ typedef struct cubature {
     const rad_mesh *mesh;
     const rad_vis *vis;
     vec3 normal;
+    const rad_light_among *set; /* the luminaires let in (NULL: all) */
     double lo[3], hi[3]; /* W/m^2: the range of the values at the points evaluated */
 } cubature;
 
 static void light_at(cubature *c, vec3 x, double out[3])
 {
-    rad_light_irradiance(c->scene, c->mesh, c->vis, x, c->normal, out);
+    rad_light_irradiance_among(c->scene, c->mesh, c->vis, x, c->normal, c->set, out);
     for (int ch = 0; ch < 3; ch++) {
         c->lo[ch] = fmin(c->lo[ch], out[ch]);
         c->hi[ch] = fmax(c->hi[ch], out[ch]);
@@ -131,15 +143,15 @@ static void refine(cubature *c, const vec3 *q, uint32_t corners, const double co
 }
 
 void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
-                                  const vec3 *corner, uint32_t corners, vec3 normal, double out[3],
-                                  double *deviation)
+                                  const vec3 *corner, uint32_t corners, vec3 normal,
+                                  const rad_light_among *set, double out[3], double *deviation)
 {
     out[0] = out[1] = out[2] = 0.0;
     if (deviation)
         *deviation = 0.0;
     if (!rad_light_present(scene) || (corners != 3 && corners != 4))
         return;
-    cubature c = {scene, mesh, vis, normal, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    cubature c = {scene, mesh, vis, normal, set, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
     const vec3 *q = corner;
     /* The region rules integrate over the corners' own area; the mean is
      * over it. */
@@ -173,5 +185,5 @@ void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, 
     vec3 q[4];
     for (uint32_t k = 0; k < e->vertex_count && k < 4; k++)
         q[k] = mesh->vertices[e->vertex[k]];
-    rad_light_polygon_irradiance(scene, mesh, vis, q, e->vertex_count, e->normal, out, NULL);
+    rad_light_polygon_irradiance(scene, mesh, vis, q, e->vertex_count, e->normal, NULL, out, NULL);
 }

@@ -49,14 +49,33 @@ void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, 
  * and the points the cubature evaluated, between the irradiance there and
  * the mean (W/m^2): how far the light varies across the polygon (a shadow
  * edge crossing it gives about the step's size).  A degenerate polygon
- * gives zeros.  Thread-safe, deterministic. */
+ * gives zeros.  `set`: the luminaires let in (below; NULL: all).
+ * Thread-safe, deterministic. */
+struct rad_light_among;
 void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
-                                  const vec3 *corner, uint32_t corners, vec3 normal, double out[3],
-                                  double *deviation);
+                                  const vec3 *corner, uint32_t corners, vec3 normal,
+                                  const struct rad_light_among *set, double out[3], double *deviation);
 
+/* Which luminaires a caller lets light a point, and which did (bit k of
+ * word k / 64: luminaire k of scene->luminaires).  `among` NULL: all of
+ * them; `reached`, when not NULL, gets the bits of those whose light
+ * reached some point asked (a clear shadow ray, in front of the surface).
+ * The hierarchy asks its roots with reached, then their nodes among what
+ * their root saw (hier/direct.c).  Daylight is not a luminaire: always. */
+typedef struct rad_light_among {
+    const uint64_t *among;
+    uint64_t *reached;
+} rad_light_among;
+/* Words of a luminaire mask for the scene. */
+size_t rad_light_mask_words(const rad_scene *scene);
+/* rad_light_irradiance for the luminaires `set` lets in (NULL: all). */
+void rad_light_irradiance_among(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                                vec3 n, const rad_light_among *set, double out[3]);
 /* The parts, one file each. */
 void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
-                               vec3 n, double out[3]);           /* light/luminaire.c */
+                               vec3 n, double out[3]);
+void rad_luminaires_irradiance_among(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                                     vec3 n, const rad_light_among *set, double out[3]);           /* light/luminaire.c */
 void rad_daylight_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                              vec3 n, double out[3]);             /* light/daylight.c */
 

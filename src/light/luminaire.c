@@ -53,10 +53,19 @@ enum {
 typedef struct pending {
     rad_ray rays[BATCH];
     double weight[BATCH]; /* W/m^2 each ray carries when clear */
+    uint32_t owner[BATCH]; /* its luminaire */
     size_t count;
     const rad_vis *vis;
     double sum;
+    uint64_t *reached;    /* NULL, or the mask of luminaires that lit the point */
+    uint32_t current;     /* the luminaire being queued */
 } pending;
+
+static void mark(pending *q, uint32_t k)
+{
+    if (q->reached)
+        q->reached[k / 64] |= (uint64_t)1 << (k % 64);
+}
 
 static void flush(pending *q)
 {
@@ -68,8 +77,10 @@ static void flush(pending *q)
     else
         memset(blocked, 0, sizeof blocked);
     for (size_t k = 0; k < q->count; k++)
-        if (!blocked[k])
+        if (!blocked[k]) {
             q->sum += q->weight[k];
+            mark(q, q->owner[k]);
+        }
     q->count = 0;
 }
 
@@ -99,10 +110,12 @@ static void point_source(pending *q, const rad_luminaire *L, const rad_photometr
         /* The centre lies within the shadow rays' tolerance of p: nothing
          * can stand between them. */
         q->sum += e;
+        mark(q, q->current);
         return;
     }
     q->rays[q->count] = (rad_ray){origin, dir, 0.0, 1.0 - eps / len};
     q->weight[q->count] = e;
+    q->owner[q->count] = q->current;
     if (++q->count == BATCH)
         flush(q);
 }
@@ -239,13 +252,25 @@ static void one_luminaire(pending *q, const rad_scene *scene, const rad_luminair
 void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                                vec3 n, double out[3])
 {
+    rad_luminaires_irradiance_among(scene, mesh, vis, p, n, NULL, out);
+}
+
+void rad_luminaires_irradiance_among(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                                     vec3 n, const rad_light_among *set, double out[3])
+{
     double lift = mesh ? rad_vis_epsilon(mesh) : 0.0;
     pending q;
     q.count = 0;
     q.vis = vis;
     q.sum = 0.0;
-    for (size_t k = 0; k < scene->luminaires.count; k++)
+    q.reached = set ? set->reached : NULL;
+    const uint64_t *among = set ? set->among : NULL;
+    for (size_t k = 0; k < scene->luminaires.count; k++) {
+        if (among && !((among[k / 64] >> (k % 64)) & 1))
+            continue;
+        q.current = (uint32_t)k;
         one_luminaire(&q, scene, &scene->luminaires.items[k], p, n, lift);
+    }
     flush(&q);
     out[0] = out[1] = out[2] = q.sum;
 }
