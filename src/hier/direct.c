@@ -49,8 +49,12 @@
 #include <string.h>
 
 /* Grow the arrays to the tree and fill the values of nodes [d->count,
- * tree->count) in parallel.  Fails for memory or cancellation. */
-static rad_result compute_new(rad_context *ctx, const hr_tree *tree, hr_direct *d)
+ * tree->count) in parallel; those the oracle will split (light varying by
+ * more than epsilon allows, hr_direct_update) from a coarser cubature.
+ * Fails for memory or cancellation. */
+enum { COARSE_DEPTH = 2 };
+
+static rad_result compute_new(rad_context *ctx, const hr_tree *tree, hr_direct *d, double epsilon)
 {
     size_t from = d->count, n = tree->count;
     if (n == from)
@@ -86,8 +90,14 @@ static rad_result compute_new(rad_context *ctx, const hr_tree *tree, hr_direct *
             bool root = nd->parent == HR_NONE || tree->nodes[nd->parent].kind == HR_CLUSTER;
             uint64_t *mask = d->reached + (size_t)nd->patch * d->words;
             rad_light_among set = {root ? NULL : mask, root ? mask : NULL};
-            rad_light_polygon_irradiance(d->scene, d->base, d->vis, nd->corner, nd->corners, nd->normal, &set, h,
-                                         &dev);
+            /* A node whose light varies enough to split it is only read for
+             * that (its leaves carry the light): two levels of the cubature
+             * tell it; the others get all four. */
+            rad_light_polygon_irradiance(d->scene, d->base, d->vis, nd->corner, nd->corners, nd->normal, &set,
+                                         COARSE_DEPTH, h, &dev);
+            if (!((double)nd->rho * nd->area * dev > epsilon && hr_splittable(tree, (uint32_t)k)))
+                rad_light_polygon_irradiance(d->scene, d->base, d->vis, nd->corner, nd->corners, nd->normal, &set, 0,
+                                             h, &dev);
         }
         d->deviation[k] = (float)dev;
         if (rad_cancelled(ctx))
@@ -114,7 +124,7 @@ rad_result hr_direct_start(rad_context *ctx, const hr_tree *tree, const rad_vis 
                            "hierarchical: the luminaires each patch sees");
     if (!d->reached)
         return RAD_ERROR_OUT_OF_MEMORY;
-    rad_result r = compute_new(ctx, tree, d);
+    rad_result r = compute_new(ctx, tree, d, INFINITY);
     if (r != RAD_OK)
         return r;
     /* The roots' first reflection, sum A rho H_d (channels summed), in node
@@ -137,7 +147,7 @@ rad_result hr_direct_update(rad_context *ctx, hr_tree *tree, hr_direct *d, doubl
         return RAD_OK;
     for (;;) {
         size_t from = d->count;
-        rad_result r = compute_new(ctx, tree, d);
+        rad_result r = compute_new(ctx, tree, d, epsilon);
         if (r != RAD_OK)
             return r;
         /* The new leaves whose light varies more than epsilon allows, in

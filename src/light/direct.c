@@ -69,6 +69,7 @@ typedef struct cubature {
     const rad_vis *vis;
     vec3 normal;
     const rad_light_among *set; /* the luminaires let in (NULL: all) */
+    int depth;           /* levels of refinement at most */
     double lo[3], hi[3]; /* W/m^2: the range of the values at the points evaluated */
 } cubature;
 
@@ -128,7 +129,7 @@ static void refine(cubature *c, const vec3 *q, uint32_t corners, const double co
     double diff = 0.0;
     for (int ch = 0; ch < 3; ch++)
         diff = fmax(diff, fabs(fine[ch] - coarse[ch]));
-    if (diff <= tol || depth + 1 >= MAX_DEPTH) {
+    if (diff <= tol || depth + 1 >= c->depth) {
         memcpy(out, fine, sizeof fine);
         return;
     }
@@ -144,14 +145,15 @@ static void refine(cubature *c, const vec3 *q, uint32_t corners, const double co
 
 void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   const vec3 *corner, uint32_t corners, vec3 normal,
-                                  const rad_light_among *set, double out[3], double *deviation)
+                                  const rad_light_among *set, int depth, double out[3], double *deviation)
 {
     out[0] = out[1] = out[2] = 0.0;
     if (deviation)
         *deviation = 0.0;
     if (!rad_light_present(scene) || (corners != 3 && corners != 4))
         return;
-    cubature c = {scene, mesh, vis, normal, set, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    cubature c = {scene, mesh, vis, normal, set, depth > 0 && depth < MAX_DEPTH ? depth : MAX_DEPTH,
+                  {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
     const vec3 *q = corner;
     /* The region rules integrate over the corners' own area; the mean is
      * over it. */
@@ -185,5 +187,5 @@ void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, 
     vec3 q[4];
     for (uint32_t k = 0; k < e->vertex_count && k < 4; k++)
         q[k] = mesh->vertices[e->vertex[k]];
-    rad_light_polygon_irradiance(scene, mesh, vis, q, e->vertex_count, e->normal, NULL, out, NULL);
+    rad_light_polygon_irradiance(scene, mesh, vis, q, e->vertex_count, e->normal, NULL, 0, out, NULL);
 }

@@ -50,11 +50,14 @@ void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, 
  * the mean (W/m^2): how far the light varies across the polygon (a shadow
  * edge crossing it gives about the step's size).  A degenerate polygon
  * gives zeros.  `set`: the luminaires let in (below; NULL: all).
- * Thread-safe, deterministic. */
+ * `depth`: levels of the cubature's refinement at most (0: all four; 2 is
+ * enough to see that the light varies, at a sixteenth of the points on a
+ * shadow edge).  Thread-safe, deterministic. */
 struct rad_light_among;
 void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   const vec3 *corner, uint32_t corners, vec3 normal,
-                                  const struct rad_light_among *set, double out[3], double *deviation);
+                                  const struct rad_light_among *set, int depth, double out[3],
+                                  double *deviation);
 
 /* Which luminaires a caller lets light a point, and which did (bit k of
  * word k / 64: luminaire k of scene->luminaires).  `among` NULL: all of
