@@ -262,7 +262,8 @@ static int intersect(vec o, vec d, double tmax, double *t_hit)
         const object_box *box = &boxes[b];
         /* Slab test, widened by the epsilon (flat boxes of walls). */
         double e = ray_epsilon, t0 = 0.0, t1 = best_t;
-        double lo[3] = {box->lo.x - e, box->lo.y - e, box->lo.z - e}, hi[3] = {box->hi.x + e, box->hi.y + e, box->hi.z + e};
+        double lo[3] = {box->lo.x - e, box->lo.y - e, box->lo.z - e};
+        double hi[3] = {box->hi.x + e, box->hi.y + e, box->hi.z + e};
         double oo[3] = {o.x, o.y, o.z}, id[3] = {inv_d.x, inv_d.y, inv_d.z};
         for (int k = 0; k < 3 && t0 <= t1; k++) {
             double ta = (lo[k] - oo[k]) * id[k], tb = (hi[k] - oo[k]) * id[k];
@@ -271,7 +272,10 @@ static int intersect(vec o, vec d, double tmax, double *t_hit)
                 ta = tb;
                 tb = tmp;
             }
-            if (!(ta <= t1 && tb >= t0)) { /* NaN (0 x inf on a slab's face) keeps the box */
+            if (!(ta <= t1 && tb >= t0)) {
+                /* Outside this slab: the box is missed.  A NaN (a direction
+                 * parallel to the slab, 0 x inf, from its face) rejects
+                 * nothing: the triangles decide. */
                 if (ta == ta && tb == tb) {
                     t0 = 1.0;
                     t1 = 0.0;
@@ -283,27 +287,27 @@ static int intersect(vec o, vec d, double tmax, double *t_hit)
         }
         if (t0 > t1)
             continue;
-    for (int i = box->first; i < box->first + box->count; i++) {
-        const triangle *tr = &tris[i];
-        vec p = vcross(d, tr->e2);
-        double det = vdot(tr->e1, p);
-        if (fabs(det) < 1e-300)
-            continue;
-        double inv = 1.0 / det;
-        vec s = vsub(o, tr->p0);
-        double u = vdot(s, p) * inv;
-        if (u < 0.0 || u > 1.0)
-            continue;
-        vec q = vcross(s, tr->e1);
-        double v = vdot(d, q) * inv;
-        if (v < 0.0 || u + v > 1.0)
-            continue;
-        double t = vdot(tr->e2, q) * inv;
-        if (t > ray_epsilon && t < best_t) {
-            best_t = t;
-            best = i;
+        for (int i = box->first; i < box->first + box->count; i++) {
+            const triangle *tr = &tris[i];
+            vec p = vcross(d, tr->e2);
+            double det = vdot(tr->e1, p);
+            if (fabs(det) < 1e-300)
+                continue;
+            double inv = 1.0 / det;
+            vec s = vsub(o, tr->p0);
+            double u = vdot(s, p) * inv;
+            if (u < 0.0 || u > 1.0)
+                continue;
+            vec q = vcross(s, tr->e1);
+            double v = vdot(d, q) * inv;
+            if (v < 0.0 || u + v > 1.0)
+                continue;
+            double t = vdot(tr->e2, q) * inv;
+            if (t > ray_epsilon && t < best_t) {
+                best_t = t;
+                best = i;
+            }
         }
-    }
     }
     *t_hit = best_t;
     return best;

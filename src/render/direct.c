@@ -2,19 +2,23 @@
  * direct.c -- the emitters' direct light at the picture's shading points
  * (render.h says why): for a point x on receiver element r,
  *
- *   D(x) = sum_j E_j F(x -> visible part of j)     j: the emitting elements
+ *   D(x) = sum_j E_j F(x -> visible part of j)    j: the emitting sources
  *
  * F is Lambert's point-to-polygon factor (Baum, Rushmeier & Winget 1989).
- * Visibility is exact where the occluder classification of the pair
- * (r, j) holds for every point of r (occluders.c: clear, blocked, or
- * partial with its blockers listed -> the source less the blockers'
- * shadows projected from x, rad_point_polygon_ff_visible); the
- * classification is made once per receiver element and kept in the
- * thread's cache, since neighbouring pixels see the same element.  Where
- * the blockers cannot be listed, 4 x 4 stratified shadow rays estimate
- * the hidden part with the unoccluded kernel as a control variate (as
- * grid/gather.c: exact when nothing blocks, unbiased otherwise), keyed on
- * the caller's key, so the picture does not depend on the thread count.
+ * A source is an emitting patch whose elements emit alike (one polygon), or
+ * else one emitting element.  Visibility is exact: the blockers that may
+ * hide part of source j from any point of r are listed once per receiver
+ * element (shaft culling with planes, as occluders.c: a blocker whose plane
+ * does not separate r from j, or whose polygon misses the plane's section
+ * of their hull, hides nothing), trimmed to the part in front of both
+ * planes, and rad_point_polygon_ff_visible takes the factor of the source
+ * less their shadows projected from x.  The blockers are the patches, a
+ * bent quad as its two triangles (the Cornell box's blocks are 2 mm out of
+ * plane; occluders.c leaves such pairs to rays).  More than
+ * RAD_FF_MAX_BLOCKERS: 4 x 4 stratified shadow rays per emitting element
+ * with the unoccluded kernel as a control variate (as grid/gather.c),
+ * keyed on the caller's key, so the picture does not depend on the thread
+ * count.  A per-thread cache keeps the lists of the last receivers.
  */
 #include "render/render.h"
 

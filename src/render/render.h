@@ -1,24 +1,25 @@
 /*
  * render.h -- what a picture needs beyond the solution's element values:
- * the emitters' direct light gathered at each shading point (direct.c).
+ * the final gather (docs/methods.md "The final gather").
  *
  * A solution's elements carry the radiosity as a mean over each element;
- * drawn by interpolation, a shadow edge is as sharp as the mesh under it
- * (too bright where an element straddles the edge, a hard wedge where the
- * vertices round it off).  The final gather splits the radiosity at a point
- * x of element e into
+ * drawn by interpolation, a shadow edge is as sharp as the mesh under it,
+ * and a hierarchical solution's leaves hold irradiance pushed down from
+ * coarser links.  The picture splits the radiosity at the point x a camera
+ * ray meets (element e) into
  *
- *   B(x) = [B_e - rho_e D_e] interpolated    emission, the interreflection,
- *                                            luminaires' and daylight's light
- *        + rho_e D(x)                        the emitters' direct light at x
+ *   B(x) = R(x)              R_e = E_e + rho_e (direct_e + I_e), drawn smooth
+ *        + rho_e D(x)        the emitters' direct light at x itself
  *
- * D(x) = sum over emitting elements j of E_j F(x -> j visible), exact: the
- * point-to-polygon factor of the part of j that no blocker hides from x
- * (formfactor/occluders.c), shadow rays only where that cannot be listed;
- * D_e is the same over element e, a mean of 3 x 3 points.  The smooth part
- * keeps the mesh's resolution; the shadows take the pixel's (the final
- * gather of Reichert 1992 and Lischinski, Tampieri & Greenberg 1993,
- * restricted to the emitters; docs/methods.md "The final gather").
+ * D(x) (direct.c) = sum over emitting sources j of E_j F(x -> visible part
+ * of j), exact: the point-to-polygon factor of the source less the
+ * blockers' shadows.  I_e (indirect.c) = the irradiance at e's centroid
+ * gathered again from every element's reflected radiosity B_j - E_j, on a
+ * uniform render mesh for hierarchical solutions, after two Jacobi sweeps
+ * that give the sources the exact direct light; direct_e = the luminaires'
+ * and daylight's light as the solution has it.  This is the final gather of
+ * Reichert 1992 and Lischinski, Tampieri & Greenberg 1993: the shadows take
+ * the pixel's resolution, the smooth light the render mesh's.
  */
 #ifndef RAD_RENDER_H
 #define RAD_RENDER_H
