@@ -561,7 +561,7 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
         rad_vpl_free(&vpls);
         rad_free(display);
         return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
-                        "rad_render_options.direct_gather must be -1, 0 or 1, got %d", o.direct_gather);
+                        "rad_render_options.direct_gather must be in [-1, 1], got %d", o.direct_gather);
     }
     if (o.direct_gather >= 0 && o.vpl_paths == 0 && o.shading != RAD_SHADING_FLAT && !s->view.vertex_radiosity &&
         s->view.vis)
