@@ -109,7 +109,8 @@ rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, co
 {
     *done = false;
     const rad_mesh *mesh = d->mesh;
-    if (!mesh || !d->blocker || mesh->patch_count > RAD_INDIRECT_MAX_PATCHES)
+    if (!mesh || !d->blocker || mesh->patch_count > RAD_INDIRECT_MAX_PATCHES ||
+        mesh->element_count > RAD_INDIRECT_MAX_ELEMENTS)
         return RAD_OK;
     size_t P = mesh->patch_count, n = mesh->element_count;
     pair_list *pairs = rad_alloc(ctx, RAD_MEM_RENDER, P * P, sizeof *pairs, "render: patch pairs");
@@ -274,17 +275,19 @@ rad_result rad_render_mesh_create(rad_context *ctx, const rad_scene *scene, cons
                                   double crease_angle_degrees, rad_mesh **out)
 {
     *out = NULL;
-    if (!solved->tree)
+    if (!solved->tree || solved->patch_count > RAD_INDIRECT_MAX_PATCHES ||
+        solved->element_count > RAD_INDIRECT_MAX_ELEMENTS)
         return RAD_OK;
-    rad_mesh_options o = {.target_elements = RAD_RENDER_MESH_ELEMENTS,
-                          .crease_angle_degrees = crease_angle_degrees};
+    /* No coarser than the leaves. */
+    size_t target = solved->element_count > RAD_RENDER_MESH_ELEMENTS ? solved->element_count : RAD_RENDER_MESH_ELEMENTS;
+    rad_mesh_options o = {.target_elements = target, .crease_angle_degrees = crease_angle_degrees};
     rad_mesh *mesh = NULL;
     rad_result r = rad_mesh_build(ctx, scene, &o, &mesh);
     if (r != RAD_OK)
         return r;
     /* The rays meet the solved mesh's patches: the render mesh must have
      * the same ones (it does, both made from the scene's polygons). */
-    bool same = mesh->patch_count == solved->patch_count && mesh->element_count > solved->element_count / 4;
+    bool same = mesh->patch_count == solved->patch_count;
     for (size_t p = 0; same && p < mesh->patch_count; p++)
         same = mesh->patches[p].corner_count == solved->patches[p].corner_count &&
                memcmp(mesh->patches[p].corner, solved->patches[p].corner,

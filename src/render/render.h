@@ -120,10 +120,13 @@ rad_result rad_direct_residual(rad_context *ctx, const rad_direct_light *d, cons
  * visibility from the blockers listed for the pair of patches (clear pairs:
  * none; else the segment between the centroids against each); direct: the
  * luminaires' and daylight's mean irradiance (NULL: none).  The solution's
- * elements are then only sources, where their errors average out.  false
- * (and nothing written) where the scene has more than
- * RAD_INDIRECT_MAX_PATCHES patches.  Fails only for memory. */
+ * elements are then only sources, where their errors average out.  *done
+ * false (and nothing written) where the mesh has more than
+ * RAD_INDIRECT_MAX_PATCHES patches or RAD_INDIRECT_MAX_ELEMENTS elements
+ * (the gather is O(n^2): 8,192 elements take about 15 s on one core).
+ * Fails only for memory. */
 #define RAD_INDIRECT_MAX_PATCHES 512
+#define RAD_INDIRECT_MAX_ELEMENTS 8192
 /* The gathering factors are kept for the sweeps (render.h) up to this many
  * bytes (4,096 elements), and the sweeps made: */
 #define RAD_INDIRECT_DENSE_BYTES (64.0 * 1024 * 1024)
@@ -137,9 +140,10 @@ rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, co
 /* The mesh a picture of a hierarchical solution is gathered on (its leaves
  * are as coarse as the links allowed: a block's face in indirect light can
  * be a few leaves, too few to draw the light across it): a uniform mesh of
- * about RAD_RENDER_MESH_ELEMENTS of the same patches.  *out NULL (and
- * RAD_OK) where the solved mesh is not a leaf mesh, or the patches would
- * differ.  Fails only for memory (then *out NULL). */
+ * about RAD_RENDER_MESH_ELEMENTS of the same patches (or as many as the
+ * leaves, if more).  *out NULL (and RAD_OK) where the solved mesh is not a
+ * leaf mesh, is beyond the gather's limits, or the patches would differ.
+ * Fails only for memory (then *out NULL). */
 #define RAD_RENDER_MESH_ELEMENTS 2000
 rad_result rad_render_mesh_create(rad_context *ctx, const rad_scene *scene, const rad_mesh *solved,
                                   double crease_angle_degrees, rad_mesh **out);
