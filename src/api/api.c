@@ -436,14 +436,16 @@ static void render_gather_free(render_gather *g)
     memset(g, 0, sizeof *g);
 }
 
-/* Fill *g for solution s with display values `display`; nothing emits (or
- * too much does): g->direct inactive, nothing else kept.  Fails only for
- * memory. */
+/* Fill *g for solution s with display values `display`; nothing emits, too
+ * much does, or the scene is beyond the gather's limits (render.h):
+ * g->direct inactive, nothing else kept.  Fails only for memory. */
 static rad_result render_gather_make(rad_context *ctx, const rad_solution *s, const double *display,
                                      render_gather *g)
 {
     const rad_solution_view *v = &s->view;
     memset(g, 0, sizeof *g);
+    if (v->mesh->patch_count > RAD_INDIRECT_MAX_PATCHES || v->mesh->element_count > RAD_INDIRECT_MAX_ELEMENTS)
+        return RAD_OK;
     rad_result r = rad_render_mesh_create(ctx, s->scene, v->mesh, s->options.crease_angle_degrees, &g->own_mesh);
     if (r != RAD_OK)
         return r;
@@ -480,10 +482,11 @@ static rad_result render_gather_make(rad_context *ctx, const rad_solution *s, co
     if (r == RAD_OK && rad_direct_light_active(&g->direct))
         r = rad_indirect_residual(ctx, &g->direct, B, self, g->reflectance, v->direct ? direct : NULL,
                                   ctx->threads, g->residual, &gathered);
-    /* Too large a scene for the gather: the elements' values less their
-     * direct part (on the solved mesh only: a render mesh was for it). */
-    if (r == RAD_OK && rad_direct_light_active(&g->direct) && !gathered)
-        r = rad_direct_residual(ctx, &g->direct, B, g->reflectance, ctx->threads, g->residual);
+    /* Beyond the gather's limits (render.h) the picture is the elements'
+     * alone, as it was: a gather of the direct light over elements that
+     * large scenes leave coarse would cost more than it mends. */
+    if (r == RAD_OK && !gathered)
+        rad_direct_light_free(&g->direct);
     if (r == RAD_OK && rad_direct_light_active(&g->direct))
         r = rad_vertex_values(ctx, mesh, g->residual, g->vertex);
     rad_free(work);

@@ -393,19 +393,3 @@ rad_result rad_direct_means(rad_context *ctx, const rad_direct_light *d, int thr
     rad_free(caches);
     return r;
 }
-
-rad_result rad_direct_residual(rad_context *ctx, const rad_direct_light *d, const double *display,
-                               const double *reflectance, int threads, double *residual)
-{
-    size_t n = d->mesh ? d->mesh->element_count : 0;
-    if (!rad_direct_light_active(d))
-        return RAD_OK;
-    double *mean = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *mean, "render: direct means");
-    if (!mean)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    rad_result r = rad_direct_means(ctx, d, threads, mean);
-    for (size_t i = 0; r == RAD_OK && i < 3 * n; i++)
-        residual[i] = display[i] - reflectance[i] * mean[i];
-    rad_free(mean);
-    return r;
-}

@@ -106,12 +106,6 @@ void rad_direct_at(const rad_direct_light *d, rad_direct_cache *cache, uint32_t 
  * element, W/m^2; parallel on `threads`.  Fails only for memory. */
 rad_result rad_direct_means(rad_context *ctx, const rad_direct_light *d, int threads, double *mean);
 
-/* The residual the picture interpolates: residual_i = display_i - rho_i D_i
- * (3 per element) with D_i the mean of rad_direct_at over element i (3 x 3
- * midpoints), parallel on `threads`; emitters' own elements keep their
- * value.  Fails only for memory. */
-rad_result rad_direct_residual(rad_context *ctx, const rad_direct_light *d, const double *display,
-                               const double *reflectance, int threads, double *residual);
 
 /* The residual from a gather instead (indirect.c): residual_i = self_i +
  * rho_i (direct_i + I_i), I_i the irradiance at element i's centroid from
