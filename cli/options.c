@@ -247,6 +247,7 @@ static const cli_flag FLAGS[] = {
                  "isoluminance)"},
     {"specular-depth", 0, "N", CLI_RENDER, RENDER(specular_depth)},
     {"glossy-samples", 0, "N", CLI_RENDER, RENDER(glossy_samples)},
+    {"direct-gather", 0, "N", CLI_RENDER, RENDER(direct_gather)},
     {"seed", 0, "S", RV, SOLVE(seed)},
     {"threads", 0, "N", RV, OWN(threads, RAD_OPTION_INT), .own.min = 1.0, .own.max = 1024.0,
      .own.default_text = "all cores", .own.help = "worker threads; results do not depend on them"},

@@ -566,6 +566,13 @@ typedef struct rad_render_options {
                                      the first hit, the first pass alone) */
     int glossy_samples;           /* rays a glossy surface seen from the eye sends (stratified);
                                      0 = 16; deeper glossy bounces send 1 */
+    /* The final gather of the emitters' direct light (docs/methods.md "The
+     * final gather"): at each shading point the emitting surfaces' light
+     * with exact visibility, the elements' values for the rest, so shadows
+     * are as sharp as the pixels.  0 or 1 = on (smooth shading, no
+     * vpl_paths, at most 256 emitting elements), -1 = off (the elements'
+     * values alone). */
+    int direct_gather;
 } rad_render_options;
 
 /* A linear-radiance RGB image, W/(m^2 sr). */

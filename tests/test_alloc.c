@@ -332,7 +332,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
     }
     if (r == RAD_OK) {
         rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
-        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0, 0};
         r = rad_solution_render(ctx, s, &ro, &image);
     }
     if (r == RAD_OK) {
@@ -347,7 +347,7 @@ static rad_result run_strategy(const scenario *sc, rad_context *ctx, outputs *ou
      * range, cairo's PNG through an atomic file. */
     for (int q = RAD_FALSE_COLOUR_LUMINANCE; q <= RAD_FALSE_COLOUR_ILLUMINANCE && r == RAD_OK; q++) {
         rad_camera camera = {{0.5, 0.5, 0.95}, {0.5, 0.5, 0.0}, {0.0, 1.0, 0.0}, 60.0};
-        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0};
+        rad_render_options ro = {16, 12, 2, &camera, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0, 0};
         rad_false_colour_options fo = {(rad_false_colour_quantity)q, q == RAD_FALSE_COLOUR_ILLUMINANCE, 0, 0, 1};
         const char *name = q == RAD_FALSE_COLOUR_LUMINANCE ? "luminance.png" : "illuminance.png";
         output_path(name, path, sizeof path);
@@ -767,7 +767,7 @@ static void test_stats_by_category(void **state)
     assert_int_equal(rad_solution_create(ctx, scene, &o, &s), RAD_OK);
     assert_int_equal(rad_solution_solve(ctx, s), RAD_OK);
     rad_image *image = NULL;
-    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0};
+    rad_render_options ro = {8, 8, 1, NULL, RAD_SHADING_SMOOTH, 0.0, 0, 0, 0, 0};
     assert_int_equal(rad_solution_render(ctx, s, &ro, &image), RAD_OK);
     char path[512];
     output_path("stats.json", path, sizeof path);

@@ -406,6 +406,86 @@ static rad_result display_values(rad_context *ctx, rad_solution *s, double **dis
     return RAD_OK;
 }
 
+/* What the final gather draws (render/render.h): the mesh (the solved one,
+ * or for a hierarchical solution a uniform one of the same patches), its
+ * elements' reflectance and emission, the residual the picture
+ * interpolates and its vertex values, and the emitters. */
+typedef struct render_gather {
+    rad_direct_light direct;
+    rad_mesh *own_mesh;           /* NULL: the solved mesh */
+    double *reflectance, *emission, *residual, *vertex; /* 3 per element (vertex: per vertex) */
+} render_gather;
+
+static void render_gather_free(render_gather *g)
+{
+    rad_direct_light_free(&g->direct);
+    rad_mesh_destroy(g->own_mesh);
+    rad_free(g->reflectance);
+    rad_free(g->emission);
+    rad_free(g->residual);
+    rad_free(g->vertex);
+    memset(g, 0, sizeof *g);
+}
+
+/* Fill *g for solution s with display values `display`; nothing emits, too
+ * much does, or the scene is beyond the gather's limits (render.h):
+ * g->direct inactive, nothing else kept.  Fails only for memory. */
+static rad_result render_gather_make(rad_context *ctx, const rad_solution *s, const double *display,
+                                     render_gather *g)
+{
+    const rad_solution_view *v = &s->view;
+    memset(g, 0, sizeof *g);
+    if (v->mesh->patch_count > RAD_INDIRECT_MAX_PATCHES || v->mesh->element_count > RAD_INDIRECT_MAX_ELEMENTS)
+        return RAD_OK;
+    rad_result r = rad_render_mesh_create(ctx, s->scene, v->mesh, s->options.crease_angle_degrees, &g->own_mesh);
+    if (r != RAD_OK)
+        return r;
+    const rad_mesh *mesh = g->own_mesh ? g->own_mesh : v->mesh;
+    size_t n = mesh->element_count;
+    double *work = rad_alloc(ctx, RAD_MEM_RENDER, 9 * n + 1, sizeof *work, "render: gather arrays");
+    g->reflectance = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n + 1, sizeof *g->reflectance, "render: reflectance");
+    g->emission = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n + 1, sizeof *g->emission, "render: emission");
+    g->residual = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n + 1, sizeof *g->residual, "render: residual");
+    g->vertex = rad_alloc(ctx, RAD_MEM_RENDER, 3 * mesh->vertex_count + 1, sizeof *g->vertex, "render: vertex values");
+    if (!work || !g->reflectance || !g->emission || !g->residual || !g->vertex) {
+        rad_free(work);
+        render_gather_free(g);
+        return RAD_ERROR_OUT_OF_MEMORY;
+    }
+    /* The elements' B, luminaires' and daylight's direct irradiance, and
+     * self-emission (the emission less that light's first reflection). */
+    double *B = work, *direct = work + 3 * n, *self = work + 6 * n;
+    if (g->own_mesh) {
+        const double *from[3] = {v->reflectance, v->emission, v->direct};
+        double *to[3] = {g->reflectance, g->emission, direct};
+        rad_render_mesh_sample(v->mesh, s->vertex_radiosity, from, 3, mesh, B, to);
+    } else {
+        memcpy(B, display, 3 * n * sizeof *B);
+        memcpy(g->reflectance, v->reflectance, 3 * n * sizeof *B);
+        memcpy(g->emission, v->emission, 3 * n * sizeof *B);
+        for (size_t i = 0; i < 3 * n; i++)
+            direct[i] = v->direct ? v->direct[i] : 0.0;
+    }
+    for (size_t i = 0; i < 3 * n; i++)
+        self[i] = fmax(g->emission[i] - g->reflectance[i] * direct[i], 0.0);
+    r = rad_direct_light_create(ctx, mesh, v->vis, self, s->options.seed, &g->direct);
+    bool gathered = false;
+    if (r == RAD_OK && rad_direct_light_active(&g->direct))
+        r = rad_indirect_residual(ctx, &g->direct, B, self, g->reflectance, v->direct ? direct : NULL,
+                                  ctx->threads, g->residual, &gathered);
+    /* Beyond the gather's limits (render.h) the picture is the elements'
+     * alone, as it was: a gather of the direct light over elements that
+     * large scenes leave coarse would cost more than it mends. */
+    if (r == RAD_OK && !gathered)
+        rad_direct_light_free(&g->direct);
+    if (r == RAD_OK && rad_direct_light_active(&g->direct))
+        r = rad_vertex_values(ctx, mesh, g->residual, g->vertex);
+    rad_free(work);
+    if (r != RAD_OK || !rad_direct_light_active(&g->direct))
+        render_gather_free(g);
+    return r;
+}
+
 rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_render_options *options,
                                rad_image **out)
 {
@@ -464,7 +544,33 @@ rad_result rad_solution_render(rad_context *ctx, rad_solution *s, const rad_rend
         }
         in.vpls = &vpls;
     }
-    r = rad_render_image(ctx, &in, &o, out);
+    /* The final gather (render/render.h): the residual B - rho D drawn
+     * smooth, the emitters' direct light added at each shading point.  Not
+     * with per-pixel VPLs (they gather it themselves), nor flat (which shows
+     * the elements as solved), nor where the vertex values are the
+     * solution's own unknowns (Galerkin's linear elements). */
+    render_gather gather = {0};
+    in.direct = NULL;
+    if (o.direct_gather < -1 || o.direct_gather > 1) {
+        rad_vpl_free(&vpls);
+        rad_free(display);
+        return rad_fail(ctx, RAD_ERROR_INVALID_ARGUMENT,
+                        "rad_render_options.direct_gather must be in [-1, 1], got %d", o.direct_gather);
+    }
+    if (o.direct_gather >= 0 && o.vpl_paths == 0 && o.shading != RAD_SHADING_FLAT && !s->view.vertex_radiosity &&
+        s->view.vis)
+        r = render_gather_make(ctx, s, display, &gather);
+    if (r == RAD_OK && rad_direct_light_active(&gather.direct)) {
+        in.direct = &gather.direct;
+        in.mesh = gather.direct.mesh;
+        in.element_radiosity = gather.residual;
+        in.vertex_radiosity = gather.vertex;
+        in.reflectance = gather.reflectance;
+        in.emission = gather.emission;
+    }
+    if (r == RAD_OK)
+        r = rad_render_image(ctx, &in, &o, out);
+    render_gather_free(&gather);
     rad_vpl_free(&vpls);
     s->view.seconds.render = rad_seconds() - t;
     int spp = o.samples > 0 ? o.samples : 4;

@@ -7,6 +7,7 @@
 #define RAD_OUTPUT_H
 
 #include "interp/interp.h"
+#include "render/render.h"
 #include "strategy/strategy.h"
 
 struct rad_image {
@@ -39,6 +40,11 @@ typedef struct rad_render_input {
     /* Rays that leave the scene (through its openings, or past an outdoor
      * model) see this daylight's sky and ground (light/sky.h); NULL: black. */
     const struct rad_daylight *daylight;
+    /* The final gather (render/render.h): with it, element_radiosity and
+     * vertex_radiosity hold the residual B - rho D the picture
+     * interpolates, and each shading point adds rho D(x) of its own
+     * (reflectance needed); NULL or inactive: the values as they are. */
+    const rad_direct_light *direct;
 } rad_render_input;
 
 /* Ray-cast the mesh from the camera; each sample takes the radiance B/pi of

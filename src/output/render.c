@@ -199,9 +199,20 @@ static void shade_vpl(const rad_render_input *input, double epsilon, uint32_t e,
         rgb[c] = input->emission[3 * (size_t)e + c] + rho[c] * fmax(H[c], 0.0);
 }
 
+/* A camera ray's point whose direct light (the final gather) is left to
+ * the pixel: a 2 x 2 pilot that sees one patch takes it once, at the mean
+ * of its four points, instead of four times. */
+typedef struct render_deferred {
+    bool valid;
+    vec3 point;           /* m */
+    uint32_t element;
+} render_deferred;
+
 /* What a trace needs beyond the input: the second pass's settings. */
 typedef struct render_pass {
     const rad_render_input *input;
+    rad_direct_cache *caches; /* one per thread: the final gather's (NULL: none) */
+    render_deferred *defer;   /* non-NULL: the eye's diffuse points' direct light is noted here, not added */
     rad_shading shading;
     int specular_depth;  /* 0: the first pass alone */
     int glossy_samples;
@@ -373,6 +384,22 @@ static uint32_t shade(const render_pass *pass, const rad_ray *ray, const rad_hit
         for (int c = 0; c < 3; c++)
             diffuse[c] = input->element_radiosity[3 * (size_t)e + (size_t)c];
     }
+    /* The final gather: the emitters' light at this very point (or at the
+     * pixel's, render_row; not where a texture varies the reflectance). */
+    if (pass->caches && pass->defer && depth == 0 && !(input->scene && rad_scene_textured(input->scene, patch->polygon))) {
+        pass->defer->valid = true;
+        pass->defer->point = p;
+        pass->defer->element = e;
+    } else if (pass->caches) {
+        int thread = 0;
+#ifdef _OPENMP
+        thread = omp_get_thread_num();
+#endif
+        double direct[3];
+        rad_direct_at(input->direct, &pass->caches[thread], e, p, key, direct);
+        for (int c = 0; c < 3; c++)
+            diffuse[c] += input->reflectance[3 * (size_t)e + (size_t)c] * direct[c];
+    }
     /* A texture modulates the reflected part by the texel's reflectance
      * over the element's mean (which the solution used): a texture of one
      * colour changes nothing. */
@@ -413,8 +440,16 @@ static void camera_ray(const render_view *view, uint64_t stream, uint64_t x, int
  * pixel's rays saw when they agree, RENDER_MIXED when they do not. */
 static void trace_pixels(const render_pass *pass, const render_view *view, int y,
                          const uint32_t *pixel, size_t count, uint64_t grid, uint64_t stream, size_t batch,
-                         rad_ray *rays, rad_hit *hits, double *sum, uint32_t *seen)
+                         rad_ray *rays, rad_hit *hits, double *sum, uint32_t *seen, double *deferred_sum,
+                         uint32_t *deferred)
 {
+    /* deferred_sum (3 per pixel: the sum of its deferred points) and
+     * deferred (2 per pixel: their count, the first one's element), or
+     * NULL: every point's direct light added at once. */
+    render_pass local = *pass;
+    render_deferred note;
+    local.defer = deferred ? &note : NULL;
+    pass = &local;
     const uint64_t per_pixel = grid * grid, total = (uint64_t)count * per_pixel;
     for (uint64_t first = 0; first < total; first += batch) {
         size_t n = (size_t)(total - first < batch ? total - first : batch);
@@ -430,12 +465,24 @@ static void trace_pixels(const render_pass *pass, const render_view *view, int y
             rad_rng rng = rad_rng_keyed(stream ^ 0x5bd1e9955bd1e995ULL,
                                         (uint64_t)y * (uint64_t)view->width + x, r % per_pixel);
             uint64_t key = ((uint64_t)y * (uint64_t)view->width + x) * per_pixel * 2 + (r % per_pixel) * 2 + stream;
+            note.valid = false;
             uint32_t what = shade(pass, &rays[k], &hits[k], 0, 1.0, key, &rng, rgb);
             if (r % per_pixel == 0) {
                 sum[3 * x] = sum[3 * x + 1] = sum[3 * x + 2] = 0.0;
                 seen[x] = what;
+                if (deferred) {
+                    deferred_sum[3 * x] = deferred_sum[3 * x + 1] = deferred_sum[3 * x + 2] = 0.0;
+                    deferred[2 * x] = 0;
+                }
             } else if (seen[x] != what) {
                 seen[x] = RENDER_MIXED;
+            }
+            if (deferred && note.valid) {
+                if (deferred[2 * x]++ == 0)
+                    deferred[2 * x + 1] = note.element;
+                deferred_sum[3 * x] += note.point.x;
+                deferred_sum[3 * x + 1] += note.point.y;
+                deferred_sum[3 * x + 2] += note.point.z;
             }
             for (int c = 0; c < 3; c++)
                 sum[3 * x + (uint64_t)c] += rgb[c];
@@ -446,15 +493,41 @@ static void trace_pixels(const render_pass *pass, const render_view *view, int y
 /* One row: every pixel's 2 x 2 pilot, then all strata where the pilot
  * saw more than one thing (file header); writes the row's pixels. */
 static void render_row(const render_pass *pass, const render_view *view, int y, size_t batch, rad_ray *rays, rad_hit *hits,
-                       double *sum, uint32_t *seen, uint32_t *pixel, float *pixels)
+                       double *sum, uint32_t *seen, uint32_t *pixel, double *deferred_sum, uint32_t *deferred,
+                       float *pixels)
 {
     const uint64_t grid = (uint64_t)view->samples, pilot = grid > 2 ? 2 : grid;
     size_t width = (size_t)view->width;
     for (size_t x = 0; x < width; x++)
         pixel[x] = (uint32_t)x;
     /* The pilot is the final sampling when the grid is no finer (stream 0,
-     * as the full strata: the same rays then). */
-    trace_pixels(pass, view, y, pixel, width, pilot, pilot == grid ? 0 : 1, batch, rays, hits, sum, seen);
+     * as the full strata: the same rays then).  The final gather's direct
+     * light is deferred in the pilot when pixels that see more go on to
+     * all strata (which take it point by point). */
+    bool defer = pass->caches && pilot < grid;
+    trace_pixels(pass, view, y, pixel, width, pilot, pilot == grid ? 0 : 1, batch, rays, hits, sum, seen,
+                 defer ? deferred_sum : NULL, defer ? deferred : NULL);
+    if (defer) {
+        const rad_render_input *input = pass->input;
+        int thread = 0;
+#ifdef _OPENMP
+        thread = omp_get_thread_num();
+#endif
+        for (size_t x = 0; x < width; x++) {
+            if (seen[x] == RENDER_MIXED || deferred[2 * x] == 0)
+                continue;
+            /* The points' mean, on the patch they all lie on. */
+            double count = deferred[2 * x];
+            vec3 p = v3(deferred_sum[3 * x] / count, deferred_sum[3 * x + 1] / count, deferred_sum[3 * x + 2] / count);
+            uint32_t patch = input->mesh->elements[deferred[2 * x + 1]].patch;
+            double s, t, ls, lt, direct[3];
+            rad_patch_parameters(&input->mesh->patches[patch], p, &s, &t);
+            uint32_t e = rad_mesh_locate(input->mesh, patch, s, t, &ls, &lt);
+            rad_direct_at(input->direct, &pass->caches[thread], e, p, (uint64_t)y * (uint64_t)width + x, direct);
+            for (int c = 0; c < 3; c++)
+                sum[3 * x + (size_t)c] += count * input->reflectance[3 * (size_t)e + (size_t)c] * direct[c];
+        }
+    }
     double scale[2] = {1.0 / (M_PI * (double)(pilot * pilot)), /* mean, and L = B / pi */
                        1.0 / (M_PI * (double)(grid * grid))};
     size_t again = 0;
@@ -469,7 +542,7 @@ static void render_row(const render_pass *pass, const render_view *view, int y, 
     /* Sums of the refined pixels are overwritten with their full strata. */
     uint32_t *unused = pixel + width; /* what the full strata saw: not needed */
     if (again)
-        trace_pixels(pass, view, y, pixel, again, grid, 0, batch, rays, hits, sum, unused);
+        trace_pixels(pass, view, y, pixel, again, grid, 0, batch, rays, hits, sum, unused, NULL, NULL);
     for (size_t x = 0; x < width; x++)
         for (int c = 0; c < 3; c++)
             pixels[3 * x + (size_t)c] = (float)(sum[3 * x + (size_t)c] * scale[seen[x]]);
@@ -498,10 +571,24 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
                         "rad_render_options.specular_depth must be in [-1, 64], got %d", o.specular_depth);
     if (o.glossy_samples != 0 && (r = check_size(ctx, "glossy_samples", o.glossy_samples)) != RAD_OK)
         return r;
-    render_pass pass = {input, o.shading, o.specular_depth < 0 ? 0 : option_or_default(o.specular_depth, 8),
+    render_pass pass = {input, NULL, NULL, o.shading, o.specular_depth < 0 ? 0 : option_or_default(o.specular_depth, 8),
                         option_or_default(o.glossy_samples, 16), rad_vis_epsilon(input->mesh)};
 
     int threads = ctx && ctx->threads > 0 ? ctx->threads : 1;
+    if (input->direct && rad_direct_light_active(input->direct) && input->reflectance && !input->vpls) {
+        pass.caches = rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads, sizeof *pass.caches, "render: gather caches");
+        int ready = 0;
+        r = pass.caches ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+        for (; r == RAD_OK && ready < threads; ready++)
+            if ((r = rad_direct_cache_init(ctx, input->direct, &pass.caches[ready])) != RAD_OK)
+                break;
+        if (r != RAD_OK) {
+            for (int t = 0; t < ready; t++)
+                rad_direct_cache_free(&pass.caches[t]);
+            rad_free(pass.caches);
+            return r;
+        }
+    }
     /* A row's rays, up to RAD_RENDER_BATCH at a time: small images need no more. */
     uint64_t row_rays = (uint64_t)width * (uint64_t)samples * (uint64_t)samples;
     size_t batch = row_rays < RAD_RENDER_BATCH ? (size_t)row_rays : RAD_RENDER_BATCH;
@@ -517,7 +604,23 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
     uint32_t *marks = sums ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * (size_t)width, 3 * sizeof(uint32_t),
                                        "render rows")
                            : NULL;
+    double *deferred_sums = marks ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * (size_t)width, 3 * sizeof(double),
+                                              "render rows")
+                                  : NULL;
+    uint32_t *deferred = deferred_sums ? rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads * (size_t)width,
+                                                   2 * sizeof(uint32_t), "render rows")
+                                       : NULL;
+    if (!deferred) {
+        rad_free(marks);
+        rad_free(deferred_sums);
+        marks = NULL;
+    }
     if (!marks) {
+        if (pass.caches) {
+            for (int t = 0; t < threads; t++)
+                rad_direct_cache_free(&pass.caches[t]);
+            rad_free(pass.caches);
+        }
         rad_image_destroy(image);
         rad_free(rays);
         rad_free(hits);
@@ -545,6 +648,7 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
                 continue;
             }
             render_row(&pass, &view, y, batch, my_rays, my_hits, my_sum, my_seen, my_pixel,
+                       deferred_sums + (size_t)thread * (size_t)width * 3, deferred + (size_t)thread * (size_t)width * 2,
                        &image->pixels[(size_t)y * (size_t)width * 3]);
             int done;
 #pragma omp atomic capture
@@ -557,6 +661,13 @@ rad_result rad_render_image(rad_context *ctx, const rad_render_input *input,
     rad_free(hits);
     rad_free(sums);
     rad_free(marks);
+    rad_free(deferred_sums);
+    rad_free(deferred);
+    if (pass.caches) {
+        for (int t = 0; t < threads; t++)
+            rad_direct_cache_free(&pass.caches[t]);
+        rad_free(pass.caches);
+    }
     rad_progress(ctx, "render", (uint64_t)rows_done, (uint64_t)height);
     *out = image;
     if (rows_skipped > 0)

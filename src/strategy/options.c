@@ -147,6 +147,10 @@ static const rad_option_info render_rows[] = {
              "specular materials; -1: the first pass alone"},
     {RENDER(glossy_samples), .type = RAD_OPTION_INT, .min = 1.0, .max = 16384.0, .default_value = 16.0,
      .default_text = "16", .help = "second pass: rays a glossy surface seen from the eye sends"},
+    {RENDER(direct_gather), .type = RAD_OPTION_INT, .min = -1.0, .max = 1.0, .default_value = 1.0,
+     .default_text = "1 (on)",
+     .help = "final gather: the emitting surfaces' direct light computed at each pixel's point with exact "
+             "visibility, the solved elements for the rest (sharp shadows); -1: the elements alone"},
 };
 
 static const rad_option_info office_rows[] = {
