@@ -18,6 +18,7 @@ packages=(build-essential g++ cmake pkg-config libembree-dev libassimp-dev libst
           libopenblas-dev liblapacke-dev libcjson-dev libcmocka-dev
           libcairo2-dev fonts-dejavu-core  # false colour and plots: cairo, and a font for its text
           libopenmpi-dev openmpi-bin
+          python3-numpy  # bench/compare_images.py
           libsdl2-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri)  # the last five: the viewer
 if [ "${RADIOSITY_FUZZ:-0}" = 1 ]; then
   packages+=(clang-14 libclang-rt-14-dev libomp-14-dev)
