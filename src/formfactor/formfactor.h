@@ -223,6 +223,16 @@ double rad_element_bend(const rad_mesh *mesh, const rad_element *e);
  * quad).  Cannot fail. */
 double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
 
+/* Shadow rays for the part of element e that a point p (normal n) does
+ * not see: k x k stratified points y of e (jittered by rng, lifted by
+ * `lift` along e's normal), each a ray from `origin` to y and a weight, the
+ * point-to-point kernel cos cos / (pi r^2) x A_e x sample weight / k^2,
+ * so that the weights of the blocked rays estimate the hidden part of
+ * F(p -> e).  Points the kernel gives nothing are skipped.  Returns the
+ * rays made (at most k^2).  Cannot fail. */
+int rad_element_kernel_rays(const rad_mesh *mesh, const rad_element *e, vec3 p, vec3 n, vec3 origin, double lift,
+                            int k, rad_rng *rng, rad_ray *ray, double *weight);
+
 /* An orthonormal tangent pair (u, v) with u x v = n (unit): the frame of
  * the hemicube's faces and of the hemisphere's directions.  Cannot fail. */
 void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v);

@@ -228,3 +228,24 @@ int rad_element_gauss(const rad_mesh *mesh, const rad_element *e, int order, vec
         }
     return q;
 }
+
+int rad_element_kernel_rays(const rad_mesh *mesh, const rad_element *e, vec3 p, vec3 n, vec3 origin, double lift,
+                            int k, rad_rng *rng, rad_ray *ray, double *weight)
+{
+    double inv = 1.0 / (k * k);
+    int count = 0;
+    for (int a = 0; a < k; a++)
+        for (int c = 0; c < k; c++) {
+            double u = (a + rad_rng_uniform(rng)) / k, v = (c + rad_rng_uniform(rng)) / k;
+            vec3 y = v3_mad(rad_element_sample(mesh, e, u, v), e->normal, lift);
+            vec3 d = v3_sub(y, p);
+            double r2 = v3_dot(d, d);
+            double kernel = fmax(0.0, v3_dot(n, d)) * fmax(0.0, -v3_dot(e->normal, d)) / (M_PI * r2 * r2) *
+                            e->area * rad_element_sample_weight(mesh, e, u, v);
+            if (!(kernel > 0.0))
+                continue;
+            ray[count] = (rad_ray){origin, v3_sub(y, origin), 0.0, 1.0};
+            weight[count++] = kernel * inv;
+        }
+    return count;
+}

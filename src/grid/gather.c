@@ -209,21 +209,8 @@ static void gather_element(const gather_shared *g, point_sums *ps, size_t j, ray
     b->elements++;
     double lift = g->eps + rad_element_bend(mesh, e);
     rad_rng rng = rad_rng_keyed(g->seed, 0x67726964ULL + ps->index, j);
-    double inv = 1.0 / (k * k);
-    for (int a = 0; a < k; a++)
-        for (int c = 0; c < k; c++) {
-            double u = (a + rad_rng_uniform(&rng)) / k, v = (c + rad_rng_uniform(&rng)) / k;
-            vec3 y = v3_mad(rad_element_sample(mesh, e, u, v), e->normal, lift);
-            vec3 d = v3_sub(y, p);
-            double r2 = v3_dot(d, d);
-            double kernel = fmax(0.0, v3_dot(n, d)) * fmax(0.0, -v3_dot(e->normal, d)) / (M_PI * r2 * r2) *
-                            e->area * rad_element_sample_weight(mesh, e, u, v);
-            if (!(kernel > 0.0))
-                continue;
-            b->ray[b->count] = (rad_ray){ps->origin, v3_sub(y, ps->origin), 0.0, 1.0};
-            b->weight[b->count] = kernel * inv;
-            b->count++;
-        }
+    b->count += (size_t)rad_element_kernel_rays(mesh, e, p, n, ps->origin, lift, k, &rng, b->ray + b->count,
+                                                b->weight + b->count);
 }
 
 /* The rays of one visibility test, handed down the walk: a child's

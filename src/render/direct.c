@@ -270,20 +270,7 @@ static double visible_by_rays(const rad_direct_light *d, const rad_element *e, u
     rad_ray rays[RAYS];
     uint8_t blocked[RAYS];
     rad_rng rng = rad_rng_keyed(d->seed ^ 0x64697265ULL /* "dire" */, key, j);
-    int count = 0;
-    for (int a = 0; a < SIDE; a++)
-        for (int c = 0; c < SIDE; c++) {
-            double u = (a + rad_rng_uniform(&rng)) / SIDE, v = (c + rad_rng_uniform(&rng)) / SIDE;
-            vec3 y = v3_mad(rad_element_sample(mesh, e, u, v), e->normal, lift);
-            vec3 to = v3_sub(y, p);
-            double r2 = v3_dot(to, to);
-            double kernel = fmax(0.0, v3_dot(n, to)) * fmax(0.0, -v3_dot(e->normal, to)) / (M_PI * r2 * r2) *
-                            e->area * rad_element_sample_weight(mesh, e, u, v);
-            if (!(kernel > 0.0))
-                continue;
-            rays[count] = (rad_ray){origin, v3_sub(y, origin), 0.0, 1.0};
-            weight[count++] = kernel / RAYS;
-        }
+    int count = rad_element_kernel_rays(mesh, e, p, n, origin, lift, SIDE, &rng, rays, weight);
     if (count == 0)
         return F;
     d->vis->backend->occluded(d->vis->state, rays, (size_t)count, blocked);

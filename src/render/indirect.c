@@ -105,9 +105,9 @@ static bool gather_hidden(const gather_geometry *g, size_t i, size_t j)
 
 rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, const double *display,
                                  const double *self, const double *reflectance, const double *direct, int threads,
-                                 double *residual, bool *done)
+                                 double *residual, bool *gathered)
 {
-    *done = false;
+    *gathered = false;
     const rad_mesh *mesh = d->mesh;
     if (!mesh || !d->blocker || mesh->patch_count > RAD_INDIRECT_MAX_PATCHES ||
         mesh->element_count > RAD_INDIRECT_MAX_ELEMENTS)
@@ -190,16 +190,8 @@ rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, co
     rad_result r = source && H && (!FV || mean) ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
     if (r == RAD_OK && FV)
         r = rad_direct_means(ctx, d, threads, mean);
-    if (r != RAD_OK) {
-        rad_free(FV);
-        rad_free(source);
-        rad_free(H);
-        rad_free(mean);
-        rad_free(pairs);
-        rad_free(diameter);
-        rad_free(point);
-        return r;
-    }
+    if (r != RAD_OK)
+        goto done;
     for (size_t k = 0; k < 3 * n; k++)
         source[k] = display[k] - self[k];
     if (FV) {
@@ -260,6 +252,8 @@ rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, co
             size_t at = 3 * i + (size_t)c;
             residual[at] = self[at] + reflectance[at] * ((direct ? direct[at] : 0.0) + H[at]);
         }
+    *gathered = true;
+done:
     rad_free(FV);
     rad_free(source);
     rad_free(H);
@@ -267,8 +261,7 @@ rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, co
     rad_free(pairs);
     rad_free(diameter);
     rad_free(point);
-    *done = true;
-    return RAD_OK;
+    return r;
 }
 
 rad_result rad_render_mesh_create(rad_context *ctx, const rad_scene *scene, const rad_mesh *solved,

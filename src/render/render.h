@@ -114,7 +114,7 @@ rad_result rad_direct_means(rad_context *ctx, const rad_direct_light *d, int thr
  * visibility from the blockers listed for the pair of patches (clear pairs:
  * none; else the segment between the centroids against each); direct: the
  * luminaires' and daylight's mean irradiance (NULL: none).  The solution's
- * elements are then only sources, where their errors average out.  *done
+ * elements are then only sources, where their errors average out.  *gathered
  * false (and nothing written) where the mesh has more than
  * RAD_INDIRECT_MAX_PATCHES patches or RAD_INDIRECT_MAX_ELEMENTS elements
  * (the gather is O(n^2): 8,192 elements take about 15 s on one core).
@@ -129,7 +129,7 @@ rad_result rad_direct_means(rad_context *ctx, const rad_direct_light *d, int thr
 #endif
 rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, const double *display,
                                  const double *self, const double *reflectance, const double *direct, int threads,
-                                 double *residual, bool *done);
+                                 double *residual, bool *gathered);
 
 /* The mesh a picture of a hierarchical solution is gathered on (its leaves
  * are as coarse as the links allowed: a block's face in indirect light can
