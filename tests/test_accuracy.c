@@ -184,6 +184,62 @@ static void test_furnace_southwell(void **state)
     furnace("southwell");
 }
 
+/* The furnace for every solver and form-factor method at its defaults
+ * (issue #26: energy exact by construction): the faces' mean B within 1e-4
+ * of E / (1 - rho), and what the closed cube absorbs within 1e-4 of what it
+ * emits; per face too, within 1e-4, where the method is deterministic
+ * (the sampled shooting scatters its faces by its rays).  The dense
+ * methods on 300 elements, to keep the quick suite quick; hierarchical and
+ * shooting as they mesh themselves.  Measured on the 1 x 2 x 3 m box at
+ * rho 0.8 (bench/furnace.py): hierarchical +7e-7 (0.7% high before its
+ * balance), shooting -6e-9 (-8e-4 before its remainder), hybrid -6e-6
+ * (+3.2e-3 before the Gauss points).  Instant radiosity is not yet among
+ * them (+4.5e-3). */
+static void test_furnace_every_method(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *options;
+        bool per_face;
+    } runs[] = {
+        {"--solver hierarchical", true},
+        {"--solver shooting", false},
+        {"--solver jacobi --elements 300", true},
+        {"--solver direct --elements 300", true},
+        {"--solver conjugate-gradient --elements 300", true},
+        {"--solver collocation --elements 300", true},
+        {"--solver galerkin-constant --elements 150", true},
+        {"--solver galerkin-linear --elements 150", true},
+        {"--solver gauss-seidel --elements 300 --form-factors hemicube", true},
+        {"--solver gauss-seidel --elements 300 --form-factors hemisphere", true},
+        {"--solver gauss-seidel --elements 300 --form-factors montecarlo", true},
+        {"--solver gauss-seidel --elements 300 --form-factors contour", true},
+        {"--solver gauss-seidel --elements 300 --form-factors hybrid", true},
+    };
+    cli_scene_writer w;
+    write_cube(&w, "furnace_all", "furnace_cube_rho0.5");
+    double exact = cli_exact_value(cli_find_case("furnace_cube_rho0.5"));
+    for (size_t i = 0; i < sizeof runs / sizeof runs[0]; i++) {
+        cJSON *stats = render_stats(&w, runs[i].options);
+        double mean = 0.0;
+        for (int f = 0; f < 6; f++) {
+            double B[3];
+            cli_stats_surface_radiosity(stats, cube_faces[f], B);
+            mean += B[0] / 6.0;
+            if (runs[i].per_face)
+                for (int c = 0; c < 3; c++)
+                    if (!(fabs(B[c] / exact - 1.0) < 1e-4))
+                        fail_msg("%s: face %s B %.9g, exact %.9g", runs[i].options, cube_faces[f], B[c], exact);
+        }
+        double emitted = cli_stats_number(stats, "power_W", "emitted");
+        double absorbed = cli_stats_number(stats, "power_W", "absorbed");
+        if (!(fabs(mean / exact - 1.0) < 1e-4) || !(fabs(absorbed / emitted - 1.0) < 1e-4))
+            fail_msg("%s: mean B %.9g (exact %.9g), absorbed / emitted - 1 = %.3g", runs[i].options, mean, exact,
+                     absorbed / emitted - 1.0);
+        cJSON_Delete(stats);
+    }
+}
+
 static void six_patch(const char *solver)
 {
     const cJSON *c = cli_find_case("cube_top_emitter_6patch");
@@ -361,6 +417,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_cube_matrix_and_closure),
         cmocka_unit_test(test_furnace_gauss_seidel),
         cmocka_unit_test(test_furnace_southwell),
+        cmocka_unit_test(test_furnace_every_method),
         cmocka_unit_test(test_six_patch_gauss_seidel),
         cmocka_unit_test(test_six_patch_southwell),
         cmocka_unit_test(test_embree_matches_brute_force),

@@ -181,13 +181,14 @@ rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, co
      * the exact mean direct light of each element (direct.c), so that the
      * sources nearest a receiver (the floor in front of a block's face,
      * in the block's penumbra) are no longer the solution's leaves. */
-    float *FV = (double)n * (double)n * sizeof(float) <= RAD_INDIRECT_DENSE_BYTES
-                    ? rad_alloc(ctx, RAD_MEM_RENDER, n * n, sizeof *FV, "render: gathering factors")
-                    : NULL;
+    bool keep = (double)n * (double)n * sizeof(float) <= RAD_INDIRECT_DENSE_BYTES;
+    float *FV = keep ? rad_alloc(ctx, RAD_MEM_RENDER, n * n, sizeof *FV, "render: gathering factors") : NULL;
     double *source = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *source, "render: sources");
     double *H = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *H, "render: gathered irradiance");
-    double *mean = FV ? rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *mean, "render: direct means") : NULL;
-    rad_result r = source && H && (!FV || mean) ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+    double *mean = keep ? rad_alloc(ctx, RAD_MEM_RENDER, 3 * n, sizeof *mean, "render: direct means") : NULL;
+    /* Kept factors that cannot be had fail the render: the picture must
+     * not depend on the memory at hand. */
+    rad_result r = source && H && (!keep || (FV && mean)) ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
     if (r == RAD_OK && FV)
         r = rad_direct_means(ctx, d, threads, mean);
     if (r != RAD_OK)
