@@ -311,9 +311,10 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
      * In a closed scene of one reflectance this is the exact remainder (a
      * furnace stopped at 1e-3 unshot read B 0.08% low; now the expected
      * value); elsewhere its error is a fraction of the unshot power the
-     * tolerance allows.  Not while solving: the display's ambient is
-     * added by the viewer. */
-    if (result == RAD_OK && unshot > 0.0) {
+     * tolerance allows.  Only on reaching the tolerance: a solve stopped
+     * at its bound with most of the light unshot keeps what it deposited,
+     * and says so. */
+    if (result == RAD_OK && unshot > 0.0 && unshot <= goal) {
         double kept = sent > 0.0 ? fmax(0.0, 1.0 - lost / sent) : 1.0;
         for (int c = 0; c < 3; c++) {
             double rho_avg = rho_area[c] / area, U = fmax(unshot_c[c], 0.0);
