@@ -182,7 +182,7 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     h.count = n;
     for (size_t k = n / 2; k-- > 0;) /* heapify */
         heap_fix(&h, h.item[k]);
-    double absorbed = 0.0, sent = 0.0, lost = 0.0, t0 = rad_seconds();
+    double absorbed = 0.0, t0 = rad_seconds();
     double eps = rad_vis_epsilon(sys->mesh);
     rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, rad_system_contraction(sys), 1.0, goal,
                                                  ceil((double)n / BATCH));
@@ -249,13 +249,8 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
             const hit_record *hk = hits + (size_t)k * N;
             for (int r = 0; r < N; r++) {
                 uint32_t j = hk[r].element;
-                for (int c = 0; c < 3; c++)
-                    sent += power[k][c] / N;
-                if (j == UINT32_MAX) {
-                    for (int c = 0; c < 3; c++)
-                        lost += power[k][c] / N;
+                if (j == UINT32_MAX)
                     continue; /* escaped: an open scene loses it */
-                }
                 double aj = sys->area[j];
                 for (int c = 0; c < 3; c++) {
                     double arriving = power[k][c] / N; /* W */
@@ -300,31 +295,6 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
         /* The unshot power is a running sum: round-off can leave it at
          * -1e-18 where all is shot, which no ambient light should become. */
         stats->ambient[c] = fmax(unshot_c[c], 0.0) / area / (1.0 - rho_avg);
-    }
-    /* What the unshot power would still add, as the notes' ambient term
-     * (Cohen, Chen, Wallace & Greenberg 1988) with the share of shot light
-     * that stayed in the scene, kept = 1 - lost / sent: U kept reaches the
-     * surfaces, each reflects rho of it, and so on, spread by area,
-     *
-     *     B_i += rho_i U kept / (A (1 - rho_avg kept))
-     *
-     * In a closed scene of one reflectance this is the exact remainder (a
-     * furnace stopped at 1e-3 unshot read B 0.08% low; now the expected
-     * value); elsewhere its error is a fraction of the unshot power the
-     * tolerance allows.  Only on reaching the tolerance: a solve stopped
-     * at its bound with most of the light unshot keeps what it deposited,
-     * and says so. */
-    if (result == RAD_OK && unshot > 0.0 && unshot <= goal) {
-        double kept = sent > 0.0 ? fmax(0.0, 1.0 - lost / sent) : 1.0;
-        for (int c = 0; c < 3; c++) {
-            double rho_avg = rho_area[c] / area, U = fmax(unshot_c[c], 0.0);
-            if (!(U > 0.0) || !(rho_avg * kept < 1.0))
-                continue;
-            double add = U * kept / (area * (1.0 - rho_avg * kept));
-            for (size_t i = 0; i < n; i++)
-                B[3 * i + (size_t)c] += sys->reflectance[3 * i + (size_t)c] * add;
-            absorbed += U * kept * (1.0 - rho_avg) / (1.0 - rho_avg * kept);
-        }
     }
     stats->iterations = batch > 2147483647LL ? 2147483647 : (int)batch;
     stats->unshot = unshot;
