@@ -278,23 +278,28 @@ static void point_shadow(void **state)
         rad_luminaires_irradiance(scene, mesh, vis, beside[k], up, c);
         assert_memory_equal(a, c, sizeof a);
     }
-    /* A subset of the luminaires (light.h, rad_light_among): the one
-     * luminaire reaches a lit point and not a shadowed one; asked among
-     * what reached, the same light; among none, none. */
+    /* A subset of the luminaires (light.h, rad_light_among): a list of the
+     * one luminaire gives all the light, an empty list none; the reach
+     * (light/reach.c) holds the lit point and the shadowed one (the plate
+     * is no wall: the fan goes round it) and gives the same light. */
     {
-        uint64_t reached = 0, none = 0;
-        rad_light_among ask = {NULL, &reached};
+        static const uint32_t one[1] = {0};
+        rad_light_among listed = {one, 1, NULL}, nothing = {one, 0, NULL};
         double a[3], c[3];
-        rad_light_irradiance_among(scene, mesh, vis, behind[0], up, &ask, a);
-        assert_true(reached == 0 && a[0] == 0.0);
-        rad_light_irradiance_among(scene, mesh, vis, beside[0], up, &ask, a);
-        assert_true(reached == 1 && a[0] > 0.0);
-        rad_light_among among = {&reached, NULL}, nothing = {&none, NULL};
-        rad_light_irradiance_among(scene, mesh, vis, beside[1], up, &among, c);
         rad_light_irradiance(scene, mesh, vis, beside[1], up, a);
+        rad_light_irradiance_among(scene, mesh, vis, beside[1], up, &listed, c);
         assert_memory_equal(a, c, sizeof a);
         rad_light_irradiance_among(scene, mesh, vis, beside[1], up, &nothing, c);
         assert_true(c[0] == 0.0 && c[1] == 0.0 && c[2] == 0.0);
+        rad_light_reach *reach = NULL;
+        assert_int_equal(rad_light_reach_build(ctx, scene, mesh, vis, 1, &reach), RAD_OK);
+        /* Open scene: rays leave it, so the reach is everywhere. */
+        assert_int_equal(rad_light_reach_everywhere(reach), 1);
+        assert_true(rad_light_reach_holds(reach, 0, behind[0]) && rad_light_reach_holds(reach, 0, beside[0]));
+        rad_light_among reached = {NULL, 0, reach};
+        rad_light_irradiance_among(scene, mesh, vis, beside[1], up, &reached, c);
+        assert_memory_equal(a, c, sizeof a);
+        rad_light_reach_destroy(reach);
     }
     /* The plate's top is lit (its own shadow rays start off it). */
     vec3 top = v3(0.5, 0.5, 1.0);

@@ -232,6 +232,17 @@ double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, dou
  * rays made (at most k^2).  Cannot fail. */
 int rad_element_kernel_rays(const rad_mesh *mesh, const rad_element *e, vec3 p, vec3 n, vec3 origin, double lift,
                             int k, rad_rng *rng, rad_ray *ray, double *weight);
+/* The visible part of F(p -> e) from those rays once traced: F times the
+ * kernel-weighted share of the clear ones,
+ *
+ *     F V = F sum_clear w_k / sum_all w_k,
+ *
+ * exact where the element is wholly seen or wholly hidden (an element
+ * behind a wall gives nothing, whatever its samples; the control variate
+ * F - sum_blocked w_k, clamped to [0, F], let F - w through when one far
+ * ray was blocked: +0.6 to +1.1% on the office's grid means, bench_gather),
+ * and consistent between.  F where no ray was made. */
+double rad_element_seen(double F, const double *weight, const uint8_t *blocked, int count);
 
 /* An orthonormal tangent pair (u, v) with u x v = n (unit): the frame of
  * the hemicube's faces and of the hemisphere's directions.  Cannot fail. */

@@ -229,6 +229,16 @@ int rad_element_gauss(const rad_mesh *mesh, const rad_element *e, int order, vec
     return q;
 }
 
+double rad_element_seen(double F, const double *weight, const uint8_t *blocked, int count)
+{
+    double all = 0.0, clear = 0.0;
+    for (int k = 0; k < count; k++) {
+        all += weight[k];
+        clear += blocked[k] ? 0.0 : weight[k];
+    }
+    return all > 0.0 ? F * (clear / all) : F;
+}
+
 int rad_element_kernel_rays(const rad_mesh *mesh, const rad_element *e, vec3 p, vec3 n, vec3 origin, double lift,
                             int k, rad_rng *rng, rad_ray *ray, double *weight)
 {

@@ -20,10 +20,10 @@
  *     point's plane are left out (their factor is zero);
  *   - otherwise (free points, work planes in the air, partial pairs the
  *     classification cannot list) shadow rays to stratified points y_k of
- *     the element estimate the hidden part:  F V = F - (1/N) sum_k
- *     [blocked] k(y_k),  k(y) = cos cos A_j / (pi r^2) (a control variate
- *     as solve/vpl.c's direct light: exact when nothing blocks, unbiased
- *     otherwise); N = 1, 4 or 16 by the element's size over its distance.
+ *     the element give its visible share:  F V = F sum_clear k(y_k) /
+ *     sum_k k(y_k),  k(y) = cos cos A_j / (pi r^2) (rad_element_seen:
+ *     exact when nothing or everything blocks, consistent between); N =
+ *     1, 4 or 16 by the element's size over its distance.
  *
  * The sum splits in the emitters' self-emission E_j (their direct light)
  * and the rest, B_j - E_j (the interreflection, luminaires' and daylight's
@@ -35,8 +35,8 @@
  * (gather_tree): far groups count as one source (Barnes & Hut 1986's
  * opening criterion; the visibility of a group by rays to its
  * representatives, as Walter et al. 2005's lightcuts), the elements it
- * reaches go through the same exact path.  Not the default: on the
- * generated offices it is no faster (docs/performance.md, bench_gather).
+ * reaches go through the same exact path.  The default from
+ * RAD_GRID_GATHER_TREE_MIN elements (grid.h; docs/performance.md).
  */
 #include "grid/grid.h"
 
@@ -64,11 +64,8 @@ typedef struct gather_shared {
     int strata;                   /* > 0: k x k rays for every element; 0: by distance */
 } gather_shared;
 
-/* Per-thread pending rays, grouped by element: each element's hidden part
- * is taken from its unoccluded factor after the query, and the difference
- * clamped to [0, F] (the estimate of a visible part is never negative nor
- * above the whole; on the generated office unclamped sums left points by
- * desks' edges at -0.6 lux). */
+/* Per-thread pending rays, grouped by element: each element's visible
+ * share is taken after the query (rad_element_seen). */
 typedef struct ray_batch {
     rad_ray ray[BATCH];
     double weight[BATCH];         /* factor hidden if blocked (kernel / N) */
@@ -91,11 +88,8 @@ static void flush(const gather_shared *g, ray_batch *b, double direct[3], double
     b->first[b->elements] = b->count;
     const double *B = g->view->radiosity;
     for (int e = 0; e < b->elements; e++) {
-        double hidden = 0.0;
-        for (int k = b->first[e]; k < b->first[e + 1]; k++)
-            if (b->blocked[k])
-                hidden += b->weight[k];
-        double F = b->factor[e], seen = fmin(fmax(F - hidden, 0.0), F);
+        int first = b->first[e];
+        double seen = rad_element_seen(b->factor[e], b->weight + first, b->blocked + first, b->first[e + 1] - first);
         size_t j = b->element[e];
         for (int c = 0; c < 3; c++) {
             direct[c] += seen * g->self[3 * j + (size_t)c];
@@ -382,12 +376,8 @@ static void gather_tree(const gather_shared *g, point_sums *ps, ray_batch *b)
                 bool one_sided = !node->emits && mid - ext > 0.0 && gamma + node->spread + beta < 0.5 * M_PI &&
                                  2.0 * radius < g->theta * fmin(mid, dist * facing);
                 int seen = cluster_visible(g, ps, node, &parent, one_sided, &mine);
-                /* Found blocked, it sends nothing: as fine as the exact path
-                 * where that casts a ray or so per element (a point off the
-                 * surfaces: against 8 x 8 rays per element it is closer
-                 * than the exact path's single ray, whose hidden part,
-                 * clamped to [0, F], lets a little of a blocked element
-                 * through; bench_gather).  On a surface the exact path's
+                /* Found blocked, it sends nothing, as the exact path where
+                 * that casts a ray or so per element.  On a surface the exact path's
                  * visibility is exact (occluders.c), so only a node whose
                  * rays sample eight distinct elements is taken as blocked:
                  * a few elements' centres hidden by a block's edge do not
@@ -426,7 +416,8 @@ static void gather_point(const gather_shared *g, size_t index, ray_batch *b, dou
     ps.direct = direct;
     ps.indirect = indirect;
     double t0 = rad_seconds();
-    rad_light_irradiance(view->scene, mesh, view->vis, ps.p, ps.n, direct);
+    rad_light_among reach = {NULL, 0, view->light_reach};
+    rad_light_irradiance_among(view->scene, mesh, view->vis, ps.p, ps.n, &reach, direct);
     *light_seconds += rad_seconds() - t0;
     indirect[0] = indirect[1] = indirect[2] = 0.0;
     ps.recv = receiver_of(g, ps.p, ps.n);
@@ -491,7 +482,8 @@ rad_result rad_grid_gather_tuned(rad_context *ctx, const rad_solution_view *view
                 d = fmax(d, v3_length(v3_sub(mesh->vertices[e->vertex[a]], mesh->vertices[e->vertex[b]])));
         diameter[j] = (float)d;
     }
-    bool use_tree = method == RAD_GRID_GATHER_TREE;
+    bool use_tree = method == RAD_GRID_GATHER_TREE ||
+                    (method == RAD_GRID_GATHER_AUTO && view->n >= RAD_GRID_GATHER_TREE_MIN);
     rad_gather_tree *tree = NULL;
     if (use_tree && (r = rad_gather_tree_build(ctx, view, self, &tree)) != RAD_OK) {
         rad_free(self);

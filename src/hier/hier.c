@@ -1112,7 +1112,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
          * and the residual, as E += rho H_d does for the dense solvers. */
         double reflected = 0.0;
         size_t grown = 0;
-        r = hr_direct_start(ctx, &st.tree, p->vis, &st.direct, &reflected);
+        r = hr_direct_start(ctx, &st.tree, p->vis, p->light_reach, &st.direct, &reflected);
         st.emitted += reflected;
         epsilon_abs += (p->epsilon > 0.0 ? p->epsilon : 1e-4) * reflected / 3.0;
         hs->epsilon_abs = epsilon_abs;

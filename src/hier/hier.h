@@ -46,6 +46,7 @@
 #define RAD_HIER_H
 
 #include "formfactor/formfactor.h"
+#include "light/light.h"
 #include "solve/solve.h"
 
 /* ---- nodes (tree.c) ---- */
@@ -241,23 +242,26 @@ typedef struct hr_direct {
     const rad_vis *vis;
     double *H;                /* 3 per node, W/m^2; NULL when the scene has no light */
     float *deviation;         /* per node: max |H_d(x) - H_d| over the cubature's points, W/m^2 */
-    size_t count, capacity;   /* nodes computed; allocated */
-    uint64_t *reached;        /* per patch, `words` each: the luminaires that lit its root
-                                 (light.h's rad_light_among), the only ones its nodes ask */
-    size_t words;
+    size_t count, capacity;   /* nodes started; allocated */
+    size_t done;              /* nodes whose H is final (finished, or split: their children carry it) */
+    rad_light_cubature *pending; /* nodes [done, count): where their cubature's first step left */
+    size_t pending_capacity;
+    uint32_t *list_start, *list; /* per patch (list_start[p] .. [p + 1]): the luminaires whose
+                                    reach meets it (light/reach.c); NULL without a reach: all */
 } hr_direct;
 
-/* Zero *d and, when the scene has luminaires or daylight, compute every
- * node of the tree (its roots: call before any split); *reflected = the
- * roots' first reflection sum A rho H_d, W with the channels summed (0
- * without light).  Fails for memory or cancellation. */
-rad_result hr_direct_start(rad_context *ctx, const hr_tree *tree, const rad_vis *vis, hr_direct *d,
-                           double *reflected);
-/* Compute the nodes made since the last call, then split every new leaf
+/* Zero *d and, when the scene has luminaires or daylight, start every node
+ * of the tree (its roots: call before any split; coarse values, finished
+ * by hr_direct_update); *reflected = the roots' first reflection sum A rho
+ * H_d, W with the channels summed (0 without light).  reach (NULL: every
+ * luminaire everywhere) must outlive d.  Fails for memory or cancellation. */
+rad_result hr_direct_start(rad_context *ctx, const hr_tree *tree, const rad_vis *vis,
+                           const rad_light_reach *reach, hr_direct *d, double *reflected);
+/* Start the nodes made since the last call, then split every pending leaf
  * where rho A max|H_d(x) - H_d| exceeds epsilon (W) and min_area allows,
- * and their children alike until none is split; *split counts the leaves
- * split.  Serial splits in node order: deterministic.  No-op without
- * light.  Fails for memory or cancellation. */
+ * and their children alike until none is split, finishing the others;
+ * *split counts the leaves split.  Serial splits in node order:
+ * deterministic.  No-op without light.  Fails for memory or cancellation. */
 rad_result hr_direct_update(rad_context *ctx, hr_tree *tree, hr_direct *d, double epsilon, size_t *split);
 /* The leaves' H_d (3 per leaf) in the leaf mesh's order, allocated for the
  * solution (RAD_MEM_SOLVER); *out NULL without light.  Fails for memory. */
@@ -283,6 +287,7 @@ typedef struct rad_hier_params {
     int max_iterations;        /* Jacobi sweeps in the final solve; 0 = automatic */
     double max_memory;         /* bytes */
     double crease_angle_degrees;
+    const rad_light_reach *light_reach; /* where each luminaire's light arrives (light.h); NULL: all */
     rad_solve_monitor_fn monitor; /* steps only (B is NULL) */
     void *monitor_user;
     /* Progressive display (NULL: none, and no cost): called after every

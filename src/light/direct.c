@@ -33,11 +33,6 @@ bool rad_light_present(const rad_scene *scene)
     return scene && (scene->luminaires.count > 0 || scene->daylight != NULL);
 }
 
-size_t rad_light_mask_words(const rad_scene *scene)
-{
-    return (scene->luminaires.count + 63) / 64;
-}
-
 void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                           vec3 n, double out[3])
 {
@@ -69,7 +64,6 @@ typedef struct cubature {
     const rad_vis *vis;
     vec3 normal;
     const rad_light_among *set; /* the luminaires let in (NULL: all) */
-    int depth;           /* levels of refinement at most */
     double lo[3], hi[3]; /* W/m^2: the range of the values at the points evaluated */
 } cubature;
 
@@ -113,68 +107,121 @@ static void region_integral(cubature *c, const vec3 *q, uint32_t corners, double
         }
 }
 
-/* The children's integral where they agree with `coarse` (the region's
- * own) within `tol` W, else each child refined alike. */
-static void refine(cubature *c, const vec3 *q, uint32_t corners, const double coarse[3], int depth,
-                   double tol, double out[3])
+/* The region's four children by the fixed rule, and their sum. */
+static void children_integral(cubature *c, const vec3 *q, uint32_t corners, vec3 sub[4][4], double part[4][3],
+                              double fine[3])
 {
-    vec3 sub[4][4];
     rad_ff_split4(q, corners, sub);
-    double part[4][3], fine[3] = {0, 0, 0};
+    fine[0] = fine[1] = fine[2] = 0.0;
     for (int k = 0; k < 4; k++) {
         region_integral(c, sub[k], corners, part[k]);
         for (int ch = 0; ch < 3; ch++)
             fine[ch] += part[k][ch];
     }
+}
+
+/* The integral over a region whose own estimate is `coarse` and whose
+ * children's are part[] (sum `fine`): the children's where the two agree
+ * within `tol` W, else each child refined alike, to MAX_DEPTH levels. */
+static void refine(cubature *c, vec3 sub[4][4], uint32_t corners, const double coarse[3],
+                   double part[4][3], const double fine[3], int depth, double tol, double out[3])
+{
     double diff = 0.0;
     for (int ch = 0; ch < 3; ch++)
         diff = fmax(diff, fabs(fine[ch] - coarse[ch]));
-    if (diff <= tol || depth + 1 >= c->depth) {
-        memcpy(out, fine, sizeof fine);
+    if (diff <= tol || depth + 1 >= MAX_DEPTH) {
+        memcpy(out, fine, 3 * sizeof *out);
         return;
     }
     out[0] = out[1] = out[2] = 0.0;
     for (int k = 0; k < 4; k++) {
-        double r[3];
+        vec3 grand[4][4];
+        double gpart[4][3], gfine[3], r[3];
+        children_integral(c, sub[k], corners, grand, gpart, gfine);
         /* A quarter of the region: a quarter of its tolerance. */
-        refine(c, sub[k], corners, part[k], depth + 1, 0.25 * tol, r);
+        refine(c, grand, corners, part[k], gpart, gfine, depth + 1, 0.25 * tol, r);
         for (int ch = 0; ch < 3; ch++)
             out[ch] += r[ch];
     }
 }
 
-void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
-                                  const vec3 *corner, uint32_t corners, vec3 normal,
-                                  const rad_light_among *set, int depth, double out[3], double *deviation)
+static double polygon_area(const vec3 *q, uint32_t corners)
 {
-    out[0] = out[1] = out[2] = 0.0;
+    if (corners == 3)
+        return 0.5 * v3_length(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
+    return 0.5 * v3_length(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[3], q[1])));
+}
+
+/* mean = total / area; deviation = the points' largest difference from it. */
+static void conclude(const rad_light_cubature *cub, const double total[3], double mean[3], double *deviation)
+{
+    double spread = 0.0;
+    for (int ch = 0; ch < 3; ch++) {
+        mean[ch] = total[ch] / cub->area;
+        spread = fmax(spread, fmax(cub->hi[ch] - mean[ch], mean[ch] - cub->lo[ch]));
+    }
+    if (deviation)
+        *deviation = spread;
+}
+
+void rad_light_polygon_start(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                             const vec3 *corner, uint32_t corners, vec3 normal, const rad_light_among *set,
+                             rad_light_cubature *cub, double mean[3], double *deviation)
+{
+    memset(cub, 0, sizeof *cub);
+    mean[0] = mean[1] = mean[2] = 0.0;
     if (deviation)
         *deviation = 0.0;
     if (!rad_light_present(scene) || (corners != 3 && corners != 4))
         return;
-    cubature c = {scene, mesh, vis, normal, set, depth > 0 && depth < MAX_DEPTH ? depth : MAX_DEPTH,
-                  {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-    const vec3 *q = corner;
     /* The region rules integrate over the corners' own area; the mean is
      * over it. */
-    double area = 0.0;
-    if (corners == 3)
-        area = 0.5 * v3_length(v3_cross(v3_sub(q[1], q[0]), v3_sub(q[2], q[0])));
-    else
-        area = 0.5 * v3_length(v3_cross(v3_sub(q[2], q[0]), v3_sub(q[3], q[1])));
+    double area = polygon_area(corner, corners);
     if (!(area > 0.0))
         return;
-    double whole[3], total[3];
-    region_integral(&c, q, corners, whole);
-    double scale = fmax(fmax(whole[0], whole[1]), whole[2]);
-    refine(&c, q, corners, whole, 0, REL_TOL * scale, total);
-    double spread = 0.0;
-    for (int ch = 0; ch < 3; ch++) {
-        out[ch] = total[ch] / area;
-        spread = fmax(spread, fmax(c.hi[ch] - out[ch], out[ch] - c.lo[ch]));
-    }
+    cubature c = {scene, mesh, vis, normal, set, {INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
+    vec3 sub[4][4];
+    double fine[3];
+    region_integral(&c, corner, corners, cub->whole);
+    children_integral(&c, corner, corners, sub, cub->part, fine);
+    cub->area = area;
+    memcpy(cub->lo, c.lo, sizeof c.lo);
+    memcpy(cub->hi, c.hi, sizeof c.hi);
+    conclude(cub, fine, mean, deviation);
+}
+
+void rad_light_polygon_finish(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                              const vec3 *corner, uint32_t corners, vec3 normal, const rad_light_among *set,
+                              double tolerance, rad_light_cubature *cub, double mean[3], double *deviation)
+{
+    mean[0] = mean[1] = mean[2] = 0.0;
     if (deviation)
-        *deviation = spread;
+        *deviation = 0.0;
+    if (!(cub->area > 0.0))
+        return;
+    cubature c = {scene, mesh, vis, normal, set, {0}, {0}};
+    memcpy(c.lo, cub->lo, sizeof c.lo);
+    memcpy(c.hi, cub->hi, sizeof c.hi);
+    vec3 sub[4][4];
+    rad_ff_split4(corner, corners, sub);
+    double fine[3] = {0, 0, 0}, total[3];
+    for (int k = 0; k < 4; k++)
+        for (int ch = 0; ch < 3; ch++)
+            fine[ch] += cub->part[k][ch];
+    double scale = fmax(fmax(cub->whole[0], cub->whole[1]), cub->whole[2]);
+    refine(&c, sub, corners, cub->whole, cub->part, fine, 0, fmax(REL_TOL * scale, tolerance), total);
+    memcpy(cub->lo, c.lo, sizeof c.lo);
+    memcpy(cub->hi, c.hi, sizeof c.hi);
+    conclude(cub, total, mean, deviation);
+}
+
+void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                                  const vec3 *corner, uint32_t corners, vec3 normal,
+                                  const rad_light_among *set, double out[3], double *deviation)
+{
+    rad_light_cubature cub;
+    rad_light_polygon_start(scene, mesh, vis, corner, corners, normal, set, &cub, out, deviation);
+    rad_light_polygon_finish(scene, mesh, vis, corner, corners, normal, set, 0.0, &cub, out, deviation);
 }
 
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
@@ -187,5 +234,5 @@ void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, 
     vec3 q[4];
     for (uint32_t k = 0; k < e->vertex_count && k < 4; k++)
         q[k] = mesh->vertices[e->vertex[k]];
-    rad_light_polygon_irradiance(scene, mesh, vis, q, e->vertex_count, e->normal, NULL, 0, out, NULL);
+    rad_light_polygon_irradiance(scene, mesh, vis, q, e->vertex_count, e->normal, NULL, out, NULL);
 }

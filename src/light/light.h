@@ -42,6 +42,22 @@ void rad_light_irradiance(const rad_scene *scene, const rad_mesh *mesh, const ra
 void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   size_t element, double out[3]);
 
+/* Which luminaires a caller lets light a point (daylight is not a
+ * luminaire: always).  `list`: these `count` luminaires only (indices into
+ * scene->luminaires); else, with `reach`: those whose reach holds the point
+ * (below); else all of them.  The hierarchy asks each node among its
+ * patch's list, the grid's points by the reach (hier/direct.c,
+ * grid/gather.c). */
+typedef struct rad_light_reach rad_light_reach;
+typedef struct rad_light_among {
+    const uint32_t *list;
+    size_t count;
+    const rad_light_reach *reach;
+} rad_light_among;
+/* rad_light_irradiance for the luminaires `set` lets in (NULL: all). */
+void rad_light_irradiance_among(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
+                                vec3 n, const rad_light_among *set, double out[3]);
+
 /* The same mean over a planar polygon: `corners` (3 or 4) points,
  * counter-clockwise about the unit normal `normal` (a hierarchical node's,
  * which is no element of `mesh`; mesh only scales the rays' lift).  When
@@ -49,31 +65,55 @@ void rad_light_element_irradiance(const rad_scene *scene, const rad_mesh *mesh, 
  * and the points the cubature evaluated, between the irradiance there and
  * the mean (W/m^2): how far the light varies across the polygon (a shadow
  * edge crossing it gives about the step's size).  A degenerate polygon
- * gives zeros.  `set`: the luminaires let in (below; NULL: all).
- * `depth`: levels of the cubature's refinement at most (0: all four; 2 is
- * enough to see that the light varies, at a sixteenth of the points on a
- * shadow edge).  Thread-safe, deterministic. */
-struct rad_light_among;
+ * gives zeros.  `set`: the luminaires let in (above; NULL: all).
+ * Thread-safe, deterministic. */
 void rad_light_polygon_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
                                   const vec3 *corner, uint32_t corners, vec3 normal,
-                                  const struct rad_light_among *set, int depth, double out[3],
-                                  double *deviation);
+                                  const rad_light_among *set, double out[3], double *deviation);
 
-/* Which luminaires a caller lets light a point, and which did (bit k of
- * word k / 64: luminaire k of scene->luminaires).  `among` NULL: all of
- * them; `reached`, when not NULL, gets the bits of those whose light
- * reached some point asked (a clear shadow ray, in front of the surface).
- * The hierarchy asks its roots with reached, then their nodes among what
- * their root saw (hier/direct.c).  Daylight is not a luminaire: always. */
-typedef struct rad_light_among {
-    const uint64_t *among;
-    uint64_t *reached;
-} rad_light_among;
-/* Words of a luminaire mask for the scene. */
-size_t rad_light_mask_words(const rad_scene *scene);
-/* rad_light_irradiance for the luminaires `set` lets in (NULL: all). */
-void rad_light_irradiance_among(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
-                                vec3 n, const rad_light_among *set, double out[3]);
+/* The same cubature in two steps, for a caller that may split the polygon
+ * before it needs the mean to the full tolerance (the hierarchy: a node
+ * whose light varies is split, and its children carry the light).
+ * _start evaluates the fixed rule over the polygon and over its four
+ * children (rad_ff_split4), 16 to 20 points: `mean` and `deviation` from
+ * those; _finish refines from there where the children disagree, as
+ * rad_light_polygon_irradiance does, without evaluating a point twice (the
+ * same result as the one call), until the children agree within 1e-3 of
+ * the polygon's light or within `tolerance` (W per channel, of the
+ * integral over the polygon), whichever is looser.  `cub` holds what lies between. */
+typedef struct rad_light_cubature {
+    double whole[3];      /* W per channel: the fixed rule over the polygon */
+    double part[4][3];    /* W: over its children */
+    double area;          /* m^2; 0: degenerate, nothing to refine */
+    double lo[3], hi[3];  /* W/m^2: the range of the values at the points */
+} rad_light_cubature;
+void rad_light_polygon_start(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                             const vec3 *corner, uint32_t corners, vec3 normal, const rad_light_among *set,
+                             rad_light_cubature *cub, double mean[3], double *deviation);
+void rad_light_polygon_finish(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis,
+                              const vec3 *corner, uint32_t corners, vec3 normal, const rad_light_among *set,
+                              double tolerance, rad_light_cubature *cub, double mean[3], double *deviation);
+
+/* Where each luminaire's light can arrive (reach.c): a box per luminaire,
+ * the bounds of a fan of rays from its centre to what they first hit,
+ * widened by the fan's angular spacing times the distance and by the
+ * luminaire's size; everywhere for a luminaire some ray of whose fan
+ * leaves the scene.  A point outside a luminaire's box gets none of its
+ * light save through a gap the fan passed between (docs/lighting.md
+ * "Reach").  So a building's rooms ask their own and their neighbours'
+ * luminaires, not all of them.  Fails for memory or cancellation. */
+rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
+                                 const rad_vis *vis, int threads, rad_light_reach **out);
+void rad_light_reach_destroy(rad_light_reach *reach);
+/* Whether luminaire k's box holds p. */
+bool rad_light_reach_holds(const rad_light_reach *reach, size_t k, vec3 p);
+/* The luminaires whose box meets [lo, hi], in index order, into out (room
+ * for all of them); returns how many. */
+size_t rad_light_reach_list(const rad_light_reach *reach, vec3 lo, vec3 hi, uint32_t *out);
+/* Rays the fans took; luminaires whose box is everywhere. */
+uint64_t rad_light_reach_rays(const rad_light_reach *reach);
+size_t rad_light_reach_everywhere(const rad_light_reach *reach);
+
 /* The parts, one file each. */
 void rad_luminaires_irradiance(const rad_scene *scene, const rad_mesh *mesh, const rad_vis *vis, vec3 p,
                                vec3 n, double out[3]);

@@ -53,19 +53,10 @@ enum {
 typedef struct pending {
     rad_ray rays[BATCH];
     double weight[BATCH]; /* W/m^2 each ray carries when clear */
-    uint32_t owner[BATCH]; /* its luminaire */
     size_t count;
     const rad_vis *vis;
     double sum;
-    uint64_t *reached;    /* NULL, or the mask of luminaires that lit the point */
-    uint32_t current;     /* the luminaire being queued */
 } pending;
-
-static void mark(pending *q, uint32_t k)
-{
-    if (q->reached)
-        q->reached[k / 64] |= (uint64_t)1 << (k % 64);
-}
 
 static void flush(pending *q)
 {
@@ -77,10 +68,8 @@ static void flush(pending *q)
     else
         memset(blocked, 0, sizeof blocked);
     for (size_t k = 0; k < q->count; k++)
-        if (!blocked[k]) {
+        if (!blocked[k])
             q->sum += q->weight[k];
-            mark(q, q->owner[k]);
-        }
     q->count = 0;
 }
 
@@ -110,12 +99,10 @@ static void point_source(pending *q, const rad_luminaire *L, const rad_photometr
         /* The centre lies within the shadow rays' tolerance of p: nothing
          * can stand between them. */
         q->sum += e;
-        mark(q, q->current);
         return;
     }
     q->rays[q->count] = (rad_ray){origin, dir, 0.0, 1.0 - eps / len};
     q->weight[q->count] = e;
-    q->owner[q->count] = q->current;
     if (++q->count == BATCH)
         flush(q);
 }
@@ -263,13 +250,15 @@ void rad_luminaires_irradiance_among(const rad_scene *scene, const rad_mesh *mes
     q.count = 0;
     q.vis = vis;
     q.sum = 0.0;
-    q.reached = set ? set->reached : NULL;
-    const uint64_t *among = set ? set->among : NULL;
-    for (size_t k = 0; k < scene->luminaires.count; k++) {
-        if (among && !((among[k / 64] >> (k % 64)) & 1))
-            continue;
-        q.current = (uint32_t)k;
-        one_luminaire(&q, scene, &scene->luminaires.items[k], p, n, lift);
+    const rad_luminaire *items = scene->luminaires.items;
+    if (set && set->list) {
+        for (size_t i = 0; i < set->count; i++)
+            one_luminaire(&q, scene, &items[set->list[i]], p, n, lift);
+    } else {
+        const rad_light_reach *reach = set ? set->reach : NULL;
+        for (size_t k = 0; k < scene->luminaires.count; k++)
+            if (!reach || rad_light_reach_holds(reach, k, p))
+                one_luminaire(&q, scene, &items[k], p, n, lift);
     }
     flush(&q);
     out[0] = out[1] = out[2] = q.sum;

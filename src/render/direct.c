@@ -259,7 +259,7 @@ static void classify_receiver(const rad_direct_light *d, rad_ff_verdict *verdict
 }
 
 /* F x V of element e from p (normal n) by 4 x 4 stratified shadow rays,
- * the unoccluded F as control variate, clamped to [0, F]. */
+ * the kernel-weighted share of clear rays (rad_element_seen). */
 static double visible_by_rays(const rad_direct_light *d, const rad_element *e, uint32_t j, vec3 p, vec3 n, double F,
                               uint64_t key)
 {
@@ -274,11 +274,7 @@ static double visible_by_rays(const rad_direct_light *d, const rad_element *e, u
     if (count == 0)
         return F;
     d->vis->backend->occluded(d->vis->state, rays, (size_t)count, blocked);
-    double hidden = 0.0;
-    for (int k = 0; k < count; k++)
-        if (blocked[k])
-            hidden += weight[k];
-    return fmin(fmax(F - hidden, 0.0), F);
+    return rad_element_seen(F, weight, blocked, count);
 }
 
 /* The source's visible factor from p by rays, member by member. */

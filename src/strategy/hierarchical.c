@@ -19,6 +19,7 @@ typedef struct hierarchical_state {
     const rad_options *options;
     rad_mesh *patches;         /* one element per patch: the roots */
     rad_vis *vis;              /* built on the patches */
+    rad_light_reach *reach;    /* where each luminaire's light arrives; NULL without luminaires */
     rad_elements patch_elements;
     rad_mesh *leaves;          /* the leaves after a solve, else NULL */
     rad_elements leaf_elements;
@@ -47,6 +48,7 @@ static void hierarchical_destroy(void *state)
     hierarchical_state *st = state;
     if (!st)
         return;
+    rad_light_reach_destroy(st->reach);
     rad_vis_destroy(st->vis);
     rad_mesh_destroy(st->patches);
     rad_mesh_destroy(st->leaves);
@@ -78,6 +80,10 @@ static rad_result hierarchical_create(rad_context *ctx, const rad_scene *scene, 
     }
     if (r == RAD_OK)
         r = rad_elements_create(ctx, scene, st->patches, &st->patch_elements);
+    /* The nodes and the grids' points ask the luminaires in reach, not all
+     * of a building's (light/reach.c). */
+    if (r == RAD_OK && scene->luminaires.count > 0)
+        r = rad_light_reach_build(ctx, scene, st->patches, st->vis, rad_context_threads(ctx), &st->reach);
     if (r != RAD_OK) {
         hierarchical_destroy(st);
         return r;
@@ -134,6 +140,7 @@ static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_st
                           .max_iterations = o->max_iterations,
                           .max_memory = o->max_memory_bytes,
                           .crease_angle_degrees = o->crease_angle_degrees,
+                          .light_reach = st->reach,
                           .monitor = hierarchical_monitor,
                           .monitor_user = st};
     if (hook->fn && hook->display) {
@@ -196,6 +203,7 @@ static void hierarchical_view(const void *state, rad_solution_view *v)
     else
         rad_view_elements(v, st->patches, &st->patch_elements);
     v->vis = st->vis;
+    v->light_reach = st->reach;
     v->F = NULL;
     v->F_variance = NULL;
     v->vertex_radiosity = NULL;

@@ -47,6 +47,8 @@ typedef struct rad_solution_view {
     int threads;                    /* for the parallel passes of the questions below */
     const rad_mesh *mesh;           /* the elements and their welded vertices */
     const rad_vis *vis;             /* closest-hit and occlusion queries */
+    const struct rad_light_reach *light_reach; /* where each luminaire's light arrives (light.h), for
+                                                  the points' direct light; NULL: every luminaire asked */
     size_t n;                       /* elements */
     const double *area;             /* n, m^2 */
     const double *reflectance;      /* 3n, RGB */
