@@ -51,6 +51,20 @@ static size_t bracket(const double *a, size_t n, double x, double *t)
         *t = 1.0;
         return k;
     }
+    /* Most tables are evenly spaced, at least from their start (a table
+     * of 0 to 90 degrees holds 90 to 180 as one more cell): guess the cell
+     * from the first cell's width and check it and its neighbours (the
+     * cell with a[k] < x <= a[k + 1] is unique, so a guess that passes is
+     * the search's answer). */
+    if (a[1] > a[0]) {
+        double guess = (x - a[0]) / (a[1] - a[0]);
+        size_t g = guess < (double)(n - 2) ? (size_t)guess : n - 2;
+        for (size_t k = g > 0 ? g - 1 : 0; k <= g + 1 && k + 1 < n; k++)
+            if (a[k] < x && x <= a[k + 1]) {
+                *t = (x - a[k]) / (a[k + 1] - a[k]);
+                return k;
+            }
+    }
     size_t lo = 0, hi = n - 1; /* a[lo] < x <= a[hi] */
     while (hi - lo > 1) {
         size_t mid = lo + (hi - lo) / 2;
