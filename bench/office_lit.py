@@ -4,7 +4,7 @@
 reference solver, side by side in one run.
 
     bench/office_lit.py [--rooms N] [--threads T] [--binary PATH]
-                        [--reference "--solver gauss-seidel --elements 8000"]
+                        [--reference "--solver gauss-seidel --elements 8000" | --no-reference]
 
 The office is `radiosity generate office --rooms N` (seed 0) with its
 ceiling panels dark (Ke 0: a scene lit by luminaires), four downlights a
@@ -13,7 +13,9 @@ ceiling at the room's quarter points) and a work-plane grid per room (the
 floor's footprint at 0.8 m, EN 12464-1 spacing).  Prints, for each run,
 the wall time and peak memory (/usr/bin/time), then per room Eavg of both
 and their difference, and the share of points within 5% of the reference.
-The working files stay in a temporary folder, removed at the end.
+--no-reference runs the default alone (the 1,000-room office: its time,
+memory and the solve's figures).  The working files stay in a temporary
+folder, removed at the end.
 """
 import argparse
 import json
@@ -64,6 +66,7 @@ def main():
     ap.add_argument('--threads', type=int, default=2)
     ap.add_argument('--binary', default=os.path.join(root, 'build', 'radiosity'))
     ap.add_argument('--reference', default='--solver gauss-seidel --elements 8000')
+    ap.add_argument('--no-reference', action='store_true')
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix='radiosity-office-')
     try:
@@ -89,7 +92,15 @@ def main():
         base = [a.binary, 'illuminance', obj, '--luminaires', os.path.join(work, 'layout.json'),
                 '--grid', os.path.join(work, 'grids.json'), '--threads', str(a.threads), '-q']
         print('office: %d rooms, %d downlights, %d threads' % (a.rooms, len(lums), a.threads))
-        t_def = run(base + ['-o', os.path.join(work, 'd.json')], 'default')
+        t_def = run(base + ['-o', os.path.join(work, 'd.json'), '--stats', os.path.join(work, 's.json')], 'default')
+        st = json.load(open(os.path.join(work, 's.json')))
+        h = st['solver'].get('hierarchical') or {}
+        print('  default: %d leaves, %d links, solve %.1f s (refinement %.1f s), grids and writing %.1f s, %.0f lm landing of %.0f'
+              % (h.get('leaves', 0), h.get('links', 0), st['seconds']['solve'], h.get('seconds_refine', 0.0),
+                 t_def - st['seconds']['solve'] - st['seconds']['load'] - st['seconds']['mesh'],
+                 st['luminaires']['direct_lumens'], st['luminaires']['lumens']))
+        if a.no_reference:
+            return
         t_ref = run(base + ['-o', os.path.join(work, 'r.json')] + a.reference.split(), 'reference')
         d = json.load(open(os.path.join(work, 'd.json')))['grids']
         r = json.load(open(os.path.join(work, 'r.json')))['grids']

@@ -100,6 +100,59 @@ static rad_vis *make_vis(rad_context *ctx, const char *name, const rad_mesh *mes
     return vis;
 }
 
+/* ---- the reach of a view (reach.c) ---- */
+
+/* Two closed rooms side by side, [0, 4] x [0, 3] x [0, 4] and [4.2, 8.2] x
+ * ...: from the first room's middle the reach holds the first room and
+ * stops short of the second's middle (widened by the fan's spacing times
+ * the distance, 0.31 x 2.6 m at 512 rays); with a hole in the wall
+ * between (the second room's near wall left out, the first's cut to a
+ * doorway) it reaches the second room's far wall; in the open it is
+ * everywhere. */
+static void test_reach(void **unused)
+{
+    (void)unused;
+    test_scene *s = calloc(1, sizeof *s);
+    s->mesh.patches = s->patches;
+    add_box(s, v3(0, 0, 0), v3(4, 3, 4));
+    add_box(s, v3(4.2, 0, 0), v3(8.2, 3, 4));
+    rad_context *ctx = test_context(1);
+    for (int b = 0; rad_vis_backends[b]; b++) {
+        rad_vis *vis = make_vis(ctx, rad_vis_backends[b]->name, &s->mesh);
+        vec3 lo, hi;
+        assert_true(rad_vis_reach(vis, v3(2, 1.5, 2), 0.0, 512, 0.0, &lo, &hi));
+        assert_true(lo.x <= 0.0 && lo.y <= 0.0 && lo.z <= 0.0 && hi.x >= 4.0 && hi.y >= 3.0 && hi.z >= 4.0);
+        assert_true(hi.x < 6.2); /* the second room's middle is out of reach */
+        assert_false(rad_vis_reach(vis, v3(9, 1.5, 2), 0.0, 512, 0.0, &lo, &hi)); /* outside: open */
+        assert_true(isinf(lo.x) && isinf(hi.x));
+        rad_vis_destroy(vis);
+    }
+    /* A doorway: the first room's +x face is replaced by the wall around a
+     * 1 x 2 m opening, the second room's -x face left out. */
+    s->mesh.patch_count = 0;
+    add_box(s, v3(0, 0, 0), v3(4, 3, 4));
+    add_box(s, v3(4.2, 0, 0), v3(8.2, 3, 4));
+    rad_patch keep[12];
+    memcpy(keep, s->patches, sizeof keep);
+    s->mesh.patch_count = 0;
+    for (int f = 0; f < 12; f++)
+        if (f != 5 && f != 6 + 4) /* the first box's +x, the second's -x */
+            s->patches[s->mesh.patch_count++] = keep[f];
+    const vec3 wall[3][4] = {{{4, 0, 0}, {4, 3, 0}, {4, 3, 1.5}, {4, 0, 1.5}},
+                             {{4, 0, 2.5}, {4, 3, 2.5}, {4, 3, 4}, {4, 0, 4}},
+                             {{4, 2, 1.5}, {4, 3, 1.5}, {4, 3, 2.5}, {4, 2, 2.5}}};
+    for (int w = 0; w < 3; w++)
+        add_patch(s, wall[w], 4);
+    rad_mesh_measure(&s->mesh);
+    rad_vis *vis = make_vis(ctx, "embree", &s->mesh);
+    vec3 lo, hi;
+    assert_true(rad_vis_reach(vis, v3(2, 1.5, 2), 0.0, 512, 0.0, &lo, &hi));
+    assert_true(hi.x >= 8.2); /* through the doorway to the far wall */
+    rad_vis_destroy(vis);
+    rad_context_destroy(ctx);
+    free(s);
+}
+
 /* ---- Embree against brute force ---- */
 
 #define RAY_COUNT 20000
@@ -417,6 +470,7 @@ int main(void)
         cmocka_unit_test(test_segment_limits),
         cmocka_unit_test(test_empty_scene),
         cmocka_unit_test(test_epsilon),
+        cmocka_unit_test(test_reach),
         cmocka_unit_test(test_embree_matches_brute),
         cmocka_unit_test(test_thread_safety),
         cmocka_unit_test(test_speed),

@@ -35,7 +35,10 @@
  * (gather_tree): far groups count as one source (Barnes & Hut 1986's
  * opening criterion; the visibility of a group by rays to its
  * representatives, as Walter et al. 2005's lightcuts), the elements it
- * reaches go through the same exact path.  The default from
+ * reaches go through the same exact path.  The walk skips nodes beyond
+ * the point's reach (vis.h's rad_vis_reach: the box a fan of
+ * RAD_GRID_REACH_FAN rays from the point reaches, widened by the fan's
+ * spacing), so that a building's other rooms cost nothing.  The default from
  * RAD_GRID_GATHER_TREE_MIN elements (grid.h; docs/performance.md).
  */
 #include "grid/grid.h"
@@ -130,6 +133,7 @@ typedef struct point_sums {
     size_t index;
     vec3 p, n, origin;
     int64_t recv;                 /* the element the point lies on, or -1 */
+    vec3 reach_lo, reach_hi;      /* the box its view reaches (vis.h rad_vis_reach; the tree's walk) */
     const rad_element *re;
     double *direct, *indirect;    /* 3 each */
     uint64_t exact_pairs, ray_pairs, cluster_pairs, cluster_rays;
@@ -345,12 +349,16 @@ static void gather_tree(const gather_shared *g, point_sums *ps, ray_batch *b)
     int top = 0;
     stack[top] = tree->root;
     rays[top++].count = 0;
-    vec3 p = ps->p, n = ps->n;
+    vec3 p = ps->p, n = ps->n, rlo = ps->reach_lo, rhi = ps->reach_hi;
     while (top > 0) {
         --top;
         const rad_gather_node *node = &tree->nodes[stack[top]];
         known_rays parent = rays[top], mine;
         mine.count = 0;
+        /* Beyond the point's reach: nothing of it is seen. */
+        if (node->lo.x > rhi.x || node->hi.x < rlo.x || node->lo.y > rhi.y || node->hi.y < rlo.y ||
+            node->lo.z > rhi.z || node->hi.z < rlo.z)
+            continue;
         vec3 centre = v3_scale(v3_add(node->lo, node->hi), 0.5), half = v3_scale(v3_sub(node->hi, node->lo), 0.5);
         double mid = v3_dot(n, v3_sub(centre, p));
         double ext = fabs(n.x) * half.x + fabs(n.y) * half.y + fabs(n.z) * half.z;
@@ -423,8 +431,13 @@ static void gather_point(const gather_shared *g, size_t index, ray_batch *b, dou
     ps.recv = receiver_of(g, ps.p, ps.n);
     ps.re = ps.recv >= 0 ? &mesh->elements[ps.recv] : NULL;
     ps.origin = v3_mad(ps.p, ps.n, g->eps);
-    if (g->tree)
+    if (g->tree) {
+        if (view->vis)
+            rad_vis_reach(view->vis, ps.origin, 0.0, RAD_GRID_REACH_FAN, 4.0 * g->eps, &ps.reach_lo, &ps.reach_hi);
+        else
+            ps.reach_lo = v3(-INFINITY, -INFINITY, -INFINITY), ps.reach_hi = v3(INFINITY, INFINITY, INFINITY);
         gather_tree(g, &ps, b);
+    }
     else
         for (size_t j = 0; j < view->n; j++)
             gather_element(g, &ps, j, b);

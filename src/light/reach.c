@@ -4,8 +4,9 @@
  * (light.h, docs/lighting.md "Reach").
  *
  * A fan of FAN rays leaves the luminaire's centre in every direction (a
- * Fibonacci sphere: near-uniform, deterministic) and stops at the first
- * surface.  The box holds the centre and every hit, each widened by
+ * Fibonacci sphere: near-uniform, deterministic; vis/reach.c) and stops at
+ * the first surface.  The box holds the centre and every hit, each widened
+ * by
  *
  *     r = SPREAD x t + size + 4 eps
  *
@@ -37,7 +38,7 @@
 #include <math.h>
 #include <string.h>
 
-enum { FAN = 8192, BATCH = 256 };
+enum { FAN = 8192 };
 
 struct rad_light_reach {
     size_t count;
@@ -46,44 +47,14 @@ struct rad_light_reach {
     size_t everywhere;
 };
 
-/* Direction i of the Fibonacci sphere of FAN points. */
-static vec3 fan_direction(size_t i)
-{
-    const double golden = M_PI * (3.0 - sqrt(5.0));
-    double z = 1.0 - (2.0 * (double)i + 1.0) / FAN, r = sqrt(fmax(0.0, 1.0 - z * z));
-    double phi = golden * (double)i;
-    return v3(r * cos(phi), r * sin(phi), z);
-}
-
-static void widen(vec3 *lo, vec3 *hi, vec3 p, double r)
-{
-    lo->x = fmin(lo->x, p.x - r), lo->y = fmin(lo->y, p.y - r), lo->z = fmin(lo->z, p.z - r);
-    hi->x = fmax(hi->x, p.x + r), hi->y = fmax(hi->y, p.y + r), hi->z = fmax(hi->z, p.z + r);
-}
-
-/* One luminaire's box; false when a ray left the scene (everywhere). */
+/* One luminaire's box (vis/reach.c's fan from its centre, widened by its
+ * luminous size); false when a ray left the scene (everywhere). */
 static bool luminaire_box(const rad_scene *scene, const rad_luminaire *L, const rad_vis *vis, double eps,
                           vec3 *lo, vec3 *hi)
 {
     const rad_photometry *ph = scene->luminaires.photometries[L->photometry];
     double size = fmax(fmax(ph->length, ph->width), ph->height);
-    double spread = 2.0 * sqrt(4.0 * M_PI / FAN), pad = (isfinite(size) ? size : 0.0) + 4.0 * eps;
-    *lo = *hi = L->position;
-    widen(lo, hi, L->position, pad);
-    rad_ray rays[BATCH];
-    rad_hit hits[BATCH];
-    for (size_t start = 0; start < FAN; start += BATCH) {
-        for (size_t k = 0; k < BATCH; k++)
-            rays[k] = (rad_ray){L->position, fan_direction(start + k), eps, INFINITY};
-        vis->backend->intersect(vis->state, rays, BATCH, hits);
-        for (size_t k = 0; k < BATCH; k++) {
-            if (!isfinite(hits[k].t))
-                return false;
-            vec3 p = v3_mad(rays[k].origin, rays[k].direction, hits[k].t);
-            widen(lo, hi, p, spread * hits[k].t + pad);
-        }
-    }
-    return true;
+    return rad_vis_reach(vis, L->position, eps, FAN, (isfinite(size) ? size : 0.0) + 4.0 * eps, lo, hi);
 }
 
 rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,

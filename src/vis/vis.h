@@ -75,4 +75,13 @@ double rad_vis_epsilon(const rad_mesh *mesh);
  * narrowest of them. */
 size_t rad_vis_unresolved(const rad_mesh *mesh, double *narrowest, uint32_t *which);
 
+/* The box a view from `origin` can reach (reach.c): a fan of `rays`
+ * directions (a Fibonacci sphere) from origin, starting at tnear, to what
+ * each first hits; the box holds the origin and every hit, each widened by
+ * 2 sqrt(4 pi / rays) x its distance + pad, so that a line of sight from
+ * origin stays in it unless it passes a gap the fan stepped over.  Returns
+ * false (and an infinite box) when a ray hits nothing: the view leaves the
+ * scene.  Thread-safe, deterministic; cannot fail. */
+bool rad_vis_reach(const rad_vis *vis, vec3 origin, double tnear, size_t rays, double pad, vec3 *lo, vec3 *hi);
+
 #endif /* RAD_VIS_H */
