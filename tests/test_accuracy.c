@@ -196,8 +196,9 @@ static void test_furnace_southwell(void **state)
  * Measured on the 1 x 2 x 3 m box at rho 0.8 (bench/furnace.py):
  * hierarchical +7e-7 (0.7% high before its balance), hybrid -6e-6 (+3.2e-3
  * before the Gauss points), shooting -6e-9 (-8e-4 before the remainder of
- * its unshot light, solve_shooting.c).  Not yet among them: instant
- * radiosity (+4.5e-3). */
+ * its unshot light, solve_shooting.c).  Not among them: instant radiosity,
+ * unbiased but 1.6e-3 rms over seeds (+4.5e-3 at seed 0 before its
+ * systematic roulette, now -1.2e-3; docs/methods.md). */
 static void test_furnace_every_method(void **state)
 {
     (void)state;
