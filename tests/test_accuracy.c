@@ -187,32 +187,38 @@ static void test_furnace_southwell(void **state)
 /* The furnace for every solver and form-factor method at its defaults
  * (issue #26: energy exact by construction): the faces' mean B within 1e-4
  * of E / (1 - rho), and what the closed cube absorbs within 1e-4 of what it
- * emits, and every face within 1e-4.  The dense methods on 300 elements,
- * to keep the quick suite quick; hierarchical as it meshes itself.
+ * emits, and every face within 1e-4 where the method is deterministic.
+ * Shooting's faces scatter by its rays (256 a shot: 2.5e-4 rms, 5.6e-4 at
+ * most over seeds 0-3 on this cube), so its faces are held to 1.5e-3 and
+ * its mean to 1e-4, as exact bookkeeping makes it.  The dense methods on
+ * 300 elements, to keep the quick suite quick; hierarchical and shooting
+ * as they mesh themselves.
  * Measured on the 1 x 2 x 3 m box at rho 0.8 (bench/furnace.py):
  * hierarchical +7e-7 (0.7% high before its balance), hybrid -6e-6 (+3.2e-3
- * before the Gauss points).  Not yet among them: shooting (-8e-4: it drops
- * the light still unshot at its 1e-3 tolerance) and instant radiosity
- * (+4.5e-3). */
+ * before the Gauss points), shooting -6e-9 (-8e-4 before the remainder of
+ * its unshot light, solve_shooting.c).  Not among them: instant radiosity,
+ * unbiased but 1.6e-3 rms over seeds (+4.5e-3 at seed 0 before its
+ * systematic roulette, now -1.2e-3; docs/methods.md). */
 static void test_furnace_every_method(void **state)
 {
     (void)state;
     static const struct {
         const char *options;
-        bool per_face;
+        double per_face; /* relative tolerance of each face */
     } runs[] = {
-        {"--solver hierarchical", true},
-        {"--solver jacobi --elements 300", true},
-        {"--solver direct --elements 300", true},
-        {"--solver conjugate-gradient --elements 300", true},
-        {"--solver collocation --elements 300", true},
-        {"--solver galerkin-constant --elements 150", true},
-        {"--solver galerkin-linear --elements 150", true},
-        {"--solver gauss-seidel --elements 300 --form-factors hemicube", true},
-        {"--solver gauss-seidel --elements 300 --form-factors hemisphere", true},
-        {"--solver gauss-seidel --elements 300 --form-factors montecarlo", true},
-        {"--solver gauss-seidel --elements 300 --form-factors contour", true},
-        {"--solver gauss-seidel --elements 300 --form-factors hybrid", true},
+        {"--solver hierarchical", 1e-4},
+        {"--solver shooting", 1.5e-3},
+        {"--solver jacobi --elements 300", 1e-4},
+        {"--solver direct --elements 300", 1e-4},
+        {"--solver conjugate-gradient --elements 300", 1e-4},
+        {"--solver collocation --elements 300", 1e-4},
+        {"--solver galerkin-constant --elements 150", 1e-4},
+        {"--solver galerkin-linear --elements 150", 1e-4},
+        {"--solver gauss-seidel --elements 300 --form-factors hemicube", 1e-4},
+        {"--solver gauss-seidel --elements 300 --form-factors hemisphere", 1e-4},
+        {"--solver gauss-seidel --elements 300 --form-factors montecarlo", 1e-4},
+        {"--solver gauss-seidel --elements 300 --form-factors contour", 1e-4},
+        {"--solver gauss-seidel --elements 300 --form-factors hybrid", 1e-4},
     };
     cli_scene_writer w;
     write_cube(&w, "furnace_all", "furnace_cube_rho0.5");
@@ -224,10 +230,9 @@ static void test_furnace_every_method(void **state)
             double B[3];
             cli_stats_surface_radiosity(stats, cube_faces[f], B);
             mean += B[0] / 6.0;
-            if (runs[i].per_face)
-                for (int c = 0; c < 3; c++)
-                    if (!(fabs(B[c] / exact - 1.0) < 1e-4))
-                        fail_msg("%s: face %s B %.9g, exact %.9g", runs[i].options, cube_faces[f], B[c], exact);
+            for (int c = 0; c < 3; c++)
+                if (!(fabs(B[c] / exact - 1.0) < runs[i].per_face))
+                    fail_msg("%s: face %s B %.9g, exact %.9g", runs[i].options, cube_faces[f], B[c], exact);
         }
         double emitted = cli_stats_number(stats, "power_W", "emitted");
         double absorbed = cli_stats_number(stats, "power_W", "absorbed");

@@ -29,9 +29,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- union-find ---- */
+/* ---- union-find (solve.h) ---- */
 
-static size_t find_root(size_t *parent, size_t i)
+size_t rad_union_find_root(size_t *parent, size_t i)
 {
     while (parent[i] != i) {
         parent[i] = parent[parent[i]]; /* path halving */
@@ -40,12 +40,10 @@ static size_t find_root(size_t *parent, size_t i)
     return i;
 }
 
-/* Join the sets of a and b; returns the new root, or SIZE_MAX if they
- * were one set already. */
-static size_t join(size_t *parent, size_t *size, size_t a, size_t b)
+size_t rad_union_find_join(size_t *parent, size_t *size, size_t a, size_t b)
 {
-    a = find_root(parent, a);
-    b = find_root(parent, b);
+    a = rad_union_find_root(parent, a);
+    b = rad_union_find_root(parent, b);
     if (a == b)
         return SIZE_MAX;
     if (size[a] < size[b]) {
@@ -70,14 +68,14 @@ static size_t label_components(const rad_system *sys, size_t *parent, size_t *si
     for (size_t i = 0; i < n && sets > 1; i++) {
         const double *Fi = sys->F + i * n;
         for (size_t j = 0; j < n; j++)
-            if (j != i && Fi[j] > 0.0 && join(parent, size, i, j) != SIZE_MAX)
+            if (j != i && Fi[j] > 0.0 && rad_union_find_join(parent, size, i, j) != SIZE_MAX)
                 sets--;
     }
     size_t count = 0;
     for (size_t i = 0; i < n; i++)
         label[i] = SIZE_MAX;
     for (size_t i = 0; i < n; i++) {
-        size_t root = find_root(parent, i);
+        size_t root = rad_union_find_root(parent, i);
         if (label[root] == SIZE_MAX)
             label[root] = count++;
         label[i] = label[root];

@@ -185,6 +185,15 @@ static inline void rad_gather(const double *F_row, const double *B, size_t n, do
     g[2] = g2;
 }
 
+/* Union-find with path halving and union by size (Tarjan 1975), over
+ * parent[] (each i its own set at first: parent[i] = i, size[i] = 1).
+ * Root of i's set; cannot fail. */
+size_t rad_union_find_root(size_t *parent, size_t i);
+
+/* Join the sets of a and b; returns the new root, or SIZE_MAX if they
+ * were one set already.  Cannot fail. */
+size_t rad_union_find_join(size_t *parent, size_t *size, size_t a, size_t b);
+
 /* Solve the independent groups of elements separately (components.c): the
  * graph with an edge i-j where F_ij > 0 or F_ji > 0 is split into connected
  * components (union-find, one O(n^2) scan of F); when two or more have more

@@ -7,10 +7,16 @@
  *        roulette: go on with probability q = max_c rho_c(y1), Phi *= rho / q
  *                  --cosine dir--> hit y2: VPL ...
  *
+ * The paths advance one generation (bounce) at a time, so that the
+ * roulette can be systematic over each generation: every path goes on
+ * with its own probability q, and the generation keeps sum q of them,
+ * give or take one, where independent coins made the number of VPLs per
+ * path geometric and the total reflected power as noisy (create below).
+ *
  * Each path starts with Phi = (emitted power) / paths in the emitter's
  * colour.  The path's numbers are the dimensions of a Halton sequence
  * (radical inverses in the first 64 prime bases: the emitter, its point,
- * the direction, then three per bounce: roulette and direction), shifted
+ * then two per bounce: the direction), shifted
  * by a Cranley-Patterson rotation keyed on the seed; dimensions past the
  * table come from the keyed stream.  The emitters' own light (a VPL on the
  * emitter, Keller's generation 0) is not a VPL here: rad_vpl_direct
@@ -67,6 +73,14 @@ static vec3 cosine_direction(vec3 n, double u, double v)
     return v3_add(v3_add(v3_scale(t, r * cos(phi)), v3_scale(b, r * sin(phi))), v3_scale(n, sqrt(fmax(0.0, 1.0 - u))));
 }
 
+/* A light path between bounces. */
+typedef struct light_path {
+    vec3 position;            /* m, lifted off its surface */
+    vec3 normal;              /* unit */
+    double phi[3];            /* W, RGB: the power it carries */
+    size_t index;             /* its point of the Halton sequence */
+} light_path;
+
 static double mean3(const double *v) { return (v[0] + v[1] + v[2]) / 3.0; }
 
 void rad_vpl_free(rad_vpl_set *set)
@@ -106,9 +120,12 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
     uint32_t *which = rad_alloc(ctx, RAD_MEM_SOLVER, emitting + 1, sizeof *which, "vpl: emitter table");
     s.emitter_patches = rad_alloc(ctx, RAD_MEM_SOLVER, patches + 1, sizeof *s.emitter_patches, "vpl: emitters");
     s.lights = rad_alloc(ctx, RAD_MEM_SOLVER, capacity, sizeof *s.lights, "vpl: lights");
-    if (!cdf || !which || !s.emitter_patches || !s.lights) {
+    light_path *live = rad_alloc(ctx, RAD_MEM_SOLVER, paths + 1, sizeof *live, "vpl: light paths");
+    size_t live_count = 0;
+    if (!cdf || !which || !s.emitter_patches || !s.lights || !live) {
         rad_free(cdf);
         rad_free(which);
+        rad_free(live);
         rad_vpl_free(&s);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -135,12 +152,9 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
     }
     double eps = rad_vis_epsilon(mesh);
     rad_result result = RAD_OK;
+    /* Generation 0: each path's emitter by power (binary search of the
+     * table) and its point. */
     for (size_t i = 0; m > 0 && i < paths; i++) {
-        if ((i & 1023) == 0 && rad_cancelled(ctx)) {
-            result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "instant radiosity: interrupted placing the VPLs");
-            break;
-        }
-        /* The emitter by power (binary search of the table). */
         double u = path_number(rotation, seed, i, 0) * sum;
         size_t lo = 0, hi = m - 1;
         while (lo < hi) {
@@ -153,35 +167,46 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
         uint32_t j = which[lo];
         const rad_element *e = &mesh->elements[j];
         const double *Ej = emission + 3 * (size_t)j;
+        light_path *a = &live[live_count++];
+        a->index = i;
         /* Phi = A_j E_j / (p_j paths), p_j = A_j mean(E_j) / sum. */
-        double phi[3];
         for (int c = 0; c < 3; c++)
-            phi[c] = Ej[c] / mean3(Ej) * sum / (double)paths;
-        vec3 x = v3_mad(rad_element_sample(mesh, e, path_number(rotation, seed, i, 1), path_number(rotation, seed, i, 2)),
-                        e->normal, eps + rad_element_bend(mesh, e));
-        vec3 normal = e->normal;
-        unsigned d = 3;
-        for (int bounce = 0; bounce < MAX_BOUNCES; bounce++) {
-            rad_ray ray = {x, cosine_direction(normal, path_number(rotation, seed, i, d),
-                                               path_number(rotation, seed, i, d + 1)),
+            a->phi[c] = Ej[c] / mean3(Ej) * sum / (double)paths;
+        a->position = v3_mad(rad_element_sample(mesh, e, path_number(rotation, seed, i, 1), path_number(rotation, seed, i, 2)),
+                             e->normal, eps + rad_element_bend(mesh, e));
+        a->normal = e->normal;
+    }
+    /* Then one generation a bounce, the live paths in their order. */
+    for (int bounce = 0; bounce < MAX_BOUNCES && live_count > 0 && result == RAD_OK; bounce++) {
+        rad_rng rrng = rad_rng_keyed(seed, 0x5650526fu, (uint64_t)bounce); /* "VPRo" */
+        double offset = rad_rng_uniform(&rrng), reach = 0.0;
+        size_t next = 0;
+        unsigned d = 3 + 2 * (unsigned)bounce;
+        for (size_t k = 0; k < live_count; k++) {
+            if ((k & 1023) == 0 && rad_cancelled(ctx)) {
+                result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "instant radiosity: interrupted placing the VPLs");
+                break;
+            }
+            light_path a = live[k];
+            rad_ray ray = {a.position, cosine_direction(a.normal, path_number(rotation, seed, a.index, d),
+                                                        path_number(rotation, seed, a.index, d + 1)),
                            0.0, INFINITY};
-            d += 2;
             rad_hit hit;
             vis->backend->intersect(vis->state, &ray, 1, &hit);
             s.rays++;
             if (!isfinite(hit.t))
-                break; /* escaped: an open scene loses it */
+                continue; /* escaped: an open scene loses it */
             const rad_patch *p = &mesh->patches[hit.patch];
             if (v3_dot(ray.direction, p->normal) >= 0.0)
-                break; /* the back of a one-sided surface: absorbed */
+                continue; /* the back of a one-sided surface: absorbed */
             vec3 y = v3_mad(ray.origin, ray.direction, hit.t);
             double ps, pt, ls, lt;
             rad_patch_parameters(p, y, &ps, &pt);
-            uint32_t k = rad_patch_locate(p, ps, pt, &ls, &lt);
-            const double *rho = reflectance + 3 * (size_t)k;
+            uint32_t j = rad_patch_locate(p, ps, pt, &ls, &lt);
+            const double *rho = reflectance + 3 * (size_t)j;
             double q = fmax(rho[0], fmax(rho[1], rho[2]));
             if (q <= 0.0)
-                break;
+                continue;
             if (s.count == capacity) {
                 rad_vpl *grown = rad_realloc(ctx, RAD_MEM_SOLVER, s.lights, 2 * capacity, sizeof *grown, "vpl: lights");
                 if (!grown) {
@@ -191,29 +216,39 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
                 s.lights = grown;
                 capacity *= 2;
             }
-            x = v3_mad(y, p->normal, eps);
-            normal = p->normal;
+            a.position = v3_mad(y, p->normal, eps);
+            a.normal = p->normal;
             rad_vpl *l = &s.lights[s.count++];
-            l->position = x;
-            l->normal = normal;
+            l->position = a.position;
+            l->normal = a.normal;
             for (int c = 0; c < 3; c++)
-                l->power[c] = phi[c] * rho[c];
+                l->power[c] = a.phi[c] * rho[c];
             /* Russian roulette by the largest channel's reflectance (Arvo &
              * Kirk 1990): the path's power then never grows (rho / q <= 1),
              * where the mean's would multiply a red wall's red by 2.5 a
              * bounce and leave a heavy tail that typical runs miss (3% low
-             * in red at 16384 paths in the Cornell box). */
-            if (path_number(rotation, seed, i, d) >= q)
-                break;
-            d++;
-            for (int c = 0; c < 3; c++)
-                phi[c] *= rho[c] / q;
+             * in red at 16384 paths in the Cornell box).  Systematic over
+             * the generation: path k goes on where an integer lies in
+             * [reach - offset, reach + q_k - offset), reach the sum of the
+             * q before it, so each goes on with probability q_k (unbiased)
+             * and the generation keeps sum q paths, give or take one.
+             * Decided path by path, the count of VPLs per path is
+             * geometric, and its spread set the total reflected power:
+             * 1024 paths in the rho 0.8 furnace held 4775 to 5257 VPLs
+             * over seeds 0-6 where 5120 are expected, B -4.2% to +1.7%. */
+            double before = reach;
+            reach += q;
+            if (floor(reach - offset) > floor(before - offset)) {
+                for (int c = 0; c < 3; c++)
+                    a.phi[c] *= rho[c] / q;
+                live[next++] = a; /* next <= k: in place */
+            }
         }
-        if (result != RAD_OK)
-            break;
+        live_count = next;
     }
     rad_free(cdf);
     rad_free(which);
+    rad_free(live);
     if (result != RAD_OK) {
         rad_vpl_free(&s);
         return result;

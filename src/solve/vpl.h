@@ -46,7 +46,8 @@ typedef struct rad_vpl_set {
 
 /* Trace `paths` light paths from the emitting elements (chosen by power,
  * points and directions from a Halton sequence rotated by `seed`), one VPL
- * at each diffuse bounce, Russian roulette by the largest reflectance.  Arrays
+ * at each diffuse bounce, Russian roulette by the largest reflectance,
+ * systematic over each generation of paths (vpl.c).  Arrays
  * are per element (3n RGB), as the strategies hold them.  Deterministic
  * for a seed.  On failure *out is zeroed and nothing leaks. */
 rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis *vis, const double *reflectance,

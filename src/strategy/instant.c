@@ -36,6 +36,13 @@
  * clamped light's own near-field share (second order: the loss times
  * itself).
  *
+ * Accuracy: unbiased in the closed furnace (1 x 2 x 3 m, rho 0.8, 1024
+ * paths: B +3e-4 on average over seeds 0-6, standard error 6e-4) but
+ * 1.6e-3 rms from seed to seed, and still 1e-3 at 16384 paths: what
+ * remains is the gathers' noise (each VPL at one random point of each
+ * element, the clamped light's realised loss against the near-field
+ * estimate of its mean), so 1e-4 is out of reach at a reasonable cost.
+ *
  * Determinism: every element's numbers come from streams keyed on (seed,
  * element), VPLs from the seeded Halton sequence; elements are
  * independent, so the thread count does not change the answer.
