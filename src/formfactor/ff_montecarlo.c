@@ -55,7 +55,8 @@
  * clip, a contour and one or two spherical triangles.  Each pair's
  * estimate is unbiased, but a row sums the noise of all its pairs: by
  * default rad_ff_balance (reciprocity.c) holds rows to their closure,
- * measured by rays.
+ * measured by rays, moving each factor by its share of its rows' variance
+ * (least squares), and reduces the variances reported to match.
  */
 #include "formfactor/formfactor.h"
 

@@ -299,7 +299,10 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
                             rad_ff_stats *stats)
 {
     *F_out = NULL;
-    bool want_variance = variance_out && (method->flags & RAD_FF_VARIANCE);
+    /* The balance weighs a pair method's factors by their variances (reciprocity.c):
+     * kept for it even where the caller declines them. */
+    bool balanced = (method->flags & RAD_FF_BALANCE) && !req->raw;
+    bool want_variance = (method->flags & RAD_FF_VARIANCE) && (variance_out || (balanced && method->pair));
     if (variance_out)
         *variance_out = NULL;
     memset(stats, 0, sizeof *stats);
@@ -327,7 +330,7 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     rad_result r = method->prepare ? method->prepare(ctx, req, &shared) : RAD_OK;
     if (r == RAD_OK)
         r = run_method(ctx, method, req, shared, F, var, stats);
-    if (r == RAD_OK && (method->flags & RAD_FF_BALANCE) && !req->raw) {
+    if (r == RAD_OK && balanced) {
         rad_ff_stats raw;
         diagnostics(req->mesh, F, &raw);
         stats->raw_reciprocity_max = raw.reciprocity_max;
@@ -361,5 +364,7 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method, const
     *F_out = F;
     if (variance_out)
         *variance_out = var;
+    else
+        rad_free(var);
     return r;
 }

@@ -47,7 +47,7 @@ typedef struct rad_ff_stats {
                                  (rad_ff_escaped), else 0 */
     bool balanced;            /* rad_ff_balance restored reciprocity and closure */
     double raw_reciprocity_max, raw_row_sum_max; /* balanced: as the method estimated F */
-    double closure_scale_min, closure_scale_max; /* balanced: the rows' scale factors x_i */
+    double closure_scale_min, closure_scale_max; /* balanced: range of balanced over raw row sums */
 } rad_ff_stats;
 
 /* Method flags. */
@@ -121,8 +121,9 @@ rad_result rad_form_factors(rad_context *ctx, const rad_ff_method *method,
 
 /* The default step after a RAD_FF_BALANCE method (reciprocity.c): the two
  * estimates of each pair combined by method->density (row methods), then
- * rows rescaled symmetrically toward their closure (measured by the row
- * methods; by cosine rays here for pair methods, with req->vis) and none
+ * rows brought to their closure (measured by the row methods and rescaled
+ * symmetrically; for pair methods, with req->vis and var, measured by
+ * cosine rays and adjusted by least squares with the variances) and none
  * left above 1.  F (and var, if not NULL) n x n, changed in place; fills
  * the stats' balance fields.  Polls rad_cancelled (RAD_ERROR_INTERRUPTED);
  * fails otherwise only for memory (F then unchanged). */

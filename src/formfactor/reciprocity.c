@@ -27,24 +27,43 @@
  * that did would bias the mean).  Variances combine as
  * (w_i^2 A_i^2 var_ij + w_j^2 A_j^2 var_ji) / (w_i + w_j)^2.
  *
- * Step 2, closure.  Each row is rescaled toward its closure t_i, the
+ * Step 2, closure.  Each row is brought to its closure t_i, the
  * fraction of the light leaving element i that meets the front of some
- * element, keeping reciprocity: x > 0 with x_i sum_j G_ij x_j = A_i t_i
- * (symmetric Sinkhorn scaling, Knight 2008, as rad_ff_close), then
- * F_ij <- x_i x_j F_ij.  Row methods measure t_i themselves (their raw
- * row sums: pixels or rays that met a front).  Monte Carlo is measured
- * here by cosine-distributed rays from each element (CLOSURE_RAYS),
- * combined with its own row sum s_i by their variances
+ * element, keeping reciprocity.  Row methods measure t_i themselves (their
+ * raw row sums: pixels or rays that met a front), and their rows are
+ * rescaled: x > 0 with x_i sum_j G_ij x_j = A_i t_i (symmetric Sinkhorn
+ * scaling, Knight 2008, as rad_ff_close), then F_ij <- x_i x_j F_ij.
  *
- *     t_i = (r_i / var r_i + s_i / var s_i) / (1 / var r_i + 1 / var s_i),
- *     var r_i = r_i (1 - r_i) / K,   var s_i = sum_j var F_ij
+ * Monte Carlo's closure is measured here by cosine-distributed rays from
+ * each element (CLOSURE_RAYS; r_i, var r_i = r_i (1 - r_i) / K), and its
+ * rows are adjusted by generalised least squares instead: the pairs are
+ * independent estimates with known variances W_ij = var(G_ij), so the
+ * least change that meets the measured closures,
  *
- * so a closed element (every ray meets a front: r_i = 1, var 0) is held
- * to exactly 1, and an open one keeps mostly its own, usually better, sum.
- * In an open scene the t_i need not be consistent with one reciprocal G
- * (two facing squares: A_1 t_1 = A_2 t_2 only up to noise); the scaling
- * then settles between them, within the noise.  Last, every row above 1
- * (rounding, or that compromise) is scaled down to 1.
+ *     min sum_{i<j} (G'_ij - G_ij)^2 / W_ij + sum_i A_i^2 (t_i - r_i)^2 / var r_i
+ *     subject to  sum_j G'_ij = A_i t_i
+ *
+ * is G'_ij = G_ij - W_ij (l_i + l_j), with (diag(d) + W) l = sum_j G_ij - A_i r_i,
+ * d_i = sum_j W_ij + A_i^2 var r_i (Lagrange multipliers; the
+ * best linear unbiased estimate under the constraints; Deming 1943 "Statistical
+ * adjustment of data"), solved by conjugate gradients.  Each factor moves by
+ * its share of its rows' variance: a precise factor (far, unoccluded)
+ * hardly at all.  The rescaling spread a row's noise over its factors in
+ * proportion to F instead, so precise factors moved by 10-20 times their
+ * reported error.  A closed element (r_i = 1, var 0) is held to exactly 1;
+ * an open one (or one whose rays met nothing) mostly keeps its own, usually
+ * better, sum.  The adjusted factor's variance combines its own with the
+ * two others that its rows' constraints give, A_i t_i less the rest of
+ * the row (variance d_i - W_ij), as independent estimates:
+ *
+ *     1 / var G'_ij = 1 / W_ij + 1 / (d_i - W_ij) + 1 / (d_j - W_ij)
+ *
+ * (exact for a lone pair; to first order in W_ij / d the diagonal of
+ * W - W A^T (A W A^T)^-1 A W).  A factor driven below 0 is held at 0 with
+ * its raw variance, and the rest adjusted again.
+ *
+ * Last, every row above 1 (rounding, or an open scene's compromise) is
+ * scaled down to 1.
  *
  * rad_options.raw_form_factors turns the step off.
  */
@@ -112,64 +131,20 @@ static void symmetrize(const rad_mesh *mesh, const double *density, double *F, d
     }
 }
 
-rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
-                          const void *shared, double *F_rows, double *var_rows, rad_ff_stats *stats)
+/* Step 2 for row methods: x with x_i sum_j F_ij x_j = target_i, by the
+ * symmetric Sinkhorn iteration x_i <- sqrt(x_i target_i / sum_j F_ij x_j),
+ * until the worst row is right to 1e-7 (far below the sampling noise), or
+ * while it still improves (inconsistent targets of an open scene stall
+ * it).  `row`: n doubles of scratch. */
+static void rescale(size_t n, const double *F, const double *target, double *x, double *row)
 {
-    double *F = F_rows, *var = var_rows;
-    const rad_mesh *mesh = req->mesh;
-    size_t n = mesh->element_count;
-    double *work = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 4 * n, sizeof *work, "form factors: reciprocity");
-    if (!work)
-        return RAD_ERROR_OUT_OF_MEMORY;
-    double *target = work, *x = work + n, *row = work + 2 * n, *density = work + 3 * n;
-    /* The raw rows: their sums (a row method's measured closure), and
-     * their variance (sum of the pairs'). */
-    double raw_max = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        double s = 0.0, v = 0.0;
-        for (size_t j = 0; j < n; j++) {
-            s += F[i * n + j];
-            v += var ? var[i * n + j] : 0.0;
-        }
-        target[i] = s;
-        row[i] = v;
-        raw_max = fmax(raw_max, s);
-    }
-    stats->raw_row_sum_max = raw_max;
-    if (method->density) {
-        for (size_t i = 0; i < n; i++)
-            density[i] = method->density(req, shared, (uint32_t)i);
-        symmetrize(mesh, density, F, var);
-    } else if (req->vis) {
-        /* Measured closure r_i, combined with the row's own sum s_i. */
-        rad_result r = closure_rays(ctx, req, density);
-        if (r != RAD_OK) {
-            rad_free(work);
-            return r;
-        }
-        for (size_t i = 0; i < n; i++) {
-            double r_i = density[i], var_r = r_i * (1.0 - r_i) / CLOSURE_RAYS, s_i = target[i], var_s = row[i];
-            if (!(var_r > 0.0))
-                target[i] = r_i;
-            else if (var && var_s > 0.0)
-                target[i] = (r_i / var_r + s_i / var_s) / (1.0 / var_r + 1.0 / var_s);
-        }
-    }
-    /* Step 2: x_i sum_j G_ij x_j = A_i t_i, by the symmetric Sinkhorn
-     * iteration x_i <- sqrt(x_i A_i t_i / sum_j G_ij x_j).  Until the worst
-     * row is right to 1e-7 (far below the sampling noise), or while it still
-     * improves (inconsistent targets of an open scene stall it). */
-    for (size_t i = 0; i < n; i++) {
-        target[i] = fmin(target[i], 1.0);
-        x[i] = 1.0;
-    }
     double previous = INFINITY;
     for (int it = 0; it < 200; it++) {
         double worst = 0.0;
         for (size_t i = 0; i < n; i++) {
             double s = 0.0;
             for (size_t j = 0; j < n; j++)
-                s += (double)F[i * n + j] * x[j];
+                s += F[i * n + j] * x[j];
             row[i] = s;
         }
         for (size_t i = 0; i < n; i++) {
@@ -182,31 +157,178 @@ rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const r
             break;
         previous = worst;
     }
+}
+
+/* (M v)_i = d_i v_i + sum_j W_ij v_j over the constrained rows (d_i > 0),
+ * W_ij = A_i^2 var_ij (held pairs carry -var: left out). */
+static void adjust_product(const rad_mesh *mesh, const double *var, const double *d, const double *v, double *out)
+{
+    size_t n = mesh->element_count;
+    for (size_t i = 0; i < n; i++) {
+        out[i] = 0.0;
+        if (!(d[i] > 0.0))
+            continue;
+        double s = 0.0, a = mesh->elements[i].area;
+        for (size_t j = 0; j < n; j++)
+            s += (var[i * n + j] > 0.0 ? var[i * n + j] : 0.0) * v[j];
+        out[i] = d[i] * v[i] + a * a * s;
+    }
+}
+
+/* Step 2 for Monte Carlo: the least-squares adjustment of the file header
+ * to the closures r[] measured by CLOSURE_RAYS rays; F and var changed in
+ * place.  `work`: 5n doubles of scratch.  Cannot fail. */
+static void adjust(const rad_mesh *mesh, const double *r, double *F, double *var, double *work)
+{
+    size_t n = mesh->element_count;
+    double *d = work, *l = work + n, *res = work + 2 * n, *p = work + 3 * n, *q = work + 4 * n;
+    /* Rounds: each holds the factors driven below 0 at 0; in practice one
+     * or two. */
+    for (int round = 0; round < 8; round++) {
+        /* d_i, and the residual A_i (s_i - r_i) as the right-hand side;
+         * the rows whose rays met no front are not constrained (d_i = 0). */
+        double rz = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            double a = mesh->elements[i].area, w = 0.0, s = 0.0;
+            for (size_t j = 0; j < n; j++) {
+                s += F[i * n + j];
+                w += var[i * n + j] > 0.0 ? var[i * n + j] : 0.0;
+            }
+            d[i] = r[i] > 0.0 ? a * a * (w + r[i] * (1.0 - r[i]) / CLOSURE_RAYS) : 0.0;
+            res[i] = d[i] > 0.0 ? a * (s - r[i]) : 0.0;
+            l[i] = 0.0;
+            p[i] = d[i] > 0.0 ? res[i] / d[i] : 0.0; /* Jacobi preconditioner */
+            rz += res[i] * p[i];
+        }
+        /* Conjugate gradients until every constrained row is right to 1e-9
+         * of its area (far below the sampling noise; rows within 1e-9 keep
+         * a closed box's energy to ~20 bounces x 1e-9). */
+        for (int it = 0; it < 500; it++) {
+            double worst = 0.0;
+            for (size_t i = 0; i < n; i++)
+                worst = fmax(worst, fabs(res[i]) / mesh->elements[i].area);
+            if (worst < 1e-9)
+                break;
+            adjust_product(mesh, var, d, p, q);
+            double pq = 0.0;
+            for (size_t i = 0; i < n; i++)
+                pq += p[i] * q[i];
+            if (!(pq > 0.0))
+                break;
+            double alpha = rz / pq, rz_next = 0.0;
+            for (size_t i = 0; i < n; i++) {
+                l[i] += alpha * p[i];
+                res[i] -= alpha * q[i];
+                rz_next += d[i] > 0.0 ? res[i] * res[i] / d[i] : 0.0;
+            }
+            for (size_t i = 0; i < n; i++)
+                p[i] = (d[i] > 0.0 ? res[i] / d[i] : 0.0) + rz_next / rz * p[i];
+            rz = rz_next;
+        }
+        /* G'_ij = G_ij - W_ij (l_i + l_j), row by row: W and G are
+         * symmetric, so F_ji's row gives the same G'. */
+        int held = 0;
+        for (size_t i = 0; i < n; i++) {
+            double ai = mesh->elements[i].area;
+            for (size_t j = 0; j < n; j++) {
+                double w = ai * ai * var[i * n + j];
+                if (!(w > 0.0))
+                    continue;
+                double g = ai * F[i * n + j] - w * (l[i] + l[j]);
+                if (g < 0.0) {
+                    g = 0.0;
+                    var[i * n + j] = -var[i * n + j];
+                    held++;
+                }
+                F[i * n + j] = g / ai;
+            }
+        }
+        if (!held)
+            break;
+    }
+    /* The adjusted variances (file header) from the last round's d; the
+     * held factors get their raw variance back. */
+    for (size_t i = 0; i < n; i++) {
+        double ai = mesh->elements[i].area;
+        for (size_t j = 0; j < n; j++) {
+            double w = ai * ai * var[i * n + j], inverse = 1.0 / w;
+            if (!(w > 0.0)) {
+                var[i * n + j] = fabs(var[i * n + j]);
+                continue;
+            }
+            if (d[i] > 0.0)
+                inverse += d[i] > w ? 1.0 / (d[i] - w) : INFINITY;
+            if (d[j] > 0.0)
+                inverse += d[j] > w ? 1.0 / (d[j] - w) : INFINITY;
+            var[i * n + j] = 1.0 / (inverse * ai * ai);
+        }
+    }
+}
+
+rad_result rad_ff_balance(rad_context *ctx, const rad_ff_method *method, const rad_ff_request *req,
+                          const void *shared, double *F, double *var, rad_ff_stats *stats)
+{
+    const rad_mesh *mesh = req->mesh;
+    size_t n = mesh->element_count;
+    double *work = rad_alloc(ctx, RAD_MEM_FORM_FACTORS, 9 * n, sizeof *work, "form factors: reciprocity");
+    if (!work)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    double *raw = work, *target = work + n, *x = work + 2 * n, *row = work + 3 * n, *scratch = work + 4 * n;
+    /* The raw rows' sums: a row method's measured closure. */
+    double raw_max = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        double s = 0.0;
+        for (size_t j = 0; j < n; j++)
+            s += F[i * n + j];
+        raw[i] = s;
+        target[i] = fmin(s, 1.0);
+        x[i] = 1.0;
+        raw_max = fmax(raw_max, s);
+    }
+    stats->raw_row_sum_max = raw_max;
+    if (method->density) {
+        for (size_t i = 0; i < n; i++)
+            scratch[i] = method->density(req, shared, (uint32_t)i);
+        symmetrize(mesh, scratch, F, var);
+        rescale(n, F, target, x, row);
+    } else if (req->vis && var) {
+        rad_result r = closure_rays(ctx, req, target);
+        if (r != RAD_OK) {
+            rad_free(work);
+            return r;
+        }
+        adjust(mesh, target, F, var, scratch);
+    }
     /* No row above 1: each row over it scaled down by its excess, all
      * at once (scaling x_i down only lowers the other rows). */
     for (size_t i = 0; i < n; i++) {
         double s = 0.0;
         for (size_t j = 0; j < n; j++)
-            s += (double)F[i * n + j] * x[i] * x[j];
+            s += F[i * n + j] * x[i] * x[j];
         row[i] = s;
     }
+    for (size_t i = 0; i < n; i++)
+        if (row[i] > 1.0)
+            x[i] /= row[i];
+    /* The rows' scales: balanced sum over raw sum. */
     stats->closure_scale_min = INFINITY;
     stats->closure_scale_max = 0.0;
     for (size_t i = 0; i < n; i++) {
-        if (row[i] > 1.0)
-            x[i] /= row[i];
-        stats->closure_scale_min = fmin(stats->closure_scale_min, x[i]);
-        stats->closure_scale_max = fmax(stats->closure_scale_max, x[i]);
-    }
-    for (size_t i = 0; i < n; i++)
+        double s = 0.0;
         for (size_t j = 0; j < n; j++) {
             double scale = x[i] * x[j];
-            F[i * n + j] = (F[i * n + j] * scale);
+            F[i * n + j] *= scale;
+            s += F[i * n + j];
             if (var)
-                var[i * n + j] = (var[i * n + j] * scale * scale);
+                var[i * n + j] *= scale * scale;
         }
-    if (n == 0)
-        stats->closure_scale_min = stats->closure_scale_max = 1.0;
+        if (raw[i] > 0.0) {
+            stats->closure_scale_min = fmin(stats->closure_scale_min, s / raw[i]);
+            stats->closure_scale_max = fmax(stats->closure_scale_max, s / raw[i]);
+        }
+    }
+    if (!(stats->closure_scale_max > 0.0))
+        stats->closure_scale_min = stats->closure_scale_max = 1.0; /* no row saw anything */
     stats->balanced = true;
     rad_free(work);
     return RAD_OK;
