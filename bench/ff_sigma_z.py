@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """RMS z = (F - exact) / std_error of montecarlo's view factors against the analytic
 ones, over seeds (docs/methods.md, "Calibrated errors").  LEVEL=surface|element.
-usage: ff_sigma_z.py RADIOSITY cube|box123|par|perp ELEMENTS SEEDS [options]"""
+usage: bench/ff_sigma_z.py RADIOSITY cube|box123|par|perp ELEMENTS SEEDS [options]"""
 import json, math, os, subprocess, sys
 
 binary, scene, elements, seeds = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
