@@ -46,6 +46,15 @@ static inline vec3 v3_lerp(vec3 a, vec3 b, double t) { return v3_mad(a, v3_sub(b
 static inline vec3 v3_min(vec3 a, vec3 b) { return v3(fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)); }
 static inline vec3 v3_max(vec3 a, vec3 b) { return v3(fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)); }
 static inline bool v3_finite(vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+/* Axis-aligned boxes [lo, hi] (closed): whether two meet, whether one holds p. */
+static inline bool v3_boxes_meet(vec3 alo, vec3 ahi, vec3 blo, vec3 bhi)
+{
+    return alo.x <= bhi.x && blo.x <= ahi.x && alo.y <= bhi.y && blo.y <= ahi.y && alo.z <= bhi.z && blo.z <= ahi.z;
+}
+static inline bool v3_box_holds(vec3 lo, vec3 hi, vec3 p)
+{
+    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+}
 
 /* ---- memory accounting (the allocator is below the context) ---- */
 

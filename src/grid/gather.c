@@ -71,7 +71,7 @@ typedef struct gather_shared {
  * share is taken after the query (rad_element_seen). */
 typedef struct ray_batch {
     rad_ray ray[BATCH];
-    double weight[BATCH];         /* factor hidden if blocked (kernel / N) */
+    double weight[BATCH];         /* the kernel at its end / N (rad_element_seen's weights) */
     uint8_t blocked[BATCH];
     int count;
     uint32_t element[BATCH];      /* pending elements ... */
@@ -356,8 +356,7 @@ static void gather_tree(const gather_shared *g, point_sums *ps, ray_batch *b)
         known_rays parent = rays[top], mine;
         mine.count = 0;
         /* Beyond the point's reach: nothing of it is seen. */
-        if (node->lo.x > rhi.x || node->hi.x < rlo.x || node->lo.y > rhi.y || node->hi.y < rlo.y ||
-            node->lo.z > rhi.z || node->hi.z < rlo.z)
+        if (!v3_boxes_meet(node->lo, node->hi, rlo, rhi))
             continue;
         vec3 centre = v3_scale(v3_add(node->lo, node->hi), 0.5), half = v3_scale(v3_sub(node->hi, node->lo), 0.5);
         double mid = v3_dot(n, v3_sub(centre, p));

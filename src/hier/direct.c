@@ -154,12 +154,11 @@ static rad_result finish_pending(rad_context *ctx, const hr_tree *tree, hr_direc
         if (stop || nd->kind != HR_SURFACE || nd->child[0] != 0)
             continue;
         rad_light_among set = among(d, nd->patch);
-        double dev = 0.0;
-        /* The integral to a tenth of epsilon's share of reflected power. */
+        /* The integral to a tenth of epsilon's share of reflected power
+         * (the deviation was read when the leaf was started: not again). */
         double tolerance = nd->rho > 0.0f ? 0.1 * epsilon / (double)nd->rho : INFINITY;
         rad_light_polygon_finish(d->scene, d->base, d->vis, nd->corner, nd->corners, nd->normal, &set, tolerance,
-                                 &d->pending[k - from], &d->H[3 * k], &dev);
-        d->deviation[k] = (float)dev;
+                                 &d->pending[k - from], &d->H[3 * k], NULL);
         if (rad_cancelled(ctx))
             stop = 1;
     }
@@ -169,50 +168,45 @@ static rad_result finish_pending(rad_context *ctx, const hr_tree *tree, hr_direc
     return RAD_OK;
 }
 
-/* The per-patch lists of luminaires whose reach meets the patch's box. */
+/* The per-patch lists of luminaires whose reach meets the patch's box
+ * (serial: a box test per patch and luminaire is cheap beside one shadow
+ * ray), appended in patch order to a list grown by doubling. */
 static rad_result patch_lists(rad_context *ctx, const hr_tree *tree, const rad_light_reach *reach, hr_direct *d)
 {
     size_t patches = tree->base->patch_count, lums = tree->scene->luminaires.count;
+    size_t total = 0, capacity = lums + 1;
     d->list_start = rad_alloc(ctx, RAD_MEM_HIERARCHY, patches + 1, sizeof *d->list_start,
                               "hierarchical: the luminaires each patch asks");
-    uint32_t *scratch = d->list_start ? rad_alloc(ctx, RAD_MEM_HIERARCHY, lums + 1, sizeof *scratch,
-                                                  "hierarchical: the luminaires each patch asks")
-                                      : NULL;
-    if (!scratch)
+    d->list = d->list_start ? rad_alloc(ctx, RAD_MEM_HIERARCHY, capacity, sizeof *d->list,
+                                        "hierarchical: the luminaires each patch asks")
+                            : NULL;
+    if (!d->list)
         return RAD_ERROR_OUT_OF_MEMORY;
-    /* Twice through the patches: count, then fill (serial: a box test per
-     * patch and luminaire is cheap beside one shadow ray). */
-    for (int pass = 0; pass < 2; pass++) {
-        size_t total = 0;
-        for (size_t p = 0; p < patches; p++) {
-            const hr_node *root = &tree->nodes[tree->root_of_patch[p]];
-            vec3 lo = root->corner[0], hi = root->corner[0];
-            for (uint32_t c = 1; c < root->corners; c++) {
-                lo = v3_min(lo, root->corner[c]);
-                hi = v3_max(hi, root->corner[c]);
-            }
-            size_t m = rad_light_reach_list(reach, lo, hi, scratch);
-            if (pass == 1)
-                memcpy(d->list + total, scratch, m * sizeof *scratch);
-            d->list_start[p] = (uint32_t)total;
-            total += m;
-        }
-        d->list_start[patches] = (uint32_t)total;
-        if (pass == 0) {
-            if (total > UINT32_MAX) {
-                rad_free(scratch);
-                return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
-                                "hierarchical: over 4 billion patch-luminaire pairs in reach");
-            }
-            d->list = rad_alloc(ctx, RAD_MEM_HIERARCHY, total + 1, sizeof *d->list,
-                                "hierarchical: the luminaires each patch asks");
-            if (!d->list) {
-                rad_free(scratch);
+    d->list_capacity = capacity;
+    for (size_t p = 0; p < patches; p++) {
+        if (total + lums > capacity) {
+            capacity = 2 * capacity > total + lums ? 2 * capacity : total + lums;
+            uint32_t *grown = rad_realloc(ctx, RAD_MEM_HIERARCHY, d->list, capacity, sizeof *grown,
+                                          "hierarchical: the luminaires each patch asks");
+            if (!grown)
                 return RAD_ERROR_OUT_OF_MEMORY;
-            }
+            d->list = grown;
+            d->list_capacity = capacity;
         }
+        const hr_node *root = &tree->nodes[tree->root_of_patch[p]];
+        vec3 lo = root->corner[0], hi = root->corner[0];
+        for (uint32_t c = 1; c < root->corners; c++) {
+            lo = v3_min(lo, root->corner[c]);
+            hi = v3_max(hi, root->corner[c]);
+        }
+        if (total > UINT32_MAX)
+            return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: over 4 billion patch-luminaire pairs in reach");
+        d->list_start[p] = (uint32_t)total;
+        total += rad_light_reach_list(reach, lo, hi, d->list + total);
     }
-    rad_free(scratch);
+    if (total > UINT32_MAX)
+        return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: over 4 billion patch-luminaire pairs in reach");
+    d->list_start[patches] = (uint32_t)total;
     return RAD_OK;
 }
 
@@ -305,8 +299,7 @@ double hr_direct_bytes(const hr_direct *d)
 {
     return (double)d->capacity * (3.0 * sizeof(double) + sizeof(float)) +
            (double)d->pending_capacity * sizeof(rad_light_cubature) +
-           (d->list_start ? (double)(d->base->patch_count + 1 + d->list_start[d->base->patch_count]) * sizeof(uint32_t)
-                          : 0.0);
+           (d->list_start ? (double)(d->base->patch_count + 1 + d->list_capacity) * sizeof(uint32_t) : 0.0);
 }
 
 void hr_direct_free(hr_direct *d)

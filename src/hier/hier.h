@@ -248,6 +248,7 @@ typedef struct hr_direct {
     size_t pending_capacity;
     uint32_t *list_start, *list; /* per patch (list_start[p] .. [p + 1]): the luminaires whose
                                     reach meets it (light/reach.c); NULL without a reach: all */
+    size_t list_capacity;
 } hr_direct;
 
 /* Zero *d and, when the scene has luminaires or daylight, start every node

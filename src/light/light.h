@@ -110,8 +110,7 @@ bool rad_light_reach_holds(const rad_light_reach *reach, size_t k, vec3 p);
 /* The luminaires whose box meets [lo, hi], in index order, into out (room
  * for all of them); returns how many. */
 size_t rad_light_reach_list(const rad_light_reach *reach, vec3 lo, vec3 hi, uint32_t *out);
-/* Rays the fans took; luminaires whose box is everywhere. */
-uint64_t rad_light_reach_rays(const rad_light_reach *reach);
+/* Luminaires whose box is everywhere. */
 size_t rad_light_reach_everywhere(const rad_light_reach *reach);
 
 /* The parts, one file each. */

@@ -36,25 +36,22 @@
 #include "photometry/photometry.h"
 
 #include <math.h>
-#include <string.h>
 
 enum { FAN = 8192 };
 
 struct rad_light_reach {
     size_t count;
     vec3 *lo, *hi;      /* per luminaire, m; +-inf: everywhere */
-    uint64_t rays;
-    size_t everywhere;
 };
 
 /* One luminaire's box (vis/reach.c's fan from its centre, widened by its
- * luminous size); false when a ray left the scene (everywhere). */
-static bool luminaire_box(const rad_scene *scene, const rad_luminaire *L, const rad_vis *vis, double eps,
+ * luminous size); infinite when a ray left the scene. */
+static void luminaire_box(const rad_scene *scene, const rad_luminaire *L, const rad_vis *vis, double eps,
                           vec3 *lo, vec3 *hi)
 {
     const rad_photometry *ph = scene->luminaires.photometries[L->photometry];
     double size = fmax(fmax(ph->length, ph->width), ph->height);
-    return rad_vis_reach(vis, L->position, eps, FAN, (isfinite(size) ? size : 0.0) + 4.0 * eps, lo, hi);
+    rad_vis_reach(vis, L->position, eps, FAN, (isfinite(size) ? size : 0.0) + 4.0 * eps, lo, hi);
 }
 
 rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
@@ -73,29 +70,20 @@ rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     double eps = mesh ? rad_vis_epsilon(mesh) : 0.0;
-    uint8_t *open = rad_alloc(ctx, RAD_MEM_SCENE, n + 1, 1, "luminaires' reach");
-    if (!open) {
-        rad_light_reach_destroy(reach);
-        return RAD_ERROR_OUT_OF_MEMORY;
-    }
     volatile int stop = 0;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads > 0 ? threads : 1)
     for (size_t k = 0; k < n; k++) {
         if (stop)
             continue;
-        open[k] = vis ? !luminaire_box(scene, &scene->luminaires.items[k], vis, eps, &reach->lo[k], &reach->hi[k])
-                      : 1;
+        if (vis) {
+            luminaire_box(scene, &scene->luminaires.items[k], vis, eps, &reach->lo[k], &reach->hi[k]);
+        } else { /* no shadows: everywhere */
+            reach->lo[k] = v3(-INFINITY, -INFINITY, -INFINITY);
+            reach->hi[k] = v3(INFINITY, INFINITY, INFINITY);
+        }
         if (rad_cancelled(ctx))
             stop = 1;
     }
-    for (size_t k = 0; k < n; k++)
-        if (open[k]) {
-            reach->lo[k] = v3(-INFINITY, -INFINITY, -INFINITY);
-            reach->hi[k] = v3(INFINITY, INFINITY, INFINITY);
-            reach->everywhere++;
-        }
-    rad_free(open);
-    reach->rays = vis ? (uint64_t)n * FAN : 0;
     if (stop) {
         rad_light_reach_destroy(reach);
         return RAD_ERROR_INTERRUPTED;
@@ -115,27 +103,22 @@ void rad_light_reach_destroy(rad_light_reach *reach)
 
 bool rad_light_reach_holds(const rad_light_reach *reach, size_t k, vec3 p)
 {
-    const vec3 lo = reach->lo[k], hi = reach->hi[k];
-    return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+    return v3_box_holds(reach->lo[k], reach->hi[k], p);
 }
 
 size_t rad_light_reach_list(const rad_light_reach *reach, vec3 lo, vec3 hi, uint32_t *out)
 {
     size_t m = 0;
-    for (size_t k = 0; k < reach->count; k++) {
-        const vec3 a = reach->lo[k], b = reach->hi[k];
-        if (lo.x <= b.x && hi.x >= a.x && lo.y <= b.y && hi.y >= a.y && lo.z <= b.z && hi.z >= a.z)
+    for (size_t k = 0; k < reach->count; k++)
+        if (v3_boxes_meet(lo, hi, reach->lo[k], reach->hi[k]))
             out[m++] = (uint32_t)k;
-    }
     return m;
-}
-
-uint64_t rad_light_reach_rays(const rad_light_reach *reach)
-{
-    return reach ? reach->rays : 0;
 }
 
 size_t rad_light_reach_everywhere(const rad_light_reach *reach)
 {
-    return reach ? reach->everywhere : 0;
+    size_t m = 0;
+    for (size_t k = 0; reach && k < reach->count; k++)
+        m += !v3_finite(reach->lo[k]);
+    return m;
 }

@@ -227,8 +227,7 @@ static double box_cells(const box *b, double inv)
 
 static bool boxes_overlap(const box *a, const box *b)
 {
-    return a->lo.x <= b->hi.x && b->lo.x <= a->hi.x && a->lo.y <= b->hi.y && b->lo.y <= a->hi.y &&
-           a->lo.z <= b->hi.z && b->lo.z <= a->hi.z;
+    return v3_boxes_meet(a->lo, a->hi, b->lo, b->hi);
 }
 
 typedef struct cell_item {

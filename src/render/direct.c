@@ -233,8 +233,7 @@ static void classify_receiver(const rad_direct_light *d, rad_ff_verdict *verdict
             const rad_direct_blocker *bl = &d->blocker[q];
             if (bl->patch == re->patch || bl->patch == src_patch)
                 continue;
-            if (bl->hi.x < lo.x || bl->lo.x > hi.x || bl->hi.y < lo.y || bl->lo.y > hi.y || bl->hi.z < lo.z ||
-                bl->lo.z > hi.z)
+            if (!v3_boxes_meet(bl->lo, bl->hi, lo, hi))
                 continue;
             if (!rad_direct_may_block(bl, v, nr, nv, d->plane_tol))
                 continue;

@@ -145,8 +145,7 @@ rad_result rad_indirect_residual(rad_context *ctx, const rad_direct_light *d, co
                 const rad_direct_blocker *bl = &d->blocker[q];
                 if (bl->patch == a || bl->patch == b)
                     continue;
-                if (bl->hi.x < lo.x || bl->lo.x > hi.x || bl->hi.y < lo.y || bl->lo.y > hi.y ||
-                    bl->hi.z < lo.z || bl->lo.z > hi.z)
+                if (!v3_boxes_meet(bl->lo, bl->hi, lo, hi))
                     continue;
                 if (!rad_direct_may_block(bl, v, na, nv, d->plane_tol))
                     continue;
