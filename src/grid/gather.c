@@ -60,6 +60,8 @@ typedef struct gather_shared {
     const rad_ff_occluders *occ;  /* NULL: no classification (rays) */
     const double *self;           /* 3n: self-emission E_j (W/m^2) */
     const float *diameter;        /* n: element diameter, m */
+    const double *lift;           /* n: the rays' lift at the element, m (eps + its bend) */
+    const int64_t *recv;          /* per point: the element it lies on, or -1 (receiver_of) */
     double eps, plane_tol;
     uint64_t seed;
     const rad_gather_tree *tree;  /* NULL: every element exactly */
@@ -205,7 +207,7 @@ static void gather_element(const gather_shared *g, point_sums *ps, size_t j, ray
     b->factor[b->elements] = F;
     b->first[b->elements] = b->count;
     b->elements++;
-    double lift = g->eps + rad_element_bend(mesh, e);
+    double lift = g->lift[j];
     rad_rng rng = rad_rng_keyed(g->seed, 0x67726964ULL + ps->index, j);
     b->count += (size_t)rad_element_kernel_rays(mesh, e, p, n, ps->origin, lift, k, &rng, b->ray + b->count,
                                                 b->weight + b->count);
@@ -258,7 +260,7 @@ static int cluster_visible(const gather_shared *g, point_sums *ps, const rad_gat
         const rad_element *e = &mesh->elements[j];
         rad_rng rng = rad_rng_keyed(g->seed, 0x67726964ULL + ps->index, j);
         double u = rad_rng_uniform(&rng), v = rad_rng_uniform(&rng);
-        vec3 y = v3_mad(rad_element_sample(mesh, e, u, v), e->normal, g->eps + rad_element_bend(mesh, e));
+        vec3 y = v3_mad(rad_element_sample(mesh, e, u, v), e->normal, g->lift[j]);
         ray[count] = (rad_ray){ps->origin, v3_sub(y, ps->origin), 0.0, 1.0};
         pending[count++] = j;
     }
@@ -427,7 +429,7 @@ static void gather_point(const gather_shared *g, size_t index, ray_batch *b, dou
     rad_light_irradiance_among(view->scene, mesh, view->vis, ps.p, ps.n, &reach, direct);
     *light_seconds += rad_seconds() - t0;
     indirect[0] = indirect[1] = indirect[2] = 0.0;
-    ps.recv = receiver_of(g, ps.p, ps.n);
+    ps.recv = g->recv[index];
     ps.re = ps.recv >= 0 ? &mesh->elements[ps.recv] : NULL;
     ps.origin = v3_mad(ps.p, ps.n, g->eps);
     if (g->tree) {
@@ -465,15 +467,30 @@ rad_result rad_grid_gather_tuned(rad_context *ctx, const rad_solution_view *view
     int threads = view->threads > 0 ? view->threads : 1;
     double *self = rad_alloc(ctx, RAD_MEM_RENDER, 3 * n + 1, sizeof *self, "illuminance: self-emission");
     float *diameter = rad_alloc(ctx, RAD_MEM_RENDER, n + 1, sizeof *diameter, "illuminance: element sizes");
+    double *lift = rad_alloc(ctx, RAD_MEM_RENDER, n + 1, sizeof *lift, "illuminance: element sizes");
+    int64_t *recv = rad_alloc(ctx, RAD_MEM_RENDER, points + 1, sizeof *recv, "illuminance: the points' surfaces");
     ray_batch *batches = rad_alloc(ctx, RAD_MEM_RENDER, (size_t)threads, sizeof *batches, "illuminance: rays");
     void *block = NULL;
     const rad_ff_occluders *occ = NULL;
-    rad_result r = self && diameter && batches ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
-    if (r == RAD_OK && view->vis)
+    rad_result r = self && diameter && lift && recv && batches ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+    /* The points on surfaces first: the occluder classification serves
+     * only them, so a grid of work planes in the air does without it. */
+    int on_surfaces = 0;
+    gather_shared probe = {.view = view, .eps = rad_vis_epsilon(mesh)};
+    if (r == RAD_OK) {
+#pragma omp parallel for schedule(static) num_threads(threads) reduction(+ : on_surfaces)
+        for (size_t k = 0; k < points; k++) {
+            recv[k] = receiver_of(&probe, set->position[k], set->normal[k]);
+            on_surfaces += recv[k] >= 0;
+        }
+    }
+    if (r == RAD_OK && view->vis && on_surfaces > 0)
         r = rad_ff_occluders_build(ctx, mesh, 0, &block, &occ);
     if (r != RAD_OK) {
         rad_free(self);
         rad_free(diameter);
+        rad_free(lift);
+        rad_free(recv);
         rad_free(batches);
         rad_free(block);
         return r;
@@ -493,6 +510,7 @@ rad_result rad_grid_gather_tuned(rad_context *ctx, const rad_solution_view *view
             for (uint32_t b = a + 1; b < e->vertex_count; b++)
                 d = fmax(d, v3_length(v3_sub(mesh->vertices[e->vertex[a]], mesh->vertices[e->vertex[b]])));
         diameter[j] = (float)d;
+        lift[j] = probe.eps + rad_element_bend(mesh, e);
     }
     bool use_tree = method == RAD_GRID_GATHER_TREE ||
                     (method == RAD_GRID_GATHER_AUTO && view->n >= RAD_GRID_GATHER_TREE_MIN);
@@ -500,12 +518,15 @@ rad_result rad_grid_gather_tuned(rad_context *ctx, const rad_solution_view *view
     if (use_tree && (r = rad_gather_tree_build(ctx, view, self, &tree)) != RAD_OK) {
         rad_free(self);
         rad_free(diameter);
+        rad_free(lift);
+        rad_free(recv);
         rad_free(batches);
         rad_free(block);
         return r;
     }
-    gather_shared g = {view, set, occ, self, diameter, rad_vis_epsilon(mesh), rad_ff_plane_tolerance(mesh),
-                       view->options ? view->options->seed : 0, tree, theta > 0.0 ? theta : RAD_GRID_GATHER_THETA, strata > 0 ? strata : 0};
+    gather_shared g = {view, set, occ, self, diameter, lift, recv, rad_vis_epsilon(mesh),
+                       rad_ff_plane_tolerance(mesh), view->options ? view->options->seed : 0, tree,
+                       theta > 0.0 ? theta : RAD_GRID_GATHER_THETA, strata > 0 ? strata : 0};
     int done = 0, skipped = 0;
     uint64_t exact = 0, by_rays = 0, clusters = 0, cluster_rays = 0;
     double light = 0.0, busy = 0.0;
@@ -553,6 +574,8 @@ rad_result rad_grid_gather_tuned(rad_context *ctx, const rad_solution_view *view
     stats->thread_seconds = busy;
     rad_free(self);
     rad_free(diameter);
+    rad_free(lift);
+    rad_free(recv);
     rad_free(batches);
     rad_free(block);
     rad_gather_tree_destroy(tree);

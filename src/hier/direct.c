@@ -55,6 +55,9 @@
 #include "light/light.h"
 
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /* Grow the per-node arrays to n nodes and the pending cubatures to the
  * nodes [done, n).  Fails for memory. */
@@ -89,14 +92,32 @@ static rad_result grow(rad_context *ctx, hr_direct *d, size_t n)
     return RAD_OK;
 }
 
-/* The luminaires a node of patch p asks (all without a reach). */
-static rad_light_among among(const hr_direct *d, uint32_t patch)
+/* The luminaires node k asks (all without a reach): its patch's list, of
+ * which a node below the root keeps those whose reach meets its own box
+ * (a floor's list has the next room's luminaires, whose light comes
+ * through the door; most of its nodes are out of that light), into this
+ * thread's node_list. */
+static rad_light_among among(const hr_tree *tree, const hr_direct *d, uint32_t k)
 {
     if (!d->list_start)
         return (rad_light_among){NULL, 0, NULL};
     static const uint32_t nothing[1] = {0};
-    uint32_t from = d->list_start[patch], to = d->list_start[patch + 1];
-    return (rad_light_among){to > from ? d->list + from : nothing, to - from, NULL};
+    const hr_node *nd = &tree->nodes[k];
+    uint32_t from = d->list_start[nd->patch], to = d->list_start[nd->patch + 1];
+    if (to == from)
+        return (rad_light_among){nothing, 0, NULL};
+    if (nd->level == 0)
+        return (rad_light_among){d->list + from, to - from, NULL};
+#ifdef _OPENMP
+    uint32_t *mine = d->node_list + (size_t)omp_get_thread_num() * d->list_max;
+#else
+    uint32_t *mine = d->node_list;
+#endif
+    size_t m = 0;
+    for (uint32_t i = from; i < to; i++)
+        if (rad_light_reach_meets(d->reach, d->list[i], nd->lo, nd->hi))
+            mine[m++] = d->list[i];
+    return (rad_light_among){m ? mine : nothing, m, NULL};
 }
 
 /* Start the nodes [d->count, tree->count) in parallel: their coarse mean
@@ -120,7 +141,7 @@ static rad_result start_new(rad_context *ctx, const hr_tree *tree, hr_direct *d)
         memset(cub, 0, sizeof *cub);
         h[0] = h[1] = h[2] = 0.0;
         if (!stop && nd->kind == HR_SURFACE) {
-            rad_light_among set = among(d, nd->patch);
+            rad_light_among set = among(tree, d, (uint32_t)k);
             rad_light_polygon_start(d->scene, d->base, d->vis, nd->corner, nd->corners, nd->normal, &set, cub, h,
                                     &dev);
         }
@@ -153,7 +174,7 @@ static rad_result finish_pending(rad_context *ctx, const hr_tree *tree, hr_direc
         const hr_node *nd = &tree->nodes[k];
         if (stop || nd->kind != HR_SURFACE || nd->child[0] != 0)
             continue;
-        rad_light_among set = among(d, nd->patch);
+        rad_light_among set = among(tree, d, (uint32_t)k);
         /* The integral to a tenth of epsilon's share of reflected power
          * (the deviation was read when the leaf was started: not again). */
         double tolerance = nd->rho > 0.0f ? 0.1 * epsilon / (double)nd->rho : INFINITY;
@@ -202,12 +223,17 @@ static rad_result patch_lists(rad_context *ctx, const hr_tree *tree, const rad_l
         if (total > UINT32_MAX)
             return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: over 4 billion patch-luminaire pairs in reach");
         d->list_start[p] = (uint32_t)total;
-        total += rad_light_reach_list(reach, lo, hi, d->list + total);
+        size_t listed = rad_light_reach_list(reach, lo, hi, d->list + total);
+        total += listed;
+        d->list_max = listed > d->list_max ? listed : d->list_max;
     }
     if (total > UINT32_MAX)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY, "hierarchical: over 4 billion patch-luminaire pairs in reach");
     d->list_start[patches] = (uint32_t)total;
-    return RAD_OK;
+    d->reach = reach;
+    d->node_list = rad_alloc(ctx, RAD_MEM_HIERARCHY, (size_t)rad_context_threads(ctx) * d->list_max + 1,
+                             sizeof *d->node_list, "hierarchical: the luminaires each node asks");
+    return d->node_list ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
 }
 
 rad_result hr_direct_start(rad_context *ctx, const hr_tree *tree, const rad_vis *vis,
@@ -299,7 +325,8 @@ double hr_direct_bytes(const hr_direct *d)
 {
     return (double)d->capacity * (3.0 * sizeof(double) + sizeof(float)) +
            (double)d->pending_capacity * sizeof(rad_light_cubature) +
-           (d->list_start ? (double)(d->base->patch_count + 1 + d->list_capacity) * sizeof(uint32_t) : 0.0);
+           (d->list_start ? (double)(d->base->patch_count + 1 + d->list_capacity) * sizeof(uint32_t) : 0.0) +
+           (d->node_list ? (double)d->list_max * sizeof(uint32_t) : 0.0);
 }
 
 void hr_direct_free(hr_direct *d)
@@ -309,5 +336,6 @@ void hr_direct_free(hr_direct *d)
     rad_free(d->pending);
     rad_free(d->list_start);
     rad_free(d->list);
+    rad_free(d->node_list);
     memset(d, 0, sizeof *d);
 }

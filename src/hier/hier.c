@@ -1110,7 +1110,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         /* Luminaires and daylight (direct.c): every node's direct
          * irradiance; its first reflection counts as emission for epsilon
          * and the residual, as E += rho H_d does for the dense solvers. */
-        double reflected = 0.0;
+        double reflected = 0.0, td = rad_seconds();
         size_t grown = 0;
         r = hr_direct_start(ctx, &st.tree, p->vis, p->light_reach, &st.direct, &reflected);
         st.emitted += reflected;
@@ -1118,6 +1118,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         hs->epsilon_abs = epsilon_abs;
         if (r == RAD_OK)
             r = hr_direct_update(ctx, &st.tree, &st.direct, epsilon_abs, &grown);
+        hs->seconds_direct += rad_seconds() - td;
         if (r == RAD_OK)
             r = ensure_values(&st);
         if (r != RAD_OK)
@@ -1165,12 +1166,16 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
             hr_tree_set_power(&st.tree, st.B, st.send);
         if (r == RAD_OK)
             r = hr_refine(ctx, &st.tree, &rp, st.B, st.spread, &st.links, &split, &rs);
+        double td = rad_seconds();
         if (r == RAD_OK) /* the new leaves' direct light (direct.c) */
             r = hr_direct_update(ctx, &st.tree, &st.direct, epsilon_abs, &grown);
+        hs->seconds_direct += rad_seconds() - td;
         if (r == RAD_OK)
             r = ensure_values(&st);
+        td = rad_seconds();
         if (r == RAD_OK)
             measure_open(&st, p->vis, p->seed);
+        hs->seconds_open += rad_seconds() - td;
         if (r == RAD_OK && (split > 0 || grown > 0))
             r = sort_links(&st);
         if (r == RAD_OK && bytes_in_use(&st) > p->max_memory)

@@ -249,6 +249,9 @@ typedef struct hr_direct {
     uint32_t *list_start, *list; /* per patch (list_start[p] .. [p + 1]): the luminaires whose
                                     reach meets it (light/reach.c); NULL without a reach: all */
     size_t list_capacity;
+    const rad_light_reach *reach; /* NULL: every luminaire everywhere */
+    uint32_t *node_list;      /* per thread, list_max entries: a node's own list (among) */
+    size_t list_max;          /* the longest patch list */
 } hr_direct;
 
 /* Zero *d and, when the scene has luminaires or daylight, start every node
@@ -313,6 +316,8 @@ typedef struct rad_hier_stats {
     double bytes;              /* nodes + links + per-node values at the end */
     double link_bytes;         /* bytes per link */
     double seconds_refine, seconds_solve, seconds_mesh;
+    double seconds_direct;     /* of seconds_refine: the luminaires' and daylight's (direct.c) */
+    double seconds_open;       /* of seconds_refine: the leaves' open fractions (measure_open) */
     double closure_mean;       /* link closure over leaves (measure_closure): area mean */
     double closure_min, closure_max;
     double closure_power;      /* ... weighted by A B */

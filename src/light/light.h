@@ -105,8 +105,9 @@ void rad_light_polygon_finish(const rad_scene *scene, const rad_mesh *mesh, cons
 rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
                                  const rad_vis *vis, int threads, rad_light_reach **out);
 void rad_light_reach_destroy(rad_light_reach *reach);
-/* Whether luminaire k's box holds p. */
+/* Whether luminaire k's reach holds p / meets the box [lo, hi]. */
 bool rad_light_reach_holds(const rad_light_reach *reach, size_t k, vec3 p);
+bool rad_light_reach_meets(const rad_light_reach *reach, size_t k, vec3 lo, vec3 hi);
 /* The luminaires whose box meets [lo, hi], in index order, into out (room
  * for all of them); returns how many. */
 size_t rad_light_reach_list(const rad_light_reach *reach, vec3 lo, vec3 hi, uint32_t *out);

@@ -27,6 +27,12 @@
  *      |   / | \   D ---->     |        wall: A's box is A and the strip
  *      +-----------+-----------+        of B behind the door
  *
+ * The same by sectors (vis/reach.c): BANDS x AZIMUTHS boxes, one per
+ * sector of the fan's directions, whose union keeps the box's promise and
+ * leaves out most of the room behind a door (the strip the door's light
+ * falls on stays in).  A query tests the whole box, then the bands', then
+ * their sectors'.
+ *
  * Cost: FAN rays a luminaire (40 downlights: 0.33 M rays), against
  * points x luminaires shadow rays saved.  Each luminaire alone, in
  * parallel: the boxes do not depend on the thread count.
@@ -37,21 +43,50 @@
 
 #include <math.h>
 
-enum { FAN = 8192 };
+enum {
+    FAN = 8192,
+    BANDS = 8,                  /* the fan's sectors (vis/reach.c): bands of z ... */
+    AZIMUTHS = 16,              /* ... times azimuths */
+    SECTORS = BANDS * AZIMUTHS
+};
 
 struct rad_light_reach {
     size_t count;
-    vec3 *lo, *hi;      /* per luminaire, m; +-inf: everywhere */
+    vec3 *lo, *hi;              /* per luminaire, m; +-inf: everywhere */
+    vec3 *band_lo, *band_hi;    /* BANDS per luminaire: the union of the band's sectors */
+    vec3 *sector_lo, *sector_hi; /* SECTORS per luminaire */
 };
 
-/* One luminaire's box (vis/reach.c's fan from its centre, widened by its
- * luminous size); infinite when a ray left the scene. */
-static void luminaire_box(const rad_scene *scene, const rad_luminaire *L, const rad_vis *vis, double eps,
-                          vec3 *lo, vec3 *hi)
+/* One luminaire's boxes (vis/reach.c's fan from its centre, widened by its
+ * luminous size), whole, by band and by sector; infinite when a ray left
+ * the scene. */
+static void luminaire_boxes(const rad_scene *scene, const rad_luminaire *L, const rad_vis *vis, double eps,
+                            rad_light_reach *reach, size_t k)
 {
     const rad_photometry *ph = scene->luminaires.photometries[L->photometry];
     double size = fmax(fmax(ph->length, ph->width), ph->height);
-    rad_vis_reach(vis, L->position, eps, FAN, (isfinite(size) ? size : 0.0) + 4.0 * eps, lo, hi);
+    vec3 *slo = reach->sector_lo + k * SECTORS, *shi = reach->sector_hi + k * SECTORS;
+    rad_vis_reach_sectors(vis, L->position, eps, FAN, (isfinite(size) ? size : 0.0) + 4.0 * eps, BANDS, AZIMUTHS,
+                          &reach->lo[k], &reach->hi[k], slo, shi);
+    for (int b = 0; b < BANDS; b++) {
+        vec3 lo = slo[b * AZIMUTHS], hi = shi[b * AZIMUTHS];
+        for (int a = 1; a < AZIMUTHS; a++) {
+            lo = v3_min(lo, slo[b * AZIMUTHS + a]);
+            hi = v3_max(hi, shi[b * AZIMUTHS + a]);
+        }
+        reach->band_lo[k * BANDS + b] = lo;
+        reach->band_hi[k * BANDS + b] = hi;
+    }
+}
+
+static void everywhere(rad_light_reach *reach, size_t k)
+{
+    vec3 lo = v3(-INFINITY, -INFINITY, -INFINITY), hi = v3(INFINITY, INFINITY, INFINITY);
+    reach->lo[k] = lo, reach->hi[k] = hi;
+    for (size_t b = 0; b < BANDS; b++)
+        reach->band_lo[k * BANDS + b] = lo, reach->band_hi[k * BANDS + b] = hi;
+    for (size_t s = 0; s < SECTORS; s++)
+        reach->sector_lo[k * SECTORS + s] = lo, reach->sector_hi[k * SECTORS + s] = hi;
 }
 
 rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
@@ -64,8 +99,12 @@ rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const
         return RAD_ERROR_OUT_OF_MEMORY;
     reach->count = n;
     reach->lo = rad_alloc(ctx, RAD_MEM_SCENE, n + 1, sizeof *reach->lo, "luminaires' reach");
-    reach->hi = reach->lo ? rad_alloc(ctx, RAD_MEM_SCENE, n + 1, sizeof *reach->hi, "luminaires' reach") : NULL;
-    if (!reach->hi) {
+    reach->hi = rad_alloc(ctx, RAD_MEM_SCENE, n + 1, sizeof *reach->hi, "luminaires' reach");
+    reach->band_lo = rad_alloc(ctx, RAD_MEM_SCENE, BANDS * n + 1, sizeof(vec3), "luminaires' reach");
+    reach->band_hi = rad_alloc(ctx, RAD_MEM_SCENE, BANDS * n + 1, sizeof(vec3), "luminaires' reach");
+    reach->sector_lo = rad_alloc(ctx, RAD_MEM_SCENE, SECTORS * n + 1, sizeof(vec3), "luminaires' reach");
+    reach->sector_hi = rad_alloc(ctx, RAD_MEM_SCENE, SECTORS * n + 1, sizeof(vec3), "luminaires' reach");
+    if (!reach->lo || !reach->hi || !reach->band_lo || !reach->band_hi || !reach->sector_lo || !reach->sector_hi) {
         rad_light_reach_destroy(reach);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -75,12 +114,10 @@ rad_result rad_light_reach_build(rad_context *ctx, const rad_scene *scene, const
     for (size_t k = 0; k < n; k++) {
         if (stop)
             continue;
-        if (vis) {
-            luminaire_box(scene, &scene->luminaires.items[k], vis, eps, &reach->lo[k], &reach->hi[k]);
-        } else { /* no shadows: everywhere */
-            reach->lo[k] = v3(-INFINITY, -INFINITY, -INFINITY);
-            reach->hi[k] = v3(INFINITY, INFINITY, INFINITY);
-        }
+        if (vis)
+            luminaire_boxes(scene, &scene->luminaires.items[k], vis, eps, reach, k);
+        else /* no shadows: everywhere */
+            everywhere(reach, k);
         if (rad_cancelled(ctx))
             stop = 1;
     }
@@ -98,19 +135,41 @@ void rad_light_reach_destroy(rad_light_reach *reach)
         return;
     rad_free(reach->lo);
     rad_free(reach->hi);
+    rad_free(reach->band_lo);
+    rad_free(reach->band_hi);
+    rad_free(reach->sector_lo);
+    rad_free(reach->sector_hi);
     rad_free(reach);
+}
+
+bool rad_light_reach_meets(const rad_light_reach *reach, size_t k, vec3 lo, vec3 hi)
+{
+    if (!v3_boxes_meet(lo, hi, reach->lo[k], reach->hi[k]))
+        return false;
+    if (!v3_finite(reach->lo[k]))
+        return true;
+    const vec3 *blo = reach->band_lo + k * BANDS, *bhi = reach->band_hi + k * BANDS;
+    const vec3 *slo = reach->sector_lo + k * SECTORS, *shi = reach->sector_hi + k * SECTORS;
+    for (int b = 0; b < BANDS; b++) {
+        if (!v3_boxes_meet(lo, hi, blo[b], bhi[b]))
+            continue;
+        for (int a = b * AZIMUTHS; a < (b + 1) * AZIMUTHS; a++)
+            if (v3_boxes_meet(lo, hi, slo[a], shi[a]))
+                return true;
+    }
+    return false;
 }
 
 bool rad_light_reach_holds(const rad_light_reach *reach, size_t k, vec3 p)
 {
-    return v3_box_holds(reach->lo[k], reach->hi[k], p);
+    return rad_light_reach_meets(reach, k, p, p);
 }
 
 size_t rad_light_reach_list(const rad_light_reach *reach, vec3 lo, vec3 hi, uint32_t *out)
 {
     size_t m = 0;
     for (size_t k = 0; k < reach->count; k++)
-        if (v3_boxes_meet(lo, hi, reach->lo[k], reach->hi[k]))
+        if (rad_light_reach_meets(reach, k, lo, hi))
             out[m++] = (uint32_t)k;
     return m;
 }

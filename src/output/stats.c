@@ -289,6 +289,8 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
         cJSON_AddNumberToObject(hi, "shafts", (double)h->shafts);
         cJSON_AddNumberToObject(hi, "shafts_clear", (double)h->shafts_clear);
         cJSON_AddNumberToObject(hi, "seconds_refine", h->seconds_refine);
+        cJSON_AddNumberToObject(hi, "seconds_direct", h->seconds_direct);
+        cJSON_AddNumberToObject(hi, "seconds_open", h->seconds_open);
         cJSON_AddNumberToObject(hi, "seconds_solve", h->seconds_solve);
         cJSON_AddNumberToObject(hi, "seconds_mesh", h->seconds_mesh);
     }

@@ -83,5 +83,11 @@ size_t rad_vis_unresolved(const rad_mesh *mesh, double *narrowest, uint32_t *whi
  * false (and an infinite box) when a ray hits nothing: the view leaves the
  * scene.  Thread-safe, deterministic; cannot fail. */
 bool rad_vis_reach(const rad_vis *vis, vec3 origin, double tnear, size_t rays, double pad, vec3 *lo, vec3 *hi);
+/* The same, and the box of each sector of the fan's directions (reach.c):
+ * `bands` bands of z times `azimuths` azimuths, sector_lo/hi[band x
+ * azimuths + azimuth] (room for bands x azimuths each), every one holding
+ * the origin; all infinite when a ray hits nothing. */
+bool rad_vis_reach_sectors(const rad_vis *vis, vec3 origin, double tnear, size_t rays, double pad, int bands,
+                           int azimuths, vec3 *lo, vec3 *hi, vec3 *sector_lo, vec3 *sector_hi);
 
 #endif /* RAD_VIS_H */
