@@ -5,6 +5,7 @@ reference solver, side by side in one run.
 
     bench/office_lit.py [--rooms N] [--threads T] [--binary PATH]
                         [--reference "--solver gauss-seidel --elements 8000" | --no-reference]
+                        [--paths N]
 
 The office is `radiosity generate office --rooms N` (seed 0) with its
 ceiling panels dark (Ke 0: a scene lit by luminaires), four downlights a
@@ -14,7 +15,10 @@ floor's footprint at 0.8 m, EN 12464-1 spacing).  Prints, for each run,
 the wall time and peak memory (/usr/bin/time), then per room Eavg of both
 and their difference, and the share of points within 5% of the reference.
 --no-reference runs the default alone (the 1,000-room office: its time,
-memory and the solve's figures).  The working files stay in a temporary
+memory and the solve's figures).  --paths N adds the converged reference
+of bench/lux_reference.c (path tracing from each point, N paths, the
+luminaires by next-event estimation; no elements or solver) and compares
+both runs with it, per room and per point.  The working files stay in a temporary
 folder, removed at the end.
 """
 import argparse
@@ -67,6 +71,8 @@ def main():
     ap.add_argument('--binary', default=os.path.join(root, 'build', 'radiosity'))
     ap.add_argument('--reference', default='--solver gauss-seidel --elements 8000')
     ap.add_argument('--no-reference', action='store_true')
+    ap.add_argument('--paths', type=int, default=0)
+    ap.add_argument('--tracer', default=os.path.join(root, 'build', 'bench', 'lux_reference'))
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix='radiosity-office-')
     try:
@@ -99,26 +105,44 @@ def main():
               % (h.get('leaves', 0), h.get('links', 0), st['seconds']['solve'], h.get('seconds_refine', 0.0),
                  t_def - st['seconds']['solve'] - st['seconds']['load'] - st['seconds']['mesh'],
                  st['luminaires']['direct_lumens'], st['luminaires']['lumens']))
+        d = json.load(open(os.path.join(work, 'd.json')))['grids']
+        if a.paths > 0:
+            p = os.path.join(work, 'p.json')
+            run([a.tracer, obj, '--luminaires', os.path.join(work, 'layout.json'), '--grid',
+                 os.path.join(work, 'grids.json'), '--paths', str(a.paths), '--threads', str(a.threads),
+                 '-o', p], 'paths')
+            paths = json.load(open(p))['grids']
+            print('  against the path-traced reference (%d paths a point; its standard error per room):' % a.paths)
+            compare('default', d, paths)
         if a.no_reference:
             return
         t_ref = run(base + ['-o', os.path.join(work, 'r.json')] + a.reference.split(), 'reference')
-        d = json.load(open(os.path.join(work, 'd.json')))['grids']
         r = json.load(open(os.path.join(work, 'r.json')))['grids']
-        within, total, worst = 0, 0, 0.0
-        for gd, gr in zip(d, r):
-            diff = gd['E_avg_lux'] / gr['E_avg_lux'] - 1.0
-            worst = max(worst, abs(diff))
-            print('  %-8s Eavg %8.1f lux  reference %8.1f lux  %+6.2f%%' % (gd['name'], gd['E_avg_lux'],
-                                                                          gr['E_avg_lux'], 100 * diff))
-            for vd, vr in zip(gd['values'], gr['values']):
-                ed = vd['E_lux'] if isinstance(vd, dict) else vd
-                er = vr['E_lux'] if isinstance(vr, dict) else vr
-                total += 1
-                within += abs(ed - er) <= 0.05 * abs(er)
-        print('speed-up %.1fx; worst room Eavg %.2f%%; points within 5%%: %d of %d (%.1f%%)' %
-              (t_ref / t_def, 100 * worst, within, total, 100.0 * within / max(total, 1)))
+        if a.paths > 0:
+            compare('reference', r, paths)
+        print('  the default against the reference run:')
+        compare('default', d, r)
+        print('speed-up %.1fx' % (t_ref / t_def))
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def compare(label, d, r):
+    """Per room Eavg of run d against r, the worst room and the points within 5%."""
+    within, total, worst = 0, 0, 0.0
+    for gd, gr in zip(d, r):
+        diff = gd['E_avg_lux'] / gr['E_avg_lux'] - 1.0
+        worst = max(worst, abs(diff))
+        err = gr.get('E_avg_stderr_lux')
+        print('  %-9s %-8s Eavg %8.1f lux  against %8.1f lux%s  %+6.2f%%' % (
+            label, gd['name'], gd['E_avg_lux'], gr['E_avg_lux'], ' (+-%.2f)' % err if err else '', 100 * diff))
+        for vd, vr in zip(gd['values'], gr['values']):
+            ed = vd['E_lux'] if isinstance(vd, dict) else vd
+            er = vr['E_lux'] if isinstance(vr, dict) else vr
+            total += 1
+            within += abs(ed - er) <= 0.05 * abs(er)
+    print('  %s: worst room Eavg %.2f%%; points within 5%%: %d of %d (%.1f%%)' %
+          (label, 100 * worst, within, total, 100.0 * within / max(total, 1)))
 
 
 if __name__ == '__main__':
