@@ -33,7 +33,8 @@ typedef struct rad_control_variate {
 
 /* Choose beta per group of elements light can join and channel, and
  * estimate T and E' (control_variate.c).  `transport_rays` rays per
- * element estimate T where some beta is not 0.  Arrays are per element
+ * element estimate T where some beta is not 0; a group some grouping ray
+ * leaves (escaping, or onto a back side) gets beta = 0.  Arrays are per element
  * (area n, reflectance and emission 3n).  Deterministic for a seed,
  * whatever `threads`.  On failure *out is zeroed and nothing leaks. */
 rad_result rad_control_variate_make(rad_context *ctx, const rad_mesh *mesh, const rad_vis *vis, const double *area,

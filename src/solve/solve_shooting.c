@@ -53,15 +53,15 @@
  * where it would go is unknown.
  *
  * The control variate (control_variate.c; Bekaert 1999): B = beta + B',
- * beta a constant per group of elements light joins, its transport known
- * (exactly beta in a closed group, else estimated by rays without bias),
- * and only B' shot, from the residual source E' = E + rho T - beta.  E'
+ * beta a constant per closed group of elements light joins, its transport
+ * T known (beta, checked by rays without bias), and only B' shot, from
+ * the residual source E' = E + rho T - beta.  E'
  * and so the unshot light can be negative: the heap orders by |unshot|,
  * the tolerance counts |unshot|, a ray carries signed power and the
  * remainder is signed (all linear).  The closed furnace has E' = 0: no
  * shot at all, B = E / (1 - rho) on every face to rounding, where shooting
- * E gave faces 2.5e-4 rms apart.  Where beta = 0 (a room lit by lamps, the
- * rule of control_variate.c) the shots are those without it.
+ * E gave faces 2.5e-4 rms apart.  Where beta = 0 (a room lit by lamps, an
+ * open group: control_variate.c) the shots are those without it.
  */
 #include "solve/solve.h"
 #include "solve/control_variate.h"

@@ -41,7 +41,12 @@
  * 1.6e-3 rms from seed to seed, and still 1e-3 at 16384 paths: what
  * remains is the gathers' noise (each VPL at one random point of each
  * element, the clamped light's realised loss against the near-field
- * estimate of its mean), so 1e-4 is out of reach at a reasonable cost.
+ * estimate of its mean), so 1e-4 is out of reach at a reasonable cost
+ * for the light paths alone.  Hence the control variate
+ * (solve/control_variate.h): the paths and the direct gather carry the
+ * residual source E' = E + rho T - beta of B' = B - beta, signed, and
+ * B = beta + B'.  The furnace's E' is 0: no path, B = 2.5 to 3e-14; a box
+ * of mixed reflectances halves the per-surface error (docs/methods.md).
  *
  * Determinism: every element's numbers come from streams keyed on (seed,
  * element), VPLs from the seeded Halton sequence; elements are
