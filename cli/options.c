@@ -181,6 +181,7 @@ static const cli_flag FLAGS[] = {
     {"near-field", 0, "X", RV, SOLVE(near_field)},
     {"closure-correction", 0, NULL, RV, SOLVE(closure_correction)},
     {"raw-form-factors", 0, NULL, RV, SOLVE(raw_form_factors)},
+    {"no-control-variate", 0, NULL, RV, SOLVE(no_control_variate)},
     {"adaptive", 0, "LEVELS", RS, SOLVE(adaptive_levels)},
     {"adaptive-threshold", 0, "X", RS, SOLVE(adaptive_threshold)},
     {"adaptive-elements", 0, "N", RS, SOLVE(adaptive_max_elements)},

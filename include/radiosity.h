@@ -357,6 +357,9 @@ typedef struct rad_options {
                                      scene sum to 1 while A_i F_ij = A_j F_ji (thermal use);
                                      hierarchical: each patch sends B / its link closure;
                                      refused by shooting */
+    int no_control_variate;       /* nonzero: shooting and instant radiosity estimate B itself
+                                     instead of B - beta, beta a constant per lit group whose
+                                     transport is known (docs/methods.md); for comparison */
     int raw_form_factors;         /* nonzero: keep a sampled method's F (hemicube, hemisphere,
                                      montecarlo) as estimated; by default the two estimates
                                      of each pair are combined (reciprocity) and rows held

@@ -249,6 +249,13 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
         cJSON_AddNumberToObject(ir, "clamp_loss_unclamped", s->solve->vpl_clamp_loss_unclamped);
         cJSON_AddBoolToObject(ir, "compensated", s->solve->vpl_compensated);
     }
+    if (s->solve->cv_groups > 0) { /* shooting, instant radiosity: B = beta + B' */
+        cJSON *cv = cJSON_AddObjectToObject(so, "control_variate");
+        cJSON_AddNumberToObject(cv, "groups", (double)s->solve->cv_groups);
+        cJSON_AddNumberToObject(cv, "groups_varied", (double)s->solve->cv_groups_varied);
+        cJSON_AddItemToObject(cv, "beta", rgb_array(s->solve->cv_beta));
+        cJSON_AddNumberToObject(cv, "rays", (double)s->solve->cv_rays);
+    }
     if (s->hier) {
         const rad_hier_stats *h = s->hier;
         cJSON *hi = cJSON_AddObjectToObject(so, "hierarchical");

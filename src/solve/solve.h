@@ -28,6 +28,7 @@ typedef struct rad_system {
     const struct rad_vis *vis;
     uint64_t seed;
     int samples;              /* rays per shot; 0 = the solver's default */
+    bool control_variate;     /* shooting: solve for B - beta (solve/control_variate.h) */
     double max_memory;        /* bytes a solver may allocate; 0 = the context's limit */
 } rad_system;
 
@@ -67,6 +68,11 @@ typedef struct rad_solve_stats {
                                  the near-field estimate, instant.c) */
     double vpl_clamp_loss_unclamped; /* the same from the unclamped gather (unbiased, heavy-tailed) */
     bool vpl_compensated;     /* the loss was added back (solver instant-radiosity) */
+    /* the control variate B = beta + B' (solve/control_variate.h; shooting and instant radiosity): */
+    size_t cv_groups;         /* groups of elements it chose beta for; 0 where it was not used */
+    size_t cv_groups_varied;  /* of those, the groups with beta != 0 */
+    double cv_beta[3];        /* W/m^2, RGB: beta's area-weighted mean over the scene */
+    uint64_t cv_rays;         /* rays it cast (counted in `rays` too) */
     char warning[320];        /* why it stopped short of its tolerance, one line; "" when
                                  it converged or was interrupted */
 } rad_solve_stats;

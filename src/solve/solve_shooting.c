@@ -51,8 +51,20 @@
  * over the whole scene lit it); a group that never shot, say an emitter
  * too faint to be reached by the tolerance, keeps its light unshot, as
  * where it would go is unknown.
+ *
+ * The control variate (control_variate.c; Bekaert 1999): B = beta + B',
+ * beta a constant per closed group of elements light joins, its transport
+ * T known (beta, checked by rays without bias), and only B' shot, from
+ * the residual source E' = E + rho T - beta.  E'
+ * and so the unshot light can be negative: the heap orders by |unshot|,
+ * the tolerance counts |unshot|, a ray carries signed power and the
+ * remainder is signed (all linear).  The closed furnace has E' = 0: no
+ * shot at all, B = E / (1 - rho) on every face to rounding, where shooting
+ * E gave faces 2.5e-4 rms apart.  Where beta = 0 (a room lit by lamps, an
+ * open group: control_variate.c) the shots are those without it.
  */
 #include "solve/solve.h"
+#include "solve/control_variate.h"
 #include "mesh/mesh.h"
 #include "vis/vis.h"
 #include "formfactor/formfactor.h"
@@ -71,7 +83,7 @@ enum { BATCH = 32, RAY_BLOCK = 64 };
 typedef struct heap {
     uint32_t *item;   /* heap order -> element */
     uint32_t *slot;   /* element -> heap position */
-    double *key;      /* element -> unshot power (W, summed over RGB) */
+    double *key;      /* element -> unshot power (W, |R| + |G| + |B|) */
     size_t count;
 } heap;
 
@@ -115,7 +127,7 @@ typedef struct light_group {
     double area;              /* m^2 */
     double rho_area[3];       /* m^2: reflectance x area */
     double unshot[3];         /* W */
-    double sent, lost;        /* W, summed over RGB: power shot, and escaped or onto back sides */
+    double sent, lost;        /* W, |R| + |G| + |B|: power shot, and escaped or onto back sides */
 } light_group;
 
 /* Add each group's expected remainder (file header) to B, and the power it
@@ -157,9 +169,10 @@ static void add_remainder(const rad_system *sys, const double *dB, size_t *paren
             continue; /* never shot: where its light goes is unknown */
         double kept = fmax(0.0, 1.0 - g->lost / g->sent);
         for (int c = 0; c < 3; c++) {
-            /* The unshot sum can end at -1e-18 where all is shot. */
-            double U = fmax(g->unshot[c], 0.0), rho = g->rho_area[c] / g->area;
-            if (!(U > 0.0) || !(rho * kept < 1.0))
+            /* Signed: the control variate's residual light can be
+             * negative, and its remainder is too (linear). */
+            double U = g->unshot[c], rho = g->rho_area[c] / g->area;
+            if (U == 0.0 || !(rho * kept < 1.0))
                 continue;
             B[3 * i + c] += sys->reflectance[3 * i + c] * U * kept / (g->area * (1.0 - rho * kept));
             if (r == i)
@@ -213,6 +226,25 @@ static void shoot_rays(const rad_context *ctx, const rad_system *sys, uint32_t i
     }
 }
 
+/* Element i's unshot power, W: |R| + |G| + |B| (the control variate's
+ * residual light is signed). */
+static double unshot_key(const rad_system *sys, const double *dB, size_t i)
+{
+    return sys->area[i] * (fabs(dB[3 * i]) + fabs(dB[3 * i + 1]) + fabs(dB[3 * i + 2]));
+}
+
+/* Unshot over emitted power, the stopping measure: the running sum of
+ * |unshot| with the control variate; without it, every unshot value is
+ * positive and the channels' sums give the same up to rounding (kept so
+ * that a scene where beta = 0 solves as it did before). */
+static double unshot_fraction(const rad_control_variate *cv, const double *unshot_c, double unshot_abs,
+                              double emitted)
+{
+    if (!(emitted > 0.0))
+        return 0.0;
+    return (cv->active ? fmax(unshot_abs, 0.0) : unshot_c[0] + unshot_c[1] + unshot_c[2]) / emitted;
+}
+
 static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_solve_params *p,
                            double *B, rad_solve_stats *stats)
 {
@@ -225,8 +257,11 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     /* O(n) vectors and the hit records of BATCH shots in flight: check the
      * estimate first, so that a huge --ff-samples is refused with a way out. */
     double limit = sys->max_memory > 0.0 ? sys->max_memory : rad_memory_limit(ctx);
+    /* The control variate: 9 doubles an element, and its groups' 4 words
+     * and weighted value while it is made. */
     double bytes = (double)BATCH * (double)N * (double)sizeof(hit_record) +
-                   (64.0 + 2.0 * sizeof(size_t) + sizeof(light_group)) * (double)n;
+                   (64.0 + 2.0 * sizeof(size_t) + sizeof(light_group) + 9.0 * sizeof(double) +
+                    4.0 * sizeof(size_t) + 2.0 * sizeof(double)) * (double)n;
     if (bytes > limit)
         return rad_fail(ctx, RAD_ERROR_OUT_OF_MEMORY,
                         "shooting: %d rays per shot for %zu elements need %.2f GiB, above the "
@@ -243,32 +278,48 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     size_t *parent = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *parent, "shooting: groups");
     size_t *size = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *size, "shooting: groups");
     light_group *group = rad_alloc(ctx, RAD_MEM_SOLVER, n, sizeof *group, "shooting: groups");
+    rad_control_variate cv = {0};
     rad_result result = RAD_OK;
     if (!dB || !h.item || !h.slot || !h.key || !hits || !rays || !rhits || !parent || !size || !group) {
         result = RAD_ERROR_OUT_OF_MEMORY;
         goto done;
     }
+    /* B = beta + B' (file header): B starts at beta + E', and only the
+     * residual light E' is shot. */
+    if (sys->control_variate)
+        result = rad_control_variate_make(ctx, sys->mesh, sys->vis, sys->area, sys->reflectance, sys->emission,
+                                          sys->seed, N, threads, &cv);
+    if (result != RAD_OK)
+        goto done;
+    if (cv.active)
+        for (size_t k = 0; k < 3 * n; k++)
+            B[k] = cv.beta[k] + cv.source[k];
 
     /* Running sums: emitted and unshot power per channel, area, rho-area. */
-    double emitted = 0.0, unshot_c[3] = {0, 0, 0}, area = 0.0, rho_area[3] = {0, 0, 0};
+    double emitted = 0.0, unshot_c[3] = {0, 0, 0}, area = 0.0, rho_area[3] = {0, 0, 0}, unshot_abs = 0.0;
+    double absorbed = 0.0;
     for (size_t i = 0; i < n; i++) {
         area += sys->area[i];
         for (int c = 0; c < 3; c++) {
-            dB[3 * i + c] = B[3 * i + c];
+            dB[3 * i + c] = cv.active ? cv.source[3 * i + c] : B[3 * i + c];
             unshot_c[c] += sys->area[i] * dB[3 * i + c];
             rho_area[c] += sys->area[i] * sys->reflectance[3 * i + c];
             emitted += sys->area[i] * sys->emission[3 * i + c];
+            /* What beta's transport leaves absorbed, known without shooting. */
+            if (cv.active)
+                absorbed += sys->area[i] * (1.0 - sys->reflectance[3 * i + c]) * cv.transport[3 * i + c];
         }
         h.item[i] = h.slot[i] = (uint32_t)i;
         parent[i] = i;
         size[i] = 1;
         group[i] = (light_group){0};
-        h.key[i] = sys->area[i] * (dB[3 * i] + dB[3 * i + 1] + dB[3 * i + 2]);
+        h.key[i] = unshot_key(sys, dB, i);
+        unshot_abs += h.key[i];
     }
     h.count = n;
     for (size_t k = n / 2; k-- > 0;) /* heapify */
         heap_fix(&h, h.item[k]);
-    double absorbed = 0.0, t0 = rad_seconds();
+    double t0 = rad_seconds();
     double eps = rad_vis_epsilon(sys->mesh);
     rad_solve_bound bound = rad_solve_bound_make(p->max_iterations, rad_system_contraction(sys), 1.0, goal,
                                                  ceil((double)n / BATCH));
@@ -276,7 +327,7 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     stats->iteration_limit = bound.limit;
     uint64_t rays_cast = 0;
     long long batch = 0;
-    double unshot = emitted > 0.0 ? (unshot_c[0] + unshot_c[1] + unshot_c[2]) / emitted : 0.0;
+    double unshot = unshot_fraction(&cv, unshot_c, unshot_abs, emitted);
     uint32_t shooter[BATCH];
     double power[BATCH][3];
 
@@ -286,6 +337,7 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
         while (K < BATCH && h.count > 0 && h.key[h.item[0]] > 0.0) {
             uint32_t i = h.item[0];
             shooter[K] = i;
+            unshot_abs -= h.key[i];
             for (int c = 0; c < 3; c++) {
                 power[K][c] = sys->area[i] * dB[3 * i + c];
                 unshot_c[c] -= power[K][c];
@@ -319,7 +371,8 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
                     dB[3 * i + c] = power[k][c] / sys->area[i];
                     unshot_c[c] += power[k][c];
                 }
-                h.key[i] = sys->area[i] * (dB[3 * i] + dB[3 * i + 1] + dB[3 * i + 2]);
+                h.key[i] = unshot_key(sys, dB, i);
+                unshot_abs += h.key[i];
                 heap_fix(&h, i);
             }
             result = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted after %lld batches", batch);
@@ -334,7 +387,7 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
         for (int k = 0; k < K; k++) {
             const hit_record *hk = hits + (size_t)k * N;
             light_group *g = &group[shooter[k]];
-            double shot = power[k][0] + power[k][1] + power[k][2];
+            double shot = fabs(power[k][0]) + fabs(power[k][1]) + fabs(power[k][2]);
             g->sent += shot;
             for (int r = 0; r < N; r++) {
                 uint32_t j = hk[r].element;
@@ -353,11 +406,13 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
                     unshot_c[c] += rho * arriving;
                     absorbed += (1.0 - rho) * arriving;
                 }
-                h.key[j] = aj * (dB[3 * j] + dB[3 * j + 1] + dB[3 * j + 2]);
+                double key = unshot_key(sys, dB, j);
+                unshot_abs += key - h.key[j];
+                h.key[j] = key;
                 heap_fix(&h, j);
             }
         }
-        unshot = emitted > 0.0 ? (unshot_c[0] + unshot_c[1] + unshot_c[2]) / emitted : 0.0;
+        unshot = unshot_fraction(&cv, unshot_c, unshot_abs, emitted);
         if (p->monitor) {
             for (int c = 0; c < 3; c++) {
                 double rho_avg = rho_area[c] / area;
@@ -399,7 +454,11 @@ static rad_result shooting(rad_context *ctx, const rad_system *sys, const rad_so
     stats->unshot = unshot;
     stats->absorbed = absorbed / 3.0;
     stats->residual = NAN;
-    stats->rays = rays_cast;
+    stats->rays = rays_cast + cv.rays;
+    stats->cv_groups = cv.groups;
+    stats->cv_groups_varied = cv.groups_varied;
+    stats->cv_rays = cv.rays;
+    memcpy(stats->cv_beta, cv.beta_mean, sizeof stats->cv_beta);
     stats->converged = result == RAD_OK && unshot <= goal;
     if (result == RAD_OK && !stats->converged)
         rad_solve_warn(stats, "shooting", &bound, (double)batch, "batches", "unshot power", unshot,
@@ -415,6 +474,7 @@ done:
     rad_free(parent);
     rad_free(size);
     rad_free(group);
+    rad_control_variate_free(&cv);
     return result;
 }
 

@@ -14,7 +14,9 @@
  * path geometric and the total reflected power as noisy (create below).
  *
  * Each path starts with Phi = (emitted power) / paths in the emitter's
- * colour.  The path's numbers are the dimensions of a Halton sequence
+ * colour.  The emission may be signed (the control variate's residual
+ * source, solve/control_variate.h): elements are chosen by |power| and a
+ * path carries the sign of its emitter's light, all else linear.  The path's numbers are the dimensions of a Halton sequence
  * (radical inverses in the first 64 prime bases: the emitter, its point,
  * then two per bounce: the direction), shifted
  * by a Cranley-Patterson rotation keyed on the seed; dimensions past the
@@ -83,6 +85,19 @@ typedef struct light_path {
 
 static double mean3(const double *v) { return (v[0] + v[1] + v[2]) / 3.0; }
 
+/* The mean of |v| over RGB: an element's emission by magnitude. */
+static double magnitude3(const double *v) { return (fabs(v[0]) + fabs(v[1]) + fabs(v[2])) / 3.0; }
+
+/* Whether any element of patch p emits (signed sources vary over a patch). */
+static bool patch_emits(const rad_mesh *mesh, const double *emission, size_t p)
+{
+    const rad_patch *patch = &mesh->patches[p];
+    for (uint32_t k = 0; k < patch->element_count; k++)
+        if (magnitude3(emission + 3 * (size_t)(patch->first_element + k)) > 0.0)
+            return true;
+    return false;
+}
+
 void rad_vpl_free(rad_vpl_set *set)
 {
     rad_free(set->lights);
@@ -98,13 +113,13 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
     double total_area = 0.0, power = 0.0, power_rgb[3] = {0, 0, 0};
     for (size_t i = 0; i < n; i++) {
         total_area += mesh->elements[i].area;
-        if (mean3(emission + 3 * i) > 0.0)
+        if (magnitude3(emission + 3 * i) > 0.0)
             emitting++;
         for (int c = 0; c < 3; c++)
             power_rgb[c] += mesh->elements[i].area * emission[3 * i + (size_t)c];
     }
     for (size_t p = 0; p < mesh->patch_count; p++)
-        if (mesh->patches[p].element_count > 0 && mean3(emission + 3 * (size_t)mesh->patches[p].first_element) > 0.0)
+        if (patch_emits(mesh, emission, p))
             patches++;
     power = mean3(power_rgb);
     /* Lights: paths x bounces at most; grown as needed from ~2 per path. */
@@ -130,12 +145,12 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
         return RAD_ERROR_OUT_OF_MEMORY;
     }
     for (size_t p = 0; p < mesh->patch_count; p++)
-        if (mesh->patches[p].element_count > 0 && mean3(emission + 3 * (size_t)mesh->patches[p].first_element) > 0.0)
+        if (patch_emits(mesh, emission, p))
             s.emitter_patches[s.emitter_count++] = (uint32_t)p;
     double sum = 0.0;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
-        double w = mesh->elements[i].area * mean3(emission + 3 * i);
+        double w = mesh->elements[i].area * magnitude3(emission + 3 * i);
         if (w > 0.0) {
             sum += w;
             cdf[m] = sum;
@@ -169,9 +184,9 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
         const double *Ej = emission + 3 * (size_t)j;
         light_path *a = &live[live_count++];
         a->index = i;
-        /* Phi = A_j E_j / (p_j paths), p_j = A_j mean(E_j) / sum. */
+        /* Phi = A_j E_j / (p_j paths), p_j = A_j mean|E_j| / sum. */
         for (int c = 0; c < 3; c++)
-            a->phi[c] = Ej[c] / mean3(Ej) * sum / (double)paths;
+            a->phi[c] = Ej[c] / magnitude3(Ej) * sum / (double)paths;
         a->position = v3_mad(rad_element_sample(mesh, e, path_number(rotation, seed, i, 1), path_number(rotation, seed, i, 2)),
                              e->normal, eps + rad_element_bend(mesh, e));
         a->normal = e->normal;
@@ -279,6 +294,7 @@ void rad_vpl_direct(const rad_vpl_set *set, const rad_mesh *mesh, const rad_vis 
          * k was 0.7% low on the Cornell floor at 4 rays: small-sample bias). */
         rad_ray rays[MAX_RAYS];
         double factor[MAX_RAYS], hidden = 0.0;
+        uint32_t element[MAX_RAYS];
         int count = 0;
         for (int r = 0; r < shadow_rays; r++) {
             double a = rad_rng_uniform(rng), u = rad_rng_uniform(rng), v = rad_rng_uniform(rng);
@@ -294,20 +310,32 @@ void rad_vpl_direct(const rad_vpl_set *set, const rad_mesh *mesh, const rad_vis 
             if (!(kernel > 0.0))
                 continue;
             factor[count] = kernel;
+            element[count] = idx;
             rays[count] = (rad_ray){x, dxy, 0.0, 1.0};
             count++;
         }
+        /* The patch's emission is its first element's, E_0; where an
+         * element's differs (a signed residual source), the same rays
+         * estimate sum_e (E_e - E_0) F_e V without bias: nothing to add
+         * where the patch is uniform, as an emitter's is. */
+        const double *E = emission + 3 * (size_t)p->first_element;
+        double deviation[3] = {0, 0, 0};
         if (count > 0) {
             uint8_t blocked[MAX_RAYS];
             vis->backend->occluded(vis->state, rays, (size_t)count, blocked);
-            for (int r = 0; r < count; r++)
-                if (blocked[r])
+            for (int r = 0; r < count; r++) {
+                if (blocked[r]) {
                     hidden += factor[r];
+                    continue;
+                }
+                const double *Ee = emission + 3 * (size_t)element[r];
+                for (int c = 0; c < 3; c++)
+                    deviation[c] += factor[r] * (Ee[c] - E[c]);
+            }
         }
         double seen = F - hidden / shadow_rays;
-        const double *E = emission + 3 * (size_t)p->first_element;
         for (int c = 0; c < 3; c++)
-            H[c] += E[c] * seen;
+            H[c] += E[c] * seen + deviation[c] / shadow_rays;
     }
 }
 

@@ -36,7 +36,8 @@ typedef struct rad_vpl_set {
     rad_vpl *lights;
     size_t count;             /* VPLs (about paths / (1 - mean reflectance) - paths) */
     size_t paths;             /* light paths traced from the emitters */
-    uint32_t *emitter_patches;/* patches holding emission (their elements share its value) */
+    uint32_t *emitter_patches;/* patches holding emission (an emitter's elements share its value; a
+                                 residual source's may not, rad_vpl_direct) */
     size_t emitter_count;
     double clamp_radius;      /* r_c, m: sqrt(total area / (pi count)), the radius of the
                                  disk of surface one VPL stands for */
@@ -59,8 +60,9 @@ void rad_vpl_free(rad_vpl_set *set);
  * point-to-polygon factor of each emitter less the part `shadow_rays`
  * rays to random points of it find blocked (unbiased; exact where nothing
  * blocks; a single point in deep shadow may come out slightly negative,
- * its expectation is not).  `emission` is the per-element array.  Cannot
- * fail. */
+ * its expectation is not).  `emission` is the per-element array, signed
+ * and varying over a patch as the control variate's residual source may
+ * be (the variation is estimated by the same rays).  Cannot fail. */
 void rad_vpl_direct(const rad_vpl_set *set, const rad_mesh *mesh, const rad_vis *vis, const double *emission,
                     vec3 x, vec3 n, int shadow_rays, rad_rng *rng, double H[3]);
 

@@ -41,7 +41,12 @@
  * 1.6e-3 rms from seed to seed, and still 1e-3 at 16384 paths: what
  * remains is the gathers' noise (each VPL at one random point of each
  * element, the clamped light's realised loss against the near-field
- * estimate of its mean), so 1e-4 is out of reach at a reasonable cost.
+ * estimate of its mean), so 1e-4 is out of reach at a reasonable cost
+ * for the light paths alone.  Hence the control variate
+ * (solve/control_variate.h): the paths and the direct gather carry the
+ * residual source E' = E + rho T - beta of B' = B - beta, signed, and
+ * B = beta + B'.  The furnace's E' is 0: no path, B = 2.5 to 3e-14; a box
+ * of mixed reflectances halves the per-surface error (docs/methods.md).
  *
  * Determinism: every element's numbers come from streams keyed on (seed,
  * element), VPLs from the seeded Halton sequence; elements are
@@ -49,6 +54,7 @@
  */
 #include "strategy/strategy.h"
 #include "solve/vpl.h"
+#include "solve/control_variate.h"
 #include "formfactor/formfactor.h"
 
 #include <stdlib.h>
@@ -63,7 +69,13 @@ enum {
     DIRECT_POINTS = 2,     /* direct light at DIRECT_POINTS^2 stratified points of each element */
     DIRECT_RAYS = 4,       /* shadow rays per emitter patch and point */
     COMPENSATION_RAYS = 16,
-    BLOCK = 64             /* shadow rays per backend call */
+    BLOCK = 64,            /* shadow rays per backend call */
+    CV_RAYS = 256,         /* rays per element for the control variate's transport, where beta != 0 */
+    /* The residual source's patches are gathered directly, as emitters are;
+     * past this many (and more than the emitters' own) the control variate
+     * is not used: its gather would cost more than the VPLs' (n x 16 rays
+     * a patch against n x ~5 VPLs a path). */
+    CV_MAX_PATCHES = 256
 };
 
 typedef struct instant_state {
@@ -119,8 +131,8 @@ static rad_result instant_create(rad_context *ctx, const rad_scene *scene, const
 
 /* Element i's direct and VPL irradiance (clamped and not), H[9]:
  * direct RGB, VPL RGB, unclamped VPL RGB. */
-static void gather_element(const rad_meshed *m, const rad_vpl_set *set, uint32_t i, double eps, rad_ray *rays,
-                           uint8_t *blocked, double *weight, double H[9])
+static void gather_element(const rad_meshed *m, const rad_vpl_set *set, const double *source, bool signed_source,
+                           uint32_t i, double eps, rad_ray *rays, uint8_t *blocked, double *weight, double H[9])
 {
     const rad_mesh *mesh = m->mesh;
     const rad_element *e = &mesh->elements[i];
@@ -133,14 +145,16 @@ static void gather_element(const rad_meshed *m, const rad_vpl_set *set, uint32_t
             double w = rad_element_sample_weight(mesh, e, u, v);
             vec3 x = v3_mad(rad_element_sample(mesh, e, u, v), e->normal, lift);
             double h[3];
-            rad_vpl_direct(set, mesh, m->vis, m->elements.emission, x, e->normal, DIRECT_RAYS, &rng, h);
+            rad_vpl_direct(set, mesh, m->vis, source, x, e->normal, DIRECT_RAYS, &rng, h);
             for (int c = 0; c < 3; c++)
                 H[c] += w * h[c] / (DIRECT_POINTS * DIRECT_POINTS);
         }
     /* The control variate of rad_vpl_direct can leave an element in deep
-     * shadow a little below 0; the element's irradiance cannot be. */
-    for (int c = 0; c < 3; c++)
-        H[c] = fmax(H[c], 0.0);
+     * shadow a little below 0; the element's irradiance cannot be.  A
+     * signed source's can (light of B' = B - beta), so it is not held. */
+    if (!signed_source)
+        for (int c = 0; c < 3; c++)
+            H[c] = fmax(H[c], 0.0);
     /* Each VPL at its own point of the element. */
     rad_rng prng = rad_rng_keyed(m->options->seed, 0x49525f56u, i); /* "IR_V" */
     for (size_t first = 0; first < set->count; first += BLOCK) {
@@ -173,7 +187,7 @@ static void gather_element(const rad_meshed *m, const rad_vpl_set *set, uint32_t
 /* The near-field light the clamp removed at element i (file header), from
  * the clamped solution B. */
 static void compensate_element(const rad_meshed *m, double radius, uint32_t i, double eps, const double *B,
-                               rad_ray *rays, rad_hit *hits, double H[3])
+                               const double *source, rad_ray *rays, rad_hit *hits, double H[3])
 {
     const rad_mesh *mesh = m->mesh;
     const rad_element *e = &mesh->elements[i];
@@ -199,8 +213,25 @@ static void compensate_element(const rad_meshed *m, double radius, uint32_t i, d
         if (missing <= 0.0)
             continue;
         for (int c = 0; c < 3; c++)
-            H[c] += missing * (B[3 * (size_t)j + c] - m->elements.emission[3 * (size_t)j + c]) / COMPENSATION_RAYS;
+            H[c] += missing * (B[3 * (size_t)j + c] - source[3 * (size_t)j + c]) / COMPENSATION_RAYS;
     }
+}
+
+/* Patches the residual source E' is not 0 on (the direct gather's emitters). */
+static size_t source_patches(const rad_mesh *mesh, const double *source)
+{
+    size_t count = 0;
+    for (size_t p = 0; p < mesh->patch_count; p++) {
+        const rad_patch *patch = &mesh->patches[p];
+        for (uint32_t k = 0; k < patch->element_count; k++) {
+            const double *E = source + 3 * (size_t)(patch->first_element + k);
+            if (E[0] != 0.0 || E[1] != 0.0 || E[2] != 0.0) {
+                count++;
+                break;
+            }
+        }
+    }
+    return count;
 }
 
 static rad_result instant_solve(rad_context *ctx, void *state, const rad_step_hook *hook)
@@ -215,10 +246,33 @@ static rad_result instant_solve(rad_context *ctx, void *state, const rad_step_ho
     size_t n = m->mesh->element_count;
     int threads = m->threads > 0 ? m->threads : 1;
     size_t paths = m->options->samples > 0 ? (size_t)m->options->samples : DEFAULT_PATHS;
-    rad_vpl_set set;
-    rad_result r = rad_vpl_create(ctx, m->mesh, m->vis, m->elements.reflectance, m->elements.emission, paths,
-                                  m->options->seed, &set);
+    /* B = beta + B' (control_variate.h): the VPLs and the direct gather
+     * carry the residual source E' = E + rho T - beta, signed; in the closed
+     * furnace E' = 0, no path is traced and B = beta exactly.  Its patches
+     * are gathered directly like emitters', so a residual on many patches
+     * (CV_MAX_PATCHES) leaves the control variate out. */
+    rad_control_variate cv = {0};
+    rad_result r = RAD_OK;
+    if (!m->options->no_control_variate)
+        r = rad_control_variate_make(ctx, m->mesh, m->vis, m->elements.area, m->elements.reflectance,
+                                     m->elements.emission, m->options->seed, CV_RAYS, threads, &cv);
     if (r != RAD_OK) {
+        rad_meshed_end(m, r, t0);
+        return r;
+    }
+    if (cv.active) {
+        size_t own = source_patches(m->mesh, m->elements.emission), residual = source_patches(m->mesh, cv.source);
+        if (residual > CV_MAX_PATCHES && residual > own) {
+            memset(cv.beta_mean, 0, sizeof cv.beta_mean);
+            cv.active = false;
+            cv.groups_varied = 0;
+        }
+    }
+    const double *source = cv.active ? cv.source : m->elements.emission;
+    rad_vpl_set set;
+    r = rad_vpl_create(ctx, m->mesh, m->vis, m->elements.reflectance, source, paths, m->options->seed, &set);
+    if (r != RAD_OK) {
+        rad_control_variate_free(&cv);
         rad_meshed_end(m, r, t0);
         return r;
     }
@@ -242,8 +296,8 @@ static rad_result instant_solve(rad_context *ctx, void *state, const rad_step_ho
 #endif
         if (rad_cancelled(ctx))
             continue;
-        gather_element(m, &set, (uint32_t)i, eps, rays + (size_t)tid * BLOCK, blocked + (size_t)tid * BLOCK,
-                       weight + (size_t)tid * BLOCK, H + 9 * i);
+        gather_element(m, &set, source, cv.active, (uint32_t)i, eps, rays + (size_t)tid * BLOCK,
+                       blocked + (size_t)tid * BLOCK, weight + (size_t)tid * BLOCK, H + 9 * i);
         int done;
 #pragma omp atomic capture
         done = ++done_count;
@@ -254,11 +308,11 @@ static rad_result instant_solve(rad_context *ctx, void *state, const rad_step_ho
         r = rad_fail(ctx, RAD_ERROR_INTERRUPTED, "solve: interrupted gathering the virtual point lights");
         goto done;
     }
+    /* B' first: the compensation reads the reflected part B' - E'. */
     double *B = m->elements.radiosity;
     for (size_t i = 0; i < n; i++)
         for (int c = 0; c < 3; c++)
-            B[3 * i + c] = m->elements.emission[3 * i + c] +
-                           m->elements.reflectance[3 * i + c] * (H[9 * i + c] + H[9 * i + 3 + c]);
+            B[3 * i + c] = source[3 * i + c] + m->elements.reflectance[3 * i + c] * (H[9 * i + c] + H[9 * i + 3 + c]);
     memset(comp, 0, n * 3 * sizeof *comp);
     /* The near-field pass measures the clamp's loss for both solvers; only
      * instant-radiosity adds it back. */
@@ -269,7 +323,7 @@ static rad_result instant_solve(rad_context *ctx, void *state, const rad_step_ho
 #ifdef _OPENMP
             tid = omp_get_thread_num();
 #endif
-            compensate_element(m, set.clamp_radius, (uint32_t)i, eps, B, rays + (size_t)tid * BLOCK,
+            compensate_element(m, set.clamp_radius, (uint32_t)i, eps, B, source, rays + (size_t)tid * BLOCK,
                                hits + (size_t)tid * BLOCK, comp + 3 * i);
         }
         if (s->compensate)
@@ -277,12 +331,17 @@ static rad_result instant_solve(rad_context *ctx, void *state, const rad_step_ho
                 for (int c = 0; c < 3; c++)
                     B[3 * i + c] += m->elements.reflectance[3 * i + c] * comp[3 * i + c];
     }
-    /* Books: power absorbed, the clamp's loss and the compensation. */
+    if (cv.active)
+        for (size_t k = 0; k < 3 * n; k++)
+            B[k] += cv.beta[k];
+    /* Books: power absorbed (beta's share from its transport T), the
+     * clamp's loss and the compensation (of B''s light). */
     double absorbed = 0.0, clamped = 0.0, raw = 0.0, added = 0.0;
     for (size_t i = 0; i < n; i++) {
         double a = m->elements.area[i];
         for (int c = 0; c < 3; c++) {
-            double h = H[9 * i + c] + H[9 * i + 3 + c] + (s->compensate ? comp[3 * i + c] : 0.0);
+            double h = H[9 * i + c] + H[9 * i + 3 + c] + (s->compensate ? comp[3 * i + c] : 0.0) +
+                       (cv.active ? cv.transport[3 * i + c] : 0.0);
             absorbed += a * (1.0 - m->elements.reflectance[3 * i + c]) * h;
             clamped += a * H[9 * i + 3 + c];
             raw += a * H[9 * i + 6 + c];
@@ -296,13 +355,20 @@ static rad_result instant_solve(rad_context *ctx, void *state, const rad_step_ho
     st->absorbed = absorbed / 3.0;
     st->rays = set.rays + (uint64_t)n * ((uint64_t)set.count + DIRECT_POINTS * DIRECT_POINTS * DIRECT_RAYS *
                                                                    (uint64_t)set.emitter_count) +
-               (uint64_t)n * COMPENSATION_RAYS;
+               (uint64_t)n * COMPENSATION_RAYS + cv.rays;
     st->vpl_paths = set.paths;
     st->vpl_lights = set.count;
     st->vpl_clamp_radius = set.clamp_radius;
-    st->vpl_clamp_loss = clamped + added > 0.0 ? added / (clamped + added) : 0.0;
-    st->vpl_clamp_loss_unclamped = raw > 0.0 ? (raw - clamped) / raw : 0.0;
+    /* Signed light can cancel in these sums: its magnitudes' ratio would
+     * need the sums of |.|, and the loss is what matters where light is
+     * positive. */
+    st->vpl_clamp_loss = clamped + added != 0.0 ? added / (clamped + added) : 0.0;
+    st->vpl_clamp_loss_unclamped = raw != 0.0 ? (raw - clamped) / raw : 0.0;
     st->vpl_compensated = s->compensate;
+    st->cv_groups = cv.groups;
+    st->cv_groups_varied = cv.groups_varied;
+    st->cv_rays = cv.rays;
+    memcpy(st->cv_beta, cv.beta_mean, sizeof st->cv_beta);
     if (hook->fn) {
         rad_solve_step step = {1, rad_seconds() - t0, NAN, NAN};
         if (hook->fn(hook->user, &step, true))
@@ -316,6 +382,7 @@ done:
     rad_free(blocked);
     rad_free(weight);
     rad_vpl_free(&set);
+    rad_control_variate_free(&cv);
     rad_meshed_end(m, r, t0);
     return r;
 }

@@ -63,6 +63,9 @@ static const rad_option_info solution_rows[] = {
     {SOLUTION(closure_correction), .type = RAD_OPTION_FLAG, .default_value = 0.0,
      .help = "rescale F so rows sum to 1 keeping reciprocity; hierarchical: scale each patch's "
              "sending by its link closure (closed scenes only; refused by shooting)"},
+    {SOLUTION(no_control_variate), .type = RAD_OPTION_FLAG, .default_value = 0.0,
+     .help = "shooting, instant-radiosity: estimate B itself, not B less a constant per lit group whose "
+             "transport is known (the control variate that makes the closed furnace exact)"},
     {SOLUTION(raw_form_factors), .type = RAD_OPTION_FLAG, .default_value = 0.0,
      .help = "hemicube, hemisphere, montecarlo: keep F as sampled, without the default step that "
              "makes it reciprocal and holds its rows to their measured closure (energy conservation)"},

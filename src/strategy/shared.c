@@ -250,6 +250,7 @@ void rad_meshed_begin(rad_meshed *m, const char *method, const rad_step_hook *ho
                         .vis = m->vis,
                         .seed = o->seed,
                         .samples = o->samples,
+                        .control_variate = !o->no_control_variate,
                         .max_memory = o->max_memory_bytes};
     *p = (rad_solve_params){o->tolerance, o->unshot_tolerance, o->max_iterations, o->relaxation, NULL, m};
     m->hook = hook;
