@@ -136,9 +136,10 @@ void hr_sample(const hr_tree *tree, uint32_t k, int count, const double *uvw, bo
 /* The transfer between nodes r and s by Monte Carlo (refine.c): the power r
  * receives from s per unit of the source's radiosity (surface source), or
  * per unit of the source cluster's power weights (*by_power) or area; and
- * the direction it flows along (transfer-weighted, from r toward s). */
+ * the direction it flows along (transfer-weighted, from r toward s); with quad
+ * (a surface r), how much of s each quarter of r sees (HR_LINK_QUADS). */
 double hr_transfer(const hr_tree *tree, const rad_vis *vis, uint32_t r, uint32_t s, int count, rad_rng *rng,
-                   uint64_t *rays, bool *by_power, vec3 *direction);
+                   uint64_t *rays, bool *by_power, vec3 *direction, double quad[4]);
 
 
 /* Is the region between the boxes of nodes a and b free of every patch
@@ -151,8 +152,37 @@ bool hr_shaft_clear(const hr_tree *tree, uint32_t a, uint32_t b, double tol);
 enum {
     HR_LINK_CLEAR = 1, /* the shaft is empty; so are the children's */
     HR_LINK_SPLIT = 2, /* a cluster link the bins cannot carry: must be split */
-    HR_LINK_ZNEG = 4   /* a cluster link's direction has z < 0 (hr_link_direction) */
+    HR_LINK_ZNEG = 4,  /* a cluster link's direction has z < 0 (hr_link_direction) */
+    HR_LINK_QUADS = 8  /* surface <- surface, partly hidden: bits 8..31 hold how much each
+                          quarter of either end sees of the other (below) */
 };
+
+/* Which quarter of surface node a (its children's order, rad_ff_split4)
+ * holds point p, which lies on it (tree.c). */
+int hr_quadrant(const hr_node *a, vec3 p);
+
+/* A partly hidden link's visibility from each quarter of its receiver and
+ * to each quarter of its source (the kernel-weighted share of its shadow
+ * rays that pass, among those from or to that quarter; 3 bits each), so
+ * that the gather gives the light to the receiver's quarters that see the
+ * source and takes it from the source's quarters seen, not the ends' area
+ * means: a pocket that a node straddles (the ceiling over a hanging
+ * luminaire's housing, the housing's top under it) gets and gives its
+ * share, not the mean.  The link's power is kept (hier.c, gather).  end:
+ * 0 receiver, 1 source. */
+static inline uint32_t hr_link_quads_encode(const double receiver[4], const double source[4])
+{
+    uint32_t bits = HR_LINK_QUADS;
+    for (int q = 0; q < 4; q++) {
+        bits |= (uint32_t)round(7.0 * fmin(fmax(receiver[q], 0.0), 1.0)) << (8 + 3 * q);
+        bits |= (uint32_t)round(7.0 * fmin(fmax(source[q], 0.0), 1.0)) << (20 + 3 * q);
+    }
+    return bits;
+}
+static inline double hr_link_quad(uint32_t flags, int end, int q)
+{
+    return (double)((flags >> (8 + 12 * end + 3 * q)) & 7u) / 7.0;
+}
 
 typedef struct hr_link {
     uint32_t r, s;        /* receiver and source nodes */
