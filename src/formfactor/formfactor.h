@@ -217,13 +217,6 @@ double rad_point_polygon_ff_front(vec3 point, vec3 normal, const vec3 *poly, siz
  * ray never starts behind the surface it leaves.  Cannot fail. */
 double rad_element_bend(const rad_mesh *mesh, const rad_element *e);
 
-/* The density correction of rad_element_sample at (u, v): the Jacobian of
- * the bilinear map over the element's area, so that the mean of
- * f(x(u,v)) * weight over uniform (u, v) is the mean of f over the element
- * (exactly 1 for triangles and parallelograms; its mean is 1 for any flat
- * quad).  Cannot fail. */
-double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
-
 /* Shadow rays for the part of element e that a point p (normal n) does
  * not see: k x k stratified points y of e (jittered by rng, lifted by
  * `lift` along e's normal), each a ray from `origin` to y and a weight, the

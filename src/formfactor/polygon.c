@@ -98,18 +98,6 @@ double rad_element_bend(const rad_mesh *mesh, const rad_element *e)
     return bend;
 }
 
-double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v)
-{
-    if (e->vertex_count != 4 || !(e->area > 0.0))
-        return 1.0;
-    const vec3 *P = mesh->vertices;
-    vec3 p0 = P[e->vertex[0]], p1 = P[e->vertex[1]], p2 = P[e->vertex[2]], p3 = P[e->vertex[3]];
-    /* x(u, v) = lerp(lerp(p0, p1, u), lerp(p3, p2, u), v), as rad_element_sample. */
-    vec3 du = v3_add(v3_scale(v3_sub(p1, p0), 1.0 - v), v3_scale(v3_sub(p2, p3), v));
-    vec3 dv = v3_sub(v3_lerp(p3, p2, u), v3_lerp(p0, p1, u));
-    return v3_length(v3_cross(du, dv)) / e->area;
-}
-
 void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v)
 {
     vec3 a = fabs(n.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
