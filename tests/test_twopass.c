@@ -205,6 +205,17 @@ static double parallel_rectangle(double a1, double a2, double b1, double b2, dou
            corner_factor(a1, b1, h);
 }
 
+/* A floor beside a vertical mirror at x = 0 (its face toward -x), a small
+ * lamp above the floor. */
+static const char *beside_mirror_obj =
+    "mtllib two.mtl\n"
+    "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
+    "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 0 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
+    "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\nf 9 10 11 12\n";
+static const char *beside_mirror_mtl = "newmtl floor\nKd 0.5 0.5 0.5\n"
+                                       "newmtl mirror\nKd 0 0 0\nKs 0.8 0.8 0.8\nillum 3\n"
+                                       "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+
 /* A floor (rho_d 0.5) under a small lamp (radiance 1, E = pi) beside a
  * vertical mirror (rho_s 0.8, no diffuse part) at x = 0: each floor
  * element receives, beyond what it receives with a black wall there,
@@ -217,14 +228,8 @@ static void test_mirror_image_irradiance(void **state)
 {
     (void)state;
     rad_context *ctx = test_context(2);
-    const char *obj = "mtllib two.mtl\n"
-                      "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
-                      "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 0 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
-                      "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
-                      "f 9 10 11 12\n";
-    const char *mtl_mirror = "newmtl floor\nKd 0.5 0.5 0.5\n"
-                             "newmtl mirror\nKd 0 0 0\nKs 0.8 0.8 0.8\nillum 3\n"
-                             "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+    const char *obj = beside_mirror_obj;
+    const char *mtl_mirror = beside_mirror_mtl;
     const char *mtl_black = "newmtl floor\nKd 0.5 0.5 0.5\n"
                             "newmtl mirror\nKd 0 0 0\n"
                             "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
@@ -307,14 +312,8 @@ static void test_mirror_solvers(void **state)
     rad_context *ctx = NULL;
     rad_context_options co = {.threads = 1, .on_warning = keep_warning, .warning_user = said};
     assert_int_equal(rad_context_create(&co, &ctx), RAD_OK);
-    const char *obj = "mtllib two.mtl\n"
-                      "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
-                      "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 0 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
-                      "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
-                      "f 9 10 11 12\n";
-    const char *mtl = "newmtl floor\nKd 0.5 0.5 0.5\n"
-                      "newmtl mirror\nKd 0 0 0\nKs 0.8 0.8 0.8\nillum 3\n"
-                      "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+    const char *obj = beside_mirror_obj;
+    const char *mtl = beside_mirror_mtl;
     rad_scene *scene = load(ctx, obj, mtl);
     rad_options o = {.target_elements = 50, .solver = "southwell"};
     rad_solution *s = NULL;
@@ -460,14 +459,8 @@ static void test_hier_mirror_agrees(void **state)
     rad_scene_destroy(plain);
 
     /* Open: a floor beside a vertical mirror under a small lamp (above). */
-    const char *obj = "mtllib two.mtl\n"
-                      "o floor\nusemtl floor\nv -2 0 -1\nv -2 0 1\nv 0 0 1\nv 0 0 -1\nf 1 2 3 4\n"
-                      "o mirror\nusemtl mirror\nv 0 0 -2\nv 0 0 2\nv 0 2 2\nv 0 2 -2\nf 5 6 7 8\n"
-                      "o lamp\nusemtl lamp\nv -0.6 1 -0.1\nv -0.4 1 -0.1\nv -0.4 1 0.1\nv -0.6 1 0.1\n"
-                      "f 9 10 11 12\n";
-    const char *mtl = "newmtl floor\nKd 0.5 0.5 0.5\n"
-                      "newmtl mirror\nKd 0 0 0\nKs 0.8 0.8 0.8\nillum 3\n"
-                      "newmtl lamp\nKd 0 0 0\nKe 1 1 1\n";
+    const char *obj = beside_mirror_obj;
+    const char *mtl = beside_mirror_mtl;
     scene = load(ctx, obj, mtl);
     d = solved(ctx, scene, &dense);
     h = solved(ctx, scene, &hier);

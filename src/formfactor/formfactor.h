@@ -199,6 +199,14 @@ rad_result rad_ff_refuse_open(rad_context *ctx, const char *source, double escap
 
 /* ---- shared kernels (polygon.c) ---- */
 
+/* Sutherland-Hodgman: the part of polygon poly[0, n) where
+ * normal . (y - x) >= 0, into out; returns its corner count.  A convex
+ * polygon gains at most one vertex, but corners within rounding of the
+ * plane can alternate sides (a piece of a source clipped by several
+ * blockers, occluders.c), each edge then giving two: `out` holds up to
+ * 2 n vertices.  Cannot fail. */
+size_t rad_polygon_clip(const vec3 *poly, size_t n, vec3 x, vec3 normal, vec3 *out);
+
 /* Unoccluded point-to-polygon form factor F_{dA -> polygon} (Lambert's
  * contour formula, Baum, Rushmeier & Winget 1989): the polygon is first
  * clipped to the half-space in front of the point's tangent plane.  The

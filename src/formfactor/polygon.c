@@ -28,11 +28,7 @@
 
 #include <string.h>
 
-/* Clip to n.(y - x) >= 0.  A convex polygon gains at most one vertex, but
- * corners within rounding of the plane can alternate sides (a piece of a
- * source clipped by several blockers, occluders.c), each edge then giving
- * two: `out` holds up to 2 n vertices. */
-static size_t clip_to_hemisphere(vec3 x, vec3 normal, const vec3 *poly, size_t n, vec3 *out)
+size_t rad_polygon_clip(const vec3 *poly, size_t n, vec3 x, vec3 normal, vec3 *out)
 {
     size_t m = 0;
     for (size_t k = 0; k < n; k++) {
@@ -66,7 +62,7 @@ double rad_point_polygon_ff_front(vec3 x, vec3 normal, const vec3 *poly, size_t 
     vec3 clipped[16];
     if (n > 8)
         n = 8;
-    size_t m = clip_to_hemisphere(x, normal, poly, n, clipped);
+    size_t m = rad_polygon_clip(poly, n, x, normal, clipped);
     if (m < 3)
         return 0.0;
     double sum = 0.0;

@@ -253,6 +253,11 @@ int hr_oracle_surfaces(const hr_tree *tree, const hr_refine_params *p, uint32_t 
  * triangles (half way); returns their count (r->corners). */
 int hr_gauss_points(const hr_node *r, vec3 *point);
 
+/* The start of a refinement pass over `links` links (refine.c, mirror.c):
+ * RAD_ERROR_INTERRUPTED when cancelled, else the per-link scratch grown
+ * (action: 1 byte, first: links + 1 slots).  Fails for memory. */
+rad_result hr_refine_pass_start(rad_context *ctx, size_t links, uint8_t **action, size_t **first);
+
 /* Six-direction bins: index of signed axis (a, sign) = 2a + (sign < 0). */
 static inline double hr_bins_eval(const double *bins, vec3 d)
 {

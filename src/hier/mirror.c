@@ -62,8 +62,9 @@ static const uint64_t HR_MIRROR_SALT = 0x4d4952524f52ULL;
  * (a building's mirror facing 10^5 patches would take 10^10 culls). */
 #define HR_MIRROR_MAX_PAIRS 4e7
 
-/* Largest polygon the clips below make: a quad cut by 5 planes. */
-enum { POLY_MAX = 12 };
+/* Room for the polygons the clips below make: a quad cut by 5 planes
+ * (rad_polygon_clip may double a polygon whose corners graze a plane). */
+enum { POLY_MAX = 32 };
 
 typedef struct mirror_geometry {
     const rad_patch *patch;
@@ -108,26 +109,10 @@ static vec3 reflect_point(vec3 p, const mirror_geometry *g)
 
 static double height(vec3 p, const mirror_geometry *g) { return v3_dot(v3_sub(p, g->q), g->m); }
 
-/* Sutherland-Hodgman: the part of polygon in[0, n) where dot(a, x - o) >= 0,
- * into out (room for n + 1); returns its corner count. */
-static int clip(const vec3 *in, int n, vec3 a, vec3 o, vec3 *out)
-{
-    int m = 0;
-    for (int i = 0; i < n; i++) {
-        vec3 p = in[i], q = in[(i + 1) % n];
-        double dp = v3_dot(a, v3_sub(p, o)), dq = v3_dot(a, v3_sub(q, o));
-        if (dp >= 0.0)
-            out[m++] = p;
-        if ((dp >= 0.0) != (dq >= 0.0))
-            out[m++] = v3_lerp(p, q, dp / (dp - dq));
-    }
-    return m;
-}
-
 /* Node x's corners, its part in front of the mirror's plane. */
 static int front_part(const hr_node *x, const mirror_geometry *g, vec3 *out)
 {
-    return clip(x->corner, x->corners, g->m, g->q, out);
+    return (int)rad_polygon_clip(x->corner, x->corners, g->q, g->m, out);
 }
 
 /* Source s's image: its part in front of the mirror, reflected, the
@@ -172,16 +157,16 @@ static double factor_through(vec3 x, vec3 n, const vec3 *image, int n_image, con
 {
     if (!(height(x, g) > 0.0))
         return 0.0;
-    vec3 a[POLY_MAX + 1], b[POLY_MAX + 1];
+    vec3 a[2 * POLY_MAX], b[2 * POLY_MAX];
     int m = n_image;
     memcpy(a, image, (size_t)m * sizeof *a);
     uint32_t corners = g->patch->corner_count;
-    for (uint32_t c = 0; c < corners && m >= 3; c++) {
+    for (uint32_t c = 0; c < corners && m >= 3 && m <= POLY_MAX; c++) {
         vec3 p = g->patch->corner[c], q = g->patch->corner[(c + 1) % corners];
         vec3 side = v3_cross(v3_sub(p, x), v3_sub(q, x));
         if (v3_dot(side, v3_sub(g->centre, x)) < 0.0)
             side = v3_scale(side, -1.0);
-        m = clip(a, m, side, x, b);
+        m = (int)rad_polygon_clip(a, (size_t)m, x, side, b);
         memcpy(a, b, (size_t)m * sizeof *a);
     }
     if (m < 3)
@@ -505,20 +490,8 @@ rad_result hr_mirrors_refine(rad_context *ctx, hr_tree *t, const hr_refine_param
     mirror_ctx mc = {t, p, geo, m};
     while (r == RAD_OK) {
         size_t L = m->links;
-        if (rad_cancelled(ctx)) {
-            r = RAD_ERROR_INTERRUPTED;
+        if ((r = hr_refine_pass_start(ctx, L, &action, &first)) != RAD_OK)
             break;
-        }
-        uint8_t *a = rad_realloc(ctx, RAD_MEM_HIERARCHY, action, L, sizeof *a, "hierarchical: mirror refinement");
-        if (a)
-            action = a;
-        size_t *f = a ? rad_realloc(ctx, RAD_MEM_HIERARCHY, first, L + 1, sizeof *f, "hierarchical: mirror refinement")
-                      : NULL;
-        if (!f) {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-            break;
-        }
-        first = f;
         /* Decide in parallel; split and count the children serially, in
          * link order (node numbers do not depend on the threads). */
         size_t splits = 0;

@@ -503,6 +503,21 @@ rad_result hr_links_initial(rad_context *ctx, hr_tree *t, const hr_refine_params
     return r;
 }
 
+rad_result hr_refine_pass_start(rad_context *ctx, size_t links, uint8_t **action, size_t **first)
+{
+    if (rad_cancelled(ctx))
+        return RAD_ERROR_INTERRUPTED;
+    uint8_t *a = rad_realloc(ctx, RAD_MEM_HIERARCHY, *action, links, sizeof *a, "hierarchical: refinement");
+    if (a)
+        *action = a;
+    size_t *f = a ? rad_realloc(ctx, RAD_MEM_HIERARCHY, *first, links + 1, sizeof *f, "hierarchical: refinement")
+                  : NULL;
+    if (!f)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    *first = f;
+    return RAD_OK;
+}
+
 rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, const double *B,
                      const double *spread, hr_links *links, size_t *split, hr_refine_stats *st)
 {
@@ -517,20 +532,8 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
     double *Bx = NULL, *Sx = NULL;
     for (;;) {
         size_t L = links->count;
-        if (rad_cancelled(ctx)) {
-            r = RAD_ERROR_INTERRUPTED;
+        if ((r = hr_refine_pass_start(ctx, L, &action, &first)) != RAD_OK)
             break;
-        }
-        uint8_t *a = rad_realloc(ctx, RAD_MEM_HIERARCHY, action, L, sizeof *a, "hierarchical: refinement");
-        if (a)
-            action = a;
-        size_t *f = a ? rad_realloc(ctx, RAD_MEM_HIERARCHY, first, L + 1, sizeof *f, "hierarchical: refinement")
-                      : NULL;
-        if (!f) {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-            break;
-        }
-        first = f;
         /* Values for nodes made in earlier passes of this call. */
         if (t->count > known) {
             double *nb = rad_realloc(ctx, RAD_MEM_HIERARCHY, Bx, 3 * t->count, sizeof *nb,
