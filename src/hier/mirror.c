@@ -419,25 +419,30 @@ rad_result hr_mirrors_start(rad_context *ctx, const hr_tree *t, const hr_refine_
                      t->scene->surfaces[g->patch->surface].name, C, (double)C * (double)C);
             continue;
         }
-        /* Every ordered pair: row a in parallel into its slots, then kept in order. */
-        hr_mirror_link *all = rad_alloc(ctx, RAD_MEM_HIERARCHY, C * C + 1, sizeof *all, "hierarchical: mirror links");
-        uint8_t *keep = all ? rad_alloc(ctx, RAD_MEM_HIERARCHY, C * C + 1, 1, "hierarchical: mirror links") : NULL;
-        if (!keep) {
-            rad_free(all);
+        /* Every ordered pair: blocks of rows, each row in parallel into its
+         * slots, the kept ones appended in order (the scratch stays near
+         * 2^20 pairs, 28 MB, however many patches face the mirror). */
+        size_t rows = C > 0 ? (((size_t)1 << 20) + C - 1) / C : 1;
+        hr_mirror_link *all = rad_alloc(ctx, RAD_MEM_HIERARCHY, rows * C + 1, sizeof *all, "hierarchical: mirror links");
+        uint8_t *keep = all ? rad_alloc(ctx, RAD_MEM_HIERARCHY, rows * C + 1, 1, "hierarchical: mirror links") : NULL;
+        if (!keep)
             r = RAD_ERROR_OUT_OF_MEMORY;
-            break;
-        }
+        for (size_t from = 0; r == RAD_OK && from < C; from += rows) {
+            size_t to = from + rows < C ? from + rows : C;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(p->threads) reduction(+ : rays, shafts, clear)
-        for (size_t a = 0; a < C; a++)
-            for (size_t b = 0; b < C; b++)
-                keep[a * C + b] = make_link(&mc, g, cand[a], cand[b], 0, &all[a * C + b], &rays, &shafts, &clear);
-        size_t kept = 0;
-        for (size_t q = 0; q < C * C; q++)
-            kept += keep[q];
-        r = reserve(ctx, &m->items, &m->capacity, m->links + kept);
-        for (size_t q = 0; r == RAD_OK && q < C * C; q++)
-            if (keep[q])
-                m->items[m->links++] = all[q];
+            for (size_t a = from; a < to; a++)
+                for (size_t b = 0; b < C; b++) {
+                    size_t q = (a - from) * C + b;
+                    keep[q] = make_link(&mc, g, cand[a], cand[b], 0, &all[q], &rays, &shafts, &clear);
+                }
+            size_t kept = 0;
+            for (size_t q = 0; q < (to - from) * C; q++)
+                kept += keep[q];
+            r = reserve(ctx, &m->items, &m->capacity, m->links + kept);
+            for (size_t q = 0; r == RAD_OK && q < (to - from) * C; q++)
+                if (keep[q])
+                    m->items[m->links++] = all[q];
+        }
         rad_free(all);
         rad_free(keep);
     }
