@@ -58,10 +58,10 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     s->options.max_memory_bytes = rad_memory_limit(ctx);
     /* mesh -> visibility -> couplings, as the strategy does them */
     s->strategy = rad_strategy_for_solver(s->options.solver);
-    /* The first pass's light through mirrors is the dense solvers'
-     * (RAD_CAN_MIRRORS; formfactor/ff_mirror.c), a solver that reads F
-     * through reciprocity refuses it, the others solve the diffuse part
-     * alone. */
+    /* The first pass's light through mirrors is the dense solvers' and the
+     * hierarchy's (RAD_CAN_MIRRORS; formfactor/ff_mirror.c, hier/mirror.c),
+     * a solver that reads F through reciprocity refuses it, the others
+     * solve the diffuse part alone. */
     bool mirrors = false;
     for (size_t m = 0; m < scene->material_count; m++)
         mirrors |= scene->materials[m].specular_kind == RAD_SPECULAR_MIRROR;
@@ -78,7 +78,7 @@ rad_result rad_solution_create(rad_context *ctx, const rad_scene *scene, const r
     if (mirrors && !(can & RAD_CAN_MIRRORS))
         rad_warn(ctx,
                  "%s: solver '%s' does not carry light through mirrors (the first pass's mirror images "
-                 "are the dense solvers'); the render's second pass still shows them",
+                 "are the dense and hierarchical solvers'); the render's second pass still shows them",
                  scene->source, s->options.solver);
     r = s->strategy->create(ctx, scene, &s->options, &s->state);
     if (r != RAD_OK) {

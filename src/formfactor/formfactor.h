@@ -199,6 +199,14 @@ rad_result rad_ff_refuse_open(rad_context *ctx, const char *source, double escap
 
 /* ---- shared kernels (polygon.c) ---- */
 
+/* Sutherland-Hodgman: the part of polygon poly[0, n) where
+ * normal . (y - x) >= 0, into out; returns its corner count.  A convex
+ * polygon gains at most one vertex, but corners within rounding of the
+ * plane can alternate sides (a piece of a source clipped by several
+ * blockers, occluders.c), each edge then giving two: `out` holds up to
+ * 2 n vertices.  Cannot fail. */
+size_t rad_polygon_clip(const vec3 *poly, size_t n, vec3 x, vec3 normal, vec3 *out);
+
 /* Unoccluded point-to-polygon form factor F_{dA -> polygon} (Lambert's
  * contour formula, Baum, Rushmeier & Winget 1989): the polygon is first
  * clipped to the half-space in front of the point's tangent plane.  The
@@ -216,13 +224,6 @@ double rad_point_polygon_ff_front(vec3 point, vec3 normal, const vec3 *poly, siz
  * Ray end points on e are lifted by rad_vis_epsilon plus this, so that a
  * ray never starts behind the surface it leaves.  Cannot fail. */
 double rad_element_bend(const rad_mesh *mesh, const rad_element *e);
-
-/* The density correction of rad_element_sample at (u, v): the Jacobian of
- * the bilinear map over the element's area, so that the mean of
- * f(x(u,v)) * weight over uniform (u, v) is the mean of f over the element
- * (exactly 1 for triangles and parallelograms; its mean is 1 for any flat
- * quad).  Cannot fail. */
-double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
 
 /* Shadow rays for the part of element e that a point p (normal n) does
  * not see: k x k stratified points y of e (jittered by rng, lifted by

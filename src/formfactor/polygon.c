@@ -28,11 +28,7 @@
 
 #include <string.h>
 
-/* Clip to n.(y - x) >= 0.  A convex polygon gains at most one vertex, but
- * corners within rounding of the plane can alternate sides (a piece of a
- * source clipped by several blockers, occluders.c), each edge then giving
- * two: `out` holds up to 2 n vertices. */
-static size_t clip_to_hemisphere(vec3 x, vec3 normal, const vec3 *poly, size_t n, vec3 *out)
+size_t rad_polygon_clip(const vec3 *poly, size_t n, vec3 x, vec3 normal, vec3 *out)
 {
     size_t m = 0;
     for (size_t k = 0; k < n; k++) {
@@ -66,7 +62,7 @@ double rad_point_polygon_ff_front(vec3 x, vec3 normal, const vec3 *poly, size_t 
     vec3 clipped[16];
     if (n > 8)
         n = 8;
-    size_t m = clip_to_hemisphere(x, normal, poly, n, clipped);
+    size_t m = rad_polygon_clip(poly, n, x, normal, clipped);
     if (m < 3)
         return 0.0;
     double sum = 0.0;
@@ -96,18 +92,6 @@ double rad_element_bend(const rad_mesh *mesh, const rad_element *e)
     for (int k = 1; k < 4; k++)
         bend += fabs(v3_dot(e->normal, v3_sub(mesh->vertices[e->vertex[k]], o)));
     return bend;
-}
-
-double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v)
-{
-    if (e->vertex_count != 4 || !(e->area > 0.0))
-        return 1.0;
-    const vec3 *P = mesh->vertices;
-    vec3 p0 = P[e->vertex[0]], p1 = P[e->vertex[1]], p2 = P[e->vertex[2]], p3 = P[e->vertex[3]];
-    /* x(u, v) = lerp(lerp(p0, p1, u), lerp(p3, p2, u), v), as rad_element_sample. */
-    vec3 du = v3_add(v3_scale(v3_sub(p1, p0), 1.0 - v), v3_scale(v3_sub(p2, p3), v));
-    vec3 dv = v3_sub(v3_lerp(p3, p2, u), v3_lerp(p0, p1, u));
-    return v3_length(v3_cross(du, dv)) / e->area;
 }
 
 void rad_tangent_frame(vec3 n, vec3 *u, vec3 *v)

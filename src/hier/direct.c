@@ -257,7 +257,7 @@ rad_result hr_direct_start(rad_context *ctx, const hr_tree *tree, const rad_vis 
         const hr_node *nd = &tree->nodes[k];
         if (nd->kind != HR_SURFACE || (nd->parent != HR_NONE && tree->nodes[nd->parent].kind == HR_SURFACE))
             continue;
-        const double *rho = tree->scene->materials[tree->base->patches[nd->patch].material].reflectance;
+        const double *rho = hr_node_reflectance(tree, (uint32_t)k);
         for (int c = 0; c < 3; c++)
             *reflected += nd->area * rho[c] * d->H[3 * k + (size_t)c];
     }

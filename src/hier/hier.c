@@ -58,6 +58,7 @@ typedef struct hr_state {
     double *bins_total;   /* 18 per cluster, pushed down */
     double *bins_exit;    /* 18 per cluster, pulled up: sum A B |n_a| */
     hr_direct direct;     /* luminaires' and daylight's H_d per node (direct.c) */
+    hr_mirrors mirrors;   /* links through mirrors and their H per node (mirror.c) */
     size_t values;        /* nodes the arrays cover */
     double emitted;       /* sum_leaves A E, channels summed */
     double absorbed;      /* W, channels summed */
@@ -77,12 +78,6 @@ static const double *node_emission(const hr_state *st, const hr_node *n)
 {
     const rad_patch *pa = &st->tree.base->patches[n->patch];
     return st->tree.scene->materials[pa->material].emission;
-}
-
-static const double *node_reflectance(const hr_state *st, const hr_node *n)
-{
-    const rad_patch *pa = &st->tree.base->patches[n->patch];
-    return st->tree.scene->materials[pa->material].reflectance;
 }
 
 #define VALUES_WHAT "hierarchical: node values (a larger rad_options.epsilon or rad_options.min_area makes fewer nodes)"
@@ -396,14 +391,19 @@ static double push_pull(hr_state *st)
         const hr_node *nd = &t->nodes[k];
         if (nd->kind != HR_SURFACE || nd->child[0] != 0)
             continue;
-        const double *E = node_emission(st, nd), *rho = node_reflectance(st, nd);
+        const double *E = node_emission(st, nd), *rho = hr_node_reflectance(t, (uint32_t)k);
         const double *hd = st->direct.H ? &st->direct.H[3 * k] : NULL; /* direct.c */
+        const double *hm = st->mirrors.H ? &st->mirrors.H[3 * k] : NULL; /* mirror.c */
         double x = st->gain ? st->gain[k] : 1.0;
+        /* A mirror's specular part leaves through the mirror links. */
+        double rho_s = hr_mirrors_specular(t, &st->mirrors, (uint32_t)k);
         for (int c = 0; c < 3; c++) {
             double h = x * st->Ht[3 * k + (size_t)c];
+            if (hm)
+                h += hm[c];
             double b = E[c] + rho[c] * (hd ? h + hd[c] : h);
             change += nd->area * fabs(b - st->B[3 * k + (size_t)c]);
-            absorbed += nd->area * (1.0 - rho[c]) * h;
+            absorbed += nd->area * (1.0 - rho[c] - rho_s) * h;
             radiant += nd->area * b;
             st->B[3 * k + (size_t)c] = b;
         }
@@ -464,6 +464,9 @@ static rad_result solve(hr_state *st, double tol, double cap, double *residual, 
         if (rad_cancelled(st->ctx))
             return RAD_ERROR_INTERRUPTED;
         gather(st);
+        rad_result rm = hr_mirrors_gather(st->ctx, &st->tree, &st->mirrors, st->B, st->send);
+        if (rm != RAD_OK)
+            return rm;
         *residual = push_pull(st);
         st->sweeps++;
         if (st->p->display) {
@@ -907,6 +910,17 @@ static rad_result link_columns(hr_state *st, const float *x, double *X, double *
     return link_closure(st, acc, X, xbins, cl);
 }
 
+/* How many of measure_open's rays left the scene: 0 for a closed one. */
+static size_t rays_escaped(const hr_state *st)
+{
+    const hr_tree *t = &st->tree;
+    size_t escaped = 0;
+    for (size_t k = 0; k < t->count; k++)
+        if (t->nodes[k].kind == HR_SURFACE && !t->nodes[k].child[0])
+            escaped += st->escape[k];
+    return escaped;
+}
+
 /* Balance the operator (above): the leaves' gain (x) and corr (y).  The
  * iterations, the last row error and the scales' range go to the stats. */
 static rad_result balance(hr_state *st, rad_hier_stats *hs)
@@ -929,10 +943,7 @@ static rad_result balance(hr_state *st, rad_hier_stats *hs)
     enum { ROW = 1, COLUMN = 2 };
     if (r == RAD_OK)
         r = link_columns(st, st->gain, X, xb, R, cl);
-    size_t escaped = 0;
-    for (size_t k = 0; r == RAD_OK && k < n; k++)
-        if (t->nodes[k].kind == HR_SURFACE && !t->nodes[k].child[0])
-            escaped += st->escape[k];
+    size_t escaped = r == RAD_OK ? rays_escaped(st) : 0;
     /* Rows through a cluster: a link with a cluster end at the leaf, an
      * ancestor or a cluster above it (flagged in role, pushed down). */
     for (size_t k = 0; r == RAD_OK && k < n; k++)
@@ -1020,6 +1031,65 @@ static rad_result balance(hr_state *st, rad_hier_stats *hs)
     rad_free(cl);
     rad_free(role);
     return r;
+}
+
+/* The mirror links' balance (mirror.c, hr_mirrors_balance), in a closed
+ * scene, where all that a mirror reflects lands somewhere: for every leaf
+ * m, the power the ordinary links bring the mirrors from it per unit of
+ * its B and area, times the mirrors' rho_s (the column sums of the
+ * operator with receiver scale rho_s x the balance's gain on the mirror
+ * leaves and 0 elsewhere), times m's own source scale.  The mirror links
+ * then send that power on: a closed scene with mirrors absorbs what it
+ * emits as one without (their geometry alone left the Gauss rule's and
+ * the sources' means' shortfall, 0.9% of what a mirror floor reflects in
+ * a closed box, and the ordinary links' own error at the mirror).  Leaves
+ * partly inside a solid keep scale 1, as in the balance.  In an open
+ * scene part of a mirror's light leaves it: nothing to hold. */
+static rad_result balance_mirrors(hr_state *st)
+{
+    const hr_tree *t = &st->tree;
+    size_t n = t->count;
+    if (st->mirrors.links == 0 || rays_escaped(st) > 0)
+        return RAD_OK;
+    float *x = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *x, "hierarchical: mirror balance");
+    double *X = x ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *X, "hierarchical: mirror balance") : NULL;
+    double *xb = X ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 6 * t->clusters + 1, sizeof *xb, "hierarchical: mirror balance")
+                   : NULL;
+    double *target = xb ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *target, "hierarchical: mirror balance") : NULL;
+    rad_result r = target ? RAD_OK : RAD_ERROR_OUT_OF_MEMORY;
+    for (size_t k = 0; r == RAD_OK && k < n; k++) {
+        bool leaf = t->nodes[k].kind == HR_SURFACE && !t->nodes[k].child[0];
+        x[k] = leaf ? (float)(hr_mirrors_specular(t, &st->mirrors, (uint32_t)k) * st->gain[k]) : 0.0f;
+    }
+    if (r == RAD_OK)
+        r = link_columns(st, x, X, xb, target, NULL);
+    for (size_t k = 0; r == RAD_OK && k < n; k++)
+        target[k] = st->open[k] == 1.0f ? target[k] * st->corr[k] : -1.0; /* -1: scale 1 */
+    if (r == RAD_OK)
+        r = hr_mirrors_balance(st->ctx, t, &st->mirrors, st->send, target);
+    rad_free(x);
+    rad_free(X);
+    rad_free(xb);
+    rad_free(target);
+    return r;
+}
+
+/* The largest reflectance of any channel of any patch, with what a
+ * carried mirror reflects specularly, and with textures the nodes' means:
+ * the most a bounce can reflect of what arrives. */
+static double reflectance_bound(const hr_state *st)
+{
+    const rad_mesh *base = st->tree.base;
+    double most = st->tree.reflectance ? st->tree.rho_max : 0.0;
+    for (size_t i = 0; i < base->element_count; i++) {
+        const rad_material *m = &st->tree.scene->materials[base->elements[i].material];
+        double specular = st->mirrors.count > 0 && m->specular_kind == RAD_SPECULAR_MIRROR
+                              ? (m->specular[0] + m->specular[1] + m->specular[2]) / 3.0
+                              : 0.0;
+        for (int c = 0; c < 3; c++)
+            most = fmax(most, m->reflectance[c] + specular);
+    }
+    return most;
 }
 
 /* q of the links (solve.h): rho_max times the largest closure of a leaf
@@ -1119,7 +1189,8 @@ static double bytes_in_use(const hr_state *st)
            (double)st->tree.clusters * 54.0 * sizeof(double) +
            2.0 * (double)(st->tree.count + 1) * sizeof(size_t) +
            (st->corr ? (double)st->values * (3.0 * sizeof(double) + sizeof(float)) : 0.0) +
-           hr_direct_bytes(&st->direct);
+           hr_direct_bytes(&st->direct) + hr_mirrors_bytes(&st->mirrors) +
+           (double)st->tree.reflectance_capacity * sizeof(double);
 }
 
 rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **leaf_mesh, double **radiosity,
@@ -1172,9 +1243,6 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
     }
     if ((r = ensure_values(&st)) != RAD_OK)
         goto done;
-    for (size_t i = 0; i < base->element_count; i++)
-        for (int c = 0; c < 3; c++)
-            st.rho_max = fmax(st.rho_max, scene->materials[base->elements[i].material].reflectance[c]);
     /* B = E, clusters pulled up; emitted power over the roots. */
     for (size_t k = st.tree.clusters; k < st.tree.count; k++) {
         const double *E = node_emission(&st, &st.tree.nodes[k]);
@@ -1215,18 +1283,13 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                            .threads = rad_context_threads(ctx)};
     hr_refine_stats rs = {0};
     r = hr_links_initial(ctx, &st.tree, &rp, &st.links, &rs);
+    if (r == RAD_OK)
+        r = hr_mirrors_start(ctx, &st.tree, &rp, &st.mirrors, &rs);
     if (r != RAD_OK)
         goto done;
-    hs->initial_links = st.links.count;
+    hs->initial_links = st.links.count + st.mirrors.links;
     hs->seconds_refine += rad_seconds() - t0;
 
-    /* How many sweeps a solve may take (solve.h): each leaf reflects at
-     * most rho_max of what it receives, and receives at most the largest
-     * closure of what is sent (links_contraction, each round). */
-    double rho_max = 0.0;
-    for (size_t i = 0; i < base->element_count; i++)
-        for (int c = 0; c < 3; c++)
-            rho_max = fmax(rho_max, scene->materials[base->elements[i].material].reflectance[c]);
     rad_solve_bound bound = {0};
     double residual = INFINITY, tol = p->tolerance;
     bool converged = false;
@@ -1241,6 +1304,11 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
             hr_tree_set_power(&st.tree, st.B, st.send);
         if (r == RAD_OK)
             r = hr_refine(ctx, &st.tree, &rp, st.B, st.spread, &st.links, &split, &rs);
+        if (r == RAD_OK) { /* against the same B: the nodes it covers (mirror.c) */
+            size_t through_mirrors = 0;
+            r = hr_mirrors_refine(ctx, &st.tree, &rp, st.B, st.spread, st.values, &st.mirrors, &through_mirrors, &rs);
+            split += through_mirrors;
+        }
         double td = rad_seconds();
         if (r == RAD_OK) /* the new leaves' direct light (direct.c) */
             r = hr_direct_update(ctx, &st.tree, &st.direct, epsilon_abs, &grown);
@@ -1269,8 +1337,10 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
          * at epsilon 1e-5: rounds 7 to 23 split 2 to 300 of 4.4 M links
          * each and took a quarter of the time; stopping at round 6 moved no
          * surface by more than 0.01%. */
-        bool last = split == 0 || (double)split <= 1e-4 * (double)st.links.count || round == max_rounds - 1;
+        bool last = split == 0 || (double)split <= 1e-4 * (double)(st.links.count + st.mirrors.links) ||
+                    round == max_rounds - 1;
         if (last) {
+            hr_mirrors_drop_empty(&st.mirrors);
             /* Links whose rays were all blocked stay while they may be
              * refined (refine.c); the final solve needs only the others. */
             size_t m = 0;
@@ -1283,11 +1353,18 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
                     goto done;
             }
             r = p->closure_correction ? correct_closure(&st, &hs->closure_corrected) : balance(&st, hs);
+            if (r == RAD_OK)
+                r = balance_mirrors(&st);
             if (r != RAD_OK)
                 goto done;
         }
         double t2 = rad_seconds();
         tol = last ? p->tolerance : fmax(p->tolerance, 1e-3);
+        /* How many sweeps a solve may take (solve.h): each leaf reflects at
+         * most rho_max of what it receives, and receives at most the largest
+         * closure of what is sent (links_contraction). */
+        double rho_max = reflectance_bound(&st);
+        st.rho_max = rho_max;
         double q = rho_max;
         if ((r = links_contraction(&st, rho_max, &q)) != RAD_OK)
             goto done;
@@ -1307,6 +1384,7 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
 
     hs->nodes = st.tree.count;
     hs->links = st.links.count;
+    hs->mirror_links = st.mirrors.links;
     for (size_t i = 0; i < st.links.count; i++) {
         const hr_link *l = &st.links.items[i];
         int kind = (st.tree.nodes[l->r].kind == HR_CLUSTER) * 2 + (st.tree.nodes[l->s].kind == HR_CLUSTER);
@@ -1366,6 +1444,7 @@ done:
     rad_free(st.bins_exit);
     rad_free(st.display_B);
     hr_direct_free(&st.direct);
+    hr_mirrors_free(&st.mirrors);
     if (!*leaf_mesh) { /* the leaves' light goes with the leaves */
         rad_free(*direct);
         *direct = NULL;

@@ -70,7 +70,9 @@ typedef struct hr_node {
     uint8_t corners;      /* 3 or 4 */
     uint8_t level;        /* subdivisions below the patch */
     uint8_t pad;
-    float rho;            /* largest reflectance (any channel) on or below it */
+    float rho;            /* surface: its largest reflectance (any channel; the textured mean
+                             where textured; a mirror's rho_s added); cluster: the largest
+                             below it */
 } hr_node;
 
 typedef struct hr_tree {
@@ -87,7 +89,21 @@ typedef struct hr_tree {
     double *order_power;       /* prefix sums of patch power along order[] (hr_tree_set_power) */
     double *power_bins;        /* 6 per cluster: its patches' power A B / open as bins */
     double min_area;           /* m^2: no child smaller than this */
+    double *reflectance;       /* 3 per node: a surface node's reflectance, its texture (times Kd)
+                                  averaged over it (rad_texture_mean), made with the node; NULL when
+                                  the scene has no texture: the materials' (hr_node_reflectance) */
+    size_t reflectance_capacity;
+    float rho_max;             /* the largest rho of any surface node made */
 } hr_tree;
+
+/* Surface node k's reflectance (RGB): its own textured mean, or its
+ * patch's material's.  Cannot fail. */
+static inline const double *hr_node_reflectance(const hr_tree *tree, uint32_t k)
+{
+    if (tree->reflectance)
+        return &tree->reflectance[3 * (size_t)k];
+    return tree->scene->materials[tree->base->patches[tree->nodes[k].patch].material].reflectance;
+}
 
 /* Root surface nodes for every base patch, and (clustered) a binary
  * bounding-volume hierarchy over them with median splits along the longest
@@ -249,6 +265,30 @@ rad_result hr_links_initial(rad_context *ctx, hr_tree *tree, const hr_refine_par
 rad_result hr_refine(rad_context *ctx, hr_tree *tree, const hr_refine_params *p, const double *B,
                      const double *spread, hr_links *links, size_t *split, hr_refine_stats *st);
 
+/* What the oracle asks of a link (refine.c): keep it, or split its
+ * receiver, its source or both. */
+enum { HR_KEEP = 0, HR_SPLIT_R = 1, HR_SPLIT_S = 2, HR_SPLIT_BOTH = 3 };
+
+/* The oracle of a link between surface nodes r <- s (refine.c): bs the
+ * source's largest channel of B, k the link's coefficient, link_spread
+ * how much its point factor varies over r, vis_err its visibility's
+ * uncertainty (both as hr_link's), source_spread the source's
+ * max |B_leaf - B_s|, pocket a floor under the receiver's error (the
+ * quarters' term, refine.c; 0 for none).  Cannot fail. */
+int hr_oracle_surfaces(const hr_tree *tree, const hr_refine_params *p, uint32_t r, uint32_t s, double bs, double k,
+                       double link_spread, double vis_err, double source_spread, double pocket);
+
+/* The receiver points of a surface node at which links take their
+ * factors: the 2 x 2 Gauss rule on quads (1/sqrt(3) of the way from the
+ * centre to the corners) or the 3-point rule exact for quadratics on
+ * triangles (half way); returns their count (r->corners). */
+int hr_gauss_points(const hr_node *r, vec3 *point);
+
+/* The start of a refinement pass over `links` links (refine.c, mirror.c):
+ * RAD_ERROR_INTERRUPTED when cancelled, else the per-link scratch grown
+ * (action: 1 byte, first: links + 1 slots).  Fails for memory. */
+rad_result hr_refine_pass_start(rad_context *ctx, size_t links, uint8_t **action, size_t **first);
+
 /* Six-direction bins: index of signed axis (a, sign) = 2a + (sign < 0). */
 static inline double hr_bins_eval(const double *bins, vec3 d)
 {
@@ -261,6 +301,72 @@ static inline void hr_bins_add(double *bins, vec3 d, double value)
     bins[d.y >= 0.0 ? 2 : 3] += fabs(d.y) * value;
     bins[d.z >= 0.0 ? 4 : 5] += fabs(d.z) * value;
 }
+
+/* ---- light through mirrors (mirror.c) ---- */
+
+/* A mirror link r <- s through mirror patch `mirror`: r gathers k B_s,
+ * the light that leaves s and reaches r by one reflection in the mirror. */
+typedef struct hr_mirror_link {
+    uint32_t r, s;        /* receiver and source surface nodes */
+    uint32_t mirror;      /* the mirror's patch */
+    uint32_t flags;       /* HR_LINK_CLEAR: both legs' shafts are empty, so are the children's */
+    float k;              /* rho_s x the mean factor from r to s's image seen through the
+                             mirror, visibility included */
+    float spread;         /* rho_s x max |F(x) - mean| over r's points; where no point of r
+                             sees the image but some part may, a bound on the factor */
+    float vis_err;        /* rho_s x the unoccluded factor x the visibility's uncertainty */
+} hr_mirror_link;
+
+typedef struct hr_mirrors {
+    uint32_t *patches;        /* the mirror patches carried (RAD_SPECULAR_MIRROR) */
+    size_t count;             /* 0: nothing here runs */
+    hr_mirror_link *items;
+    size_t links, capacity;
+    double *H;                /* 3 per node, W/m^2: irradiance by way of the mirrors, each
+                                 node's own links' and its ancestors' (hr_mirrors_gather) */
+    double *sent;             /* 3 per node: what sources send through mirrors, the leaves'
+                                 scale x B, area means above */
+    size_t H_capacity;        /* doubles, of H and sent each */
+    float *scale;             /* per node (leaves): the balance's source scale (hr_mirrors_balance);
+                                 NULL until then: 1 */
+    size_t scale_count;
+} hr_mirrors;
+
+/* Zero *m, find the mirror patches and make the initial links between
+ * the roots (every pair of patches that may see each other in a mirror).
+ * Fails for memory. */
+rad_result hr_mirrors_start(rad_context *ctx, const hr_tree *tree, const hr_refine_params *p, hr_mirrors *m,
+                            hr_refine_stats *st);
+/* Refine the mirror links against B and spread (as hr_refine: 3 and 1 per
+ * node for the nodes [0, known); a later node takes its nearest such
+ * ancestor's B and a spread of 0).  *split counts the links split.
+ * Level-synchronous passes as hr_refine: the result does not depend on
+ * the thread count.  Fails for memory or the memory limit. */
+rad_result hr_mirrors_refine(rad_context *ctx, hr_tree *tree, const hr_refine_params *p, const double *B,
+                             const double *spread, size_t known, hr_mirrors *m, size_t *split,
+                             hr_refine_stats *st);
+/* Drop the links that carry nothing (the final solve's). */
+void hr_mirrors_drop_empty(hr_mirrors *m);
+/* The balance of the mirror links, once they are final: leaf m sends
+ * through them scale_m B_m, scale_m such that they deliver target[m] per
+ * unit of its B and area (the rho_s part of what the ordinary links bring
+ * the mirrors from it; hier.c), so that a mirror reflects exactly the
+ * power that reaches it.  Scales outside [0.5, 2], and leaves whose target
+ * is negative, are left at 1.  Fails only for memory. */
+rad_result hr_mirrors_balance(rad_context *ctx, const hr_tree *tree, hr_mirrors *m, const float *send,
+                              const double *target);
+/* m->H for every node of the tree from the leaves' B (3 per node; times
+ * their balance scale, area means above, scaled by send as the ordinary
+ * gather does), pushed down the quadtrees.  Serial, in link order.  No-op
+ * without mirrors.  Fails only for memory. */
+rad_result hr_mirrors_gather(rad_context *ctx, const hr_tree *tree, hr_mirrors *m, const double *B,
+                             const float *send);
+/* Surface node k's specular reflectance rho_s (channels' mean) when its
+ * patch is a mirror the links carry, else 0: the part of what it receives
+ * that it neither absorbs nor reflects diffusely. */
+double hr_mirrors_specular(const hr_tree *tree, const hr_mirrors *m, uint32_t k);
+double hr_mirrors_bytes(const hr_mirrors *m);
+void hr_mirrors_free(hr_mirrors *m);
 
 /* ---- direct light (direct.c) ---- */
 
@@ -339,6 +445,7 @@ typedef struct rad_hier_params {
 typedef struct rad_hier_stats {
     size_t patches;            /* the roots (set by the caller: strategy/hierarchical.c) */
     size_t nodes, clusters, leaves, links, initial_links;
+    size_t mirror_links;       /* links through mirrors at the end (mirror.c) */
     size_t links_by_kind[4];   /* surface<-surface, surface<-cluster, cluster<-surface,
                                   cluster<-cluster (receiver<-source) */
     int refine_rounds, refine_passes;

@@ -64,8 +64,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { KEEP = 0, SPLIT_R = 1, SPLIT_S = 2, SPLIT_BOTH = 3 };
-
 static const uint64_t HR_SALT = 0x4852414449554dULL;
 
 /* The transfer between two nodes, at least one a cluster, by Monte Carlo:
@@ -234,11 +232,6 @@ static bool reaches_front(const hr_node *x, const hr_node *p, double tol)
     return rad_ff_in_front(box, 8, p->center, p->normal, tol);
 }
 
-/* The mean over a receiver polygon of the exact point-to-polygon factor to
- * s: the 2 x 2 Gauss rule on quads (points 1/sqrt(3) of the way from the
- * centre to the corners) or the 3-point rule exact for quadratics on
- * triangles (half way).  *spread = the largest deviation from the mean of
- * the point value there or at the centre. */
 /* The contour integral's shortest outer piece, relative to its edge: the
  * singular ends of edges meeting at a shared vertex (pieces cut along
  * contact lines meet block faces at every angle) cost most of the
@@ -246,11 +239,24 @@ static bool reaches_front(const hr_node *x, const hr_node *p, double tol)
  * touches moves by 2.5e-7 (far below the 1% the oracle asks). */
 #define HR_CONTOUR_REL 1e-2
 
+int hr_gauss_points(const hr_node *r, vec3 *point)
+{
+    double t = r->corners == 4 ? 0.5773502691896258 : 0.5;
+    for (int c = 0; c < r->corners; c++)
+        point[c] = v3_lerp(r->center, r->corner[c], t);
+    return r->corners;
+}
+
+/* The mean over a receiver polygon of the exact point-to-polygon factor to
+ * s at its Gauss points (hr_gauss_points).  *spread = the largest
+ * deviation from the mean of the point value there or at the centre. */
 static double gauss_factor(const hr_node *r, const hr_node *s, double *spread)
 {
-    double f[4], mean = 0.0, t = r->corners == 4 ? 0.5773502691896258 : 0.5;
+    double f[4], mean = 0.0;
+    vec3 x[4];
+    hr_gauss_points(r, x);
     for (int c = 0; c < r->corners; c++) {
-        f[c] = rad_point_polygon_ff(v3_lerp(r->center, r->corner[c], t), r->normal, s->corner, s->corners);
+        f[c] = rad_point_polygon_ff(x[c], r->normal, s->corner, s->corners);
         mean += f[c];
     }
     mean /= r->corners;
@@ -419,65 +425,78 @@ static double quad_error(const hr_tree *t, const double *B, const hr_link *l)
     return (double)nr->rho * nr->area * l->k * fmax(Bs[0], fmax(Bs[1], Bs[2])) * moved;
 }
 
+/* Which end to split given the two ends' errors (W): the end responsible
+ * for the larger, if it may be split, else the other where its own error
+ * is over epsilon too. */
+static int choose_split(const hr_tree *t, const hr_refine_params *p, uint32_t r, uint32_t s, double e_r, double e_s)
+{
+    if (fmax(e_r, e_s) <= p->epsilon)
+        return HR_KEEP;
+    bool rs = hr_splittable(t, r), ss = hr_splittable(t, s);
+    if (e_r >= e_s) {
+        if (rs)
+            return HR_SPLIT_R;
+        return ss && e_s > p->epsilon ? HR_SPLIT_S : HR_KEEP;
+    }
+    if (ss)
+        return HR_SPLIT_S;
+    return rs && e_r > p->epsilon ? HR_SPLIT_R : HR_KEEP;
+}
+
+int hr_oracle_surfaces(const hr_tree *t, const hr_refine_params *p, uint32_t r, uint32_t s, double bs, double k,
+                       double link_spread, double vis_err, double source_spread, double pocket)
+{
+    const hr_node *nr = &t->nodes[r], *ns = &t->nodes[s];
+    double rho = nr->rho;
+    if (!(rho > 0.0))
+        return HR_KEEP; /* nothing reflected: the receiver's B is its E */
+    double e_r = rho * bs * link_spread * nr->area;
+    double e_s = p->source_weight * rho * k * source_spread * nr->area;
+    double e_v = rho * bs * vis_err * nr->area;
+    if (nr->area >= ns->area)
+        e_r += e_v;
+    else
+        e_s += e_v;
+    return choose_split(t, p, r, s, fmax(e_r, pocket), e_s);
+}
+
 static int decide(const hr_tree *t, const hr_refine_params *p, const double *B, const double *spread,
                   const double *node_quad, const hr_link *l)
 {
     const hr_node *nr = &t->nodes[l->r], *ns = &t->nodes[l->s];
     if (l->r == l->s)
-        return SPLIT_BOTH; /* a cluster's self-link: its members' interactions */
+        return HR_SPLIT_BOTH; /* a cluster's self-link: its members' interactions */
     const double *Bs = &B[3 * (size_t)l->s];
     double bs = fmax(Bs[0], fmax(Bs[1], Bs[2]));
-    double rho = nr->rho;
-    if (!(rho > 0.0))
-        return KEEP; /* nothing reflected: the receiver's B is its E */
-    double e_r, e_s;
-    if (nr->kind == HR_SURFACE && ns->kind == HR_SURFACE) {
-        e_r = rho * bs * l->spread * nr->area;
-        e_s = p->source_weight * rho * l->k * spread[l->s] * nr->area;
-        double e_v = rho * bs * l->vis_err * nr->area;
-        if (nr->area >= ns->area)
-            e_r += e_v;
-        else
-            e_s += e_v;
-    } else {
-        vec3 w = v3_sub(ns->center, nr->center);
-        double d2 = v3_dot(w, w);
-        double reach = nr->radius + ns->radius;
-        if (d2 <= reach * reach || (l->flags & HR_LINK_SPLIT)) {
-            /* Overlapping bounds, or a transfer the bins cannot carry:
-             * split the larger end (a cluster if equal). */
-            bool r_larger = nr->radius > ns->radius ||
-                            (nr->radius == ns->radius && nr->kind == HR_CLUSTER);
-            bool rs = hr_splittable(t, l->r), ss = hr_splittable(t, l->s);
-            if (rs && (r_larger || !ss))
-                return SPLIT_R;
-            return ss ? SPLIT_S : KEEP;
-        } else {
-            double d = sqrt(d2);
-            vec3 u = v3_scale(w, 1.0 / d);
-            double cr = nr->kind == HR_SURFACE ? fmax(0.0, v3_dot(nr->normal, u)) : 1.0;
-            double cs = ns->kind == HR_SURFACE ? fmax(0.0, -v3_dot(ns->normal, u)) : 1.0;
-            double g = rho * bs * cr * cs * nr->area;
-            e_s = g * ns->area / (M_PI * d2 + ns->area);
-            e_r = g * nr->area / (M_PI * d2 + nr->area);
-        }
-    }
     /* What the quarters of all the receiver's partly hidden links leave
      * misplaced, summed (each alone is small; in a pocket they add up with
      * one sign): over epsilon, they are refined at the receiver. */
-    if (node_quad && (l->flags & HR_LINK_QUADS) && node_quad[l->r] > p->epsilon)
-        e_r = fmax(e_r, node_quad[l->r]);
-    if (fmax(e_r, e_s) <= p->epsilon)
-        return KEEP;
-    bool rs = hr_splittable(t, l->r), ss = hr_splittable(t, l->s);
-    if (e_r >= e_s) {
-        if (rs)
-            return SPLIT_R;
-        return ss && e_s > p->epsilon ? SPLIT_S : KEEP;
+    double pocket = node_quad && (l->flags & HR_LINK_QUADS) && node_quad[l->r] > p->epsilon ? node_quad[l->r] : 0.0;
+    if (nr->kind == HR_SURFACE && ns->kind == HR_SURFACE)
+        return hr_oracle_surfaces(t, p, l->r, l->s, bs, l->k, l->spread, l->vis_err, spread[l->s], pocket);
+    double rho = nr->rho;
+    if (!(rho > 0.0))
+        return HR_KEEP;
+    vec3 w = v3_sub(ns->center, nr->center);
+    double d2 = v3_dot(w, w);
+    double reach = nr->radius + ns->radius;
+    if (d2 <= reach * reach || (l->flags & HR_LINK_SPLIT)) {
+        /* Overlapping bounds, or a transfer the bins cannot carry: split
+         * the larger end (a cluster if equal). */
+        bool r_larger = nr->radius > ns->radius || (nr->radius == ns->radius && nr->kind == HR_CLUSTER);
+        bool rs = hr_splittable(t, l->r), ss = hr_splittable(t, l->s);
+        if (rs && (r_larger || !ss))
+            return HR_SPLIT_R;
+        return ss ? HR_SPLIT_S : HR_KEEP;
     }
-    if (ss)
-        return SPLIT_S;
-    return rs && e_r > p->epsilon ? SPLIT_R : KEEP;
+    double d = sqrt(d2);
+    vec3 u = v3_scale(w, 1.0 / d);
+    double cr = nr->kind == HR_SURFACE ? fmax(0.0, v3_dot(nr->normal, u)) : 1.0;
+    double cs = ns->kind == HR_SURFACE ? fmax(0.0, -v3_dot(ns->normal, u)) : 1.0;
+    double g = rho * bs * cr * cs * nr->area;
+    double e_s = g * ns->area / (M_PI * d2 + ns->area);
+    double e_r = g * nr->area / (M_PI * d2 + nr->area);
+    return choose_split(t, p, l->r, l->s, fmax(e_r, pocket), e_s);
 }
 
 /* ---- link lists ---- */
@@ -542,6 +561,21 @@ rad_result hr_links_initial(rad_context *ctx, hr_tree *t, const hr_refine_params
     return r;
 }
 
+rad_result hr_refine_pass_start(rad_context *ctx, size_t links, uint8_t **action, size_t **first)
+{
+    if (rad_cancelled(ctx))
+        return RAD_ERROR_INTERRUPTED;
+    uint8_t *a = rad_realloc(ctx, RAD_MEM_HIERARCHY, *action, links, sizeof *a, "hierarchical: refinement");
+    if (a)
+        *action = a;
+    size_t *f = a ? rad_realloc(ctx, RAD_MEM_HIERARCHY, *first, links + 1, sizeof *f, "hierarchical: refinement")
+                  : NULL;
+    if (!f)
+        return RAD_ERROR_OUT_OF_MEMORY;
+    *first = f;
+    return RAD_OK;
+}
+
 rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, const double *B,
                      const double *spread, hr_links *links, size_t *split, hr_refine_stats *st)
 {
@@ -556,20 +590,8 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
     double *Bx = NULL, *Sx = NULL, *node_quad = NULL;
     for (;;) {
         size_t L = links->count;
-        if (rad_cancelled(ctx)) {
-            r = RAD_ERROR_INTERRUPTED;
+        if ((r = hr_refine_pass_start(ctx, L, &action, &first)) != RAD_OK)
             break;
-        }
-        uint8_t *a = rad_realloc(ctx, RAD_MEM_HIERARCHY, action, L, sizeof *a, "hierarchical: refinement");
-        if (a)
-            action = a;
-        size_t *f = a ? rad_realloc(ctx, RAD_MEM_HIERARCHY, first, L + 1, sizeof *f, "hierarchical: refinement")
-                      : NULL;
-        if (!f) {
-            r = RAD_ERROR_OUT_OF_MEMORY;
-            break;
-        }
-        first = f;
         /* Values for nodes made in earlier passes of this call. */
         if (t->count > known) {
             double *nb = rad_realloc(ctx, RAD_MEM_HIERARCHY, Bx, 3 * t->count, sizeof *nb,
@@ -612,7 +634,7 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
 #pragma omp parallel for schedule(static) num_threads(p->threads) reduction(+ : splits)
         for (size_t i = 0; i < L; i++) {
             action[i] = (uint8_t)decide(t, p, Bv, Sv, p->source_weight > 0.0 ? node_quad : NULL, &links->items[i]);
-            splits += action[i] != KEEP;
+            splits += action[i] != HR_KEEP;
         }
         if (splits == 0)
             break;
@@ -628,16 +650,16 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
         for (size_t i = 0; i < L && r == RAD_OK; i++) {
             const hr_link *l = &links->items[i];
             first[i] = total;
-            if (action[i] == KEEP) {
+            if (action[i] == HR_KEEP) {
                 done.items[done.count++] = *l;
                 continue;
             }
-            if (action[i] & SPLIT_R)
+            if (action[i] & HR_SPLIT_R)
                 r = hr_subdivide(ctx, t, l->r);
-            if (r == RAD_OK && (action[i] & SPLIT_S))
+            if (r == RAD_OK && (action[i] & HR_SPLIT_S))
                 r = hr_subdivide(ctx, t, l->s);
-            int cr = action[i] & SPLIT_R ? hr_children(t, l->r) : 1;
-            int cs = action[i] & SPLIT_S ? hr_children(t, l->s) : 1;
+            int cr = action[i] & HR_SPLIT_R ? hr_children(t, l->r) : 1;
+            int cs = action[i] & HR_SPLIT_S ? hr_children(t, l->s) : 1;
             total += (size_t)(cr * cs);
         }
         first[L] = total;
@@ -662,14 +684,14 @@ rad_result hr_refine(rad_context *ctx, hr_tree *t, const hr_refine_params *p, co
         for (size_t i = 0; i < L; i++) {
             const hr_link *l = &links->items[i];
             size_t o = first[i];
-            if (action[i] == KEEP)
+            if (action[i] == HR_KEEP)
                 continue;
-            int cr = action[i] & SPLIT_R ? hr_children(t, l->r) : 1;
-            int cs = action[i] & SPLIT_S ? hr_children(t, l->s) : 1;
+            int cr = action[i] & HR_SPLIT_R ? hr_children(t, l->r) : 1;
+            int cs = action[i] & HR_SPLIT_S ? hr_children(t, l->s) : 1;
             for (int x = 0; x < cr; x++)
                 for (int y = 0; y < cs; y++) {
-                    uint32_t rr = action[i] & SPLIT_R ? hr_child(t, l->r, x) : l->r;
-                    uint32_t ss = action[i] & SPLIT_S ? hr_child(t, l->s, y) : l->s;
+                    uint32_t rr = action[i] & HR_SPLIT_R ? hr_child(t, l->r, x) : l->r;
+                    uint32_t ss = action[i] & HR_SPLIT_S ? hr_child(t, l->s, y) : l->s;
                     hr_link nl;
                     if (make_link(&lc, rr, ss, l->flags, &nl, &rays, &shafts, &clear)) {
                         out[o] = nl;

@@ -77,7 +77,36 @@ static rad_result reserve(rad_context *ctx, hr_tree *t, size_t extra)
     if (!nodes)
         return RAD_ERROR_OUT_OF_MEMORY;
     t->nodes = nodes;
+    if (t->scene->texture_count > 0) {
+        double *rgb = hr_grow(ctx, t->reflectance, &t->reflectance_capacity, 3 * t->capacity, sizeof *rgb,
+                              "hierarchical: textured reflectance of the nodes");
+        if (!rgb)
+            return RAD_ERROR_OUT_OF_MEMORY;
+        t->reflectance = rgb;
+    }
     return RAD_OK;
+}
+
+/* Surface node n's reflectance into rgb (3 doubles): its material's, or
+ * with a texture the texels' mean over the node; n->rho its largest
+ * channel, plus a mirror's rho_s (what it sends on through the mirror
+ * links, hier/mirror.c: the oracle refines what reaches a mirror as what
+ * reaches a white wall).  rgb may be NULL where the scene has no texture. */
+static void surface_reflectance(hr_tree *t, hr_node *n, double *rgb)
+{
+    const rad_patch *pa = &t->base->patches[n->patch];
+    const rad_material *m = &t->scene->materials[pa->material];
+    const double *rho = m->reflectance;
+    if (rgb) {
+        memcpy(rgb, rho, 3 * sizeof *rgb);
+        rad_texture_mean(t->scene, pa->polygon, n->corner, n->corners, n->area, rgb);
+        rho = rgb;
+    }
+    double most = fmax(rho[0], fmax(rho[1], rho[2]));
+    if (m->specular_kind == RAD_SPECULAR_MIRROR)
+        most += (m->specular[0] + m->specular[1] + m->specular[2]) / 3.0;
+    n->rho = (float)most;
+    t->rho_max = fmaxf(t->rho_max, n->rho);
 }
 
 double hr_projected(const hr_tree *t, uint32_t k, vec3 d)
@@ -187,11 +216,16 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
     t->lift = rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *t->lift, "hierarchical: lifts");
     hr_node *roots = rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *roots, "hierarchical: roots");
     sort_item *scratch = clustered ? rad_alloc(ctx, RAD_MEM_HIERARCHY, P, sizeof *scratch, "hierarchical: sort") : NULL;
+    double *root_rgb = scene->texture_count > 0
+                           ? rad_alloc(ctx, RAD_MEM_HIERARCHY, 3 * P, sizeof *root_rgb, "hierarchical: roots")
+                           : NULL;
     rad_result r = RAD_OK;
     if (!t->root_of_patch || !t->order || !t->order_area || !t->lift || !roots ||
-        (clustered && !scratch) || (r = reserve(ctx, t, clusters + P)) != RAD_OK) {
+        (clustered && !scratch) || (scene->texture_count > 0 && !root_rgb) ||
+        (r = reserve(ctx, t, clusters + P)) != RAD_OK) {
         rad_free(roots);
         rad_free(scratch);
+        rad_free(root_rgb);
         hr_tree_free(t);
         return r != RAD_OK ? r : RAD_ERROR_OUT_OF_MEMORY;
     }
@@ -209,9 +243,8 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
         n->normal = pa->normal;
         n->patch = (uint32_t)p;
         n->parent = HR_NONE;
-        const double *rho = scene->materials[pa->material].reflectance;
-        n->rho = (float)fmax(rho[0], fmax(rho[1], rho[2]));
         surface_geometry(n);
+        surface_reflectance(t, n, root_rgb ? &root_rgb[3 * p] : NULL);
     }
     if (clustered) {
         bvh_builder b = {t, roots, scratch, 0, (uint32_t)clusters};
@@ -221,7 +254,10 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
     for (size_t i = 0; i < P; i++) {
         t->nodes[clusters + i] = roots[t->order[i]];
         t->root_of_patch[t->order[i]] = (uint32_t)(clusters + i);
+        if (root_rgb)
+            memcpy(&t->reflectance[3 * (clusters + i)], &root_rgb[3 * (size_t)t->order[i]], 3 * sizeof *root_rgb);
     }
+    rad_free(root_rgb);
     t->count = clusters + P;
     t->clusters = clusters;
     /* Projected-area bins, bottom-up (children follow their parent). */
@@ -266,6 +302,7 @@ void hr_tree_free(hr_tree *t)
     rad_free(t->cluster_bins);
     rad_free(t->power_bins);
     rad_free(t->order_power);
+    rad_free(t->reflectance);
     memset(t, 0, sizeof *t);
 }
 
@@ -317,27 +354,12 @@ rad_result hr_subdivide(rad_context *ctx, hr_tree *t, uint32_t k)
         n->patch = parent.patch;
         n->parent = k;
         n->level = (uint8_t)(parent.level + 1);
-        n->rho = parent.rho;
         surface_geometry(n);
+        surface_reflectance(t, n, t->reflectance ? &t->reflectance[3 * (size_t)(first + (uint32_t)i)] : NULL);
     }
     t->nodes[k].child[0] = first;
     t->count += 4;
     return RAD_OK;
-}
-
-/* A point of a surface node at unit-square parameters (bilinear on quads,
- * the folded square on triangles). */
-static vec3 surface_point(const hr_node *n, double u, double v)
-{
-    const vec3 *c = n->corner;
-    if (n->corners == 3) {
-        if (u + v > 1.0) {
-            u = 1.0 - u;
-            v = 1.0 - v;
-        }
-        return v3_add(c[0], v3_add(v3_scale(v3_sub(c[1], c[0]), u), v3_scale(v3_sub(c[2], c[0]), v)));
-    }
-    return v3_lerp(v3_lerp(c[0], c[1], u), v3_lerp(c[3], c[2], u), v);
 }
 
 void hr_tree_set_power(hr_tree *t, const double *B, const float *send)
@@ -397,7 +419,7 @@ void hr_sample(const hr_tree *t, uint32_t k, int count, const double *uvw, bool 
     }
     for (int i = 0; i < count; i++) {
         const hr_node *m = n->kind == HR_CLUSTER ? &t->nodes[t->root_of_patch[t->order[at[i]]]] : n;
-        point[i] = surface_point(m, uvw[3 * i], uvw[3 * i + 1]);
+        point[i] = rad_corners_sample(m->corner, m->corners, uvw[3 * i], uvw[3 * i + 1]);
         normal[i] = m->normal;
         lift[i] = t->lift[m->patch];
     }

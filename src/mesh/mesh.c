@@ -10,21 +10,78 @@
 #include <stdlib.h>
 #include <string.h>
 
-vec3 rad_element_sample(const rad_mesh *mesh, const rad_element *e, double u, double v)
+vec3 rad_corners_sample(const vec3 *corner, uint32_t count, double u, double v)
 {
-    const vec3 *P = mesh->vertices;
-    if (e->vertex_count == 3) {
+    if (count == 3) {
         if (u + v > 1.0) {
             u = 1.0 - u;
             v = 1.0 - v;
         }
-        vec3 a = P[e->vertex[0]];
-        return v3_add(a, v3_add(v3_scale(v3_sub(P[e->vertex[1]], a), u),
-                                v3_scale(v3_sub(P[e->vertex[2]], a), v)));
+        vec3 a = corner[0];
+        return v3_add(a, v3_add(v3_scale(v3_sub(corner[1], a), u), v3_scale(v3_sub(corner[2], a), v)));
     }
-    vec3 a = v3_lerp(P[e->vertex[0]], P[e->vertex[1]], u);
-    vec3 b = v3_lerp(P[e->vertex[3]], P[e->vertex[2]], u);
-    return v3_lerp(a, b, v);
+    return v3_lerp(v3_lerp(corner[0], corner[1], u), v3_lerp(corner[3], corner[2], u), v);
+}
+
+double rad_corners_sample_weight(const vec3 *corner, uint32_t count, double area, double u, double v)
+{
+    if (count != 4 || !(area > 0.0))
+        return 1.0;
+    vec3 p0 = corner[0], p1 = corner[1], p2 = corner[2], p3 = corner[3];
+    /* x(u, v) = lerp(lerp(p0, p1, u), lerp(p3, p2, u), v), as rad_corners_sample. */
+    vec3 du = v3_add(v3_scale(v3_sub(p1, p0), 1.0 - v), v3_scale(v3_sub(p2, p3), v));
+    vec3 dv = v3_sub(v3_lerp(p3, p2, u), v3_lerp(p0, p1, u));
+    return v3_length(v3_cross(du, dv)) / area;
+}
+
+/* The element's corners as its welded vertices. */
+static uint32_t element_corners(const rad_mesh *mesh, const rad_element *e, vec3 corner[4])
+{
+    for (uint32_t k = 0; k < e->vertex_count && k < 4; k++)
+        corner[k] = mesh->vertices[e->vertex[k]];
+    return e->vertex_count;
+}
+
+vec3 rad_element_sample(const rad_mesh *mesh, const rad_element *e, double u, double v)
+{
+    vec3 corner[4];
+    return rad_corners_sample(corner, element_corners(mesh, e, corner), u, v);
+}
+
+double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v)
+{
+    vec3 corner[4];
+    return rad_corners_sample_weight(corner, element_corners(mesh, e, corner), e->area, u, v);
+}
+
+void rad_texture_mean(const rad_scene *scene, uint32_t polygon, const vec3 *corner, uint32_t count, double area,
+                      double rgb[3])
+{
+    if (!rad_scene_textured(scene, polygon))
+        return;
+    const rad_texture *t = &scene->textures[scene->materials[scene->polygons[polygon].material].texture - 1];
+    double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
+    for (uint32_t k = 0; k < count; k++) {
+        double u, v;
+        if (!rad_scene_uv(scene, polygon, corner[k], &u, &v))
+            return;
+        lo_u = fmin(lo_u, u), hi_u = fmax(hi_u, u), lo_v = fmin(lo_v, v), hi_v = fmax(hi_v, v);
+    }
+    double span = fmax((hi_u - lo_u) * t->width, (hi_v - lo_v) * t->height);
+    int side = (int)fmin(64.0, fmax(4.0, ceil(2.0 * span)));
+    double sum[3] = {0, 0, 0}, weights = 0.0;
+    for (int a = 0; a < side; a++)
+        for (int b = 0; b < side; b++) {
+            double u = (a + 0.5) / side, v = (b + 0.5) / side;
+            double w = rad_corners_sample_weight(corner, count, area, u, v);
+            double texel[3];
+            rad_scene_reflectance_at(scene, polygon, rad_corners_sample(corner, count, u, v), texel);
+            for (int c = 0; c < 3; c++)
+                sum[c] += w * texel[c];
+            weights += w;
+        }
+    for (int c = 0; c < 3; c++)
+        rgb[c] = weights > 0.0 ? sum[c] / weights : rgb[c];
 }
 
 /* Area, normal and centroid of an element from its own corners: the grid

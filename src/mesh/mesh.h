@@ -160,8 +160,29 @@ void rad_patch_parameters(const rad_patch *patch, vec3 p, double *s, double *t);
 /* The point of the patch at parameters (s, t). */
 vec3 rad_patch_point(const rad_patch *patch, double s, double t);
 
-/* A point of element e at unit-square parameters (u, v) in [0,1)^2, uniform
- * in area (triangles fold the square).  For sampling. */
+/* A point of a triangle or quad (count 3 or 4 corners) at unit-square
+ * parameters (u, v) in [0,1)^2: bilinear on quads, the folded square on
+ * triangles (uniform in area there).  For sampling.  Cannot fail. */
+vec3 rad_corners_sample(const vec3 *corner, uint32_t count, double u, double v);
+/* The density correction of that map at (u, v): the Jacobian of the
+ * bilinear map over the polygon's area, so that the mean of f(x(u,v)) *
+ * weight over uniform (u, v) is the mean of f over the polygon (exactly 1
+ * for triangles and parallelograms; its mean is 1 for any flat quad).
+ * Cannot fail. */
+double rad_corners_sample_weight(const vec3 *corner, uint32_t count, double area, double u, double v);
+/* The same for element e's (welded) corners, e->area its area. */
 vec3 rad_element_sample(const rad_mesh *mesh, const rad_element *e, double u, double v);
+double rad_element_sample_weight(const rad_mesh *mesh, const rad_element *e, double u, double v);
+
+/* A textured polygon piece's reflectance: the texture (times Kd) of scene
+ * polygon `polygon` averaged over the triangle or quad `corner` (on that
+ * polygon; area m^2), so that the power it reflects is the texels' (docs/
+ * methods.md, "Textures"): k x k stratum centres weighted by the map's
+ * density, k from the texels the piece spans (two samples a texel, 4 to 64
+ * a side).  rgb is left as it is (the material's value) where the polygon
+ * is not textured.  Used for the dense strategies' elements and the
+ * hierarchy's nodes alike.  Cannot fail. */
+void rad_texture_mean(const rad_scene *scene, uint32_t polygon, const vec3 *corner, uint32_t count, double area,
+                      double rgb[3]);
 
 #endif /* RAD_MESH_H */

@@ -271,6 +271,7 @@ rad_result rad_write_stats_extra(rad_context *ctx, const rad_solution_view *s, c
         cJSON_AddNumberToObject(hi, "leaves", (double)h->leaves);
         cJSON_AddNumberToObject(hi, "links", (double)h->links);
         cJSON_AddNumberToObject(hi, "initial_links", (double)h->initial_links);
+        cJSON_AddNumberToObject(hi, "mirror_links", (double)h->mirror_links);
         cJSON *kinds = cJSON_AddObjectToObject(hi, "links_by_kind");
         cJSON_AddNumberToObject(kinds, "surface_from_surface", (double)h->links_by_kind[0]);
         cJSON_AddNumberToObject(kinds, "surface_from_cluster", (double)h->links_by_kind[1]);

@@ -176,14 +176,12 @@ static rad_result hierarchical_solve(rad_context *ctx, void *state, const rad_st
         /* Luminaires and daylight: each leaf's direct irradiance, its first
          * reflection in the emission, as rad_elements_add_light leaves the
          * dense strategies' elements (the power balance and the grids'
-         * gathering read them so).  The solver used the materials'
-         * reflectance, so it is the part added here too. */
+         * gathering read them so).  The reflectance is each leaf's, its
+         * texture's mean over it where textured, as the solver's nodes
+         * took it (rad_texture_mean). */
         if (direct) {
-            for (size_t i = 0; i < leaves->element_count; i++) {
-                const double *rho = st->scene->materials[leaves->elements[i].material].reflectance;
-                for (int c = 0; c < 3; c++)
-                    e.emission[3 * i + (size_t)c] += rho[c] * direct[3 * i + (size_t)c];
-            }
+            for (size_t i = 0; i < 3 * leaves->element_count; i++)
+                e.emission[i] += e.reflectance[i] * direct[i];
             e.direct = direct;
         }
         rad_mesh_destroy(st->leaves);
@@ -222,7 +220,7 @@ const rad_strategy rad_strategy_hierarchical = {
     "links between quadtree nodes and clusters, refined as the radiosity converges",
     /* Progress images: with a step hook that displays, the current leaves
      * are the elements at every sweep (hierarchical_display). */
-    RAD_CAN_CLOSURE_CORRECTION | RAD_CAN_LIGHTS | RAD_CAN_PROGRESS_IMAGES,
+    RAD_CAN_MIRRORS | RAD_CAN_CLOSURE_CORRECTION | RAD_CAN_LIGHTS | RAD_CAN_PROGRESS_IMAGES,
     hierarchical_solver_info,
     hierarchical_create,
     hierarchical_solve,

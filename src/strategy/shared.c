@@ -16,38 +16,15 @@
 #include <string.h>
 
 /* A textured element's reflectance: the texture (times Kd) averaged over
- * the element, so that the power it reflects is the texels' (docs/
- * methods.md, "Textures"): k x k stratum centres, k from the texels the
- * element spans (two samples a texel, 4 to 64 a side).  Untextured
- * elements keep their material's value. */
+ * the element (rad_texture_mean); untextured elements keep their
+ * material's value. */
 static void element_texture_mean(const rad_scene *scene, const rad_mesh *mesh, const rad_element *el,
                                  double rgb[3])
 {
-    uint32_t polygon = mesh->patches[el->patch].polygon;
-    if (!rad_scene_textured(scene, polygon))
-        return;
-    const rad_texture *t = &scene->textures[scene->materials[scene->polygons[polygon].material].texture - 1];
-    double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
-    for (uint32_t k = 0; k < el->vertex_count; k++) {
-        double u, v;
-        if (!rad_scene_uv(scene, polygon, mesh->vertices[el->vertex[k]], &u, &v))
-            return;
-        lo_u = fmin(lo_u, u), hi_u = fmax(hi_u, u), lo_v = fmin(lo_v, v), hi_v = fmax(hi_v, v);
-    }
-    double span = fmax((hi_u - lo_u) * t->width, (hi_v - lo_v) * t->height);
-    int side = (int)fmin(64.0, fmax(4.0, ceil(2.0 * span)));
-    double sum[3] = {0, 0, 0}, weights = 0.0;
-    for (int a = 0; a < side; a++)
-        for (int b = 0; b < side; b++) {
-            double u = (a + 0.5) / side, v = (b + 0.5) / side, w = rad_element_sample_weight(mesh, el, u, v);
-            double texel[3];
-            rad_scene_reflectance_at(scene, polygon, rad_element_sample(mesh, el, u, v), texel);
-            for (int c = 0; c < 3; c++)
-                sum[c] += w * texel[c];
-            weights += w;
-        }
-    for (int c = 0; c < 3; c++)
-        rgb[c] = weights > 0.0 ? sum[c] / weights : rgb[c];
+    vec3 corner[4];
+    for (uint32_t k = 0; k < el->vertex_count && k < 4; k++)
+        corner[k] = mesh->vertices[el->vertex[k]];
+    rad_texture_mean(scene, mesh->patches[el->patch].polygon, corner, el->vertex_count, el->area, rgb);
 }
 
 rad_result rad_elements_create(rad_context *ctx, const rad_scene *scene, const rad_mesh *mesh,
