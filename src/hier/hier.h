@@ -174,8 +174,14 @@ enum {
 };
 
 /* Which quarter of surface node a (its children's order, rad_ff_split4)
- * holds point p, which lies on it (tree.c). */
-int hr_quadrant(const hr_node *a, vec3 p);
+ * holds a point on it: hr_quarter(&frame, p), frame = hr_quarters_of(a)
+ * made once per node (tree.c). */
+typedef struct hr_quarters {
+    vec3 n, o[3], e[3];
+    int corners;
+} hr_quarters;
+hr_quarters hr_quarters_of(const hr_node *a);
+int hr_quarter(const hr_quarters *frame, vec3 p);
 
 /* A partly hidden link's visibility from each quarter of its receiver and
  * to each quarter of its source (the kernel-weighted share of its shadow

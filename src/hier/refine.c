@@ -142,10 +142,11 @@ double hr_transfer(const hr_tree *t, const rad_vis *vis, uint32_t r, uint32_t s,
     }
     double sum = 0.0, all = 0.0, qpass[4] = {0, 0, 0, 0}, qall[4] = {0, 0, 0, 0};
     vec3 flow = v3(0.0, 0.0, 0.0);
+    hr_quarters fr = hr_quarters_of(&t->nodes[r]);
     for (int k = 0; k < m; k++) {
         all += g[k];
         if (quad) {
-            int q = hr_quadrant(&t->nodes[r], ray[k].origin);
+            int q = hr_quarter(&fr, ray[k].origin);
             qall[q] += g[k];
             qpass[q] += hit[k] ? 0.0 : g[k];
         }
@@ -196,6 +197,7 @@ static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t 
     *rays += (uint64_t)m;
     double floor2 = fmin(a->area, b->area) / 16.0, pass = 0.0, all = 0.0;
     double qpass[4] = {0, 0, 0, 0}, qall[4] = {0, 0, 0, 0}, spass[4] = {0, 0, 0, 0}, sall[4] = {0, 0, 0, 0};
+    hr_quarters fa = hr_quarters_of(a), fb = hr_quarters_of(b);
     for (int k = 0; k < m; k++) {
         vec3 d = ray[k].direction;
         double d2 = v3_dot(d, d);
@@ -204,10 +206,10 @@ static double surface_visibility(const hr_tree *t, const rad_vis *vis, uint32_t 
         if (!hit[k])
             pass += w;
         if (quad) {
-            int q = hr_quadrant(a, ray[k].origin);
+            int q = hr_quarter(&fa, ray[k].origin);
             qall[q] += w;
             qpass[q] += hit[k] ? 0.0 : w;
-            q = hr_quadrant(b, v3_add(ray[k].origin, ray[k].direction));
+            q = hr_quarter(&fb, v3_add(ray[k].origin, ray[k].direction));
             sall[q] += w;
             spass[q] += hit[k] ? 0.0 : w;
         }

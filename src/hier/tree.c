@@ -425,29 +425,49 @@ void hr_sample(const hr_tree *t, uint32_t k, int count, const double *uvw, bool 
     }
 }
 
-int hr_quadrant(const hr_node *a, vec3 p)
+hr_quarters hr_quarters_of(const hr_node *a)
 {
     const vec3 *c = a->corner;
-    vec3 n = a->normal;
+    hr_quarters f;
+    f.n = a->normal;
+    f.corners = a->corners;
     if (a->corners == 4) {
         /* The quad's mid-lines (straight: the bilinear map's iso-lines at
-         * one half); the side of corner 0 is the low side. */
+         * one half), oriented so that corner 0 lies on their low side. */
         vec3 m01 = v3_lerp(c[0], c[1], 0.5), m23 = v3_lerp(c[2], c[3], 0.5);
         vec3 m30 = v3_lerp(c[3], c[0], 0.5), m12 = v3_lerp(c[1], c[2], 0.5);
-        vec3 du = v3_sub(m23, m01), dv = v3_sub(m12, m30);
-        bool u_low = v3_dot(v3_cross(du, v3_sub(p, m01)), n) * v3_dot(v3_cross(du, v3_sub(c[0], m01)), n) >= 0.0;
-        bool v_low = v3_dot(v3_cross(dv, v3_sub(p, m30)), n) * v3_dot(v3_cross(dv, v3_sub(c[0], m30)), n) >= 0.0;
-        return u_low ? (v_low ? 0 : 3) : (v_low ? 1 : 2);
+        f.o[0] = m01;
+        f.o[1] = m30;
+        f.e[0] = v3_cross(f.n, v3_sub(m23, m01)); /* in plane, across the u = 1/2 line */
+        f.e[1] = v3_cross(f.n, v3_sub(m12, m30));
+        for (int k = 0; k < 2; k++)
+            if (v3_dot(f.e[k], v3_sub(c[0], f.o[k])) > 0.0)
+                f.e[k] = v3_scale(f.e[k], -1.0);
+        return f;
     }
-    /* Triangles: the corner children where p's barycentric of that corner
-     * is at least one half, else the middle one. */
-    double area = v3_dot(v3_cross(v3_sub(c[1], c[0]), v3_sub(c[2], c[0])), n);
-    if (!(fabs(area) > 0.0))
-        return 0;
+    /* Triangles: barycentric of corner k = (distance from the opposite
+     * edge) / (corner k's): o[k] on that edge, e[k] the scaled normal. */
     for (int k = 0; k < 3; k++) {
         vec3 b = c[(k + 1) % 3], d = c[(k + 2) % 3];
-        if (v3_dot(v3_cross(v3_sub(b, p), v3_sub(d, p)), n) / area >= 0.5)
-            return k;
+        vec3 across = v3_cross(f.n, v3_sub(d, b));
+        double h = v3_dot(across, v3_sub(c[k], b));
+        f.o[k] = b;
+        f.e[k] = fabs(h) > 0.0 ? v3_scale(across, 1.0 / h) : v3(0, 0, 0);
     }
+    return f;
+}
+
+int hr_quarter(const hr_quarters *f, vec3 p)
+{
+    if (f->corners == 4) {
+        bool u_low = v3_dot(f->e[0], v3_sub(p, f->o[0])) <= 0.0;
+        bool v_low = v3_dot(f->e[1], v3_sub(p, f->o[1])) <= 0.0;
+        return u_low ? (v_low ? 0 : 3) : (v_low ? 1 : 2);
+    }
+    /* The corner children where p's barycentric of that corner is at
+     * least one half, else the middle one. */
+    for (int k = 0; k < 3; k++)
+        if (v3_dot(f->e[k], v3_sub(p, f->o[k])) >= 0.5)
+            return k;
     return 3;
 }
