@@ -190,9 +190,9 @@ static void surface_box(const rad_scene *scene, const char *name, vec3 *lo, vec3
 
 /* Two generated rooms, each lit by one downlight at its centre 10 cm
  * under its ceiling. */
-static rad_scene *two_rooms(int closed_doors)
+static rad_scene *rooms_lit(int rooms, int closed_doors)
 {
-    rad_office_options oo = {.rooms = 2, .seed = 3, .closed_doors = closed_doors};
+    rad_office_options oo = {.rooms = rooms, .seed = 3, .closed_doors = closed_doors};
     rad_scene *scene = NULL;
     assert_int_equal(rad_scene_generate_office(ctx, &oo, &scene), RAD_OK);
     for (size_t m = 0; m < scene->material_count; m++)
@@ -200,7 +200,7 @@ static rad_scene *two_rooms(int closed_doors)
             scene->materials[m].emission[c] = 0.0; /* lit by the downlights only */
     char layout[1024];
     int at = snprintf(layout, sizeof layout, "{\"up\": [0, 1, 0], \"luminaires\": [");
-    for (int r = 0; r < 2; r++) {
+    for (int r = 0; r < rooms; r++) {
         char floor[32], ceiling[32];
         vec3 flo, fhi, clo, chi;
         snprintf(floor, sizeof floor, "room%d/floor", r);
@@ -217,6 +217,8 @@ static rad_scene *two_rooms(int closed_doors)
                      RAD_OK);
     return scene;
 }
+
+static rad_scene *two_rooms(int closed_doors) { return rooms_lit(2, closed_doors); }
 
 static const char two_floors[] = "{\"up\": \"y\", \"grids\": ["
                                  "{\"name\": \"r0\", \"surface\": \"room0/floor\", \"height\": 0.8, \"spacing\": 0.4},"
@@ -292,6 +294,50 @@ static void test_reach_rooms(void **state)
     surface_box(scene, "room0/floor", &lo, &hi);
     assert_true(rad_light_reach_holds(reach, 0, v3(0.5 * (lo.x + hi.x), 0.8, 0.5 * (lo.z + hi.z))));
     rad_solution_destroy(h);
+    rad_scene_destroy(scene);
+}
+
+/* ---- pockets ---- */
+
+/* The generator's ceiling lights hang 2 cm under the ceiling in a closed
+ * housing: the housing's top and the ceiling over it see each other and,
+ * through the slit, little of the room.  A coarse ceiling node straddling
+ * that pocket used to pass its links' mean visibility down to the leaves
+ * in it, and the housings read three times the dense solution's radiosity
+ * (the room's light absorbed in the pocket, the ceiling the room sees
+ * darker); the links' quarters (hier.h, HR_LINK_QUADS) keep the light
+ * where the other end is seen.  Measured: housings 0.029 against
+ * gauss-seidel's 0.037 at 3,000 elements and 0.0255 at 8,000 (its coarse
+ * elements over the pocket see past the housing's edge), 0.116 before the
+ * quarters; the ceiling -0.9% against +1.95% before. */
+static void test_pocket(void **state)
+{
+    (void)state;
+    rad_scene *scene = rooms_lit(1, 0);
+    rad_solution *h = solve(ctx, scene, (rad_options){.seed = 1});
+    rad_solution *g = solve(ctx, scene, (rad_options){.solver = "gauss-seidel", .target_elements = 3000});
+    int housings = 0;
+    for (size_t k = 0; k < rad_scene_surface_count(scene); k++) {
+        const char *name = rad_scene_surface_name(scene, k);
+        double bh[3], bg[3];
+        rad_solution_surface_radiosity(h, k, bh);
+        rad_solution_surface_radiosity(g, k, bg);
+        if (strstr(name, "housing")) {
+            print_message("%-24s hierarchical %.4f gauss-seidel %.4f (%+.1f%%)\n", name, bh[1], bg[1],
+                          100.0 * (bh[1] / bg[1] - 1.0));
+            if (!(bh[1] < 1.5 * bg[1] && bg[1] < 1.5 * bh[1]))
+                fail_msg("%s: %g against %g: the pocket takes the room's light", name, bh[1], bg[1]);
+            housings++;
+        }
+        if (strstr(name, "ceiling")) {
+            print_message("%-24s hierarchical %.4f gauss-seidel %.4f (%+.2f%%)\n", name, bh[1], bg[1],
+                          100.0 * (bh[1] / bg[1] - 1.0));
+            assert_true(rel(bh[1], bg[1]) < 0.015);
+        }
+    }
+    assert_true(housings > 0);
+    rad_solution_destroy(h);
+    rad_solution_destroy(g);
     rad_scene_destroy(scene);
 }
 
@@ -506,6 +552,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_luminaires_agree_with_dense),
         cmocka_unit_test(test_luminaires_energy),
         cmocka_unit_test(test_reach_rooms),
+        cmocka_unit_test(test_pocket),
         cmocka_unit_test(test_shadow_edge_leaves),
         cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_daylight_solution_file),
