@@ -139,15 +139,8 @@ static double gather_solution(const rad_solution_view *v, const tracer *t, vec3 
     rad_ray ray = {v3_mad(x, n, t->eps), cosine_direction(n, rng), 0.0, INFINITY};
     rad_hit hit;
     t->vis->backend->intersect(t->vis->state, &ray, 1, &hit);
-    if (!isfinite(hit.t))
-        return 0.0;
-    const rad_patch *p = &v->mesh->patches[hit.patch];
-    if (v3_dot(p->normal, ray.direction) >= 0.0)
-        return 0.0;
-    double s, u, ls, lt;
-    rad_patch_parameters(p, v3_mad(ray.origin, ray.direction, hit.t), &s, &u);
-    uint32_t e = rad_mesh_locate(v->mesh, hit.patch, fmin(fmax(s, 0.0), 1.0), fmin(fmax(u, 0.0), 1.0), &ls, &lt);
-    return luminance(v->radiosity + 3 * (size_t)e);
+    uint32_t e = rad_vis_front_element(v->mesh, &ray, &hit);
+    return e == UINT32_MAX ? 0.0 : luminance(v->radiosity + 3 * (size_t)e);
 }
 
 int main(int argc, char **argv)

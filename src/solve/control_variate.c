@@ -84,18 +84,8 @@ static void bundle_hits(const rad_mesh *mesh, const rad_vis *vis, const rad_elem
 {
     rad_element_cosine_rays(mesh, e, lift, side, first, count, rng, rays);
     vis->backend->intersect(vis->state, rays, (size_t)count, hits);
-    for (int k = 0; k < count; k++) {
-        out[k] = UINT32_MAX;
-        if (!isfinite(hits[k].t))
-            continue;
-        const rad_patch *p = &mesh->patches[hits[k].patch];
-        if (v3_dot(rays[k].direction, p->normal) >= 0.0)
-            continue;
-        vec3 q = v3_mad(rays[k].origin, rays[k].direction, hits[k].t);
-        double s0, t0, ls, lt;
-        rad_patch_parameters(p, q, &s0, &t0);
-        out[k] = rad_patch_locate(p, s0, t0, &ls, &lt);
-    }
+    for (int k = 0; k < count; k++)
+        out[k] = rad_vis_front_element(mesh, &rays[k], &hits[k]);
 }
 
 static int side_of(int rays)

@@ -212,16 +212,8 @@ static void shoot_rays(const rad_context *ctx, const rad_system *sys, uint32_t i
         rad_element_cosine_rays(mesh, e, lift, side, first, count, &rng, rays);
         sys->vis->backend->intersect(sys->vis->state, rays, (size_t)count, hits);
         for (int k = 0; k < count; k++) {
-            out[first + k].element = UINT32_MAX;
-            if (!isfinite(hits[k].t))
-                continue;
-            const rad_patch *p = &mesh->patches[hits[k].patch];
-            if (v3_dot(rays[k].direction, p->normal) >= 0.0)
-                continue; /* back side: absorbed by nothing we track */
-            vec3 q = v3_mad(rays[k].origin, rays[k].direction, hits[k].t);
-            double s0, t0, ls, lt;
-            rad_patch_parameters(p, q, &s0, &t0);
-            out[first + k].element = rad_patch_locate(p, s0, t0, &ls, &lt);
+            /* Escaped, or a back side: absorbed by nothing we track. */
+            out[first + k].element = rad_vis_front_element(mesh, &rays[k], &hits[k]);
         }
     }
 }

@@ -209,15 +209,13 @@ rad_result rad_vpl_create(rad_context *ctx, const rad_mesh *mesh, const rad_vis 
             rad_hit hit;
             vis->backend->intersect(vis->state, &ray, 1, &hit);
             s.rays++;
-            if (!isfinite(hit.t))
-                continue; /* escaped: an open scene loses it */
+            /* Escaped (an open scene loses it), or the back of a
+             * one-sided surface (absorbed). */
+            uint32_t j = rad_vis_front_element(mesh, &ray, &hit);
+            if (j == UINT32_MAX)
+                continue;
             const rad_patch *p = &mesh->patches[hit.patch];
-            if (v3_dot(ray.direction, p->normal) >= 0.0)
-                continue; /* the back of a one-sided surface: absorbed */
             vec3 y = v3_mad(ray.origin, ray.direction, hit.t);
-            double ps, pt, ls, lt;
-            rad_patch_parameters(p, y, &ps, &pt);
-            uint32_t j = rad_patch_locate(p, ps, pt, &ls, &lt);
             const double *rho = reflectance + 3 * (size_t)j;
             double q = fmax(rho[0], fmax(rho[1], rho[2]));
             if (q <= 0.0)

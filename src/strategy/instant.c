@@ -200,15 +200,9 @@ static void compensate_element(const rad_meshed *m, double radius, uint32_t i, d
     m->vis->backend->intersect(m->vis->state, rays, COMPENSATION_RAYS, hits);
     H[0] = H[1] = H[2] = 0.0;
     for (int k = 0; k < COMPENSATION_RAYS; k++) {
-        if (!isfinite(hits[k].t))
+        uint32_t j = rad_vis_front_element(mesh, &rays[k], &hits[k]);
+        if (j == UINT32_MAX)
             continue;
-        const rad_patch *p = &mesh->patches[hits[k].patch];
-        if (v3_dot(rays[k].direction, p->normal) >= 0.0)
-            continue;
-        vec3 q = v3_mad(rays[k].origin, rays[k].direction, hits[k].t);
-        double s0, t0, ls, lt;
-        rad_patch_parameters(p, q, &s0, &t0);
-        uint32_t j = rad_patch_locate(p, s0, t0, &ls, &lt);
         double missing = 1.0 - (hits[k].t * hits[k].t) / (radius * radius);
         if (missing <= 0.0)
             continue;

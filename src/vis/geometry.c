@@ -15,6 +15,18 @@ double rad_vis_epsilon(const rad_mesh *mesh)
     return 1e-5 * (mesh->diagonal > 0.0 ? mesh->diagonal : 1.0);
 }
 
+uint32_t rad_vis_front_element(const rad_mesh *mesh, const rad_ray *ray, const rad_hit *hit)
+{
+    if (!isfinite(hit->t))
+        return UINT32_MAX;
+    const rad_patch *p = &mesh->patches[hit->patch];
+    if (v3_dot(ray->direction, p->normal) >= 0.0)
+        return UINT32_MAX;
+    double s, t, ls, lt;
+    rad_patch_parameters(p, v3_mad(ray->origin, ray->direction, hit->t), &s, &t);
+    return rad_mesh_locate(mesh, hit->patch, s, t, &ls, &lt);
+}
+
 size_t rad_vis_unresolved(const rad_mesh *mesh, double *narrowest, uint32_t *which)
 {
     double eps = rad_vis_epsilon(mesh);

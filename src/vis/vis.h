@@ -69,6 +69,12 @@ void rad_vis_destroy(rad_vis *vis);
  * element size we mesh to.  O(1); cannot fail. */
 double rad_vis_epsilon(const rad_mesh *mesh);
 
+/* The element of mesh that `ray`, cast with the result `hit`, meets on the
+ * front of its patch (one-sided surfaces: the back absorbs), located from
+ * the hit point's patch parameters (rad_mesh_locate); UINT32_MAX when the
+ * ray left the scene or met a back side. */
+uint32_t rad_vis_front_element(const rad_mesh *mesh, const rad_ray *ray, const rad_hit *hit);
+
 /* Patches narrower than rad_vis_epsilon: shadow rays end that far off the
  * surfaces, so an occluder nearer than it to such a patch is not seen.
  * Returns their count; *narrowest (m) and *which (a patch) tell the
