@@ -270,20 +270,26 @@ static void test_classic_oracle(void **state)
     rad_scene *scene = cornell(false);
     rad_solution *sources = solve_options(scene, (rad_options){.epsilon = 3e-5});
     rad_solution *classic = solve_options(scene, (rad_options){.epsilon = 3e-5, .classic_oracle = 1});
-    /* Measured: classic 4,285 leaves, 25k links (5.9 per leaf), 2.2%;
-     * sources 3,838 leaves, 68k links, 0.47%. */
+    /* Measured: classic 25k links, 1.5% (2.2% before the quarters'
+     * shares of uneven factors, refine.c); sources 99k links, 0.43%. */
     double e_classic = cornell_error(classic), e_sources = cornell_error(sources);
     assert_true(e_classic < 0.035);
     assert_true(e_sources < 0.4 * e_classic);
     const rad_hier_stats *hc = classic->view.hier, *hs = sources->view.hier;
     assert_true((double)hc->links / (double)hc->leaves < 8.0);
     assert_true(hc->links < hs->links / 2);
-    /* The power absorbed in the (open) box: the same physics either way
-     * (measured 0.01% apart). */
     double em_c, ab_c, em_s, ab_s;
     rad_solution_power(classic, &em_c, &ab_c);
     rad_solution_power(sources, &em_s, &ab_s);
-    assert_true(relative(ab_c, ab_s) < 0.003);
+    /* The power absorbed in the (open) box: the same physics either way.
+     * The quarters' shares of a link's source (refine.c, quarter_shape)
+     * are point estimates of each quarter's factor, so what a coarse
+     * source sends is not conserved exactly: measured 0.317205 W (sources)
+     * and 0.319070 W (classic, its links coarser), against 0.317282 W at
+     * epsilon 1e-6 and 0.317754 W by gauss-seidel at 8,000 elements;
+     * 0.26% apart before the shares. */
+    assert_true(relative(ab_s, 0.317282) < 0.002);
+    assert_true(relative(ab_c, ab_s) < 0.01);
     rad_solution_destroy(classic);
     rad_solution_destroy(sources);
     rad_scene_destroy(scene);
@@ -600,13 +606,19 @@ static void test_office_energy(void **state)
     assert_true(s->view.hier->clustered);
     double emitted, absorbed;
     rad_solution_power(s, &emitted, &absorbed);
-    /* Measured: 0.79% of the power, closure 0.9964 (the point estimates:
-     * 4.9%). */
-    assert_true(relative(absorbed, emitted) < 0.015);
+    /* The links' own closure: 0.9964 of the power (the point estimates of
+     * cluster links from their centres: 0.951).  Rows through clusters
+     * are not balanced, but each patch sends B / its closure by default
+     * (hier.c, balance), and the leaves inside solids receive nothing
+     * (push): measured 0.79% of the power lost without either, 0.2% with
+     * the correction alone (the reflected part of what hidden leaves took),
+     * 1.1e-4 with both. */
+    if (!(relative(absorbed, emitted) < 5e-4))
+        fail_msg("default: absorbed %.9g W, emitted %.9g W", absorbed, emitted);
+    assert_true(s->view.hier->closure_corrected > s->view.hier->leaves / 2);
     assert_true(fabs(s->view.hier->closure_power - 1.0) < 0.01);
 
-    /* With the closure correction each patch sends B / its closure: the
-     * building's power balances. */
+    /* The option corrects every patch: the building's power balances. */
     rad_solution *c = solve_options(scene, (rad_options){.epsilon = 1e-3, .closure_correction = 1});
     double emitted_c, absorbed_c;
     rad_solution_power(c, &emitted_c, &absorbed_c);

@@ -85,7 +85,8 @@ typedef struct hr_tree {
     uint32_t *order;           /* patches in cluster order */
     double *order_area;        /* prefix sums of patch areas along order[] */
     double *lift;              /* per patch: shadow-ray lift, m (epsilon + bend) */
-    double *cluster_bins;      /* 6 per cluster: sum A |n_a| of its patches, by signed axis */
+    double *cluster_bins;      /* 6 per cluster: sum A |n_a| of its patches, by signed axis (their
+                                  open parts once measured, hr_tree_set_open) */
     double *order_power;       /* prefix sums of patch power along order[] (hr_tree_set_power) */
     double *power_bins;        /* 6 per cluster: its patches' power A B / open as bins */
     double min_area;           /* m^2: no child smaller than this */
@@ -136,6 +137,10 @@ uint32_t hr_child(const hr_tree *tree, uint32_t k, int c);
  * channels; open: per node, see hier.c), for sampling source clusters by
  * power and for their exitance bins. */
 void hr_tree_set_power(hr_tree *tree, const double *B, const float *send);
+/* The clusters' projected-area bins (hr_projected) of their patches' open
+ * parts, A open (open: per node, see hier.c, measure_open): what a cluster
+ * shares among its members is theirs by the area that can receive it. */
+void hr_tree_set_open(hr_tree *tree, const float *open);
 /* Total power below cluster k (0 for a surface or before set_power). */
 double hr_cluster_power(const hr_tree *tree, uint32_t k);
 
@@ -169,8 +174,9 @@ enum {
     HR_LINK_CLEAR = 1, /* the shaft is empty; so are the children's */
     HR_LINK_SPLIT = 2, /* a cluster link the bins cannot carry: must be split */
     HR_LINK_ZNEG = 4,  /* a cluster link's direction has z < 0 (hr_link_direction) */
-    HR_LINK_QUADS = 8  /* surface <- surface, partly hidden: bits 8..31 hold how much each
-                          quarter of either end sees of the other (below) */
+    HR_LINK_QUADS = 8, /* surface <- surface, partly hidden or its factor uneven over an
+                          end: bits 8..31 hold each quarter's share (below) */
+    HR_LINK_PARTLY = 16 /* surface <- surface, partly hidden (0 < visibility < 1) */
 };
 
 /* Which quarter of surface node a (its children's order, rad_ff_split4)

@@ -382,6 +382,22 @@ void hr_tree_set_power(hr_tree *t, const double *B, const float *send)
             t->power_bins[6 * (size_t)t->nodes[k].parent + (size_t)q] += t->power_bins[6 * k + (size_t)q];
 }
 
+void hr_tree_set_open(hr_tree *t, const float *open)
+{
+    size_t P = t->base->patch_count, C = t->clusters;
+    if (C == 0)
+        return;
+    memset(t->cluster_bins, 0, 6 * C * sizeof *t->cluster_bins);
+    for (size_t i = 0; i < P; i++) {
+        uint32_t k = t->root_of_patch[i];
+        hr_bins_add(&t->cluster_bins[6 * (size_t)t->nodes[k].parent], t->nodes[k].normal,
+                    t->nodes[k].area * (double)open[k]);
+    }
+    for (size_t k = C; k-- > 1;)
+        for (int q = 0; q < 6; q++)
+            t->cluster_bins[6 * (size_t)t->nodes[k].parent + (size_t)q] += t->cluster_bins[6 * k + (size_t)q];
+}
+
 double hr_cluster_power(const hr_tree *t, uint32_t k)
 {
     const hr_node *n = &t->nodes[k];
