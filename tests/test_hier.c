@@ -612,7 +612,7 @@ static void test_office_energy(void **state)
      * (hier.c, balance), and the leaves inside solids receive nothing
      * (push): measured 0.79% of the power lost without either, 0.2% with
      * the correction alone (the reflected part of what hidden leaves took),
-     * 1.1e-4 with both. */
+     * 7.2e-5 with both. */
     if (!(relative(absorbed, emitted) < 5e-4))
         fail_msg("default: absorbed %.9g W, emitted %.9g W", absorbed, emitted);
     assert_true(s->view.hier->closure_corrected > s->view.hier->leaves / 2);

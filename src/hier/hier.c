@@ -55,7 +55,6 @@ typedef struct hr_state {
                              1 / closure (--closure-correction); 1 until then */
     float *gain;          /* per leaf: the receiver scale x of the balance; 1 until then */
     uint8_t *escape;      /* per leaf: how many of measure_open's rays left the scene */
-    uint8_t *closure_mask; /* correct_closure's mask from the balance, while it applies */
     double *Bsend;        /* 3 per node: what sources send, B with the leaves' corr
                              pulled up */
     double *bins_in;      /* 18 per cluster: [channel][signed axis] */
@@ -522,15 +521,6 @@ static rad_result solve(hr_state *st, double tol, double cap, double *residual, 
     return RAD_OK;
 }
 
-/* Contact lines.  A leaf that runs under a block resting on it is partly
- * inside a solid: its links' visibility is 0 from the hidden part, so what
- * it reflects, averaged over its whole area, would leave from the open part
- * only and the rest vanish (0.3% of the power for one box on a floor).  So
- * each leaf's open fraction is measured (cosine-weighted rays from random
- * points; a point is inside when its ray first meets the back of a
- * surface), and a source's radiosity is sent as B / open: the power it
- * reflects, from the part that can send it.  Internal nodes take the area
- * mean of their children's open fractions. */
 #define OPEN_RAYS 16 /* measure_open's rays a leaf */
 
 /* A per-node fraction's internal values: their children's area means,
@@ -550,6 +540,15 @@ static void area_means(const hr_tree *t, float *v)
     }
 }
 
+/* Contact lines.  A leaf that runs under a block resting on it is partly
+ * inside a solid: its links' visibility is 0 from the hidden part, so what
+ * it reflects, averaged over its whole area, would leave from the open part
+ * only and the rest vanish (0.3% of the power for one box on a floor).  So
+ * each leaf's open fraction is measured (cosine-weighted rays from random
+ * points; a point is inside when its ray first meets the back of a
+ * surface), and a source's radiosity is sent as B / open: the power it
+ * reflects, from the part that can send it.  Internal nodes take the area
+ * mean of their children's open fractions. */
 static void measure_open(hr_state *st, const rad_vis *vis, uint64_t seed)
 {
     const hr_tree *t = &st->tree;
@@ -811,7 +810,7 @@ static rad_result correct_closure(hr_state *st, const uint8_t *mask, size_t *cor
     const hr_tree *t = &st->tree;
     size_t n = t->count;
     double *acc = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *acc, "hierarchical: closure correction");
-    double *sum = acc ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 3 * n + 1, sizeof *sum, "hierarchical: closure correction")
+    double *sum = acc ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, 2 * n + 1, sizeof *sum, "hierarchical: closure correction")
                       : NULL;
     uint32_t *root = sum ? rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, sizeof *root, "hierarchical: closure correction")
                          : NULL;
@@ -841,8 +840,8 @@ static rad_result correct_closure(hr_state *st, const uint8_t *mask, size_t *cor
             continue;
         const double *B = &st->B[3 * k];
         double power = nd->area * (B[0] + B[1] + B[2]);
-        sum[3 * (size_t)root[k]] += power * acc[k];
-        sum[3 * (size_t)root[k] + 1] += power * (1.0 - (double)st->escape[k] / OPEN_RAYS);
+        sum[2 * (size_t)root[k]] += power * acc[k];
+        sum[2 * (size_t)root[k] + 1] += power * (1.0 - (double)st->escape[k] / OPEN_RAYS);
     }
     /* With a mask, only the patches with a leaf marked HR_FIX_CLOSURE and
      * none marked HR_HELD (the balance holds those). */
@@ -851,13 +850,13 @@ static rad_result correct_closure(hr_state *st, const uint8_t *mask, size_t *cor
             root_mark[root[k]] |= mask[k];
     for (size_t k = 0; r == RAD_OK && mask && k < n; k++)
         if (root_mark[k] != HR_FIX_CLOSURE)
-            sum[3 * k + 1] = NAN;
+            sum[2 * k + 1] = NAN;
     for (size_t k = 0; r == RAD_OK && k < n; k++) {
         const hr_node *nd = &t->nodes[k];
         st->corr[k] = 1.0f;
         if (nd->kind != HR_SURFACE || nd->child[0] != 0)
             continue;
-        double delivered = sum[3 * (size_t)root[k]], power = sum[3 * (size_t)root[k] + 1];
+        double delivered = sum[2 * (size_t)root[k]], power = sum[2 * (size_t)root[k] + 1];
         double c = power > 0.0 ? delivered / power : 1.0;
         if (c >= 0.5 && c <= 2.0 && c != 1.0) {
             st->corr[k] = (float)(1.0 / c);
@@ -1047,18 +1046,12 @@ static rad_result balance(hr_state *st, rad_hier_stats *hs)
      * each patch sends B / its closure (correct_closure), so that its
      * links deliver all it sends and a closed scene absorbs what it emits.
      * The lit office of 10 rooms: the links' own closure 0.990 of the
-     * power, corrected 1.000; its balance from 1.2% to 1.1e-4 (with push's
+     * power, corrected 1.000; its balance from 1.2% to 4.9e-5 (with push's
      * open shares), the work planes' Eavg 0.45% nearer the path-traced
      * reference (bench/office_lit.py --paths). */
     if (r == RAD_OK) {
         if ((r = correct_closure(st, role, &hs->closure_corrected)) == RAD_OK && rows > 0)
             r = link_columns(st, st->gain, X, xb, R, cl);
-    }
-    if (r == RAD_OK && hs->closure_corrected > 0) { /* kept for the solve's second pass */
-        if (!(st->closure_mask = rad_alloc(st->ctx, RAD_MEM_HIERARCHY, n, 1, "hierarchical: closure correction")))
-            r = RAD_ERROR_OUT_OF_MEMORY;
-        else
-            memcpy(st->closure_mask, role, n);
     }
     /* Alternate: rows to 1 with y fixed, columns to 1 with x fixed, until
      * the rows are off by under 1e-6 after a column step (the scales are
@@ -1456,16 +1449,6 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
         ss->iteration_limit = fmax(ss->iteration_limit, bound.limit);
         int sweeps_before = st.sweeps;
         r = solve(&st, tol, bound.limit, &residual, &converged);
-        /* The closure correction weighs each patch's leaves by what they
-         * send, and did so with the B before this solve: once more with
-         * its B, so that every corrected patch delivers what it sends to
-         * the solve's precision. */
-        if (r == RAD_OK && last && (p->closure_correction || st.closure_mask) && hs->closure_corrected > 0) {
-            if ((r = correct_closure(&st, st.closure_mask, &hs->closure_corrected)) == RAD_OK) {
-                pull(&st);
-                r = solve(&st, tol, bound.limit, &residual, &converged);
-            }
-        }
         rounds_solved = round + 1;
         round_sweeps = st.sweeps - sweeps_before;
         hs->seconds_solve += rad_seconds() - t2;
@@ -1520,7 +1503,6 @@ rad_result rad_hier_run(rad_context *ctx, const rad_hier_params *p, rad_mesh **l
 done:
     hr_tree_free(&st.tree);
     rad_free(st.links.items);
-    rad_free(st.closure_mask);
     rad_free(st.offset);
     rad_free(st.live);
     rad_free(st.B);

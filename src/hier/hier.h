@@ -138,8 +138,9 @@ uint32_t hr_child(const hr_tree *tree, uint32_t k, int c);
  * power and for their exitance bins. */
 void hr_tree_set_power(hr_tree *tree, const double *B, const float *send);
 /* The clusters' projected-area bins (hr_projected) of their patches' open
- * parts, A open (open: per node, see hier.c, measure_open): what a cluster
- * shares among its members is theirs by the area that can receive it. */
+ * parts, A open (open: per node, see hier.c, measure_open; NULL: all
+ * open, as the tree is built): what a cluster shares among its members is
+ * theirs by the area that can receive it. */
 void hr_tree_set_open(hr_tree *tree, const float *open);
 /* Total power below cluster k (0 for a surface or before set_power). */
 double hr_cluster_power(const hr_tree *tree, uint32_t k);

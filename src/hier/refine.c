@@ -426,10 +426,11 @@ static bool make_link(const link_ctx *lc, uint32_t r, uint32_t s, uint32_t paren
             v = surface_visibility(t, p->vis, r, s, p->shadow_rays, &rng, rays, &facing, quad, squad);
             /* Partly hidden: which quarters of either end see the other. */
             shaped = v > 0.0 && v < 1.0;
-            for (int q = 0; q < 4 && !shaped; q++)
-                quad[q] = squad[q] = 1.0;
             if (shaped)
                 flags |= HR_LINK_PARTLY;
+            else
+                for (int q = 0; q < 4; q++)
+                    quad[q] = squad[q] = 1.0;
         }
     }
     /* The quarters' shares (hier.h, HR_LINK_QUADS), for the gather to

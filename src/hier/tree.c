@@ -270,20 +270,9 @@ rad_result hr_tree_build(rad_context *ctx, const rad_mesh *base, const rad_scene
         hr_tree_free(t);
         return RAD_ERROR_OUT_OF_MEMORY;
     }
-    memset(t->cluster_bins, 0, (6 * clusters + 1) * sizeof *t->cluster_bins);
     memset(t->power_bins, 0, (6 * clusters + 1) * sizeof *t->power_bins);
     memset(t->order_power, 0, (P + 1) * sizeof *t->order_power);
-    for (size_t k = clusters + P; k-- > 0;) {
-        const hr_node *n = &t->nodes[k];
-        if (n->parent == HR_NONE)
-            continue;
-        double *pb = &t->cluster_bins[6 * (size_t)n->parent];
-        if (n->kind == HR_SURFACE)
-            hr_bins_add(pb, n->normal, n->area);
-        else
-            for (int q = 0; q < 6; q++)
-                pb[q] += t->cluster_bins[6 * k + (size_t)q];
-    }
+    hr_tree_set_open(t, NULL);
     t->order_area[0] = 0.0;
     for (size_t i = 0; i < P; i++)
         t->order_area[i + 1] = t->order_area[i] + roots[t->order[i]].area;
@@ -362,6 +351,15 @@ rad_result hr_subdivide(rad_context *ctx, hr_tree *t, uint32_t k)
     return RAD_OK;
 }
 
+/* Per-cluster bins (6 each) summed up the clusters: children follow their
+ * parent in pre-order, so one backward loop. */
+static void bins_up(const hr_tree *t, double *bins)
+{
+    for (size_t k = t->clusters; k-- > 1;)
+        for (int q = 0; q < 6; q++)
+            bins[6 * (size_t)t->nodes[k].parent + (size_t)q] += bins[6 * k + (size_t)q];
+}
+
 void hr_tree_set_power(hr_tree *t, const double *B, const float *send)
 {
     size_t P = t->base->patch_count, C = t->clusters;
@@ -376,10 +374,7 @@ void hr_tree_set_power(hr_tree *t, const double *B, const float *send)
         t->order_power[i + 1] = t->order_power[i] + power;
         hr_bins_add(&t->power_bins[6 * (size_t)t->nodes[k].parent], t->nodes[k].normal, power);
     }
-    /* Up the clusters: children after their parent in pre-order. */
-    for (size_t k = C; k-- > 1;)
-        for (int q = 0; q < 6; q++)
-            t->power_bins[6 * (size_t)t->nodes[k].parent + (size_t)q] += t->power_bins[6 * k + (size_t)q];
+    bins_up(t, t->power_bins);
 }
 
 void hr_tree_set_open(hr_tree *t, const float *open)
@@ -391,11 +386,9 @@ void hr_tree_set_open(hr_tree *t, const float *open)
     for (size_t i = 0; i < P; i++) {
         uint32_t k = t->root_of_patch[i];
         hr_bins_add(&t->cluster_bins[6 * (size_t)t->nodes[k].parent], t->nodes[k].normal,
-                    t->nodes[k].area * (double)open[k]);
+                    t->nodes[k].area * (open ? (double)open[k] : 1.0));
     }
-    for (size_t k = C; k-- > 1;)
-        for (int q = 0; q < 6; q++)
-            t->cluster_bins[6 * (size_t)t->nodes[k].parent + (size_t)q] += t->cluster_bins[6 * k + (size_t)q];
+    bins_up(t, t->cluster_bins);
 }
 
 double hr_cluster_power(const hr_tree *t, uint32_t k)
